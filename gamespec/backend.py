@@ -1,0 +1,84 @@
+"""The backend contract (after cvxpy's solver interfaces and Pyomo's ``available()``).
+
+A backend declares the kinds and features it supports, says whether it can run here and why not,
+validates its own options block, compiles a spec once into a :class:`CompiledModel` and re-solves
+that model with new parameter values and warm starts.
+"""
+
+from __future__ import annotations
+
+from abc import ABC, abstractmethod
+from dataclasses import dataclass
+from typing import Any, ClassVar
+
+from pydantic import ValidationError
+
+from gamespec.errors import SpecError, UnsupportedFeature
+from gamespec.result import Result
+from gamespec.specs.base import SpecBase, StrictModel
+
+
+@dataclass(frozen=True)
+class Availability:
+    """Whether a backend can run here; ``reason`` says why not (or what it found)."""
+
+    ok: bool
+    reason: str = ""
+
+
+class NoOptions(StrictModel):
+    """Options block of a backend that takes none."""
+
+
+class CompiledModel(ABC):
+    """A spec compiled into a backend's own modelling objects, re-solvable without a rebuild."""
+
+    build_time_s: float = 0.0
+
+    @abstractmethod
+    def solve(self, parameters: dict[str, float] | None = None, guess: Result | None = None) -> Result:
+        """Solve with optional new parameter values and an optional previous Result as a guess."""
+
+
+class Backend(ABC):
+    """A solver backend plugin, registered in the ``gamespec.backends`` entry-point group."""
+
+    name: ClassVar[str]
+    kinds: ClassVar[frozenset[str]]
+    features: ClassVar[frozenset[str]] = frozenset()
+    options_model: ClassVar[type[StrictModel]] = NoOptions
+
+    @classmethod
+    @abstractmethod
+    def available(cls) -> Availability:
+        """Whether the backend's libraries import here, with the reason when they do not."""
+
+    def unsupported(self, spec: SpecBase) -> str | None:
+        """Why this backend cannot take ``spec``, or None when it can."""
+        if spec.kind not in self.kinds:
+            return f"backend {self.name!r} does not solve kind {spec.kind!r}"
+        missing = spec.required_features() - self.features
+        if missing:
+            return f"backend {self.name!r} lacks {', '.join(sorted(missing))}"
+        return None
+
+    def options(self, spec: SpecBase, overrides: dict[str, Any] | None = None) -> StrictModel:
+        """This backend's options block from the spec's ``solver.options``, validated."""
+        raw = {**spec.solver.options.get(self.name, {}), **(overrides or {})}
+        try:
+            return self.options_model.model_validate(raw)
+        except ValidationError as err:
+            first = err.errors()[0]
+            loc = ".".join(str(p) for p in first["loc"])
+            raise SpecError(first["msg"], field=f"solver.options.{self.name}.{loc}") from None
+
+    def compile(self, spec: SpecBase, options: StrictModel | None = None) -> CompiledModel:
+        """Check support, then build the backend model once."""
+        reason = self.unsupported(spec)
+        if reason:
+            raise UnsupportedFeature(reason)
+        return self._compile(spec, options if options is not None else self.options(spec))
+
+    @abstractmethod
+    def _compile(self, spec: SpecBase, options: StrictModel) -> CompiledModel:
+        """Build the backend model (called after the support check)."""

@@ -1,0 +1,44 @@
+"""One root error and a few subclasses; every user-facing failure is one of these.
+
+The CLI turns a :class:`GamespecError` into exit code 2 and one line (``str(err)``); anything else
+is a bug and keeps its traceback.
+"""
+
+from __future__ import annotations
+
+
+class GamespecError(Exception):
+    """Root of all errors gamespec raises on purpose."""
+
+
+class SpecError(GamespecError):
+    """A problem file (or spec built in Python) is invalid.
+
+    ``source`` is the file (or ``<spec>``), ``field`` the dotted location, ``reason`` the why.
+    """
+
+    def __init__(self, reason: str, *, field: str = "", source: str = "<spec>") -> None:
+        self.reason = reason
+        self.field = field
+        self.source = source
+        where = f"{source}: {field}: " if field else f"{source}: "
+        super().__init__(where + reason)
+
+
+class ExpressionError(GamespecError):
+    """An expression string uses something outside the whitelisted language."""
+
+    def __init__(self, expression: str, reason: str, column: int | None = None) -> None:
+        self.expression = expression
+        self.reason = reason
+        self.column = column
+        at = f" at column {column + 1}" if column is not None else ""
+        super().__init__(f"expression {expression!r}{at}: {reason}")
+
+
+class BackendError(GamespecError):
+    """A backend is unknown, not installed, or cannot take the problem it was given."""
+
+
+class UnsupportedFeature(BackendError):
+    """The chosen backend lacks a kind or feature the problem needs."""

@@ -1,0 +1,163 @@
+"""The safe expression language of problem files (DESIGN.md, "Expressions are data").
+
+Strings are parsed with :mod:`ast` and walked against an explicit whitelist into SymPy: numbers,
+declared names and ``t``, ``+ - * / **``, unary minus, the functions in :data:`FUNCTIONS` and the
+constant ``pi``. Comparisons are accepted only by :func:`parse_relation`, for constraints. Nothing
+is ever ``eval``-ed; anything else is an :class:`~gamespec.errors.ExpressionError` naming the
+expression and the column.
+"""
+
+from __future__ import annotations
+
+import ast
+from collections.abc import Mapping
+from dataclasses import dataclass
+
+import sympy as sp
+
+from gamespec.errors import ExpressionError
+
+FUNCTIONS: dict[str, tuple[int, object]] = {
+    "sin": (1, sp.sin),
+    "cos": (1, sp.cos),
+    "tan": (1, sp.tan),
+    "asin": (1, sp.asin),
+    "acos": (1, sp.acos),
+    "atan": (1, sp.atan),
+    "atan2": (2, sp.atan2),
+    "exp": (1, sp.exp),
+    "log": (1, sp.log),
+    "sqrt": (1, sp.sqrt),
+    "abs": (1, sp.Abs),
+    "tanh": (1, sp.tanh),
+    "min": (2, sp.Min),
+    "max": (2, sp.Max),
+}
+CONSTANTS: dict[str, sp.Expr] = {"pi": sp.pi}
+RESERVED = frozenset(FUNCTIONS) | frozenset(CONSTANTS) | {"t"}
+TIME = sp.Symbol("t", real=True)
+
+_BINARY = {
+    ast.Add: lambda a, b: a + b,
+    ast.Sub: lambda a, b: a - b,
+    ast.Mult: lambda a, b: a * b,
+    ast.Div: lambda a, b: a / b,
+    ast.Pow: lambda a, b: a**b,
+}
+
+
+def symbol(name: str) -> sp.Symbol:
+    """The SymPy symbol gamespec uses for a declared name (real-valued)."""
+    return TIME if name == "t" else sp.Symbol(name, real=True)
+
+
+class _Translator:
+    def __init__(self, text: str, symbols: Mapping[str, sp.Expr]) -> None:
+        self.text = text
+        self.symbols = symbols
+
+    def fail(self, node: ast.AST, reason: str) -> ExpressionError:
+        return ExpressionError(self.text, reason, getattr(node, "col_offset", None))
+
+    def __call__(self, node: ast.AST) -> sp.Expr:
+        if isinstance(node, ast.Constant):
+            if isinstance(node.value, bool) or not isinstance(node.value, int | float):
+                raise self.fail(node, f"only numbers are allowed as literals, not {node.value!r}")
+            return sp.Float(node.value) if isinstance(node.value, float) else sp.Integer(node.value)
+        if isinstance(node, ast.Name):
+            if node.id in self.symbols:
+                return self.symbols[node.id]
+            if node.id in CONSTANTS:
+                return CONSTANTS[node.id]
+            if node.id in FUNCTIONS:
+                raise self.fail(node, f"function {node.id!r} used without arguments")
+            known = ", ".join(sorted(self.symbols)) or "none"
+            raise self.fail(node, f"undefined symbol {node.id!r} (declared: {known})")
+        if isinstance(node, ast.BinOp) and type(node.op) in _BINARY:
+            return _BINARY[type(node.op)](self(node.left), self(node.right))
+        if isinstance(node, ast.UnaryOp) and isinstance(node.op, ast.USub | ast.UAdd):
+            value = self(node.operand)
+            return -value if isinstance(node.op, ast.USub) else value
+        if isinstance(node, ast.Call):
+            return self.call(node)
+        if isinstance(node, ast.Compare):
+            raise self.fail(node, "comparisons are only allowed in constraints")
+        raise self.fail(node, f"{type(node).__name__} is not allowed")
+
+    def call(self, node: ast.Call) -> sp.Expr:
+        if not isinstance(node.func, ast.Name):
+            raise self.fail(node, "only calls of the whitelisted functions by name are allowed")
+        if node.func.id not in FUNCTIONS:
+            raise self.fail(node, f"unknown function {node.func.id!r}")
+        if node.keywords:
+            raise self.fail(node, "keyword arguments are not allowed")
+        arity, func = FUNCTIONS[node.func.id]
+        if len(node.args) != arity:
+            raise self.fail(node, f"{node.func.id} takes {arity} argument(s), got {len(node.args)}")
+        return func(*(self(a) for a in node.args))
+
+
+def _parse_tree(text: str) -> ast.expr:
+    if not isinstance(text, str):
+        return ast.Constant(value=text)
+    if len(text) > 10_000:
+        raise ExpressionError(text[:40] + "...", "expression longer than 10000 characters")
+    try:
+        tree = ast.parse(text.strip(), mode="eval")
+    except SyntaxError as err:
+        col = (err.offset - 1) if err.offset else None
+        raise ExpressionError(text, f"syntax error: {err.msg}", col) from None
+    return tree.body
+
+
+def parse(text: str | float, symbols: Mapping[str, sp.Expr]) -> sp.Expr:
+    """Parse an expression over ``symbols`` (name → SymPy expression) into SymPy (no comparisons)."""
+    return _Translator(str(text), symbols)(_parse_tree(text))
+
+
+@dataclass(frozen=True)
+class Relation:
+    """``lower <= expr <= upper`` (equality when both bounds are equal); bounds may be infinite."""
+
+    expr: sp.Expr
+    lower: float
+    upper: float
+
+    @property
+    def is_equality(self) -> bool:
+        return self.lower == self.upper
+
+
+def parse_relation(text: str, symbols: Mapping[str, sp.Expr]) -> Relation:
+    """Parse a constraint ``a <= b``, ``a >= b``, ``a == b`` or ``lo <= a <= hi`` into a Relation.
+
+    A two-sided chain needs numeric (parameter-free) outer terms; one-sided relations become
+    ``a - b`` compared with zero.
+    """
+    node = _parse_tree(text)
+    tr = _Translator(text, symbols)
+    if not isinstance(node, ast.Compare):
+        raise ExpressionError(text, "a constraint needs one of <=, >=, ==")
+    ops = [type(o) for o in node.ops]
+    allowed = {ast.LtE, ast.GtE, ast.Eq, ast.Lt, ast.Gt}
+    if not set(ops) <= allowed:
+        raise tr.fail(node, "only <=, >=, == (and < >, read as <= >=) are allowed in constraints")
+    terms = [tr(node.left), *(tr(c) for c in node.comparators)]
+    inf = float("inf")
+    if len(ops) == 1:
+        diff = terms[0] - terms[1]
+        op = ops[0]
+        if op is ast.Eq:
+            return Relation(diff, 0.0, 0.0)
+        if op in (ast.LtE, ast.Lt):
+            return Relation(diff, -inf, 0.0)
+        return Relation(diff, 0.0, inf)
+    if len(ops) == 2 and ops[0] == ops[1] and ops[0] is not ast.Eq:
+        lo, mid, hi = terms
+        if not (lo.is_number and hi.is_number):
+            raise tr.fail(node, "the outer terms of a chained constraint must be numbers")
+        lo_f, hi_f = float(lo), float(hi)
+        if ops[0] in (ast.GtE, ast.Gt):
+            lo_f, hi_f = hi_f, lo_f
+        return Relation(mid, lo_f, hi_f)
+    raise tr.fail(node, "a constraint is one comparison or a chain lo <= expr <= hi")

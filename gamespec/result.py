@@ -1,0 +1,175 @@
+"""One result type for every backend and every kind (DESIGN.md, stage 4).
+
+A :class:`Result` holds the status, the objective, trajectories on a time grid, backend-independent
+checks, solver statistics, timings and provenance. It is saved as ``result.json`` plus
+``arrays.npz`` and read back without any solver installed. Plots and reports read Results only.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+from enum import StrEnum
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+from pydantic import BaseModel, ConfigDict, Field, field_serializer, field_validator
+
+ArrayDict = dict[str, np.ndarray]
+
+
+class Status(StrEnum):
+    """Backend-independent outcome of a solve (each backend maps its native statuses here)."""
+
+    OPTIMAL = "optimal"
+    FEASIBLE = "feasible"
+    INFEASIBLE = "infeasible"
+    UNBOUNDED = "unbounded"
+    ITERATION_LIMIT = "iteration_limit"
+    TIME_LIMIT = "time_limit"
+    NUMERICAL_ERROR = "numerical_error"
+    ERROR = "error"
+
+    @property
+    def ok(self) -> bool:
+        """True for statuses that carry a usable solution."""
+        return self in (Status.OPTIMAL, Status.FEASIBLE)
+
+
+class Provenance(BaseModel):
+    """Where a Result came from: the spec's hash, its file, package versions, when."""
+
+    model_config = ConfigDict(extra="allow")
+
+    spec_hash: str = ""
+    source: str = ""
+    versions: dict[str, str] = Field(default_factory=dict)
+    created: str = ""
+
+
+class Result(BaseModel):
+    """The outcome of solving one spec on one backend.
+
+    ``time`` is the grid of ``states``/``costates`` (and of ``controls``, which may have their own
+    grid ``control_time`` when a transcription puts them elsewhere). ``checks`` hold quantities
+    recomputed independently of the solver (``max_constraint_violation``, ``max_defect``,
+    ``hamiltonian_max_abs`` ...). ``metrics`` hold kind-specific results (capture times, terminal
+    covariance, ...) and must be JSON-able. ``arrays`` hold any other named arrays.
+    """
+
+    model_config = ConfigDict(arbitrary_types_allowed=True, extra="forbid")
+
+    problem: str = ""
+    kind: str = ""
+    backend: str = ""
+    status: Status
+    message: str = ""
+    objective: float | None = None
+    t_final: float | None = None
+    solve_time_s: float = 0.0
+    build_time_s: float = 0.0
+    iterations: int | None = None
+    time: np.ndarray | None = None
+    control_time: np.ndarray | None = None
+    states: ArrayDict = Field(default_factory=dict)
+    controls: ArrayDict = Field(default_factory=dict)
+    costates: ArrayDict = Field(default_factory=dict)
+    arrays: ArrayDict = Field(default_factory=dict)
+    parameters: dict[str, float] = Field(default_factory=dict)
+    checks: dict[str, float | None] = Field(default_factory=dict)
+    metrics: dict[str, Any] = Field(default_factory=dict)
+    solver_stats: dict[str, Any] = Field(default_factory=dict)
+    provenance: Provenance = Field(default_factory=Provenance)
+
+    @field_validator("time", "control_time", mode="before")
+    @classmethod
+    def _as_array(cls, v: Any) -> np.ndarray | None:
+        return None if v is None else np.asarray(v, dtype=float)
+
+    @field_validator("states", "controls", "costates", "arrays", mode="before")
+    @classmethod
+    def _as_arrays(cls, v: Any) -> ArrayDict:
+        return {k: np.asarray(a) for k, a in (v or {}).items()}
+
+    @field_serializer("time", "control_time")
+    def _ser_array(self, v: np.ndarray | None) -> list | None:
+        return None if v is None else v.tolist()
+
+    @field_serializer("states", "controls", "costates", "arrays")
+    def _ser_arrays(self, v: ArrayDict) -> dict[str, list]:
+        return {k: a.tolist() for k, a in v.items()}
+
+    @property
+    def ok(self) -> bool:
+        """True when the status carries a usable solution."""
+        return self.status.ok
+
+    def summary(self) -> dict[str, Any]:
+        """The scalar fields: what ``--json`` always shows and what tables are made of."""
+        return {
+            "problem": self.problem,
+            "kind": self.kind,
+            "backend": self.backend,
+            "status": self.status.value,
+            "message": self.message,
+            "objective": self.objective,
+            "t_final": self.t_final,
+            "solve_time_s": self.solve_time_s,
+            "build_time_s": self.build_time_s,
+            "iterations": self.iterations,
+            **{k: v for k, v in self.checks.items()},
+        }
+
+    def to_json(self, *, arrays: bool = True, indent: int | None = 2) -> str:
+        """JSON text of the Result; with ``arrays=False`` only scalars, checks and metrics."""
+        exclude = None if arrays else _ARRAY_FIELDS
+        data = self.model_dump(mode="json", exclude=exclude)
+        return json.dumps(_finite(data), indent=indent)
+
+    def save(self, directory: str | Path) -> Path:
+        """Write ``result.json`` (scalars, metrics) and ``arrays.npz`` (every array) into ``directory``."""
+        out = Path(directory)
+        out.mkdir(parents=True, exist_ok=True)
+        (out / "result.json").write_text(self.to_json(arrays=False))
+        packed: dict[str, np.ndarray] = {}
+        for field in _ARRAY_FIELDS:
+            value = getattr(self, field)
+            if isinstance(value, np.ndarray):
+                packed[field] = value
+            elif isinstance(value, dict):
+                packed.update({f"{field}/{k}": a for k, a in value.items()})
+        np.savez_compressed(out / "arrays.npz", **packed)
+        return out
+
+    @classmethod
+    def load(cls, path: str | Path) -> Result:
+        """Read a Result saved by :meth:`save` (a folder or its ``result.json``), or a ``--json`` dump."""
+        path = Path(path)
+        folder = path if path.is_dir() else path.parent
+        json_file = path / "result.json" if path.is_dir() else path
+        data = json.loads(json_file.read_text())
+        npz = folder / "arrays.npz"
+        if npz.exists() and json_file.name == "result.json":
+            with np.load(npz) as packed:
+                for key in packed.files:
+                    field, _, name = key.partition("/")
+                    if name:
+                        data.setdefault(field, {})[name] = packed[key]
+                    else:
+                        data[field] = packed[key]
+        return cls.model_validate(data)
+
+
+_ARRAY_FIELDS = {"time", "control_time", "states", "controls", "costates", "arrays"}
+
+
+def _finite(value: Any) -> Any:
+    """Replace NaN/inf by None so the JSON is standard."""
+    if isinstance(value, float) and not math.isfinite(value):
+        return None
+    if isinstance(value, dict):
+        return {k: _finite(v) for k, v in value.items()}
+    if isinstance(value, list):
+        return [_finite(v) for v in value]
+    return value

@@ -1,0 +1,194 @@
+"""The ``optimal_control`` kind: states, controls, parameters, dynamics, objective, time, constraints.
+
+Three sections as in rockit: ``problem`` (what), ``method`` (transcription) and ``solver`` (which
+backend, with per-backend options), plus an optional ``guess``. Every expression is a string in the
+safe language of :mod:`gamespec.expressions`; this module checks that each one parses over the
+symbols it may use, so a typo stops at load time with the field that holds it.
+"""
+
+from __future__ import annotations
+
+from typing import Literal
+
+from pydantic import Field, field_validator, model_validator
+
+from gamespec.errors import ExpressionError, SpecError
+from gamespec.expressions import RESERVED, parse, parse_relation, symbol
+from gamespec.specs.base import SpecBase, StrictModel
+
+Value = float | str
+"""A number, or an expression over the problem's parameters."""
+
+
+class StateSpec(StrictModel):
+    """One state: its bounds and its initial/final values (``None`` means free)."""
+
+    initial: Value | None = None
+    final: Value | None = None
+    lower: Value | None = None
+    upper: Value | None = None
+
+
+class ControlSpec(StrictModel):
+    """One control: its bounds."""
+
+    lower: Value | None = None
+    upper: Value | None = None
+
+
+class ObjectiveSpec(StrictModel):
+    """Mayer term (over ``<state>_0``, ``<state>_f``, ``t_f``, parameters) plus Lagrange integrand."""
+
+    sense: Literal["minimize", "maximize"] = "minimize"
+    mayer: Value = 0.0
+    lagrange: Value = 0.0
+
+
+class TimeSpec(StrictModel):
+    """Initial time, and the final time: a value, or ``free`` within ``bounds`` from ``guess``."""
+
+    initial: float = 0.0
+    final: Value | Literal["free"] = 1.0
+    bounds: tuple[float, float] | None = None
+    guess: float | None = None
+
+    @model_validator(mode="after")
+    def _free_needs_bounds(self) -> TimeSpec:
+        if self.final == "free":
+            if self.bounds is None:
+                raise ValueError("a free final time needs bounds: [lower, upper]")
+            lo, hi = self.bounds
+            if not self.initial <= lo < hi:
+                raise ValueError("bounds must satisfy initial <= lower < upper")
+        elif self.bounds is not None:
+            raise ValueError("bounds are only for a free final time (final: free)")
+        return self
+
+    @property
+    def free(self) -> bool:
+        return self.final == "free"
+
+
+class OcpProblem(StrictModel):
+    """The mathematics of an optimal-control problem."""
+
+    parameters: dict[str, float] = Field(default_factory=dict)
+    states: dict[str, StateSpec]
+    controls: dict[str, ControlSpec] = Field(default_factory=dict)
+    dynamics: dict[str, Value]
+    objective: ObjectiveSpec = Field(default_factory=ObjectiveSpec)
+    time: TimeSpec = Field(default_factory=TimeSpec)
+    path_constraints: list[str] = Field(default_factory=list)
+    boundary_constraints: list[str] = Field(default_factory=list)
+
+    @field_validator("states")
+    @classmethod
+    def _some_states(cls, v: dict[str, StateSpec]) -> dict[str, StateSpec]:
+        if not v:
+            raise ValueError("at least one state is needed")
+        return v
+
+    @model_validator(mode="after")
+    def _consistent(self) -> OcpProblem:
+        names = [*self.parameters, *self.states, *self.controls]
+        boundary = [f"{s}_0" for s in self.states] + [f"{s}_f" for s in self.states] + ["t_f"]
+        for name in names:
+            if not name.isidentifier() or name in RESERVED:
+                raise ValueError(f"{name!r} cannot be a symbol name (reserved or not an identifier)")
+        clashes = {n for n in names if names.count(n) > 1} | (set(names) & set(boundary))
+        if clashes:
+            raise ValueError(f"names used twice: {', '.join(sorted(clashes))}")
+        missing = set(self.states) - set(self.dynamics)
+        extra = set(self.dynamics) - set(self.states)
+        if missing or extra:
+            what = (f"no dynamics for {sorted(missing)}" if missing else "") + (
+                f" dynamics for undeclared states {sorted(extra)}" if extra else ""
+            )
+            raise ValueError(f"dynamics must give one equation per state: {what.strip()}")
+        self._check_expressions()
+        return self
+
+    def _check_expressions(self) -> None:
+        params = {n: symbol(n) for n in self.parameters}
+        running = {**params, **{n: symbol(n) for n in [*self.states, *self.controls, "t"]}}
+        ends = {
+            **params,
+            **{f"{s}_{e}": symbol(f"{s}_{e}") for s in self.states for e in "0f"},
+            "t_f": symbol("t_f"),
+        }
+        checks: list[tuple[str, object, dict, bool]] = []
+        for group, items in (("states", self.states), ("controls", self.controls)):
+            for name, spec in items.items():
+                for key, value in spec.model_dump().items():
+                    if isinstance(value, str):
+                        checks.append((f"{group}.{name}.{key}", value, params, False))
+        checks += [(f"dynamics.{k}", v, running, False) for k, v in self.dynamics.items()]
+        checks += [
+            ("objective.mayer", self.objective.mayer, ends, False),
+            ("objective.lagrange", self.objective.lagrange, running, False),
+        ]
+        if isinstance(self.time.final, str) and self.time.final != "free":
+            checks.append(("time.final", self.time.final, params, False))
+        checks += [(f"path_constraints.{i}", c, running, True) for i, c in enumerate(self.path_constraints)]
+        checks += [
+            (f"boundary_constraints.{i}", c, ends, True) for i, c in enumerate(self.boundary_constraints)
+        ]
+        for field, text, symbols, relation in checks:
+            try:
+                (parse_relation if relation else parse)(text, symbols)
+            except ExpressionError as err:
+                raise SpecError(str(err), field=f"problem.{field}") from None
+
+
+class MethodSpec(StrictModel):
+    """Transcription: Legendre–Gauss–Radau collocation of ``degree`` on ``intervals``, or trapezoidal.
+
+    ``grading`` > 1 shrinks the intervals geometrically toward the final time (ratio between the
+    first and the last interval's length).
+    """
+
+    scheme: Literal["radau", "trapezoidal"] = "radau"
+    intervals: int = Field(40, ge=1, le=100_000)
+    degree: int = Field(3, ge=1, le=12)
+    grading: float = Field(1.0, gt=0)
+
+
+class GuessSpec(StrictModel):
+    """Initial guess: per-variable values (a number, an expression of normalized time ``tau`` and the
+    parameters, or ``linear`` between a state's initial and final values), a final-time guess, or a
+    previous Result file (``result``) interpolated onto the new grid."""
+
+    states: dict[str, Value] = Field(default_factory=dict)
+    controls: dict[str, Value] = Field(default_factory=dict)
+    t_final: float | None = None
+    result: str | None = None
+
+
+class OptimalControlSpec(SpecBase):
+    """An optimal-control problem (kind ``optimal_control``)."""
+
+    kind: Literal["optimal_control"] = "optimal_control"
+    problem: OcpProblem
+    method: MethodSpec = Field(default_factory=MethodSpec)
+    guess: GuessSpec = Field(default_factory=GuessSpec)
+
+    default_backend = "casadi"
+
+    @model_validator(mode="after")
+    def _guess_names(self) -> OptimalControlSpec:
+        for group in ("states", "controls"):
+            unknown = set(getattr(self.guess, group)) - set(getattr(self.problem, group))
+            if unknown:
+                raise ValueError(f"guess.{group} names undeclared {group}: {sorted(unknown)}")
+        return self
+
+    def required_features(self) -> frozenset[str]:
+        p = self.problem
+        needed = {"ode"}
+        if p.time.free:
+            needed.add("free_final_time")
+        if p.path_constraints:
+            needed.add("path_constraints")
+        if p.boundary_constraints:
+            needed.add("boundary_constraints")
+        return frozenset(needed)

@@ -1,0 +1,131 @@
+"""The reduced-state dynamics of an engagement, generated as expression strings.
+
+Fixed frame (eqs. 2.8, 2.34, 3.2, 3.15–3.16), control θ_E (``theta_E``):
+
+- constant bearing ``i``: state r_i, ṙ_i = v cos(θ_E − φ_i) − √(u_i² − v² sin²(θ_E − φ_i)) with the
+  line-of-sight angle φ_i a constant parameter (eqs. 2.8–2.9, 3.2–3.3);
+- pure pursuit ``i``: states r_i, φ_i, ṙ_i = −u_i + v cos(θ_E − φ_i), φ̇_i = v sin(θ_E − φ_i)/r_i
+  (eqs. 3.15–3.16);
+- stationary ``i``: the same with u_i = 0 (eqs. 2.34b–c).
+
+Line-of-sight frame (eqs. 2.21, 2.42): the frame turns with pursuer 1's line of sight (pure
+pursuit), the control is θ = θ_E − φ_1 (``theta``) and pursuer i ≥ 2 sits at angle ψ_i seen from
+the evader: ṙ_1 = −u_1 + v cos θ, ṙ_i = −u_i − v cos(ψ_i − θ), ψ̇_i = v sin(ψ_i − θ)/r_i − v sin θ/r_1
+(u_i = 0 when stationary); a constant-bearing pursuer i has ṙ_i = −v cos(ψ_i − θ) −
+√(u_i² − v² sin²(ψ_i − θ)) and ψ̇_i = −v sin θ/r_1, its line of sight being fixed in the inertial frame.
+
+Capture is r_i ≥ ε for every active pursuer with the final time maximized: since every r_i of an
+active pursuer decreases (u_i > v), the optimum ends with some r_i = ε (eq. 3.5). A relay
+engagement adds the Voronoi constraint ½(r_a² − r_s²) ≤ 0 per stationary pursuer s (eq. 2.36).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field, replace
+
+import numpy as np
+
+from gamespec.pursuit.simulation import Players, Trajectory
+from gamespec.specs.engagement import EngagementSpec
+
+
+@dataclass(frozen=True)
+class Reduction:
+    """An engagement's reduced-state problem: names, parameters and expression strings."""
+
+    frame: str
+    control: str
+    parameters: dict[str, float] = field(default_factory=dict)
+    dynamics: dict[str, str] = field(default_factory=dict)
+    initial: dict[str, str] = field(default_factory=dict)
+    distance: dict[int, str] = field(default_factory=dict)
+    angle: dict[int, str] = field(default_factory=dict)
+    path_constraints: list[str] = field(default_factory=list)
+    t_max: float = 0.0
+
+    @property
+    def capture_states(self) -> list[str]:
+        """The distance states that the capture radius bounds (active pursuers)."""
+        return [self.distance[i] for i in sorted(self.distance) if f"u{i + 1}" in self.parameters]
+
+
+def _angle_name(frame: str, index: int, n: int) -> str:
+    if frame == "fixed":
+        return f"phi{index + 1}"
+    return "psi" if n == 2 else f"psi{index + 1}"
+
+
+def reduce(spec: EngagementSpec) -> Reduction:
+    """The reduced-state dynamics, initial values and constraints of ``spec`` (see module doc)."""
+    players = Players.from_spec(spec)
+    frame = spec.resolved_frame
+    n = len(players.names)
+    r0, phi0 = players.distances(), players.los_angles()
+    red = Reduction(frame=frame, control="theta_E" if frame == "fixed" else "theta")
+    red.parameters.update(v=players.v, eps=players.eps)
+    for i, strategy in enumerate(players.strategies):
+        k = i + 1
+        r, ang = f"r{k}", _angle_name(frame, i, n)
+        red.distance[i] = r
+        red.parameters[f"r{k}_init"] = float(r0[i])
+        red.initial[r] = f"r{k}_init"
+        if strategy != "stationary":
+            red.parameters[f"u{k}"] = float(players.speeds[i])
+        if frame == "fixed":
+            _fixed_frame(red, strategy, k, r, ang, float(phi0[i]))
+        elif i == 0:
+            red.dynamics[r] = "-u1 + v*cos(theta)"
+        else:
+            psi0 = float(np.angle(np.exp(1j * (np.pi - phi0[0] + phi0[i]))))
+            _line_of_sight_frame(red, strategy, k, r, ang, psi0)
+    active = [i for i, s in enumerate(players.strategies) if s != "stationary"]
+    for i, strategy in enumerate(players.strategies):
+        if strategy == "stationary":
+            red.path_constraints.append(f"0.5*({red.distance[active[0]]}**2 - {red.distance[i]}**2) <= 0")
+    latest = (r0[active] - players.eps) / (players.speeds[active] - players.v)
+    return replace(red, t_max=float(np.min(latest)))
+
+
+def _fixed_frame(red: Reduction, strategy: str, k: int, r: str, ang: str, phi0: float) -> None:
+    rel = f"theta_E - {ang}"
+    if strategy == "cb":
+        red.parameters[ang] = phi0
+        red.dynamics[r] = f"v*cos({rel}) - sqrt(u{k}**2 - v**2*sin({rel})**2)"
+        red.angle[k - 1] = ang
+        return
+    red.dynamics[r] = (f"-u{k} + " if strategy == "pp" else "") + f"v*cos({rel})"
+    red.dynamics[ang] = f"v*sin({rel})/{r}"
+    red.parameters[f"{ang}_init"] = phi0
+    red.initial[ang] = f"{ang}_init"
+    red.angle[k - 1] = ang
+
+
+def _line_of_sight_frame(red: Reduction, strategy: str, k: int, r: str, ang: str, psi0: float) -> None:
+    rel = f"{ang} - theta"
+    turn = "v*sin(theta)/r1"
+    if strategy == "cb":
+        red.dynamics[r] = f"-v*cos({rel}) - sqrt(u{k}**2 - v**2*sin({rel})**2)"
+        red.dynamics[ang] = f"-{turn}"
+    else:
+        red.dynamics[r] = (f"-u{k} " if strategy == "pp" else "") + f"-v*cos({rel})"
+        red.dynamics[ang] = f"v*sin({rel})/{r} - {turn}"
+    red.parameters[f"{ang}_init"] = psi0
+    red.initial[ang] = f"{ang}_init"
+    red.angle[k - 1] = ang
+
+
+def observe(red: Reduction, traj: Trajectory) -> dict[str, np.ndarray]:
+    """The reduced states and the control along a simulated trajectory (angles unwrapped)."""
+    rel = traj.evader[:, None, :] - traj.pursuers
+    dist = np.hypot(rel[..., 0], rel[..., 1])
+    los = np.unwrap(np.arctan2(rel[..., 1], rel[..., 0]), axis=0)
+    out = {red.distance[i]: dist[:, i] for i in red.distance}
+    heading = np.unwrap(traj.heading)
+    if red.frame == "fixed":
+        out.update({red.angle[i]: los[:, i] for i in red.angle if red.angle[i] in red.dynamics})
+        out[red.control] = heading
+        return out
+    for i, name in red.angle.items():
+        out[name] = np.unwrap(np.angle(np.exp(1j * (np.pi - los[:, 0] + los[:, i]))))
+    out[red.control] = np.unwrap(heading - los[:, 0])
+    return out

@@ -1,19 +1,30 @@
-"""Optimal evasion from constant-bearing pursuers in closed form (§2.4.1, §3.2.1).
+"""Optimal evasion from constant-bearing pursuers (§2.4.1, §3.2.1), as a linear program.
 
-With every pursuer on constant bearing the line-of-sight angles stay at their initial values and
-each distance closes at a constant rate for a constant evader heading (eqs. 2.8–2.9, 3.2–3.3). The
-optimal heading is constant (eq. 2.15), so the optimum is the best constant heading of
-:mod:`gamespec.pursuit.headings`; in a non-degenerate two-pursuer case it is the farther
-intersection of the two Apollonius circles (Fig. 2.7).
+With every pursuer on constant bearing the line-of-sight angles never move, whatever the evader does
+(eq. 3.3), so ṙ_i depends on the evader's heading alone (eqs. 2.8, 3.2) and r_i(t) = r_i(0) +
+Σ_k s_k ṙ_i(θ_k) when the evader spends time s_k on heading θ_k, in any order. The longest capture
+time is therefore the linear program max Σ s_k s.t. Σ_k s_k (−ṙ_i(θ_k)) ≤ r_i(0) − ε, s ≥ 0, over a
+grid of headings (refined once around the headings it uses). Its solution uses at most
+card(P*) headings. The thesis concludes from eq. 2.15 that the optimal heading is constant; that
+holds when the program uses one heading (as in every two-pursuer case tried here, where it is the
+farther intersection of the two Apollonius circles, Fig. 2.7), but with more pursuers the program
+can use two or more headings (H of eq. 3.6 then has several maximizers) and beat every constant
+heading; :func:`best_constant_heading` keeps the thesis's constant-heading answer for comparison.
 """
 
 from __future__ import annotations
 
+from dataclasses import dataclass
+
 import numpy as np
+from scipy.optimize import linprog
 
 from gamespec.errors import UnsupportedFeature
-from gamespec.pursuit.headings import HeadingChoice, best_constant_heading
-from gamespec.pursuit.simulation import Players
+from gamespec.pursuit import headings
+from gamespec.pursuit.simulation import HeadingLaw, Players
+
+GRID = 1441
+"""Headings in the first linear program; the second refines ±2 grid steps around each one used."""
 
 
 def closing_rate(theta_E: np.ndarray, phi: np.ndarray, u: np.ndarray, v: float) -> np.ndarray:
@@ -30,13 +41,57 @@ def capture_times(players: Players, headings: np.ndarray) -> np.ndarray:
     return (players.distances() - players.eps) / -rate
 
 
-def optimal_evasion(players: Players) -> HeadingChoice:
-    """The evader's optimal constant heading against CB pursuers and its capture time.
+def best_constant_heading(players: Players) -> headings.HeadingChoice:
+    """The best constant heading against CB pursuers (the thesis's optimum, §2.4.1).
 
     Degenerate cases come out as pure evasion (θ_E = φ_i, Theorem 1's proof); non-degenerate ones
     as a heading of simultaneous capture.
     """
-    return best_constant_heading(lambda h: capture_times(players, h), players.los_angles())
+    return headings.best_constant_heading(lambda h: capture_times(players, h), players.los_angles())
+
+
+@dataclass(frozen=True)
+class EvasionPlan:
+    """Headings θ_k held for durations s_k, one after the other; capture at Σ s_k."""
+
+    headings: np.ndarray
+    durations: np.ndarray
+
+    @property
+    def capture_time(self) -> float:
+        return float(self.durations.sum())
+
+    @property
+    def switch_times(self) -> np.ndarray:
+        return np.cumsum(self.durations)[:-1]
+
+    def law(self) -> HeadingLaw:
+        """The plan as a heading law θ_E(t) (the last heading held after the last switch)."""
+        switches = self.switch_times
+        return lambda t, P, E: float(self.headings[np.searchsorted(switches, t, side="right")])
+
+
+def _program(players: Players, grid: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    rates = closing_rate(grid[:, None], players.los_angles(), players.speeds, players.v)
+    budget = players.distances() - players.eps
+    res = linprog(-np.ones(grid.size), A_ub=-rates.T, b_ub=budget, bounds=(0, None), method="highs")
+    used = res.x > 1e-12 * max(budget.max(), 1.0)
+    return grid[used], res.x[used]
+
+
+def optimal_evasion(players: Players) -> EvasionPlan:
+    """The evader's optimal plan against CB pursuers: the linear program of the module doc."""
+    if any(s != "cb" for s in players.strategies):
+        raise UnsupportedFeature("the constant-bearing closed form needs every pursuer on cb")
+    coarse = np.linspace(-np.pi, np.pi, GRID, endpoint=False)
+    step = coarse[1] - coarse[0]
+    used, _ = _program(players, coarse)
+    fine = np.unique(np.concatenate([np.linspace(h - 2 * step, h + 2 * step, 81) for h in used]))
+    heads, durations = _program(players, fine)
+    clusters = np.split(np.arange(heads.size), np.flatnonzero(np.diff(heads) > step) + 1)
+    merged = np.array([np.average(heads[c], weights=durations[c]) for c in clusters])
+    heads, durations = _program(players, merged)
+    return EvasionPlan(np.angle(np.exp(1j * heads)), durations)
 
 
 def apollonius_circle(p: np.ndarray, e: np.ndarray, u: float, v: float) -> tuple[np.ndarray, float]:

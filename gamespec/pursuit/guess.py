@@ -1,9 +1,10 @@
 """The default initial guess of the evader's optimal-control problem: a good constant heading.
 
-Constant bearing: the closed-form optimal heading (§2.4.1). Pure pursuit: the suboptimal heading of
-eq. 2.27. Anything else (mixed strategies, relay pursuit): the best constant heading found by
-simulating the true dynamics over a grid of headings, discarding those that enter a stationary
-pursuer's Voronoi cell (eq. 2.28). The guess trajectory is that heading simulated to capture.
+Constant bearing: the best constant heading (§2.4.1; the optimum whenever one heading suffices).
+Pure pursuit: the suboptimal heading of eq. 2.27. Anything else (mixed strategies, relay
+pursuit): the best constant heading found by simulating the true dynamics over a grid of headings,
+discarding those that enter a stationary pursuer's Voronoi cell (eq. 2.28). The guess trajectory is
+that heading simulated to capture.
 """
 
 from __future__ import annotations
@@ -21,18 +22,14 @@ def voronoi_margin(traj: Trajectory, players: Players) -> np.ndarray:
     return 0.5 * (dist[:, active][:, :1] ** 2 - dist[:, ~active] ** 2)
 
 
-def best_simulated_heading(players: Players, samples: int = 72) -> tuple[float, Trajectory]:
-    """The constant heading with the latest simulated capture that respects eq. 2.28."""
-    best: tuple[float, Trajectory] | None = None
+def best_simulated_heading(players: Players, samples: int = 48) -> float:
+    """The constant heading with the latest simulated capture that respects eq. 2.28 (pure evasion
+    from the first active pursuer when none does); a coarse integration is enough to rank them."""
+    best, latest = float(players.los_angles()[players.active][0]), -np.inf
     for heading in np.linspace(-np.pi, np.pi, samples, endpoint=False):
-        traj = pure_pursuit.simulate_heading(players, float(heading))
-        if voronoi_margin(traj, players).max(initial=-np.inf) > 0:
-            continue
-        if best is None or traj.capture_time > best[1].capture_time:
-            best = (float(heading), traj)
-    if best is None:
-        heading = float(players.los_angles()[players.active][0])
-        return heading, pure_pursuit.simulate_heading(players, heading)
+        traj = pure_pursuit.simulate_heading(players, float(heading), rtol=1e-6)
+        if voronoi_margin(traj, players).max(initial=-np.inf) <= 0 and traj.capture_time > latest:
+            best, latest = float(heading), traj.capture_time
     return best
 
 
@@ -40,9 +37,9 @@ def default_heading(players: Players) -> tuple[float, Trajectory]:
     """The guess heading (see module doc) and its simulated trajectory."""
     strategies = set(players.strategies)
     if strategies == {"cb"}:
-        heading = constant_bearing.optimal_evasion(players).heading
+        heading = constant_bearing.best_constant_heading(players).heading
     elif strategies == {"pp"}:
         heading = pure_pursuit.suboptimal_heading(players).heading
     else:
-        return best_simulated_heading(players)
+        heading = best_simulated_heading(players)
     return heading, pure_pursuit.simulate_heading(players, heading)

@@ -28,6 +28,11 @@ import numpy as np
 from gamespec.pursuit.simulation import Players, Trajectory
 from gamespec.specs.engagement import EngagementSpec
 
+T_MAX_FACTOR = 1.25
+"""Final-time upper bound relative to the latest possible capture min_i (r_i(0) − ε)/(u_i − v): no
+evader outlives it (ṙ_i ≤ v − u_i), and the margin keeps the bound inactive so that the
+transversality condition H(t_c) = 0 holds even for pure evasion."""
+
 
 @dataclass(frozen=True)
 class Reduction:
@@ -83,7 +88,7 @@ def reduce(spec: EngagementSpec) -> Reduction:
         if strategy == "stationary":
             red.path_constraints.append(f"0.5*({red.distance[active[0]]}**2 - {red.distance[i]}**2) <= 0")
     latest = (r0[active] - players.eps) / (players.speeds[active] - players.v)
-    return replace(red, t_max=float(np.min(latest)))
+    return replace(red, t_max=T_MAX_FACTOR * float(np.min(latest)))
 
 
 def _fixed_frame(red: Reduction, strategy: str, k: int, r: str, ang: str, phi0: float) -> None:

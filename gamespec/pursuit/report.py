@@ -1,0 +1,71 @@
+"""What an engagement Result reports, from any solution method (OCP, closed form, suboptimal).
+
+A solution is judged by re-simulating the true dynamics (eq. 2.1) under its evader heading with an
+ODE integrator, independently of how it was found: the capture time of the re-simulation, the
+Voronoi margin for relay pursuit (eq. 2.28), and the players' paths for plots. The capturing set
+(Definition 2) and the simultaneous-capture gap come from the solution's terminal distances.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+
+from gamespec.pursuit import regions
+from gamespec.pursuit.guess import voronoi_margin
+from gamespec.pursuit.simulation import HeadingLaw, Players, Trajectory, simulate
+from gamespec.specs.engagement import EngagementSpec
+
+CAPTURE_RTOL = 1e-3
+"""A pursuer is in the capturing set when its terminal distance is within ε(1 + CAPTURE_RTOL)."""
+
+
+def capturing_set(players: Players, terminal: np.ndarray) -> list[str]:
+    """Names of the active pursuers within the capture radius at the capture time (Definition 2)."""
+    inside = terminal <= players.eps * (1 + CAPTURE_RTOL)
+    return [n for n, a, c in zip(players.names, players.active, inside, strict=True) if a and c]
+
+
+def capture_gap(players: Players, terminal: np.ndarray) -> float | None:
+    """Second-smallest minus smallest terminal distance of active pursuers (0: simultaneous capture)."""
+    ends = np.sort(terminal[players.active])
+    return float(ends[1] - ends[0]) if ends.size > 1 else None
+
+
+def region_of_p2(spec: EngagementSpec, players: Players) -> str | None:
+    """D1, D2 or N (§2.3) for two active pursuers with the same cb or pp strategy, else None."""
+    if len(players.names) != 2 or spec.is_relay or len(set(players.strategies)) != 1:
+        return None
+    p1, p2 = players.positions
+    u1, u2 = players.speeds
+    return str(regions.classify(players.strategies[0], p1, p2, players.evader, u1, u2, players.v))
+
+
+def resimulate(players: Players, law: HeadingLaw, t_final: float) -> Trajectory:
+    """The true dynamics under ``law``, run long enough to see capture after ``t_final``."""
+    return simulate(players, law, 1.5 * t_final + 1e-6)
+
+
+def engagement_report(
+    spec: EngagementSpec, players: Players, terminal: np.ndarray, t_final: float, traj: Trajectory
+) -> tuple[dict[str, Any], dict[str, float | None], dict[str, np.ndarray]]:
+    """Metrics, checks and path arrays of a solution with terminal distances ``terminal``."""
+    metrics: dict[str, Any] = {
+        "capture_time": t_final,
+        "capturing_set": capturing_set(players, terminal),
+        "simultaneous_capture_gap": capture_gap(players, terminal),
+        "terminal_distances": dict(zip(players.names, map(float, terminal), strict=True)),
+        "region": region_of_p2(spec, players),
+        "initial_heading": float(traj.heading[0]),
+        "engagement": spec.model_dump(mode="json", include={"pursuers", "evader", "capture_radius"}),
+    }
+    checks: dict[str, float | None] = {
+        "resimulated_capture_time": traj.capture_time if traj.captured else None,
+        "resimulated_capture_time_error": abs(traj.capture_time - t_final) if traj.captured else None,
+    }
+    if spec.is_relay:
+        checks["resimulated_max_voronoi_margin"] = float(voronoi_margin(traj, players).max())
+    arrays = {"path_time": traj.time, "path_evader": traj.evader}
+    arrays |= {f"path_{name}": traj.pursuers[:, i] for i, name in enumerate(players.names)}
+    return metrics, checks, arrays

@@ -33,13 +33,11 @@ def best_simulated_heading(players: Players, samples: int = 48) -> float:
     return best
 
 
-def default_heading(players: Players) -> tuple[float, Trajectory]:
-    """The guess heading (see module doc) and its simulated trajectory."""
+def default_heading(players: Players) -> float:
+    """The guess heading (see module doc)."""
     strategies = set(players.strategies)
     if strategies == {"cb"}:
-        heading = constant_bearing.best_constant_heading(players).heading
-    elif strategies == {"pp"}:
-        heading = pure_pursuit.suboptimal_heading(players).heading
-    else:
-        heading = best_simulated_heading(players)
-    return heading, pure_pursuit.simulate_heading(players, heading)
+        return constant_bearing.best_constant_heading(players).heading
+    if strategies == {"pp"}:
+        return pure_pursuit.suboptimal_heading(players).heading
+    return best_simulated_heading(players)

@@ -53,6 +53,11 @@ class EngagementSpec(SpecBase):
     capture_radius: float = Field(0.001, gt=0, description="Capture radius ε.")
     frame: Literal["auto", "fixed", "line_of_sight"] = "auto"
     method: MethodSpec = Field(default_factory=MethodSpec)
+    guess_heading: float | None = Field(
+        None,
+        description="Constant inertial-frame evader heading simulated to capture as the OCP's initial "
+        "guess; default: the best constant heading (eq. 2.27 for pure pursuit), see gamespec.pursuit.guess.",
+    )
 
     default_backend = "casadi"
 

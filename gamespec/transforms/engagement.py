@@ -17,6 +17,7 @@ from typing import Any
 import numpy as np
 
 from gamespec.pursuit.guess import default_heading
+from gamespec.pursuit.pure_pursuit import simulate_heading
 from gamespec.pursuit.reduced import Reduction, observe, reduce
 from gamespec.pursuit.relay import detect_arcs
 from gamespec.pursuit.report import engagement_report, resimulate
@@ -68,7 +69,8 @@ def to_ocp(spec: EngagementSpec) -> tuple[OptimalControlSpec, EngagementInverse]
     """The reduced-state OCP of ``spec`` and the data to map its Result back."""
     red = reduce(spec)
     players = Players.from_spec(spec)
-    _, traj = default_heading(players)
+    heading = default_heading(players) if spec.guess_heading is None else spec.guess_heading
+    traj = simulate_heading(players, heading)
     tau = traj.time / traj.time[-1]
     observed = observe(red, traj)
     capture = set(red.capture_states)

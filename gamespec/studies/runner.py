@@ -6,6 +6,7 @@ from __future__ import annotations
 from collections.abc import Callable, Mapping
 from typing import Any
 
+from rich.console import Console
 from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeRemainingColumn
 
 from gamespec.studies.executors import Executor, SerialExecutor
@@ -22,6 +23,7 @@ def run_study(
     show_progress: bool = True,
 ) -> dict[str, Any]:
     """Evaluate ``fn(point)`` for every ``key → point`` not yet in ``store``; return all values.
+    The progress bar goes to stderr, so stdout stays clean for ``--json``.
 
     ``fn`` must return JSON-able data. Values already stored are reused, so an interrupted study
     resumes where it stopped.
@@ -30,7 +32,8 @@ def run_study(
     todo = [(key, point) for key, point in points.items() if key not in done]
     runner = executor or SerialExecutor()
     columns = (TextColumn("{task.description}"), BarColumn(), MofNCompleteColumn(), TimeRemainingColumn())
-    with Progress(*columns, disable=not show_progress, transient=False) as progress:
+    progress_bar = Progress(*columns, disable=not show_progress, console=Console(stderr=True))
+    with progress_bar as progress:
         task = progress.add_task(description, total=len(points), completed=len(points) - len(todo))
         for (_fn, (key, _point)), value in runner.imap(_call, [(fn, item) for item in todo]):
             store.put(key, value)

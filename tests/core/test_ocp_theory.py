@@ -89,14 +89,14 @@ def test_two_on_one_capture_is_simultaneous_with_zero_hamiltonian() -> None:
 def test_two_on_one_poor_guess_reaches_a_worse_local_optimum() -> None:
     """What the file's comment claims about its initial guess."""
     shipped = gamespec.solve(TWO_ON_ONE)
-    poor = gamespec.solve(gamespec.load(TWO_ON_ONE, ["guess.controls.theta=-2.5"]))
+    poor = gamespec.solve(gamespec.load(TWO_ON_ONE, ["guess_heading=-1.5"]))
     assert poor.status == gamespec.Status.OPTIMAL
     assert poor.objective < shipped.objective - 0.1
 
 
 def test_uniform_grid_two_on_one_is_caught_by_the_defect_check() -> None:
     """The re-integration check sees what the solver's own residuals do not."""
-    result = gamespec.solve(gamespec.load(TWO_ON_ONE, ["method.grading=1"]))
+    result = gamespec.solve(gamespec.load(TWO_ON_ONE, ["method.grading=1", "guess_heading=-1.5"]))
     assert result.checks["max_defect"] > 1e-2
 
 

@@ -20,13 +20,15 @@ from gamespec.specs.engagement import EngagementSpec
 
 
 def keep_pursuers(spec: EngagementSpec, names: list[str]) -> EngagementSpec:
-    """The same engagement with only the pursuers named in ``names`` (in their original order)."""
+    """The same engagement with only the pursuers named in ``names`` (in their original order), in
+    the same reduced frame as ``spec``, so that both are solved in the same formulation."""
     unknown = set(names) - {p.name for p in spec.pursuers}
     if unknown:
         raise SpecError(f"no pursuer named {sorted(unknown)}", field="pursuers", source=spec.source)
     data = spec.model_dump(mode="json")
     data["pursuers"] = [p for p in data["pursuers"] if p["name"] in names]
     data["name"] = f"{spec.name}_capturing_set"
+    data["frame"] = spec.resolved_frame
     return spec_from_dict(data, source=spec.source)
 
 

@@ -51,8 +51,9 @@ def test_vertices_lie_on_the_arcs_of_eq_2_33_and_bound_the_region() -> None:
         assert relay.boundary_residual(-2.0, 1.0, 0.8, *point) == pytest.approx(0.0, abs=1e-12)
     a, b = v["A"], v["B"]
     assert np.allclose(a, [-2.0 * 0.8, 0.0])
-    assert not relay.is_nondegenerate(ACTIVE, GUARD, a - [1e-3, 0.0], 1.0, 0.8)
-    assert relay.is_nondegenerate(ACTIVE, GUARD, a + [1e-3, 0.0], 1.0, 0.8)
+    step = np.array([1e-3, 0.0])
+    assert not relay.is_nondegenerate(ACTIVE, GUARD, a - step, 1.0, 0.8)
+    assert relay.is_nondegenerate(ACTIVE, GUARD, a + step, 1.0, 0.8)
     inside, outside = b * [1.0, 0.98] - [1e-4, 0.0], b * [1.0, 1.02] - [1e-4, 0.0]
     assert relay.is_nondegenerate(ACTIVE, GUARD, inside, 1.0, 0.8)
     assert not relay.is_nondegenerate(ACTIVE, GUARD, outside, 1.0, 0.8)

@@ -47,8 +47,11 @@ def voronoi_violation(
 def is_nondegenerate(
     p_active: np.ndarray, p_stationary: np.ndarray, e: np.ndarray, u: float, v: float
 ) -> np.ndarray:
-    """Proposition 2: the quadratic of eq. 2.29 has a root in [0, t_f] (vectorized over ``e``)."""
-    return voronoi_violation(p_active, p_stationary, e, u, v) > 0
+    """Proposition 2: the evader starts in the active pursuer's Voronoi cell and the quadratic of
+    eq. 2.29 has a root in [0, t_f] (vectorized over ``e``)."""
+    e = np.asarray(e, float)
+    in_cell = np.linalg.norm(e - p_active, axis=-1) <= np.linalg.norm(e - p_stationary, axis=-1)
+    return in_cell & (voronoi_violation(p_active, p_stationary, e, u, v) > 0)
 
 
 def vertices(p_active: np.ndarray, p_stationary: np.ndarray, u: float, v: float) -> dict[str, np.ndarray]:

@@ -1,0 +1,165 @@
+"""Plots of ``engagement`` Results: paths (Figs. 2.9, 2.10a, 2.14a), the regions of non-degeneracy
+(Figs. 2.3, 2.5, 2.11) and distances over time (Figs. 2.10b, 2.14b).
+
+Everything is read from the Result: the players' paths re-simulated with the true dynamics
+(``arrays["path_*"]``) and the engagement itself (``metrics["engagement"]``).
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import matplotlib
+import numpy as np
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt
+
+from gamespec.pursuit import regions, relay
+from gamespec.result import Result
+from gamespec.specs.engagement import EngagementSpec
+
+REGION_COLOURS = {"D1": "#f4cccc", "D2": "#d9e2f3", "N": "#d9ead3"}
+PLAYER_COLOURS = ["tab:blue", "tab:red", "tab:green", "tab:orange", "tab:purple", "tab:brown"]
+
+
+def _engagement(result: Result) -> EngagementSpec:
+    return EngagementSpec.model_validate(result.metrics["engagement"])
+
+
+def _paths(result: Result, spec: EngagementSpec, ax) -> None:
+    for i, p in enumerate(spec.pursuers):
+        path = result.arrays[f"path_{p.name}"]
+        colour = PLAYER_COLOURS[i % len(PLAYER_COLOURS)]
+        style = "s" if p.strategy == "stationary" else "-"
+        ax.plot(path[:, 0], path[:, 1], style, color=colour, label=f"{p.name} ({p.strategy})")
+        ax.plot(*path[0], "o", color=colour)
+    evader = result.arrays["path_evader"]
+    ax.plot(evader[:, 0], evader[:, 1], "k-", label="evader")
+    ax.plot(*evader[0], "ko")
+    ax.plot(*evader[-1], "kx")
+
+
+def plot_paths(result: Result, spec: EngagementSpec, path: Path) -> Path:
+    """The players' paths up to capture (x: capture point)."""
+    fig, ax = plt.subplots(figsize=(6, 5))
+    _paths(result, spec, ax)
+    ax.set(xlabel="x", ylabel="y", title=f"{result.problem}: t_c = {result.t_final:.4f}", aspect="equal")
+    ax.legend(fontsize="small")
+    fig.savefig(path, dpi=120, bbox_inches="tight")
+    plt.close(fig)
+    return path
+
+
+def _window(points: np.ndarray, pad: float = 0.6) -> tuple[np.ndarray, np.ndarray]:
+    lo, hi = points.min(axis=0), points.max(axis=0)
+    span = max(float(np.max(hi - lo)), 1.0)
+    return lo - pad * span, hi + pad * span
+
+
+def plot_regions(result: Result, spec: EngagementSpec, path: Path) -> Path | None:
+    """Fig. 2.3/2.5 (two active pursuers, same strategy) or Fig. 2.11 (relay); None otherwise."""
+    players = [np.array(p.position) for p in spec.pursuers]
+    e = np.array(spec.evader.position)
+    fig, ax = plt.subplots(figsize=(6, 5))
+    if spec.is_relay and len(spec.pursuers) == 2:
+        active, guard = (players[i] for i in (spec.active_indices[0], 1 - spec.active_indices[0]))
+        u = spec.pursuers[spec.active_indices[0]].speed
+        vertices = relay.vertices(active, guard, u, spec.evader.speed)
+        lo, hi = _window(np.array([active, guard, e, *vertices.values()]), pad=0.2)
+        gx, gy = np.meshgrid(np.linspace(lo[0], hi[0], 300), np.linspace(lo[1], hi[1], 300))
+        grid = np.stack([gx, gy], axis=-1)
+        inside = relay.is_nondegenerate(active, guard, grid, u, spec.evader.speed)
+        ax.contourf(gx, gy, inside.astype(float), levels=[0.5, 1.5], colors=[REGION_COLOURS["N"]])
+        for name, point in vertices.items():
+            ax.plot(*point, "k.")
+            ax.annotate(name, point, textcoords="offset points", xytext=(4, 4))
+        ax.set_title("Region of non-degeneracy (Prop. 2)")
+    elif len(spec.pursuers) == 2 and spec.pursuers[0].strategy == spec.pursuers[1].strategy != "stationary":
+        strategy = spec.pursuers[0].strategy
+        u1, u2 = (p.speed for p in spec.pursuers)
+        v = spec.evader.speed
+        curves = regions.boundary_curves(strategy, players[0], e, u1, u2, v)
+        lo, hi = _window(np.concatenate([*curves.values(), np.array(players)]), pad=0.1)
+        gx, gy = np.meshgrid(np.linspace(lo[0], hi[0], 300), np.linspace(lo[1], hi[1], 300))
+        labels = regions.classify(strategy, players[0], np.stack([gx, gy], axis=-1), e, u1, u2, v)
+        codes = np.select([labels == "D1", labels == "N"], [0.0, 1.0], 2.0)
+        colours = [REGION_COLOURS[k] for k in ("D1", "N", "D2")]
+        ax.contourf(gx, gy, codes, levels=[-0.5, 0.5, 1.5, 2.5], colors=colours)
+        for name, points in curves.items():
+            ax.plot(points[:, 0], points[:, 1], "k--", linewidth=0.8)
+            ax.annotate(name, points[len(points) // 4], textcoords="offset points", xytext=(4, 4))
+        ax.set_title(f"Regions D1 (red), N (green), D2 (blue) for P2 ({strategy})")
+    else:
+        plt.close(fig)
+        return None
+    _paths(result, spec, ax)
+    ax.set(xlabel="x", ylabel="y", aspect="equal")
+    ax.legend(fontsize="small", loc="upper right")
+    fig.savefig(path, dpi=120, bbox_inches="tight")
+    plt.close(fig)
+    return path
+
+
+def plot_distances(result: Result, spec: EngagementSpec, path: Path) -> Path:
+    """r_i(t) (re-simulated), with r1 − r2 (Fig. 2.10b) or S = ½(r1² − r2²) (Fig. 2.14b)."""
+    t = result.arrays["path_time"]
+    evader = result.arrays["path_evader"]
+    dist = {p.name: np.linalg.norm(evader - result.arrays[f"path_{p.name}"], axis=1) for p in spec.pursuers}
+    fig, (top, bottom) = plt.subplots(2, 1, figsize=(6, 5), sharex=True)
+    for name, d in dist.items():
+        top.plot(t, d, label=f"r to {name}")
+    top.set(ylabel="distance")
+    top.legend(fontsize="small")
+    if len(spec.pursuers) == 2:
+        r1, r2 = dist.values()
+        if spec.is_relay:
+            bottom.plot(t, 0.5 * (r1**2 - r2**2))
+            bottom.set(ylabel="S = (r1² − r2²)/2")
+            for key in ("tau1", "tau2"):
+                if key in result.metrics.get("arcs", {}):
+                    bottom.axvline(result.metrics["arcs"][key], color="grey", linestyle=":")
+        else:
+            bottom.plot(t, r1 - r2)
+            bottom.set(ylabel="r1 − r2")
+    bottom.set(xlabel="t")
+    fig.savefig(path, dpi=120, bbox_inches="tight")
+    plt.close(fig)
+    return path
+
+
+def animate_paths(result: Result, spec: EngagementSpec, path: Path, frames: int = 60) -> Path:
+    """A GIF of the players moving to capture."""
+    from matplotlib.animation import FuncAnimation, PillowWriter
+
+    fig, ax = plt.subplots(figsize=(5, 4))
+    _paths(result, spec, ax)
+    ax.set(aspect="equal")
+    names = [f"path_{p.name}" for p in spec.pursuers] + ["path_evader"]
+    dots = [ax.plot([], [], "o", color="k" if n == "path_evader" else "grey")[0] for n in names]
+    index = np.linspace(0, len(result.arrays["path_time"]) - 1, frames).astype(int)
+
+    def update(k: int):
+        for dot, name in zip(dots, names, strict=True):
+            dot.set_data([result.arrays[name][index[k], 0]], [result.arrays[name][index[k], 1]])
+        return dots
+
+    FuncAnimation(fig, update, frames=frames).save(path, writer=PillowWriter(fps=15))
+    plt.close(fig)
+    return path
+
+
+def plot_engagement(result: Result, output_dir: Path, *, animate: bool = False) -> list[Path]:
+    """Paths, regions (where defined) and distances of an engagement Result."""
+    output_dir = Path(output_dir)
+    output_dir.mkdir(parents=True, exist_ok=True)
+    if "path_evader" not in result.arrays:
+        return []
+    spec = _engagement(result)
+    written = [plot_paths(result, spec, output_dir / "paths.png")]
+    region = plot_regions(result, spec, output_dir / "regions.png")
+    written += [region] if region else []
+    written.append(plot_distances(result, spec, output_dir / "distances.png"))
+    if animate:
+        written.append(animate_paths(result, spec, output_dir / "paths.gif"))
+    return written

@@ -19,6 +19,7 @@ from rich.table import Table
 from gamespec import registry
 from gamespec.errors import GamespecError
 from gamespec.loader import load
+from gamespec.pursuit.cli import pursuit_app
 from gamespec.result import Result
 from gamespec.studies.compare import compare_backends, parse_backend_list
 
@@ -29,6 +30,7 @@ app = typer.Typer(
 )
 console = Console()
 err_console = Console(stderr=True)
+app.add_typer(pursuit_app, name="pursuit")
 
 FileArg = Annotated[Path, typer.Argument(help="Problem file (.yaml, .toml or .json).")]
 SetOpt = Annotated[

@@ -1,0 +1,243 @@
+"""Table 2.1: the suboptimal heading of eq. 2.27 against the optimal evasion of Prop. 1 (§2.4.4).
+
+For each evader speed v, r1(0) = r1 and u1 = u2 = u, a grid of non-degenerate initial conditions
+(r2(0), ψ(0)) (eq. 2.21's reduced state; P1 at (0, 0), E at (r1, 0), P2 = E + r2 (cos ψ, sin ψ)):
+
+- ψ(0) at ``grid.angles`` angles −π + (j + ½) 2π/angles, j = 0 … angles − 1;
+- r2(0) at ``grid.fractions`` points (k + ½)/fractions of the way from the curve F (eq. 2.6) to the
+  ellipse E (§2.3.2) along the ray from E at angle ψ(0): the region N of that ray.
+
+Each point: t_c of the suboptimal heading (true dynamics simulated, eq. 2.1), and the optimal t_c of
+the generated eq. 2.21 OCP, compiled once per speed and re-solved with the point's r2(0), ψ(0) and
+the simulated suboptimal path as initial guess. Reported per v: average and maximum of the
+percentage variation 100 (t_opt − t_sub)/t_opt. Points are saved as they finish (a rerun resumes).
+"""
+
+from __future__ import annotations
+
+import json
+from dataclasses import dataclass
+from functools import cache
+from pathlib import Path
+from typing import Any, Literal
+
+import numpy as np
+from pydantic import Field, ValidationError
+
+from gamespec.errors import SpecError
+from gamespec.loader import format_validation_error, read_file
+from gamespec.pursuit import pure_pursuit
+from gamespec.pursuit.reduced import observe, reduce
+from gamespec.pursuit.regions import classify
+from gamespec.pursuit.report import capture_gap, resimulate
+from gamespec.pursuit.simulation import Players
+from gamespec.result import Result, Status
+from gamespec.specs.base import StrictModel
+from gamespec.specs.engagement import EngagementSpec
+from gamespec.specs.ocp import MethodSpec
+from gamespec.studies.executors import executor
+from gamespec.studies.runner import run_study
+from gamespec.studies.store import ResultStore
+from gamespec.transforms.engagement import heading_law, to_ocp
+
+
+class StudyGrid(StrictModel):
+    """The grid of (r2(0), ψ(0)) per speed (see module doc)."""
+
+    angles: int = Field(16, ge=1, description="Values of psi(0), evenly spread, none on P1's ray.")
+    fractions: int = Field(9, ge=1, description="Values of r2(0) per angle, between F and E.")
+
+
+class SuboptimalStudySpec(StrictModel):
+    """A study file: ``study: pure_pursuit_suboptimal_vs_optimal`` and its settings."""
+
+    study: Literal["pure_pursuit_suboptimal_vs_optimal"]
+    name: str = "table_2_1"
+    description: str = ""
+    r1: float = Field(1.0, gt=0)
+    u: float = Field(1.0, gt=0)
+    speeds: list[float] = Field(default_factory=lambda: [0.3, 0.4, 0.5, 0.6, 0.7], min_length=1)
+    capture_radius: float = Field(0.001, gt=0)
+    grid: StudyGrid = Field(default_factory=StudyGrid)
+    method: MethodSpec = Field(default_factory=lambda: MethodSpec(intervals=40, grading=10.0))
+    backend: str = Field("casadi", description="OCP backend for the optimal solutions.")
+
+
+def load_study(path: str | Path) -> SuboptimalStudySpec:
+    """Read and validate a study file."""
+    try:
+        spec = SuboptimalStudySpec.model_validate(read_file(path))
+    except ValidationError as err:
+        raise format_validation_error(err, SuboptimalStudySpec, str(path)) from None
+    if any(not 0 < v < spec.u for v in spec.speeds):
+        raise SpecError(f"every speed must lie in (0, u = {spec.u})", field="speeds", source=str(path))
+    return spec
+
+
+@dataclass(frozen=True)
+class StudyPoint:
+    """One initial condition at one speed, with what a worker needs (picklable)."""
+
+    v: float
+    r2: float
+    psi: float
+    r1: float
+    u: float
+    eps: float
+    method: str
+    backend: str
+
+    @property
+    def key(self) -> str:
+        return f"v={self.v:.6g},r2={self.r2:.9g},psi={self.psi:.9g}"
+
+
+def ray_bounds(d: float, u: float, v: float, psi: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Distances from E along angle ψ to F (eqs. 2.5–2.6) and to E (the isochrone u r − v r cos ψ =
+    (u² − v²) t_f, §2.3.2), for identical pursuers: the region N of that ray lies between them."""
+    inner = (u - v) * d * (u - v * np.cos(psi)) / (u**2 - v**2)
+    outer = (u**2 - v**2) * d / ((u - v) * (u - v * np.cos(psi)))
+    return inner, outer
+
+
+def study_points(spec: SuboptimalStudySpec) -> dict[str, StudyPoint]:
+    """Every (v, r2(0), ψ(0)) of the study, keyed for the result store."""
+    g = spec.grid
+    psis = -np.pi + (np.arange(g.angles) + 0.5) * 2 * np.pi / g.angles
+    fractions = (np.arange(g.fractions) + 0.5) / g.fractions
+    method = spec.method.model_dump_json()
+    points = {}
+    for v in spec.speeds:
+        inner, outer = ray_bounds(spec.r1, spec.u, v, psis)
+        for psi, lo, hi in zip(psis, inner, outer, strict=True):
+            for r2 in lo + fractions * (hi - lo):
+                p2 = np.array([spec.r1 + r2 * np.cos(psi), r2 * np.sin(psi)])
+                if classify("pp", [0.0, 0.0], p2, [spec.r1, 0.0], spec.u, spec.u, v) != "N":
+                    continue
+                point = StudyPoint(
+                    v, float(r2), float(psi), spec.r1, spec.u, spec.capture_radius, method, spec.backend
+                )
+                points[point.key] = point
+    return points
+
+
+def _engagement(point: StudyPoint, r2: float, psi: float) -> EngagementSpec:
+    e = np.array([point.r1, 0.0])
+    p2 = e + r2 * np.array([np.cos(psi), np.sin(psi)])
+    return EngagementSpec.model_validate(
+        {
+            "name": "table_2_1_point",
+            "pursuers": [
+                {"name": "P1", "position": [0.0, 0.0], "speed": point.u, "strategy": "pp"},
+                {"name": "P2", "position": p2.tolist(), "speed": point.u, "strategy": "pp"},
+            ],
+            "evader": {"position": e.tolist(), "speed": point.v},
+            "capture_radius": point.eps,
+            "frame": "line_of_sight",
+            "method": json.loads(point.method),
+        }
+    )
+
+
+@cache
+def _model(v: float, r1: float, u: float, eps: float, method: str, backend: str):
+    """The eq. 2.21 OCP of one speed, compiled once per process (P2 far away only sets the bounds)."""
+    from gamespec.solving import get_backend
+
+    reference = StudyPoint(v, 10 * r1, 0.5 * np.pi, r1, u, eps, method, backend)
+    ocp, _ = to_ocp(_engagement(reference, reference.r2, reference.psi))
+    solver = get_backend(backend)
+    return solver.compile(ocp)
+
+
+def evaluate(point: StudyPoint) -> dict[str, Any]:
+    """Suboptimal and optimal capture times of one point (the row the store keeps)."""
+    spec = _engagement(point, point.r2, point.psi)
+    players = Players.from_spec(spec)
+    red = reduce(spec)
+    choice = pure_pursuit.suboptimal_heading(players)
+    traj = pure_pursuit.simulate_heading(players, choice.heading)
+    observed = observe(red, traj)
+    control = observed.pop(red.control)
+    guess = Result(status=Status.FEASIBLE, time=traj.time, states=observed, controls={red.control: control})
+    model = _model(point.v, point.r1, point.u, point.eps, point.method, point.backend)
+    result = model.solve(parameters={k: red.parameters[k] for k in ("r2_init", "psi_init")}, guess=guess)
+    row: dict[str, Any] = {
+        "v": point.v,
+        "r2": point.r2,
+        "psi": point.psi,
+        "status": result.status.value,
+        "t_suboptimal": traj.capture_time,
+        "heading_suboptimal": choice.heading,
+        "solve_time_s": result.solve_time_s,
+    }
+    if not result.ok:
+        return row
+    terminal = np.array([result.states[red.distance[i]][-1] for i in (0, 1)])
+    check = resimulate(players, heading_law(red, result), result.t_final)
+    return row | {
+        "t_optimal": result.t_final,
+        "variation_percent": 100.0 * (result.t_final - traj.capture_time) / result.t_final,
+        "simultaneous_capture_gap": capture_gap(players, terminal),
+        "max_defect": result.checks.get("max_defect"),
+        "resimulated_capture_time_error": abs(check.capture_time - result.t_final),
+    }
+
+
+def summarize(rows: list[dict[str, Any]]) -> list[dict[str, Any]]:
+    """Per speed: points, points solved, average and maximum percentage variation (Table 2.1)."""
+    table = []
+    for v in sorted({r["v"] for r in rows}):
+        at_v = [r for r in rows if r["v"] == v]
+        solved = np.array([r["variation_percent"] for r in at_v if "variation_percent" in r])
+        table.append(
+            {
+                "v": v,
+                "points": len(at_v),
+                "solved": int(solved.size),
+                "average_variation_percent": float(solved.mean()) if solved.size else None,
+                "maximum_variation_percent": float(solved.max()) if solved.size else None,
+                "suboptimal_better": int(np.sum(solved < 0)),
+            }
+        )
+    return table
+
+
+def plot_study(rows: list[dict[str, Any]], table: list[dict[str, Any]], path: Path) -> Path:
+    """Percentage variation per point against v, with the average and maximum of Table 2.1."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    fig, ax = plt.subplots(figsize=(6, 4))
+    solved = [r for r in rows if "variation_percent" in r]
+    ax.scatter([r["v"] for r in solved], [r["variation_percent"] for r in solved], s=8, alpha=0.4)
+    speeds = [t["v"] for t in table]
+    ax.plot(speeds, [t["average_variation_percent"] for t in table], "o-", label="average")
+    ax.plot(speeds, [t["maximum_variation_percent"] for t in table], "s--", label="maximum")
+    ax.set(xlabel="evader speed v", ylabel="100 (t_opt − t_sub)/t_opt  [%]", title="Table 2.1")
+    ax.legend()
+    fig.savefig(path, dpi=120, bbox_inches="tight")
+    plt.close(fig)
+    return path
+
+
+def run(spec: SuboptimalStudySpec, out: Path, *, workers: int = 1, progress: bool = True) -> list[dict]:
+    """Run (or resume) the study into ``out``; return the Table 2.1 rows, also written to
+    ``out/table.json`` with a plot ``out/table_2_1.png``."""
+    out = Path(out)
+    points = study_points(spec)
+    values = run_study(
+        points,
+        evaluate,
+        ResultStore(out / "points"),
+        executor=executor(workers),
+        description=spec.name,
+        show_progress=progress,
+    )
+    rows = list(values.values())
+    table = summarize(rows)
+    (out / "table.json").write_text(json.dumps(table, indent=2))
+    plot_study(rows, table, out / "table_2_1.png")
+    return table

@@ -121,9 +121,10 @@ def study_points(spec: SuboptimalStudySpec) -> dict[str, StudyPoint]:
     return points
 
 
-def _engagement(point: StudyPoint, r2: float, psi: float) -> EngagementSpec:
+def point_engagement(point: StudyPoint) -> EngagementSpec:
+    """The engagement of one study point: P1 at (0, 0), E at (r1, 0), P2 = E + r2 (cos ψ, sin ψ)."""
     e = np.array([point.r1, 0.0])
-    p2 = e + r2 * np.array([np.cos(psi), np.sin(psi)])
+    p2 = e + point.r2 * np.array([np.cos(point.psi), np.sin(point.psi)])
     return EngagementSpec.model_validate(
         {
             "name": "table_2_1_point",
@@ -145,14 +146,14 @@ def _model(v: float, r1: float, u: float, eps: float, method: str, backend: str)
     from gamespec.solving import get_backend
 
     reference = StudyPoint(v, 10 * r1, 0.5 * np.pi, r1, u, eps, method, backend)
-    ocp, _ = to_ocp(_engagement(reference, reference.r2, reference.psi))
+    ocp, _ = to_ocp(point_engagement(reference))
     solver = get_backend(backend)
     return solver.compile(ocp)
 
 
 def evaluate(point: StudyPoint) -> dict[str, Any]:
     """Suboptimal and optimal capture times of one point (the row the store keeps)."""
-    spec = _engagement(point, point.r2, point.psi)
+    spec = point_engagement(point)
     players = Players.from_spec(spec)
     red = reduce(spec)
     choice = pure_pursuit.suboptimal_heading(players)

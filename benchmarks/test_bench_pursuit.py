@@ -1,0 +1,57 @@
+"""Pursuit-evasion speed: one OCP solve (build + solve) per problem file, the closed forms beside
+them, and the Table 2.1 study's total time, serial.
+
+Run: ``python -m pytest benchmarks/test_bench_pursuit.py --benchmark-enable`` (the study is marked
+slow: add ``-m slow`` to time it; it starts from an empty store so nothing is resumed).
+"""
+
+from __future__ import annotations
+
+import pytest
+
+import gamespec
+from gamespec.pursuit import study
+from tests.conftest import PROBLEMS
+
+CASES = {
+    "constant_bearing_two_on_one": PROBLEMS / "ch2" / "constant_bearing_two_on_one.yaml",
+    "constant_bearing_degenerate": PROBLEMS / "ch2" / "constant_bearing_degenerate.yaml",
+    "pure_pursuit_two_on_one": PROBLEMS / "ch2" / "pure_pursuit_two_on_one.yaml",
+    "relay_pure_pursuit": PROBLEMS / "ch2" / "relay_pure_pursuit.yaml",
+    "relay_constant_bearing": PROBLEMS / "ch2" / "relay_constant_bearing.yaml",
+    "mpse_optimal_evasion_cb": PROBLEMS / "ch3" / "mpse_optimal_evasion_cb.yaml",
+}
+ANALYTIC = [
+    "constant_bearing_two_on_one",
+    "constant_bearing_degenerate",
+    "pure_pursuit_two_on_one",
+    "mpse_optimal_evasion_cb",
+]
+
+
+def _solve(path, backend: str | None) -> float:
+    result = gamespec.solve(gamespec.load(path), backend)
+    assert result.ok
+    return result.t_final
+
+
+@pytest.mark.parametrize("case", sorted(CASES))
+def test_ocp_solve(benchmark, case: str) -> None:
+    """Load, generate the reduced OCP and its guess, build the NLP, solve, re-simulate."""
+    benchmark.group = case
+    benchmark.pedantic(_solve, args=(CASES[case], None), rounds=3, warmup_rounds=1)
+
+
+@pytest.mark.parametrize("case", ANALYTIC)
+def test_analytic(benchmark, case: str) -> None:
+    """The closed form (CB) or eq. 2.27 suboptimal heading (PP), simulated with the true dynamics."""
+    benchmark.group = case
+    benchmark.pedantic(_solve, args=(CASES[case], "analytic"), rounds=3, warmup_rounds=1)
+
+
+@pytest.mark.slow
+def test_table_2_1_study_serial(benchmark, tmp_path) -> None:
+    """All 720 points of the shipped study file, one process, from an empty store."""
+    spec = study.load_study(PROBLEMS / "ch2" / "pure_pursuit_suboptimal_study.yaml")
+    table = benchmark.pedantic(study.run, args=(spec, tmp_path / "run"), kwargs={"progress": False}, rounds=1)
+    assert all(row["solved"] == row["points"] for row in table)

@@ -45,13 +45,9 @@ class Reduction:
     initial: dict[str, str] = field(default_factory=dict)
     distance: dict[int, str] = field(default_factory=dict)
     angle: dict[int, str] = field(default_factory=dict)
+    capture_states: list[str] = field(default_factory=list)
     path_constraints: list[str] = field(default_factory=list)
     t_max: float = 0.0
-
-    @property
-    def capture_states(self) -> list[str]:
-        """The distance states that the capture radius bounds (active pursuers)."""
-        return [self.distance[i] for i in sorted(self.distance) if f"u{i + 1}" in self.parameters]
 
 
 def _angle_name(frame: str, index: int, n: int) -> str:
@@ -76,6 +72,7 @@ def reduce(spec: EngagementSpec) -> Reduction:
         red.initial[r] = f"r{k}_init"
         if strategy != "stationary":
             red.parameters[f"u{k}"] = float(players.speeds[i])
+            red.capture_states.append(r)
         if frame == "fixed":
             _fixed_frame(red, strategy, k, r, ang, float(phi0[i]))
         elif i == 0:

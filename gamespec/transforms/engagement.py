@@ -126,7 +126,8 @@ def relay_arcs(red: Reduction, players: Players, result: Result) -> dict[str, fl
     tc = np.asarray(result.control_time if result.control_time is not None else t)
     control = np.interp(t, tc, result.controls[red.control])
     if red.frame == "fixed":
-        phi_a = s.get(red.angle[active], np.full_like(t, red.parameters.get(red.angle[active], 0.0)))
+        name = red.angle[active]
+        phi_a = s[name] if name in s else np.full_like(t, red.parameters[name])
         switching = (v - u) * r_a - v * r_s * np.cos(phi_a - s[red.angle[guard]])
         off_los = control - phi_a
     else:

@@ -109,9 +109,8 @@ def _nearest_capture(circles: ApolloniusCircles, evader: np.ndarray) -> int:
 def active_cb_lifted(circles: ApolloniusCircles, evader: np.ndarray) -> np.ndarray:
     """Active pursuers (CB) from the lower convex hull of the lifted disks, ``O(n log n)``.
 
-    See the module docstring. Configurations whose lifted points are degenerate (all dual points
-    coplanar, as for co-circular pursuers of equal speed) are retried with Qhull's joggle; fewer than
-    four disks go to :func:`aapc`.
+    See the module docstring. Fewer than four disks, and configurations whose dual points span no
+    volume (all coplanar, as for co-circular or collinear pursuers of equal speed), go to :func:`aapc`.
     """
     if len(circles.radii) < 4:
         return aapc(circles)
@@ -124,7 +123,7 @@ def active_cb_lifted(circles: ApolloniusCircles, evader: np.ndarray) -> np.ndarr
     try:
         hull = ConvexHull(lifted)
     except QhullError:
-        hull = ConvexHull(lifted, qhull_options="QJ")
+        return aapc(circles)
     normals = hull.equations[:, :3]
     lower = normals[:, 2] < -_ROUND_OFF
     vertex = np.zeros((len(normals), 2))

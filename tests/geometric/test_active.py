@@ -4,12 +4,12 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+from gamespec_geometric import active_pursuers
+from gamespec_geometric.apollonius import refined_pp_radius
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from gamespec.errors import SpecError
-from gamespec_geometric import active_pursuers
-from gamespec_geometric.apollonius import refined_pp_radius
 from tests.geometric.helpers import random_team
 
 SEEDS = st.integers(0, 2**32 - 1)

@@ -3,11 +3,10 @@
 from __future__ import annotations
 
 import numpy as np
-from hypothesis import given, settings
-from hypothesis import strategies as st
-
 from gamespec_geometric import active_pursuers, allocate
 from gamespec_geometric.allocation import UNASSIGNED
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 SEEDS = st.integers(0, 2**32 - 1)
 
@@ -26,7 +25,7 @@ def _teams(seed: int, n: int, m: int, heterogeneous: bool):
 def test_lemmas_5_and_7_shortest_pair_is_allocated(
     seed: int, n: int, m: int, hetero: bool, strategy: str
 ) -> None:
-    """The pair with the current shortest time |p_i - e_j| / (u_i + v_j) is in F (A2; AVAA when homogeneous)."""
+    """The pair with the shortest time |p_i - e_j| / (u_i + v_j) is in F (A2; AVAA when homogeneous)."""
     pursuers, evaders, u, v = _teams(seed, n, m, hetero)
     result = allocate(pursuers, evaders, u, v, algorithm="a2", strategy=strategy)
     times = np.linalg.norm(pursuers[:, None] - evaders[None], axis=2) / (u[:, None] + v[None, :])

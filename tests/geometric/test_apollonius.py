@@ -3,10 +3,6 @@
 from __future__ import annotations
 
 import numpy as np
-from hypothesis import given, settings
-from hypothesis import strategies as st
-
-from gamespec.loader import spec_from_dict
 from gamespec_geometric.apollonius import (
     apollonius_circles,
     circle_radial_distance,
@@ -17,6 +13,10 @@ from gamespec_geometric.apollonius import (
     refined_pp_radius,
 )
 from gamespec_geometric.simulation import simulate
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from gamespec.loader import spec_from_dict
 from tests.geometric.helpers import random_team
 
 SEEDS = st.integers(0, 2**32 - 1)

@@ -8,14 +8,14 @@ from pathlib import Path
 import numpy as np
 import pytest
 import yaml
+from gamespec_geometric.plot import plot_scenario
+from gamespec_geometric.simulation import simulate
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
 import gamespec
 from gamespec.errors import SpecError
 from gamespec.loader import spec_from_dict
-from gamespec_geometric.plot import plot_scenario
-from gamespec_geometric.simulation import simulate
 from tests.conftest import PROBLEMS
 
 SEEDS = st.integers(0, 2**32 - 1)

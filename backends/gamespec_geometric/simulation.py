@@ -19,7 +19,7 @@ import numpy as np
 
 from gamespec_geometric.active import Method
 from gamespec_geometric.allocation import UNASSIGNED, allocate, tie_break_cost
-from gamespec_geometric.spec import BlindEvasion, FixedHeading, PursuitScenarioSpec
+from gamespec_geometric.spec import BlindEvasion, FixedHeading, PureEvasion, PursuitScenarioSpec
 
 HeadingPolicy = Callable[[float, np.ndarray, np.ndarray], float]
 """``policy(t, evader, pursuers) -> heading`` of one evader."""
@@ -43,7 +43,7 @@ class Trajectories:
 
 
 def heading_policy(
-    strategy: FixedHeading | BlindEvasion | object, evader: int, horizon: float
+    strategy: FixedHeading | PureEvasion | BlindEvasion, evader: int, horizon: float
 ) -> HeadingPolicy:
     """The heading rule of one evader: fixed, blind with switching headings (§3.3.2), or pure evasion."""
     if isinstance(strategy, FixedHeading):
@@ -94,78 +94,110 @@ def first_contact(relative: np.ndarray, motion: np.ndarray, radius: float) -> np
     return np.where(c <= 0, 0.0, np.where(hit, s, np.inf))
 
 
+@dataclass(frozen=True)
+class StepPlan:
+    """Velocities for one step, the allocation behind them (global evader indices, -1: redundant),
+    AVAA/A2 rounds, and the current shortest time with whether its pair is allocated (Lemmas 5/7)."""
+
+    pursuer_velocity: np.ndarray
+    evader_velocity: np.ndarray
+    assignment: np.ndarray
+    rounds: int
+    shortest_time: float
+    shortest_pair_allocated: bool
+
+
+def plan_step(
+    spec: PursuitScenarioSpec,
+    t: float,
+    pursuers: np.ndarray,
+    evaders: np.ndarray,
+    free: np.ndarray,
+    policies: list[HeadingPolicy],
+    *,
+    method: Method,
+    samples: int,
+) -> StepPlan:
+    """Evader headings, the allocation, and the pursuers' headings (redundant pursuers stop)."""
+    u, v = spec.pursuers.speeds(), spec.evaders.speeds()
+    idx = np.flatnonzero(free)
+    headings = np.array([policies[j](t, evaders[j], pursuers) for j in idx])
+    result = allocate(
+        pursuers,
+        evaders[idx],
+        u,
+        v[idx],
+        algorithm=spec.algorithm,
+        strategy=spec.pursuers.strategy,
+        method=method,
+        samples=samples,
+    )
+    local = result.assignment
+    cost = tie_break_cost(pursuers, evaders[idx], u, v[idx], spec.algorithm)
+    i_star, j_star = np.unravel_index(np.argmin(cost), cost.shape)
+
+    chasing = np.flatnonzero(local >= 0)
+    targets = local[chasing]
+    theta = pursuer_headings(
+        pursuers[chasing],
+        evaders[idx][targets],
+        u[chasing],
+        v[idx][targets],
+        headings[targets],
+        spec.pursuers.strategy,
+    )
+    pursuer_velocity = np.zeros_like(pursuers)
+    pursuer_velocity[chasing] = u[chasing, None] * np.column_stack([np.cos(theta), np.sin(theta)])
+    evader_velocity = np.zeros_like(evaders)
+    evader_velocity[idx] = v[idx, None] * np.column_stack([np.cos(headings), np.sin(headings)])
+    return StepPlan(
+        pursuer_velocity,
+        evader_velocity,
+        np.where(local >= 0, idx[np.maximum(local, 0)], UNASSIGNED),
+        result.rounds,
+        float(cost.min()),
+        bool(local[i_star] == j_star),
+    )
+
+
 def simulate(spec: PursuitScenarioSpec, *, method: Method = "fast", samples: int = 64) -> Trajectories:
     """Run the scenario until every evader is caught or the horizon is reached."""
     pursuers = np.array(spec.pursuers.positions, dtype=float)
     evaders = np.array(spec.evaders.positions, dtype=float)
-    u, v = spec.pursuers.speeds(), spec.evaders.speeds()
     n, m = len(pursuers), len(evaders)
-    dt, radius, algorithm = spec.time_step, spec.capture_radius, spec.algorithm
+    dt, radius = spec.time_step, spec.capture_radius
     policies = [heading_policy(s, j, spec.horizon) for j, s in enumerate(spec.evaders.strategies())]
 
     capture_times: list[float | None] = [None] * m
     capturers: list[int | None] = [None] * m
-    times, p_track, e_track, allocations, rounds = [0.0], [pursuers.copy()], [evaders.copy()], [], []
+    times, p_track, e_track, allocations, rounds = [0.0], [pursuers], [evaders], [], []
     shortest_increase, pair_unassigned = -math.inf, 0
-    _capture(
-        np.zeros((n, m, 2)), pursuers, evaders, np.ones(m, bool), 0.0, 0.0, radius, capture_times, capturers
-    )
+    no_motion = np.zeros((n, m, 2))
+    _capture(no_motion, pursuers, evaders, np.ones(m, bool), 0.0, 0.0, radius, capture_times, capturers)
 
-    t = 0.0
-    for _ in range(math.ceil(spec.horizon / dt - 1e-9)):
+    for k in range(math.ceil(spec.horizon / dt - 1e-9)):
         free = np.array([c is None for c in capture_times])
         if not free.any():
             break
-        idx = np.flatnonzero(free)
-        headings = np.array([policies[j](t, evaders[j], pursuers) for j in idx])
-        result = allocate(
-            pursuers,
-            evaders[idx],
-            u,
-            v[idx],
-            algorithm=algorithm,
-            strategy=spec.pursuers.strategy,
-            method=method,
-            samples=samples,
-        )
-        local = result.assignment
-        assignment = np.where(local >= 0, idx[np.maximum(local, 0)], UNASSIGNED)
-        cost = tie_break_cost(pursuers, evaders[idx], u, v[idx], algorithm)
-        i_star, j_star = np.unravel_index(np.argmin(cost), cost.shape)
-        pair_unassigned += int(local[i_star] != j_star)
-
-        velocity_p = np.zeros((n, 2))
-        chasing = np.flatnonzero(local >= 0)
-        targets = local[chasing]
-        theta = pursuer_headings(
-            pursuers[chasing],
-            evaders[idx][targets],
-            u[chasing],
-            v[idx][targets],
-            headings[targets],
-            spec.pursuers.strategy,
-        )
-        velocity_p[chasing] = u[chasing, None] * np.column_stack([np.cos(theta), np.sin(theta)])
-        velocity_e = np.zeros((m, 2))
-        velocity_e[idx] = v[idx, None] * np.column_stack([np.cos(headings), np.sin(headings)])
-
-        motion = dt * (velocity_e[None, :, :] - velocity_p[:, None, :])
+        t = k * dt
+        plan = plan_step(spec, t, pursuers, evaders, free, policies, method=method, samples=samples)
+        motion = dt * (plan.evader_velocity[None, :, :] - plan.pursuer_velocity[:, None, :])
         caught = _capture(motion, pursuers, evaders, free, t, dt, radius, capture_times, capturers)
         stop = np.ones(m)
-        for j, s in caught.items():
-            stop[j] = s
-        new_pursuers = pursuers + dt * velocity_p
-        evaders = evaders + dt * stop[:, None] * velocity_e
+        stop[list(caught)] = list(caught.values())
+        pursuers = pursuers + dt * plan.pursuer_velocity
+        evaders = evaders + dt * stop[:, None] * plan.evader_velocity
         if not caught:
-            after = tie_break_cost(new_pursuers, evaders[idx], u, v[idx], algorithm).min()
-            shortest_increase = max(shortest_increase, after - cost.min())
-        pursuers = new_pursuers
-        t += dt
-        times.append(t)
-        p_track.append(pursuers.copy())
-        e_track.append(evaders.copy())
-        allocations.append(assignment)
-        rounds.append(result.rounds)
+            after = tie_break_cost(
+                pursuers, evaders[free], spec.pursuers.speeds(), spec.evaders.speeds()[free], spec.algorithm
+            ).min()
+            shortest_increase = max(shortest_increase, after - plan.shortest_time)
+        pair_unassigned += not plan.shortest_pair_allocated
+        times.append((k + 1) * dt)
+        p_track.append(pursuers)
+        e_track.append(evaders)
+        allocations.append(plan.assignment)
+        rounds.append(plan.rounds)
 
     allocations.append(np.full(n, UNASSIGNED))
     return Trajectories(

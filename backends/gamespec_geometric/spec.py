@@ -36,7 +36,10 @@ def _constant(value: float | str) -> float:
     return float(number)
 
 
-Heading = Annotated[float, Field(description="Radians: a number or a constant expression like '-pi/4'.")]
+Heading = Annotated[
+    float | str, Field(description="Radians: a number or a constant expression like '-pi/4'.")
+]
+"""Read into a float by :func:`_constant` before validation."""
 
 
 class FixedHeading(StrictModel):
@@ -159,8 +162,8 @@ class PursuitScenarioSpec(SpecBase):
                 field="pursuers.speed",
             )
         self._check_distinct()
-        if self.time_step >= self.horizon:
-            raise SpecError("time_step must be shorter than the horizon", field="time_step")
+        if self.time_step > self.horizon:
+            raise SpecError("time_step must not exceed the horizon", field="time_step")
         return self
 
     def _check_distinct(self) -> None:

@@ -31,7 +31,7 @@ The public entry is :func:`active_pursuers`.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from typing import Literal
 
 import numpy as np
@@ -41,7 +41,9 @@ from gamespec.errors import SpecError
 from gamespec_geometric.apollonius import (
     ApolloniusCircles,
     apollonius_circles,
+    cb_reach,
     refined_pp_polygons,
+    refined_pp_reach,
 )
 
 Strategy = Literal["cb", "pp"]
@@ -262,24 +264,29 @@ class CaptureRegions:
     """The Apollonius regions of ``n`` pursuers around one evader: circles (CB) or polygons (PP).
 
     ``inner[i]`` is the radius of a disk around the evader inside region ``i`` and ``outer[i]`` that
-    of one holding it, so that regions which cannot touch the boundary are dropped cheaply.
+    of one holding it (closed forms, :func:`~gamespec_geometric.apollonius.cb_reach` and
+    :func:`~gamespec_geometric.apollonius.refined_pp_reach`), so that regions which cannot touch the
+    boundary are dropped before any circle or polygon is built.
     """
 
+    pursuers: np.ndarray
     evader: np.ndarray
+    pursuer_speeds: np.ndarray
+    evader_speed: float
+    strategy: Strategy
+    samples: int
     inner: np.ndarray
     outer: np.ndarray
-    circles: ApolloniusCircles | None = None
-    polygons: np.ndarray | None = None
 
     def take(self, index: np.ndarray) -> CaptureRegions:
         """The regions of the pursuers ``index`` only."""
-        circles = self.circles
-        if circles is not None:
-            circles = ApolloniusCircles(
-                circles.centers[index], circles.radii[index], circles.closest_points[index]
-            )
-        polygons = None if self.polygons is None else self.polygons[index]
-        return CaptureRegions(self.evader, self.inner[index], self.outer[index], circles, polygons)
+        return replace(
+            self,
+            pursuers=self.pursuers[index],
+            pursuer_speeds=self.pursuer_speeds[index],
+            inner=self.inner[index],
+            outer=self.outer[index],
+        )
 
     def may_touch(self) -> np.ndarray:
         """Indices of the regions that can reach the boundary of the intersection of all of them.
@@ -288,6 +295,16 @@ class CaptureRegions:
         exceeds that contains it strictly and is redundant.
         """
         return np.flatnonzero(self.inner <= self.outer.min())
+
+    def circles(self) -> ApolloniusCircles:
+        """The Apollonius circles (CB)."""
+        return apollonius_circles(self.pursuers, self.evader, self.pursuer_speeds, self.evader_speed)
+
+    def polygons(self) -> np.ndarray:
+        """The polygons inscribed in the refined Apollonius curves (PP), ``(n, samples, 2)``."""
+        return refined_pp_polygons(
+            self.pursuers, self.evader, self.pursuer_speeds, self.evader_speed, self.samples
+        )
 
 
 def capture_regions(
@@ -298,32 +315,34 @@ def capture_regions(
     strategy: Strategy,
     samples: int = 64,
 ) -> CaptureRegions:
-    """Apollonius circles (CB) or inscribed refined Apollonius polygons (PP) with their radii bounds."""
+    """The CB or PP regions of the pursuers around the evader, with their reach bounds.
+
+    A ``samples``-gon inscribed in a refined curve has its vertices on the curve at polar steps of
+    at most ``2 pi / samples`` seen from the evader, so its edges stay ``cos(pi / samples)`` times
+    the curve's nearest distance away.
+    """
+    distance = np.linalg.norm(pursuers - evader, axis=1)
     if strategy == "cb":
-        circles = apollonius_circles(pursuers, evader, pursuer_speeds, evader_speed)
-        inner = np.linalg.norm(circles.closest_points - evader, axis=1)
-        outer = np.linalg.norm(circles.centers - evader, axis=1) + circles.radii
-        return CaptureRegions(evader, inner, outer, circles=circles)
-    polygons = refined_pp_polygons(pursuers, evader, pursuer_speeds, evader_speed, samples)
-    normals, offsets = _polygon_halfplanes(polygons, evader)
-    inner = np.min(offsets / np.linalg.norm(normals, axis=-1), axis=1)
-    outer = np.max(np.linalg.norm(polygons - evader, axis=-1), axis=1)
-    return CaptureRegions(evader, inner, outer, polygons=polygons)
+        inner, outer = cb_reach(distance, pursuer_speeds, evader_speed)
+    else:
+        nearest, outer = refined_pp_reach(distance, pursuer_speeds, evader_speed)
+        inner = nearest * np.cos(np.pi / samples)
+    return CaptureRegions(pursuers, evader, pursuer_speeds, evader_speed, strategy, samples, inner, outer)
 
 
 def active_in(regions: CaptureRegions, method: Method = "fast") -> np.ndarray:
     """Active pursuers among ``regions``: the fast check after dropping far regions, or the reference."""
-    if regions.circles is not None and method == "reference":
-        return aapc(regions.circles)
     if method == "reference":
-        return active_polygons_clipped(regions.polygons, regions.evader)
+        if regions.strategy == "cb":
+            return aapc(regions.circles())
+        return active_polygons_clipped(regions.polygons(), regions.evader)
     status = np.zeros(len(regions.inner), dtype=bool)
     keep = regions.may_touch()
     near = regions.take(keep)
-    if near.circles is not None:
-        status[keep] = active_cb_lifted(near.circles, near.evader)
+    if near.strategy == "cb":
+        status[keep] = active_cb_lifted(near.circles(), near.evader)
     else:
-        status[keep] = active_polygons_dual(near.polygons, near.evader)
+        status[keep] = active_polygons_dual(near.polygons(), near.evader)
     return status
 
 

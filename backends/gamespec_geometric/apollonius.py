@@ -119,6 +119,31 @@ def refined_pp_radius(
     return np.where(on_chord, chord, curve)
 
 
+def cb_reach(
+    initial_distance: FloatArray, pursuer_speed: FloatArray, evader_speed: float
+) -> tuple[FloatArray, FloatArray]:
+    """Nearest and farthest distance from the evader to each Apollonius circle.
+
+    ``v r0 / (u + v)`` at ``T_i`` and ``|O_i - e| + d_i = v r0 / (u - v)`` across from it (§3.3).
+    """
+    u = np.asarray(pursuer_speed, dtype=float)
+    return evader_speed * initial_distance / (u + evader_speed), evader_speed * initial_distance / (
+        u - evader_speed
+    )
+
+
+def refined_pp_reach(
+    initial_distance: FloatArray, pursuer_speed: FloatArray, evader_speed: float
+) -> tuple[FloatArray, FloatArray]:
+    """Nearest and farthest distance from the evader to each refined Apollonius curve.
+
+    The farthest is ``A + B`` (heading straight away, eq. 3.24); the nearest is the bitangent's
+    distance ``A**2 / (4 B)`` when the limaçon has a dimple, else ``A - B`` (heading at the pursuer).
+    """
+    a, b = _limacon_coefficients(initial_distance, pursuer_speed, evader_speed)
+    return np.where(a < 2.0 * b, a**2 / (4.0 * b), a - b), a + b
+
+
 def line_of_sight_angles(pursuers: FloatArray, evader: FloatArray) -> FloatArray:
     """Angle of the line of sight from each pursuer to the evader (eq. 3.17)."""
     delta = evader - pursuers

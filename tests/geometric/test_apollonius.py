@@ -5,12 +5,14 @@ from __future__ import annotations
 import numpy as np
 from gamespec_geometric.apollonius import (
     apollonius_circles,
+    cb_reach,
     circle_radial_distance,
     line_of_sight_angles,
     pp_capture_time,
     pp_curve_radius,
     refined_pp_polygons,
     refined_pp_radius,
+    refined_pp_reach,
 )
 from gamespec_geometric.simulation import simulate
 from hypothesis import given, settings
@@ -110,3 +112,17 @@ def test_constant_bearing_captures_on_the_apollonius_circle() -> None:
         circles = apollonius_circles(np.zeros((1, 2)), np.array([4.0, 1.0]), np.ones(1), 0.6)
         exact = circle_radial_distance(circles, np.array([4.0, 1.0]), np.array([heading]))[0, 0] / 0.6
         assert exact - radius / (1.0 - 0.6) <= captured <= exact + 1e-9
+
+
+@settings(max_examples=40, deadline=None)
+@given(SEEDS, st.integers(1, 12), st.booleans())
+def test_reach_bounds_are_the_nearest_and_farthest_points(seed: int, n: int, heterogeneous: bool) -> None:
+    """The closed-form reach of circles and refined curves matches their sampled radial distances."""
+    pursuers, evader, u, v = random_team(seed, n, heterogeneous)
+    distance = np.linalg.norm(pursuers - evader, axis=1)
+    circle = circle_radial_distance(apollonius_circles(pursuers, evader, u, v), evader, ANGLES)
+    near, far = cb_reach(distance, u, v)
+    np.testing.assert_allclose([circle.min(axis=1), circle.max(axis=1)], [near, far], rtol=1e-4)
+    refined = refined_pp_radius(distance[:, None], ANGLES[None, :], u[:, None], v)
+    near, far = refined_pp_reach(distance, u, v)
+    np.testing.assert_allclose([refined.min(axis=1), refined.max(axis=1)], [near, far], rtol=1e-4)

@@ -126,35 +126,16 @@ def active_cb_lifted(circles: ApolloniusCircles, evader: np.ndarray) -> np.ndarr
         hull = ConvexHull(lifted)
     except QhullError:
         return aapc(circles)
-    normals = hull.equations[:, :3]
-    lower = normals[:, 2] < -_ROUND_OFF
-    vertex = np.zeros((len(normals), 2))
-    vertex[lower] = normals[lower, :2] / normals[lower, 2:3]
+    a, b, start, step, end = _farthest_power_edges(hull, centers)
 
-    facets = np.flatnonzero(lower)
-    simplices = hull.simplices[facets]
-    neighbors = hull.neighbors[facets]
-    a = simplices[:, [1, 2, 0]].ravel()
-    b = simplices[:, [2, 0, 1]].ravel()
-    c = simplices.ravel()
-    across = neighbors.ravel()
-    start = np.repeat(vertex[facets], 3, axis=0)
-    bounded = lower[across]
-
-    along = centers[b] - centers[a]
-    ray = np.stack([-along[:, 1], along[:, 0]], axis=1)
-    ray *= np.sign(np.sum(ray * (centers[c] - centers[a]), axis=1))[:, None]
-    ray /= np.maximum(np.linalg.norm(ray, axis=1), np.finfo(float).tiny)[:, None]
-    step = np.where(bounded[:, None], vertex[across] - start, ray)
-
+    # Does circle a (equivalently b: equal power on the edge) cross the edge start + s step, 0 <= s <= end?
     offset = start - centers[a]
     power0 = np.sum(offset**2, axis=1) - radii[a] ** 2
     slope = np.sum(offset * step, axis=1)
     curvature = np.sum(step**2, axis=1)
-    end = np.where(bounded, 1.0, np.inf)
     s = np.clip(-slope / np.maximum(curvature, np.finfo(float).tiny), 0.0, end)
     lowest = power0 + 2 * s * slope + s**2 * curvature
-    power1 = np.where(bounded, power0 + 2 * slope + curvature, np.inf)
+    power1 = np.where(np.isfinite(end), power0 + 2 * slope + curvature, np.inf)
     crosses = (lowest <= _ROUND_OFF) & (np.maximum(power0, power1) >= -_ROUND_OFF)
 
     status = np.zeros(n, dtype=bool)
@@ -162,6 +143,37 @@ def active_cb_lifted(circles: ApolloniusCircles, evader: np.ndarray) -> np.ndarr
     status[b[crosses]] = True
     status[_nearest_capture(circles, evader)] = True
     return status
+
+
+def _farthest_power_edges(
+    hull: ConvexHull, centers: np.ndarray
+) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """Edges of the farthest-power diagram from the lower hull of the lifted disks.
+
+    A lower facet (outward normal ``n`` with ``n_z < 0``) is the diagram vertex ``n_xy / n_z``; the
+    hull edge between disks ``a`` and ``b`` is the diagram edge ``start + s step``, ``0 <= s <= end``:
+    a segment (``end = 1``) to the neighbouring facet's vertex when that facet is lower too, else a
+    ray (``end = inf``) along the bisector, away from the facet's third disk ``c``. Each edge is
+    listed once per lower facet that holds it.
+    """
+    normals = hull.equations[:, :3]
+    lower = normals[:, 2] < -_ROUND_OFF
+    vertex = np.zeros((len(normals), 2))
+    vertex[lower] = normals[lower, :2] / normals[lower, 2:3]
+    facets = np.flatnonzero(lower)
+    simplices = hull.simplices[facets]
+    a = simplices[:, [1, 2, 0]].ravel()
+    b = simplices[:, [2, 0, 1]].ravel()
+    c = simplices.ravel()
+    across = hull.neighbors[facets].ravel()
+    start = np.repeat(vertex[facets], 3, axis=0)
+    bounded = lower[across]
+    along = centers[b] - centers[a]
+    ray = np.stack([-along[:, 1], along[:, 0]], axis=1)
+    ray *= np.sign(np.sum(ray * (centers[c] - centers[a]), axis=1))[:, None]
+    ray /= np.maximum(np.linalg.norm(ray, axis=1), np.finfo(float).tiny)[:, None]
+    step = np.where(bounded[:, None], vertex[across] - start, ray)
+    return a, b, start, step, np.where(bounded, 1.0, np.inf)
 
 
 def _polygon_halfplanes(polygons: np.ndarray, evader: np.ndarray) -> tuple[np.ndarray, np.ndarray]:

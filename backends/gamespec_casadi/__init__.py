@@ -1,0 +1,1 @@
+"""CasADi backend of gamespec: direct collocation solved by the IPOPT inside the CasADi wheel."""

@@ -1,0 +1,199 @@
+"""The ``casadi`` backend: an ``optimal_control`` spec as a CasADi NLP by direct collocation.
+
+The NLP is built once from the backend-neutral :class:`~gamespec.ocp.transcription.Transcription`:
+decision variables ``[vec(X); vec(U); T]``, defects ``D X - T W F`` with ``F`` a mapped CasADi
+function over the evaluation points, and the problem's parameters (and a fixed horizon) as NLP
+parameters, so a re-solve with new values reuses the solver and warm-starts from the last solution.
+"""
+
+from __future__ import annotations
+
+import time
+from typing import Any, ClassVar
+
+import numpy as np
+from pydantic import Field
+
+from gamespec.backend import Availability, Backend, CompiledModel
+from gamespec.ocp.transcription import Guess, Transcription
+from gamespec.ocp.translate import Library, translate
+from gamespec.result import Result, Status
+from gamespec.specs.base import StrictModel
+from gamespec.specs.ocp import OptimalControlSpec
+
+STATUS_MAP = {
+    "Solve_Succeeded": Status.OPTIMAL,
+    "Solved_To_Acceptable_Level": Status.FEASIBLE,
+    "Feasible_Point_Found": Status.FEASIBLE,
+    "Infeasible_Problem_Detected": Status.INFEASIBLE,
+    "Diverging_Iterates": Status.UNBOUNDED,
+    "Maximum_Iterations_Exceeded": Status.ITERATION_LIMIT,
+    "Maximum_CpuTime_Exceeded": Status.TIME_LIMIT,
+    "Maximum_WallTime_Exceeded": Status.TIME_LIMIT,
+    "Restoration_Failed": Status.NUMERICAL_ERROR,
+    "Error_In_Step_Computation": Status.NUMERICAL_ERROR,
+    "Invalid_Number_Detected": Status.NUMERICAL_ERROR,
+}
+
+
+class CasadiOptions(StrictModel):
+    """Options block ``solver.options.casadi``: IPOPT options passed through, and a tolerance."""
+
+    solver: str = Field("ipopt", description="NLP solver plugin of CasADi's nlpsol.")
+    tol: float = Field(1e-8, gt=0, description="IPOPT's tol.")
+    max_iter: int = Field(3000, ge=1)
+    ipopt: dict[str, Any] = Field(default_factory=dict, description="Further IPOPT options.")
+    warm_start: bool = Field(True, description="Re-solves start from the previous solution.")
+
+
+def _library(ca) -> Library:
+    return Library(
+        functions={
+            "sin": ca.sin,
+            "cos": ca.cos,
+            "tan": ca.tan,
+            "asin": ca.asin,
+            "acos": ca.acos,
+            "atan": ca.atan,
+            "atan2": ca.atan2,
+            "exp": ca.exp,
+            "log": ca.log,
+            "sqrt": ca.sqrt,
+            "abs": ca.fabs,
+            "tanh": ca.tanh,
+            "min": ca.fmin,
+            "max": ca.fmax,
+        }
+    )
+
+
+class CasadiModel(CompiledModel):
+    """The NLP and its solver, built once."""
+
+    def __init__(self, spec: OptimalControlSpec, options: CasadiOptions) -> None:
+        import casadi as ca
+
+        self.ca = ca
+        self.tr = tr = Transcription(spec)
+        self.options = options
+        ocp, grid = tr.ocp, tr.grid
+        lib = _library(ca)
+        nx, nu, npar = tr.n_x, tr.n_u, len(ocp.p)
+        x, u, p, t = ca.SX.sym("x", nx), ca.SX.sym("u", nu), ca.SX.sym("p", npar), ca.SX.sym("t")
+        values = dict(zip(ocp.x, ca.vertsplit(x), strict=True)) | dict(
+            zip(ocp.u, ca.vertsplit(u), strict=True)
+        )
+        values |= dict(zip(ocp.p, ca.vertsplit(p), strict=True)) | {ocp.t: t}
+        f = ca.vertcat(*(translate(e, values, lib) for e in ocp.dynamics))
+        L = translate(ocp.lagrange, values, lib)
+        path = ca.vertcat(*(translate(r.expr, values, lib) for r in ocp.path))
+        k = len(grid.eval_index)
+        point = ca.Function("point", [x, u, t, p], [f, L, path]).map(k)
+
+        X = ca.SX.sym("X", nx, grid.n_nodes)
+        U = ca.SX.sym("U", nu, k)
+        T = ca.SX.sym("T") if tr.free_time else None
+        p_all = ca.SX.sym("p_all", npar + (0 if tr.free_time else 1))
+        params = p_all[:npar]
+        horizon = T if tr.free_time else p_all[npar]
+        t_eval = tr.t0 + horizon * ca.DM(grid.eval_tau).T
+        F, Lv, G = point(X[:, grid.eval_index.tolist()], U, t_eval, params)
+        D, W, q = grid.matrices
+        defects = X @ ca.DM(D.T) - horizon * (F @ ca.DM(W.T))
+
+        ends = dict(zip(ocp.x0, ca.vertsplit(X[:, 0]), strict=True))
+        ends |= dict(zip(ocp.xf, ca.vertsplit(X[:, -1]), strict=True)) | {ocp.tf: tr.t0 + horizon}
+        ends |= dict(zip(ocp.p, ca.vertsplit(params), strict=True))
+        mayer = translate(ocp.mayer, ends, lib)
+        boundary = [translate(r.expr, ends, lib) for r in ocp.boundary]
+        objective = mayer + horizon * (Lv @ ca.DM(q))
+
+        self.n_defects = defects.numel()
+        g = ca.vertcat(ca.vec(defects), ca.vec(G.T), *boundary)
+        w = ca.vertcat(ca.vec(X), ca.vec(U), *([T] if tr.free_time else []))
+        lower = [np.zeros(self.n_defects)]
+        upper = [np.zeros(self.n_defects)]
+        for r in ocp.path:
+            lower.append(np.full(k, r.lower))
+            upper.append(np.full(k, r.upper))
+        lower += [np.array([r.lower for r in ocp.boundary])]
+        upper += [np.array([r.upper for r in ocp.boundary])]
+        self.lbg, self.ubg = np.concatenate(lower), np.concatenate(upper)
+        ipopt = {"print_level": 0, "sb": "yes", "tol": options.tol, "max_iter": options.max_iter}
+        nlp_opts = {"ipopt": ipopt | options.ipopt, "print_time": False}
+        self.solver = ca.nlpsol(
+            "gamespec", options.solver, {"x": w, "p": p_all, "f": objective, "g": g}, nlp_opts
+        )
+        self.shape = (nx, grid.n_nodes, nu, k)
+        self._last: np.ndarray | None = None
+
+    def _pack(self, X: np.ndarray, U: np.ndarray, T: float) -> np.ndarray:
+        parts = [X.ravel(order="F"), U.ravel(order="F")]
+        return np.concatenate([*parts, [T]] if self.tr.free_time else parts)
+
+    def _unpack(self, w: np.ndarray, params_T: float) -> tuple[np.ndarray, np.ndarray, float]:
+        nx, n, nu, k = self.shape
+        X = w[: nx * n].reshape((nx, n), order="F")
+        U = w[nx * n : nx * n + nu * k].reshape((nu, k), order="F")
+        T = float(w[-1]) if self.tr.free_time else params_T
+        return X, U, T
+
+    def solve(self, parameters: dict[str, float] | None = None, guess: Result | None = None) -> Result:
+        tr = self.tr
+        params = tr.ocp.parameter_values(parameters)
+        b = tr.bounds(params)
+        if guess is None and self._last is not None and self.options.warm_start:
+            w0 = self._last
+        else:
+            start: Guess = tr.guess(params, guess)
+            w0 = self._pack(start.X, start.U, start.T)
+        lbx = self._pack(b.x_lower, b.u_lower, b.t_lower)
+        ubx = self._pack(b.x_upper, b.u_upper, b.t_upper)
+        p_val = [params[n] for n in tr.ocp.parameters] + ([] if tr.free_time else [b.t_lower])
+        tic = time.perf_counter()
+        sol = self.solver(x0=np.clip(w0, lbx, ubx), lbx=lbx, ubx=ubx, lbg=self.lbg, ubg=self.ubg, p=p_val)
+        elapsed = time.perf_counter() - tic
+        stats = self.solver.stats()
+        native = stats.get("return_status", "unknown")
+        w = np.asarray(sol["x"]).ravel()
+        self._last = w
+        X, U, T = self._unpack(w, b.t_lower)
+        nx = self.shape[0]
+        nu_def = np.asarray(sol["lam_g"]).ravel()[: self.n_defects].reshape((nx, -1), order="F")
+        return tr.result(
+            X=X,
+            U=U,
+            T=T,
+            objective=float(sol["f"]) * tr.ocp.sign,
+            params=params,
+            status=STATUS_MAP.get(native, Status.ERROR),
+            message=native,
+            solve_time_s=elapsed,
+            iterations=int(stats.get("iter_count", 0)),
+            defect_multipliers=nu_def,
+            solver_stats={"return_status": native, "solver": self.options.solver},
+        )
+
+
+class CasadiBackend(Backend):
+    """Direct collocation (LGR or trapezoidal) on CasADi with IPOPT."""
+
+    name: ClassVar[str] = "casadi"
+    kinds: ClassVar[frozenset[str]] = frozenset({"optimal_control"})
+    features: ClassVar[frozenset[str]] = frozenset(
+        {"ode", "free_final_time", "path_constraints", "boundary_constraints"}
+    )
+    options_model = CasadiOptions
+
+    @classmethod
+    def available(cls) -> Availability:
+        try:
+            import casadi
+        except ImportError as err:
+            return Availability(False, f"casadi does not import: {err}")
+        if not casadi.has_nlpsol("ipopt"):
+            return Availability(False, "casadi was built without the ipopt plugin")
+        return Availability(True, f"casadi {casadi.__version__} with ipopt")
+
+    def _compile(self, spec: OptimalControlSpec, options: CasadiOptions) -> CasadiModel:
+        return CasadiModel(spec, options)

@@ -1,0 +1,159 @@
+"""Checks of an OCP solution computed from the Result's arrays alone, never from the solver.
+
+- ``max_defect``: each interval re-integrated with RK4 (``RK4_STEPS`` steps) from its first node
+  under the interpolated control; the largest gap to the next interval's first node.
+- ``max_constraint_violation``: bounds, fixed end values, path and boundary constraints.
+- ``hamiltonian_variation``: ``max |H - mean H|`` along the solution for autonomous problems, with
+  ``H = sign*L + lambda^T f`` from the costate estimates (constant on an optimal arc).
+- ``hamiltonian_end_error``: ``max |H + dPhi/dt_f|`` on free-final-time autonomous problems, where
+  the transversality condition fixes the constant (``H = 0`` for minimum time, eqs. 2.22–2.23).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+from typing import TYPE_CHECKING
+
+import numpy as np
+
+from gamespec.expressions import Relation, symbol
+from gamespec.ocp.translate import NUMPY, translate
+
+if TYPE_CHECKING:
+    from gamespec.ocp.transcription import Transcription
+
+RK4_STEPS = 16
+
+
+def _dynamics(tr: Transcription, x: np.ndarray, u: np.ndarray, t: np.ndarray, params: Mapping[str, float]):
+    values = _values(tr, x, u, t, params)
+    return np.array([np.broadcast_to(translate(f, values, NUMPY), t.shape) for f in tr.ocp.dynamics])
+
+
+def _values(tr: Transcription, x, u, t, params) -> dict:
+    ocp = tr.ocp
+    values = {s: x[i] for i, s in enumerate(ocp.x)} | {s: u[j] for j, s in enumerate(ocp.u)}
+    return values | {symbol(k): v for k, v in params.items()} | {ocp.t: t}
+
+
+def _control_basis(tr: Transcription, s: np.ndarray) -> np.ndarray:
+    """Weights (len(s) × points) interpolating an interval's controls at local times ``s``."""
+    grid = tr.grid
+    if grid.scheme == "trapezoidal":
+        return np.stack([1.0 - s, s], axis=1)
+    pts = grid.local_points[1:]
+    basis = np.ones((len(s), len(pts)))
+    for r, pr in enumerate(pts):
+        for q, pq in enumerate(pts):
+            if q != r:
+                basis[:, r] *= (s - pq) / (pr - pq)
+    return basis
+
+
+def max_defect(
+    tr: Transcription, X: np.ndarray, U: np.ndarray, T: float, params: Mapping[str, float]
+) -> float:
+    """Largest gap between an RK4 re-integration of each interval and the collocated state."""
+    grid = tr.grid
+    starts = grid.interval_start_index
+    h = np.diff(grid.breaks) * T
+    t0 = tr.t0 + T * grid.breaks[:-1]
+    d = grid.points_per_interval
+    if grid.scheme == "radau":
+        Ui = U.reshape(tr.n_u, grid.intervals, d)
+    else:
+        Ui = np.stack([U[:, :-1], U[:, 1:]], axis=2)
+    x = X[:, starts[:-1]].astype(float)
+    ds = 1.0 / RK4_STEPS
+
+    def control(s: float) -> np.ndarray:
+        return Ui @ _control_basis(tr, np.array([s]))[0]
+
+    for step in range(RK4_STEPS):
+        s = step * ds
+        t = t0 + s * h
+        k1 = _dynamics(tr, x, control(s), t, params)
+        k2 = _dynamics(tr, x + 0.5 * ds * h * k1, control(s + ds / 2), t + 0.5 * ds * h, params)
+        k3 = _dynamics(tr, x + 0.5 * ds * h * k2, control(s + ds / 2), t + 0.5 * ds * h, params)
+        k4 = _dynamics(tr, x + ds * h * k3, control(s + ds), t + ds * h, params)
+        x = x + ds * h / 6.0 * (k1 + 2 * k2 + 2 * k3 + k4)
+    return float(np.max(np.abs(x - X[:, starts[1:]]))) if x.size else 0.0
+
+
+def _violation(values: np.ndarray, lower: np.ndarray | float, upper: np.ndarray | float) -> float:
+    if np.size(values) == 0:
+        return 0.0
+    return float(max(np.max(lower - values, initial=0.0), np.max(values - upper, initial=0.0)))
+
+
+def _relation_violation(rel: Relation, values: dict, shape: tuple[int, ...]) -> float:
+    v = np.broadcast_to(np.asarray(translate(rel.expr, values, NUMPY), dtype=float), shape)
+    return _violation(v, rel.lower, rel.upper)
+
+
+def max_constraint_violation(
+    tr: Transcription, X: np.ndarray, U: np.ndarray, T: float, params: Mapping[str, float]
+) -> float:
+    """Largest violation of bounds, fixed end values, path and boundary constraints."""
+    b = tr.bounds(params)
+    worst = [_violation(X, b.x_lower, b.x_upper), _violation(U, b.u_lower, b.u_upper)]
+    worst.append(_violation(np.array([T]), b.t_lower, b.t_upper))
+    t_eval = tr.t0 + T * tr.grid.eval_tau
+    running = _values(tr, X[:, tr.grid.eval_index], U, t_eval, params)
+    worst += [_relation_violation(r, running, t_eval.shape) for r in tr.ocp.path]
+    ends = _end_values(tr, X, T, params)
+    worst += [_relation_violation(r, ends, ()) for r in tr.ocp.boundary]
+    return max(worst)
+
+
+def _end_values(tr: Transcription, X: np.ndarray, T: float, params: Mapping[str, float]) -> dict:
+    ocp = tr.ocp
+    values = {s: X[i, 0] for i, s in enumerate(ocp.x0)} | {s: X[i, -1] for i, s in enumerate(ocp.xf)}
+    return values | {ocp.tf: tr.t0 + T} | {symbol(k): v for k, v in params.items()}
+
+
+def hamiltonian(
+    tr: Transcription, X: np.ndarray, U: np.ndarray, T: float, params: Mapping[str, float], lam: np.ndarray
+) -> np.ndarray:
+    """``H = sign*L + lambda^T f`` at the collocation points (eq. 2.22 in general form)."""
+    t_eval = tr.t0 + T * tr.grid.eval_tau
+    xe = X[:, tr.grid.eval_index]
+    f = _dynamics(tr, xe, U, t_eval, params)
+    values = _values(tr, xe, U, t_eval, params)
+    running = np.broadcast_to(translate(tr.ocp.lagrange, values, NUMPY), t_eval.shape)
+    return running + np.sum(lam * f, axis=0)
+
+
+def solution_checks(
+    tr: Transcription,
+    X: np.ndarray,
+    U: np.ndarray,
+    T: float,
+    params: Mapping[str, float],
+    lam: np.ndarray | None,
+) -> dict[str, float | None]:
+    """All checks that apply to this problem and solution (NaN where a value cannot be computed,
+    e.g. a diverging re-integration of a failed solve)."""
+    with np.errstate(all="ignore"):
+        return _checks(tr, X, U, T, params, lam)
+
+
+def _checks(
+    tr: Transcription,
+    X: np.ndarray,
+    U: np.ndarray,
+    T: float,
+    params: Mapping[str, float],
+    lam: np.ndarray | None,
+) -> dict[str, float | None]:
+    checks: dict[str, float | None] = {
+        "max_constraint_violation": max_constraint_violation(tr, X, U, T, params),
+        "max_defect": max_defect(tr, X, U, T, params),
+    }
+    if lam is not None and tr.ocp.autonomous:
+        H = hamiltonian(tr, X, U, T, params, lam)
+        checks["hamiltonian_variation"] = float(np.max(np.abs(H - H.mean())))
+        if tr.free_time:
+            end = translate(tr.ocp.hamiltonian_end_value, _end_values(tr, X, T, params), NUMPY)
+            checks["hamiltonian_end_error"] = float(np.max(np.abs(H - float(end))))
+    return checks

@@ -1,0 +1,142 @@
+"""Transcription grids for direct collocation, shared by every OCP backend so that the same
+``method`` section gives the same discretization everywhere.
+
+Time is normalized, ``t = t0 + tau * T``. States live at the *nodes* (interval starts, plus the
+collocation points), the dynamics are imposed at *evaluation points*, and the defects read
+
+    D @ X_nodes - T * W @ F(X_eval, U, t_eval) = 0,
+
+with ``D`` (differentiation, in tau) and ``W`` (quadrature of the dynamics) sparse. Legendre–Gauss–
+Radau of degree d: d points per interval, the last at the interval's end; controls at the
+collocation points. Trapezoidal: controls at the nodes. The Lagrange term is ``T * q @ L(eval)``.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from functools import cached_property
+
+import numpy as np
+import scipy.sparse as sps
+from numpy.polynomial import legendre
+
+
+def radau_points(degree: int) -> np.ndarray:
+    """The ``degree`` Legendre–Gauss–Radau points on (0, 1], the last at 1 (flipped LGR roots)."""
+    if degree == 1:
+        return np.array([1.0])
+    # Roots of P_{d-1}(x) + P_d(x) on [-1, 1) include -1; flipping puts the fixed point at +1.
+    coeffs = np.zeros(degree + 1)
+    coeffs[degree - 1] = 1.0
+    coeffs[degree] = 1.0
+    roots = np.sort(legendre.legroots(coeffs))
+    return np.sort((1.0 - roots[::-1]) / 2.0)
+
+
+def lagrange_matrices(nodes: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """For polynomial interpolation through ``nodes`` (on [0, 1]): the derivative of each basis
+    polynomial at each node (``C[r, j] = l_r'(nodes[j])``) and the integrals of the basis over
+    [0, 1] (quadrature weights)."""
+    n = len(nodes)
+    deriv = np.zeros((n, n))
+    weights = np.zeros(n)
+    for r in range(n):
+        others = np.delete(nodes, r)
+        basis = np.poly1d(np.poly(others) / np.prod(nodes[r] - others))
+        deriv[r] = basis.deriv()(nodes)
+        weights[r] = basis.integ()(1.0) - basis.integ()(0.0)
+    return deriv, weights
+
+
+@dataclass(frozen=True)
+class Grid:
+    """A collocation grid on normalized time [0, 1]."""
+
+    scheme: str
+    intervals: int
+    degree: int
+    grading: float = 1.0
+
+    @cached_property
+    def breaks(self) -> np.ndarray:
+        """Interval boundaries in tau; geometric lengths when ``grading`` != 1."""
+        n = self.intervals
+        if self.grading == 1.0:
+            return np.linspace(0.0, 1.0, n + 1)
+        ratio = (1.0 / self.grading) ** (1.0 / max(n - 1, 1))
+        lengths = ratio ** np.arange(n)
+        return np.concatenate([[0.0], np.cumsum(lengths / lengths.sum())])
+
+    @property
+    def points_per_interval(self) -> int:
+        return self.degree if self.scheme == "radau" else 1
+
+    @cached_property
+    def local_points(self) -> np.ndarray:
+        """The nodes of one interval in local coordinates [0, 1], the start included."""
+        if self.scheme == "radau":
+            return np.concatenate([[0.0], radau_points(self.degree)])
+        return np.array([0.0, 1.0])
+
+    @cached_property
+    def nodes(self) -> np.ndarray:
+        """All state nodes in tau (``intervals * points_per_interval + 1`` of them)."""
+        h = np.diff(self.breaks)
+        inner = self.breaks[:-1, None] + h[:, None] * self.local_points[None, 1:]
+        return np.concatenate([[0.0], inner.ravel()])
+
+    @property
+    def n_nodes(self) -> int:
+        return self.intervals * self.points_per_interval + 1
+
+    @cached_property
+    def eval_index(self) -> np.ndarray:
+        """Indices of the nodes where the dynamics (and controls) are evaluated."""
+        if self.scheme == "radau":
+            return np.arange(1, self.n_nodes)
+        return np.arange(self.n_nodes)
+
+    @property
+    def eval_tau(self) -> np.ndarray:
+        return self.nodes[self.eval_index]
+
+    @property
+    def interval_start_index(self) -> np.ndarray:
+        """Node index of each interval's start (the last entry is the final node)."""
+        return np.arange(self.intervals + 1) * self.points_per_interval
+
+    @cached_property
+    def matrices(self) -> tuple[sps.csr_matrix, sps.csr_matrix, np.ndarray]:
+        """``(D, W, q)``: defects ``D X - T W F`` and the Lagrange quadrature weights ``q``."""
+        h = np.diff(self.breaks)
+        d = self.points_per_interval
+        if self.scheme == "radau":
+            deriv, weights = lagrange_matrices(self.local_points)
+            block = deriv[:, 1:].T
+            rows, cols, vals = [], [], []
+            for k in range(self.intervals):
+                for j in range(d):
+                    for r in range(d + 1):
+                        rows.append(k * d + j)
+                        cols.append(k * d + r)
+                        vals.append(block[j, r])
+            dmat = sps.csr_matrix((vals, (rows, cols)), shape=(self.intervals * d, self.n_nodes))
+            scale = np.repeat(h, d)
+            wmat = sps.diags(scale).tocsr()
+            q = np.repeat(h, d) * np.tile(weights[1:], self.intervals)
+            return dmat, wmat, q
+        k = np.arange(self.intervals)
+        dmat = sps.csr_matrix(
+            (np.r_[-np.ones(self.intervals), np.ones(self.intervals)], (np.r_[k, k], np.r_[k, k + 1])),
+            shape=(self.intervals, self.n_nodes),
+        )
+        wmat = sps.csr_matrix((np.r_[h, h] / 2.0, (np.r_[k, k], np.r_[k, k + 1])), shape=dmat.shape)
+        q = np.asarray(wmat.sum(axis=0)).ravel()
+        return dmat, wmat, q
+
+    def costate_scale(self) -> np.ndarray:
+        """Per LGR defect row, the factor turning a defect multiplier into a costate estimate:
+        ``lambda = -nu / w_j`` with w_j the Radau weight of the point, from the Lagrangian
+        ``J + nu^T g`` with ``g = D X - T W F`` (defined for the Radau scheme only)."""
+        _, weights = lagrange_matrices(self.local_points)
+        return -1.0 / np.tile(weights[1:], self.intervals)

@@ -1,0 +1,167 @@
+"""An ``optimal_control`` spec as SymPy objects, the one form every OCP backend translates.
+
+Everything is stated for minimization: ``J = sign * (Mayer + integral of Lagrange)``, with
+``sign = -1`` when the file says ``maximize``. The Hamiltonian is ``H = sign*L + lambda^T f``.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+from dataclasses import dataclass
+from functools import cached_property
+
+import sympy as sp
+
+from gamespec.errors import SpecError
+from gamespec.expressions import TIME, Relation, parse, parse_relation, symbol
+from gamespec.ocp.translate import numeric
+from gamespec.specs.ocp import OptimalControlSpec
+
+INF = float("inf")
+
+
+@dataclass(frozen=True)
+class SymbolicOcp:
+    """The parsed problem: symbols, dynamics, objective, constraints and parameter-only values."""
+
+    spec: OptimalControlSpec
+
+    @property
+    def states(self) -> list[str]:
+        return list(self.spec.problem.states)
+
+    @property
+    def controls(self) -> list[str]:
+        return list(self.spec.problem.controls)
+
+    @property
+    def parameters(self) -> list[str]:
+        return list(self.spec.problem.parameters)
+
+    @cached_property
+    def x(self) -> list[sp.Symbol]:
+        return [symbol(n) for n in self.states]
+
+    @cached_property
+    def u(self) -> list[sp.Symbol]:
+        return [symbol(n) for n in self.controls]
+
+    @cached_property
+    def p(self) -> list[sp.Symbol]:
+        return [symbol(n) for n in self.parameters]
+
+    @property
+    def t(self) -> sp.Symbol:
+        return TIME
+
+    @cached_property
+    def x0(self) -> list[sp.Symbol]:
+        return [symbol(f"{n}_0") for n in self.states]
+
+    @cached_property
+    def xf(self) -> list[sp.Symbol]:
+        return [symbol(f"{n}_f") for n in self.states]
+
+    @cached_property
+    def tf(self) -> sp.Symbol:
+        return symbol("t_f")
+
+    @cached_property
+    def _running(self) -> dict[str, sp.Expr]:
+        names = [*self.parameters, *self.states, *self.controls]
+        return {n: symbol(n) for n in names} | {"t": TIME}
+
+    @cached_property
+    def _ends(self) -> dict[str, sp.Expr]:
+        ends = {str(s): s for s in [*self.x0, *self.xf, self.tf]}
+        return {n: symbol(n) for n in self.parameters} | ends
+
+    @cached_property
+    def _params(self) -> dict[str, sp.Expr]:
+        return {n: symbol(n) for n in self.parameters}
+
+    @property
+    def sign(self) -> float:
+        return -1.0 if self.spec.problem.objective.sense == "maximize" else 1.0
+
+    @cached_property
+    def dynamics(self) -> list[sp.Expr]:
+        dyn = self.spec.problem.dynamics
+        return [parse(dyn[n], self._running) for n in self.states]
+
+    @cached_property
+    def lagrange(self) -> sp.Expr:
+        """The running cost in minimization form (``sign`` applied)."""
+        return self.sign * parse(self.spec.problem.objective.lagrange, self._running)
+
+    @cached_property
+    def mayer(self) -> sp.Expr:
+        """The end cost in minimization form (``sign`` applied), over x0, xf, t_f, parameters."""
+        return self.sign * parse(self.spec.problem.objective.mayer, self._ends)
+
+    @cached_property
+    def path(self) -> list[Relation]:
+        return [parse_relation(c, self._running) for c in self.spec.problem.path_constraints]
+
+    @cached_property
+    def boundary(self) -> list[Relation]:
+        return [parse_relation(c, self._ends) for c in self.spec.problem.boundary_constraints]
+
+    @cached_property
+    def hamiltonian_end_value(self) -> sp.Expr:
+        """``-dPhi/dt_f`` for the minimization form: the constant value of H on an autonomous,
+        free-final-time problem (transversality, e.g. eq. 2.23)."""
+        return -sp.diff(self.mayer, self.tf)
+
+    @property
+    def autonomous(self) -> bool:
+        exprs = [*self.dynamics, self.lagrange]
+        return not any(TIME in e.free_symbols for e in exprs)
+
+    def parameter_values(self, overrides: Mapping[str, float] | None = None) -> dict[str, float]:
+        """The file's parameter values with ``overrides`` applied (unknown names are an error)."""
+        values = dict(self.spec.problem.parameters)
+        for name, value in (overrides or {}).items():
+            if name not in values:
+                raise SpecError(
+                    f"unknown parameter {name!r} (declared: {', '.join(values) or 'none'})",
+                    field="problem.parameters",
+                )
+            values[name] = float(value)
+        return values
+
+    def value(self, raw: float | str | None, params: Mapping[str, float], default: float) -> float:
+        """A bound or fixed value (number or parameter expression) as a float."""
+        if raw is None:
+            return default
+        if isinstance(raw, int | float):
+            return float(raw)
+        return numeric(parse(raw, self._params), {symbol(k): v for k, v in params.items()})
+
+    def state_bounds(
+        self, params: Mapping[str, float]
+    ) -> list[tuple[float, float, float | None, float | None]]:
+        """Per state: ``(lower, upper, initial, final)`` as floats (initial/final None when free)."""
+        out = []
+        for spec in self.spec.problem.states.values():
+            fixed = [None if v is None else self.value(v, params, 0.0) for v in (spec.initial, spec.final)]
+            out.append((self.value(spec.lower, params, -INF), self.value(spec.upper, params, INF), *fixed))
+        return out
+
+    def control_bounds(self, params: Mapping[str, float]) -> list[tuple[float, float]]:
+        return [
+            (self.value(c.lower, params, -INF), self.value(c.upper, params, INF))
+            for c in self.spec.problem.controls.values()
+        ]
+
+    def final_time(self, params: Mapping[str, float]) -> tuple[float, float, float]:
+        """``(lower, upper, guess)`` of the final time (lower == upper when it is fixed)."""
+        time = self.spec.problem.time
+        if time.free:
+            lo, hi = time.bounds
+            guess = self.spec.guess.t_final or time.guess or 0.5 * (lo + hi)
+            return lo, hi, guess
+        tf = self.value(time.final, params, 1.0)
+        if tf <= time.initial:
+            raise SpecError("final time must be after the initial time", field="problem.time.final")
+        return tf, tf, tf

@@ -1,0 +1,210 @@
+"""What every direct-collocation backend shares: the grid, bounds and initial guesses as arrays, and
+the assembly of a Result from a solution (with the solver-independent checks).
+
+Variables: ``X`` (n_x × n_nodes), ``U`` (n_u × n_eval), and the horizon ``T = t_f - t0``.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+from dataclasses import dataclass
+from functools import cached_property
+
+import numpy as np
+
+from gamespec.errors import SpecError
+from gamespec.expressions import ExpressionError, parse, symbol
+from gamespec.ocp.checks import solution_checks
+from gamespec.ocp.collocation import Grid
+from gamespec.ocp.symbolic import SymbolicOcp
+from gamespec.ocp.translate import NUMPY, translate
+from gamespec.result import Result, Status
+from gamespec.specs.ocp import OptimalControlSpec
+
+
+@dataclass(frozen=True)
+class Bounds:
+    """Variable bounds of one solve (after parameter values are known)."""
+
+    x_lower: np.ndarray
+    x_upper: np.ndarray
+    u_lower: np.ndarray
+    u_upper: np.ndarray
+    t_lower: float
+    t_upper: float
+
+
+@dataclass(frozen=True)
+class Guess:
+    """A starting point: X, U and the horizon T."""
+
+    X: np.ndarray
+    U: np.ndarray
+    T: float
+
+
+class Transcription:
+    """The discretized form of an ``optimal_control`` spec, independent of any backend."""
+
+    def __init__(self, spec: OptimalControlSpec) -> None:
+        self.spec = spec
+        self.ocp = SymbolicOcp(spec)
+        m = spec.method
+        self.grid = Grid(m.scheme, m.intervals, m.degree if m.scheme == "radau" else 1, m.grading)
+        self.t0 = spec.problem.time.initial
+
+    @property
+    def n_x(self) -> int:
+        return len(self.ocp.states)
+
+    @property
+    def n_u(self) -> int:
+        return len(self.ocp.controls)
+
+    @property
+    def free_time(self) -> bool:
+        return self.spec.problem.time.free
+
+    def bounds(self, params: Mapping[str, float]) -> Bounds:
+        """Bounds on X, U and T; fixed initial/final states are bounds with lower == upper."""
+        n = self.grid.n_nodes
+        xl = np.empty((self.n_x, n))
+        xu = np.empty((self.n_x, n))
+        for i, (lo, hi, x0, xf) in enumerate(self.ocp.state_bounds(params)):
+            xl[i], xu[i] = lo, hi
+            for col, fixed in ((0, x0), (-1, xf)):
+                if fixed is not None:
+                    xl[i, col] = xu[i, col] = fixed
+        cb = np.array(self.ocp.control_bounds(params)).reshape(self.n_u, 2)
+        k = len(self.grid.eval_index)
+        ul = np.repeat(cb[:, :1], k, axis=1)
+        uu = np.repeat(cb[:, 1:], k, axis=1)
+        tf_lo, tf_hi, _ = self.ocp.final_time(params)
+        return Bounds(xl, xu, ul, uu, tf_lo - self.t0, tf_hi - self.t0)
+
+    def guess(self, params: Mapping[str, float], previous: Result | None = None) -> Guess:
+        """The starting point: from ``previous`` (or the spec's ``guess.result`` file), else from the
+        spec's ``guess`` section, else linear between fixed end values and mid-bounds controls."""
+        if previous is None and self.spec.guess.result:
+            try:
+                previous = Result.load(self.spec.guess.result)
+            except (OSError, ValueError) as err:
+                raise SpecError(f"cannot read guess result: {err}", field="guess.result") from None
+        if previous is not None and previous.time is not None and previous.states:
+            return self._guess_from_result(previous)
+        *_, tf_guess = self.ocp.final_time(params)
+        tau_nodes = self.grid.nodes
+        X = np.empty((self.n_x, self.grid.n_nodes))
+        for i, (name, (lo, hi, x0, xf)) in enumerate(
+            zip(self.ocp.states, self.ocp.state_bounds(params), strict=True)
+        ):
+            raw = self.spec.guess.states.get(name, "linear")
+            X[i] = self._profile(raw, tau_nodes, params, f"guess.states.{name}", x0, xf, lo, hi)
+        U = np.empty((self.n_u, len(self.grid.eval_index)))
+        for j, (name, (lo, hi)) in enumerate(
+            zip(self.ocp.controls, self.ocp.control_bounds(params), strict=True)
+        ):
+            raw = self.spec.guess.controls.get(name, "linear")
+            U[j] = self._profile(
+                raw, self.grid.eval_tau, params, f"guess.controls.{name}", None, None, lo, hi
+            )
+        return Guess(X, U, tf_guess - self.t0)
+
+    def _profile(
+        self,
+        raw: float | str,
+        tau: np.ndarray,
+        params: Mapping[str, float],
+        field: str,
+        start: float | None,
+        end: float | None,
+        lo: float,
+        hi: float,
+    ) -> np.ndarray:
+        if isinstance(raw, int | float):
+            return np.full_like(tau, float(raw))
+        if raw == "linear":
+            mid = _midpoint(lo, hi)
+            a = start if start is not None else (end if end is not None else mid)
+            b = end if end is not None else a
+            return a + (b - a) * tau
+        symbols = {n: symbol(n) for n in params} | {"tau": symbol("tau")}
+        try:
+            expr = parse(raw, symbols)
+        except ExpressionError as err:
+            raise SpecError(str(err), field=field) from None
+        values = {symbol(k): v for k, v in params.items()} | {symbol("tau"): tau}
+        return np.broadcast_to(np.asarray(translate(expr, values, NUMPY), dtype=float), tau.shape).copy()
+
+    def _guess_from_result(self, previous: Result) -> Guess:
+        t = np.asarray(previous.time)
+        span = t[-1] - t[0]
+        tau_prev = (t - t[0]) / span
+        missing = [n for n in self.ocp.states if n not in previous.states]
+        missing += [n for n in self.ocp.controls if n not in previous.controls]
+        if missing:
+            raise SpecError(f"guess result lacks {', '.join(missing)}", field="guess.result")
+        X = np.array([np.interp(self.grid.nodes, tau_prev, previous.states[n]) for n in self.ocp.states])
+        tc = np.asarray(previous.control_time if previous.control_time is not None else t)
+        tau_c = (tc - t[0]) / span
+        U = np.array([np.interp(self.grid.eval_tau, tau_c, previous.controls[n]) for n in self.ocp.controls])
+        return Guess(X.reshape(self.n_x, -1), U.reshape(self.n_u, -1), float(span))
+
+    @cached_property
+    def costate_rows(self) -> np.ndarray:
+        return self.grid.costate_scale()
+
+    def result(
+        self,
+        *,
+        X: np.ndarray,
+        U: np.ndarray,
+        T: float,
+        objective: float | None,
+        params: Mapping[str, float],
+        status: Status,
+        message: str,
+        solve_time_s: float,
+        iterations: int | None,
+        defect_multipliers: np.ndarray | None = None,
+        solver_stats: dict | None = None,
+    ) -> Result:
+        """A Result from a solution, with costates from the defect multipliers and the checks."""
+        t_nodes = self.t0 + T * self.grid.nodes
+        t_eval = self.t0 + T * self.grid.eval_tau
+        costates: dict[str, np.ndarray] = {}
+        arrays: dict[str, np.ndarray] = {}
+        lam = None
+        if defect_multipliers is not None and self.grid.scheme == "radau":
+            lam = defect_multipliers * self.costate_rows[None, :]
+            costates = {f"lambda_{n}": lam[i] for i, n in enumerate(self.ocp.states)}
+        checks = solution_checks(self, X, U, T, params, lam)
+        if lam is not None:
+            arrays["costate_time"] = t_eval
+        return Result(
+            status=status,
+            message=message,
+            objective=objective,
+            t_final=self.t0 + T,
+            solve_time_s=solve_time_s,
+            iterations=iterations,
+            time=t_nodes,
+            control_time=t_eval,
+            states={n: X[i] for i, n in enumerate(self.ocp.states)},
+            controls={n: U[j] for j, n in enumerate(self.ocp.controls)},
+            costates=costates,
+            arrays=arrays,
+            parameters=dict(params),
+            checks=checks,
+            solver_stats=solver_stats or {},
+        )
+
+
+def _midpoint(lo: float, hi: float) -> float:
+    if np.isfinite(lo) and np.isfinite(hi):
+        return 0.5 * (lo + hi)
+    if np.isfinite(lo):
+        return max(lo, 0.0)
+    if np.isfinite(hi):
+        return min(hi, 0.0)
+    return 0.0

@@ -1,0 +1,108 @@
+"""SymPy → a backend's own expressions, by walking the tree (no code generation, no ``eval``).
+
+A :class:`Library` names the functions of the target (NumPy, CasADi, Pyomo, ...). The walk is
+memoised per node, so shared sub-expressions are translated once.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable, Mapping
+from dataclasses import dataclass, field
+from functools import reduce
+from typing import Any
+
+import numpy as np
+import sympy as sp
+
+from gamespec.errors import ExpressionError
+
+
+@dataclass(frozen=True)
+class Library:
+    """The target's elementary functions, by the names of :data:`gamespec.expressions.FUNCTIONS`."""
+
+    functions: Mapping[str, Callable[..., Any]]
+    power: Callable[[Any, Any], Any] = field(default=lambda a, b: a**b)
+
+
+_SYMPY_NAMES: dict[type, str] = {
+    sp.sin: "sin",
+    sp.cos: "cos",
+    sp.tan: "tan",
+    sp.asin: "asin",
+    sp.acos: "acos",
+    sp.atan: "atan",
+    sp.atan2: "atan2",
+    sp.exp: "exp",
+    sp.log: "log",
+    sp.Abs: "abs",
+    sp.tanh: "tanh",
+    sp.Min: "min",
+    sp.Max: "max",
+}
+
+NUMPY = Library(
+    functions={
+        "sin": np.sin,
+        "cos": np.cos,
+        "tan": np.tan,
+        "asin": np.arcsin,
+        "acos": np.arccos,
+        "atan": np.arctan,
+        "atan2": np.arctan2,
+        "exp": np.exp,
+        "log": np.log,
+        "sqrt": np.sqrt,
+        "abs": np.abs,
+        "tanh": np.tanh,
+        "min": np.minimum,
+        "max": np.maximum,
+    },
+    power=np.power,
+)
+
+
+def translate(expr: sp.Expr, values: Mapping[sp.Symbol, Any], library: Library) -> Any:
+    """The value of ``expr`` with each symbol replaced by ``values[symbol]``, built with ``library``."""
+    memo: dict[sp.Basic, Any] = {}
+
+    def walk(node: sp.Basic) -> Any:
+        if node in memo:
+            return memo[node]
+        if node.is_Symbol:
+            if node not in values:
+                raise ExpressionError(str(expr), f"symbol {node} has no value here")
+            out = values[node]
+        elif node.is_Number or node is sp.pi or node is sp.E:
+            out = float(node)
+        elif node.is_Add:
+            out = reduce(lambda a, b: a + b, (walk(a) for a in node.args))
+        elif node.is_Mul:
+            out = reduce(lambda a, b: a * b, (walk(a) for a in node.args))
+        elif node.is_Pow:
+            base, exponent = node.args
+            if exponent == sp.Rational(1, 2):
+                out = library.functions["sqrt"](walk(base))
+            elif exponent == -1:
+                out = 1.0 / walk(base)
+            else:
+                out = library.power(walk(base), walk(exponent))
+        elif type(node) in _SYMPY_NAMES:
+            func = library.functions[_SYMPY_NAMES[type(node)]]
+            args = [walk(a) for a in node.args]
+            out = reduce(func, args) if len(args) > 2 else func(*args)
+        else:
+            raise ExpressionError(str(expr), f"cannot translate {type(node).__name__}")
+        memo[node] = out
+        return out
+
+    return walk(sp.sympify(expr))
+
+
+def numeric(expr: sp.Expr, values: Mapping[sp.Symbol, float]) -> float:
+    """A parameter-only expression evaluated to a float (bounds, fixed times, initial values)."""
+    value = float(translate(expr, values, NUMPY))
+    if math.isnan(value):
+        raise ExpressionError(str(expr), "evaluates to NaN")
+    return value

@@ -1,0 +1,1 @@
+"""Studies built from load → solve → Result: backend comparisons, sweeps, Monte Carlo."""

@@ -13,6 +13,7 @@ only when this backend is used.
 from __future__ import annotations
 
 import time
+import warnings
 from typing import Any, ClassVar
 
 import numpy as np
@@ -53,7 +54,8 @@ class CvxpyOptions(StrictModel):
 
 
 class _Problem:
-    """A CVXPY problem re-solved with new parameter values; returns our Status."""
+    """A CVXPY problem re-solved with new parameter values; returns our Status (an inaccurate
+    solution is ``feasible``, so cvxpy's warning about it is not repeated)."""
 
     def __init__(self, problem: Any, options: CvxpyOptions) -> None:
         self.problem = problem
@@ -65,7 +67,9 @@ class _Problem:
 
         start = time.perf_counter()
         try:
-            self.problem.solve(solver=self.options.solver, warm_start=True, **self.options.solver_options)
+            with warnings.catch_warnings():
+                warnings.filterwarnings("ignore", message="Solution may be inaccurate")
+                self.problem.solve(solver=self.options.solver, warm_start=True, **self.options.solver_options)
         except cp.SolverError:
             return Status.NUMERICAL_ERROR
         finally:
@@ -73,7 +77,7 @@ class _Problem:
         return STATUS_MAP.get(self.problem.status, Status.ERROR)
 
 
-class _MeanProblem:
+class MeanProblem:
     """The controller's upper game eq. 4.43 as a CVXPY QP in ``Ū``."""
 
     def __init__(self, model: GameModel, options: CvxpyOptions) -> None:
@@ -94,7 +98,7 @@ class _MeanProblem:
         return MeanOutcome(U, model.mean.stopper_response(U), status, solve_time_s=self.problem.seconds)
 
 
-class _CovariancePlayers:
+class CovariancePlayers:
     """Both players' best-response problems of Algorithm 2, built once on ``cp.Parameter``s."""
 
     def __init__(self, model: GameModel, options: CvxpyOptions) -> None:
@@ -188,9 +192,9 @@ class CvxpyModel(CompiledModel):
         self.failure = self.model.assumption_failure()
         if self.failure:
             return
-        self.mean = _MeanProblem(self.model, self.options)
+        self.mean = MeanProblem(self.model, self.options)
         self.players = (
-            _CovariancePlayers(self.model, self.options) if self.model.game.SigmaN is not None else None
+            CovariancePlayers(self.model, self.options) if self.model.game.SigmaN is not None else None
         )
 
     def solve(self, parameters: dict[str, float] | None = None, guess: Result | None = None) -> Result:

@@ -55,7 +55,8 @@ class QpModel(CompiledModel):
             P, A = csc_matrix(P), None if A is None else csc_matrix(A)
         self.problem = qpsolvers.Problem(P, qp.q, A=A, b=qp.b)
 
-    def _solve_mean(self, guess: Result | None) -> MeanOutcome:
+    def solve_mean(self, guess: Result | None = None) -> MeanOutcome:
+        """The mean game alone: Lemma 11, then the QP (warm-started from ``guess``'s controls)."""
         import qpsolvers
 
         unreachable = self.model.unreachable_mean()
@@ -84,7 +85,7 @@ class QpModel(CompiledModel):
         failure = self.model.assumption_failure()
         if failure:
             return Result(status=Status.ERROR, message=failure, metrics=self.model.assumptions.as_metrics())
-        mean = self._solve_mean(guess)
+        mean = self.solve_mean(guess)
         note = UNENFORCED if self.model.game.SigmaN is not None else ""
         cov = unconstrained_covariance(self.model, note)
         method = self.spec.method
@@ -102,7 +103,7 @@ class QpBackend(Backend):
 
     name: ClassVar[str] = "qp"
     kinds: ClassVar[frozenset[str]] = frozenset({"lq_stochastic_game"})
-    features: ClassVar[frozenset[str]] = frozenset({"mean_steering", "covariance_constraint"})
+    features: ClassVar[frozenset[str]] = frozenset({"mean_steering"})
     options_model: ClassVar[type[StrictModel]] = QpOptions
 
     @classmethod

@@ -75,7 +75,7 @@ def test_null_terminal_mean_entries_are_free():
     spec = spec_from_dict(data)
     game = spec.game()
     assert game.muN[0] == 0 and np.isnan(game.muN[1])
-    assert spec.required_features() == {"mean_steering", "covariance_constraint"}
+    np.testing.assert_allclose(game.SigmaN, 0.5 * np.eye(2))
 
 
 @pytest.mark.parametrize(

@@ -21,7 +21,7 @@ from pydantic import Field
 
 from gamespec.backend import Availability, Backend, CompiledModel
 from gamespec.errors import BackendError
-from gamespec.lqgame.covariance import jacobi
+from gamespec.lqgame.covariance import gains_to_vector, jacobi
 from gamespec.lqgame.solution import (
     CovarianceOutcome,
     GameModel,
@@ -151,10 +151,16 @@ class CovariancePlayers:
     def seconds(self) -> float:
         return self.controller.seconds + self.stopper.seconds + self.scaling.seconds
 
-    def solve(self, tolerance: float, max_iterations: int) -> CovarianceOutcome:
-        """Algorithm 2 from the UCSG saddle point."""
+    def solve(
+        self, tolerance: float, max_iterations: int, start_gains: tuple[np.ndarray, np.ndarray] | None = None
+    ) -> CovarianceOutcome:
+        """Algorithm 2 from ``start_gains`` ``(K, L)`` (arrays (N, m, n), (N, ℓ, n)), or else from the
+        UCSG saddle point (the thesis leaves ``K_0, L_0`` open)."""
         start = self.seconds
-        kappa0, ell0 = self.model.covariance.unconstrained_saddle()
+        if start_gains is None:
+            kappa0, ell0 = self.model.covariance.unconstrained_saddle()
+        else:
+            kappa0, ell0 = (gains_to_vector(G) for G in start_gains)
         run = jacobi(self.stopper_step, self.controller_step, kappa0, ell0, tolerance, max_iterations)
         outcome = CovarianceOutcome(
             run.kappa,
@@ -197,7 +203,17 @@ class CvxpyModel(CompiledModel):
             CovariancePlayers(self.model, self.options) if self.model.game.SigmaN is not None else None
         )
 
+    def _start_gains(self, guess: Result | None) -> tuple[np.ndarray, np.ndarray] | None:
+        """A previous Result's gains as Algorithm 2's start, when they fit this game."""
+        if guess is None or "K" not in guess.arrays or "L" not in guess.arrays:
+            return None
+        g = self.model.game
+        K, L = guess.arrays["K"], guess.arrays["L"]
+        fits = K.shape == (g.N, g.m, g.n) and L.shape == (g.N, g.ell, g.n)
+        return (K, L) if fits else None
+
     def solve(self, parameters: dict[str, float] | None = None, guess: Result | None = None) -> Result:
+        """Mean QP, then Algorithm 2 (warm-started from ``guess``'s gains) or the UCSG closed form."""
         if parameters and parameters != self.parameters:
             self._build(parameters)
         if self.failure:
@@ -212,7 +228,7 @@ class CvxpyModel(CompiledModel):
         )
         method = self.spec.method
         cov = (
-            self.players.solve(method.tolerance, method.max_iterations)
+            self.players.solve(method.tolerance, method.max_iterations, self._start_gains(guess))
             if self.players is not None
             else unconstrained_covariance(self.model)
         )

@@ -5,9 +5,9 @@ a continuous model (``A, B, C`` and the noise input) discretized with step ``ste
 hold (eq. 4.70); the weights ``Q, R, S`` (eq. 4.4, constant or per step); the initial Gaussian; and
 optionally the controller's terminal mean and covariance (eq. 4.11). A ``null`` entry of the
 terminal mean leaves that component free. Every matrix entry is a number or an expression over
-``parameters``; a matrix is a list of rows, ``{diag: [...]}`` or ``{identity: scale}`` (square, of
-the size the slot needs). :meth:`LQGameSpec.game` evaluates all of it into an
-:class:`~gamespec.lqgame.game.LQGame`.
+``parameters``; a matrix is a list of rows, ``{diag: [...]}`` or ``{identity: scale}`` (square:
+n × n for ``A, B, C, D``, ``Q`` and the covariances, m × m for ``R``, ℓ × ℓ for ``S``).
+:meth:`LQGameSpec.game` evaluates all of it into an :class:`~gamespec.lqgame.game.LQGame`.
 """
 
 from __future__ import annotations

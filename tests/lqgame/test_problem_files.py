@@ -117,3 +117,11 @@ def test_solve_out_then_plot(cli, tmp_path):
         "ellipses.png",
         "first_state.png",
     ]
+
+
+def test_guess_warm_starts_the_jacobi_procedure(solved):
+    """Re-solving from a converged Result's gains needs a single Jacobi iteration."""
+    result = gamespec.compile_spec(CH4 / "test_example.yaml").solve(guess=solved["test_example"])
+    assert result.status is Status.OPTIMAL
+    assert result.iterations == 1
+    np.testing.assert_allclose(result.arrays["K"], solved["test_example"].arrays["K"], atol=1e-5)

@@ -173,9 +173,13 @@ class CovariancePlayers:
         if run.status is Status.INFEASIBLE and run.failed_step == "controller":
             gamma = self.smallest_scaling()
             outcome.min_covariance_scaling = gamma
+            scaling = (
+                f"the smallest achievable scaling of Σ_N against the stopper's gains is γ* = {gamma:.4g}"
+                if gamma is not None
+                else "the smallest achievable scaling of Σ_N could not be computed"
+            )
             outcome.message = (
-                f"terminal covariance cannot be met at Jacobi iteration {run.iterations + 1}: the "
-                f"smallest achievable scaling of Σ_N against the stopper's gains is γ* = {gamma:.4g}; "
+                f"terminal covariance cannot be met at Jacobi iteration {run.iterations + 1}: {scaling}; "
                 "gains shown are the last iterate"
             )
         elif not run.status.ok:

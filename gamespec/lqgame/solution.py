@@ -101,7 +101,11 @@ def fallback_mean(model: GameModel, status: Status, message: str) -> MeanOutcome
 
 
 def _combined_status(mean: MeanOutcome, cov: CovarianceOutcome) -> Status:
-    return mean.status if not mean.status.ok else cov.status if not cov.status.ok else mean.status
+    """The first failed part's status; else ``feasible`` if either part is, else ``optimal``."""
+    for status in (mean.status, cov.status):
+        if not status.ok:
+            return status
+    return Status.OPTIMAL if Status.FEASIBLE not in (mean.status, cov.status) else Status.FEASIBLE
 
 
 def assemble(

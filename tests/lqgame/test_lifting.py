@@ -1,9 +1,11 @@
-"""The lifted matrices of eq. 4.6 against the step-by-step recursion eq. 4.1, and the
+"""The lifted matrices of eq. 4.6 against the step-by-step recursion eq. 4.1 (for any sizes), and the
 zero-order hold of eq. 4.70 against scipy's discretization."""
 
 from __future__ import annotations
 
 import numpy as np
+from hypothesis import given, settings
+from hypothesis import strategies as st
 from scipy.signal import cont2discrete
 
 from gamespec.lqgame.game import zero_order_hold
@@ -11,10 +13,19 @@ from gamespec.lqgame.lifting import lift
 from tests.lqgame.conftest import random_game
 
 
-def test_lifted_matrices_reproduce_the_recursion():
-    game = random_game(3, N=5)
+@settings(max_examples=25, deadline=None)
+@given(
+    seed=st.integers(0, 2**16),
+    N=st.integers(1, 6),
+    n=st.integers(1, 4),
+    m=st.integers(1, 3),
+    ell=st.integers(1, 3),
+    r=st.integers(1, 3),
+)
+def test_lifted_matrices_reproduce_the_recursion(seed: int, N: int, n: int, m: int, ell: int, r: int):
+    game = random_game(seed, N=N, n=n, m=m, ell=ell, r=r)
     lifted = lift(game)
-    rng = np.random.default_rng(0)
+    rng = np.random.default_rng(seed)
     x0 = rng.standard_normal(game.n)
     U, V, W = (rng.standard_normal((game.N, w)) for w in (game.m, game.ell, game.r))
     x = [x0]

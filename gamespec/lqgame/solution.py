@@ -150,6 +150,9 @@ def assemble(
         excess = np.linalg.eigvalsh(covariances[-1] - game.SigmaN).max()
         checks["terminal_covariance_violation"] = float(max(excess, 0.0))
         arrays["target_covariance"] = game.SigmaN
+    violations = [checks[k] for k in ("terminal_mean_error", "terminal_covariance_violation") if k in checks]
+    if violations:
+        checks["max_constraint_violation"] = max(violations)
     if cov.min_covariance_scaling is not None:
         metrics["min_covariance_scaling"] = cov.min_covariance_scaling
     if cov.history:

@@ -41,6 +41,7 @@ def test_example_meets_both_targets(solved):
     assert result.metrics["relative_controllability_rank"] == 4
     assert result.checks["terminal_mean_error"] < 1e-8
     assert result.checks["terminal_covariance_violation"] < 1e-7
+    assert result.checks["max_constraint_violation"] < 1e-7
     assert result.iterations > 0
     assert result.checks["mean_closed_form_gap"] < 1e-8
     assert result.checks["monte_carlo_mean_z"] < 5 and result.checks["monte_carlo_covariance_z"] < 5

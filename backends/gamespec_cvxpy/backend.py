@@ -72,6 +72,11 @@ class _Problem:
                 self.problem.solve(solver=self.options.solver, warm_start=True, **self.options.solver_options)
         except cp.SolverError:
             return Status.NUMERICAL_ERROR
+        except (TypeError, ValueError) as err:
+            reason = str(err).splitlines()[0]
+            raise BackendError(
+                f"{self.options.solver} rejected solver_options {self.options.solver_options}: {reason}"
+            ) from None
         finally:
             self.seconds += time.perf_counter() - start
         return STATUS_MAP.get(self.problem.status, Status.ERROR)

@@ -68,9 +68,15 @@ class QpModel(CompiledModel):
                 [guess.controls[f"u{i + 1}"] for i in range(self.model.game.m)]
             ).ravel()
         start = time.perf_counter()
-        solution = qpsolvers.solve_problem(
-            self.problem, solver=self.options.solver, initvals=initvals, **self.options.solver_options
-        )
+        try:
+            solution = qpsolvers.solve_problem(
+                self.problem, solver=self.options.solver, initvals=initvals, **self.options.solver_options
+            )
+        except (TypeError, ValueError, qpsolvers.ParamError) as err:
+            reason = str(err).splitlines()[0]
+            raise BackendError(
+                f"{self.options.solver} rejected solver_options {self.options.solver_options}: {reason}"
+            ) from None
         seconds = time.perf_counter() - start
         if not solution.found or solution.x is None:
             return fallback_mean(

@@ -126,3 +126,11 @@ def test_guess_warm_starts_the_jacobi_procedure(solved):
     assert result.status is Status.OPTIMAL
     assert result.iterations == 1
     np.testing.assert_allclose(result.arrays["K"], solved["test_example"].arrays["K"], atol=1e-5)
+
+
+@pytest.mark.parametrize("backend", ["cvxpy", "qp"])
+def test_bad_solver_options_are_one_line_errors(cli, backend: str):
+    setting = f"solver.options.{backend}.solver_options.bogus=1"
+    code, _, err = cli("solve", CH4 / "missile_endgame.yaml", "--backend", backend, "--set", setting)
+    assert code == 2
+    assert "bogus" in err and "Traceback" not in err

@@ -18,7 +18,8 @@ from scipy.linalg import expm
 class LQGame:
     """Per-step arrays of eq. 4.1/4.4: ``A`` (N, n, n), ``B`` (N, n, m), ``C`` (N, n, ℓ),
     ``D`` (N, n, r), ``Q`` (N, n, n), ``R`` (N, m, m), ``S`` (N, ℓ, ℓ); the initial Gaussian and the
-    controller's optional terminal mean and covariance; ``dt`` the step (for time axes only)."""
+    controller's optional terminal mean (a NaN entry leaves that component free) and covariance;
+    ``dt`` the step (for time axes only)."""
 
     A: np.ndarray
     B: np.ndarray

@@ -23,10 +23,11 @@ Position = tuple[FiniteFloat, FiniteFloat]
 PositiveFloat = Annotated[float, Field(gt=0, allow_inf_nan=False)]
 
 
-def _constant(value: float | str) -> float:
-    """A heading given as a number or a constant expression (e.g. ``3*pi/4``), in radians."""
+def _constant(value: object) -> object:
+    """A heading given as a constant expression (e.g. ``3*pi/4``) read into radians; other values are
+    left to the field's type check."""
     if not isinstance(value, str):
-        return float(value)
+        return value
     try:
         number = parse(value, {}).evalf()
     except ExpressionError as err:
@@ -37,7 +38,8 @@ def _constant(value: float | str) -> float:
 
 
 Heading = Annotated[
-    float | str, Field(description="Radians: a number or a constant expression like '-pi/4'.")
+    float | str,
+    Field(allow_inf_nan=False, description="Radians: a number or a constant expression like '-pi/4'."),
 ]
 """Read into a float by :func:`_constant` before validation."""
 
@@ -50,7 +52,7 @@ class FixedHeading(StrictModel):
 
     @field_validator("heading", mode="before")
     @classmethod
-    def _read(cls, value: float | str) -> float:
+    def _read(cls, value: object) -> object:
         return _constant(value)
 
 

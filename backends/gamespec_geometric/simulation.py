@@ -27,9 +27,11 @@ HeadingPolicy = Callable[[float, np.ndarray, np.ndarray], float]
 
 @dataclass(frozen=True)
 class Trajectories:
-    """What a simulation produced: positions on the time grid, the allocation in force during each
-    step (``-1``: redundant), capture times and capturers (None if not captured), and per-step
-    quantities for the checks of Lemmas 5–8."""
+    """What a simulation produced: positions on the time grid, the allocation in force during the
+    step from each grid time (``-1``: redundant; the last row, after the final time, is all ``-1``),
+    capture times and capturers (None if not captured), and the checks of Lemmas 5–8: the largest
+    one-step rise of the current shortest time between captures and the number of steps whose
+    shortest pair was not allocated."""
 
     time: np.ndarray
     pursuers: np.ndarray

@@ -179,16 +179,18 @@ class PyomoBackend(Backend):
 
     @classmethod
     def available(cls) -> Availability:
-        import importlib.util
-        from importlib.metadata import version
-
-        if importlib.util.find_spec("pyomo") is None:
-            return Availability(False, "pyomo is not installed")
+        try:
+            from pyomo.environ import SolverFactory
+            from pyomo.version import version
+        except ImportError as err:
+            return Availability(False, f"pyomo does not import: {err}")
         try:
             exe = find_executable("auto")
         except BackendError as err:
             return Availability(False, str(err))
-        return Availability(True, f"pyomo {version('pyomo')} with {exe.name} ({exe.origin})")
+        if not SolverFactory(exe.name, executable=exe.path).available(exception_flag=False):
+            return Availability(False, f"{exe.name} at {exe.path} does not run")
+        return Availability(True, f"pyomo {version} with {exe.name} ({exe.origin})")
 
     def _compile(self, spec: OptimalControlSpec, options: PyomoOptions) -> PyomoModel:
         return PyomoModel(spec, options)

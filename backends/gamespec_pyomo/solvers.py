@@ -82,10 +82,12 @@ def find_executable(choice: str = "auto") -> Executable:
     else:
         raise BackendError(f"unknown Pyomo NLP solver {choice!r} (use auto, {', '.join(SOLVERS)})")
     if exe is None:
-        wanted = "ipopt or ripopt" if choice == "auto" else choice
-        raise BackendError(
-            f"no {wanted} executable: pyomo-ripopt's bundled ripopt is missing and none is on PATH"
-        )
+        why = {
+            "auto": "pyomo-ripopt's bundled ripopt is missing and no ipopt or ripopt is on PATH",
+            "ripopt": "pyomo-ripopt's bundled ripopt is missing and none is on PATH",
+            "ipopt": "no ipopt executable on PATH (pip ships none; the bundled ripopt is solver 'ripopt')",
+        }
+        raise BackendError(why[choice])
     return exe
 
 

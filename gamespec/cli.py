@@ -128,6 +128,39 @@ def compare(
 
 
 @app.command()
+def sweep(
+    file: FileArg,
+    param: Annotated[list[str], typer.Option(help="name=a:b:n or name=v1,v2 (repeatable: a grid).")],
+    out: Annotated[Path, typer.Option(help="Folder for the per-point results (a rerun resumes).")],
+    backend: Annotated[str | None, typer.Option(help="Backend name (default: the file's).")] = None,
+    workers: Annotated[int, typer.Option(min=1, help="Local processes.")] = 1,
+    set_: SetOpt = None,
+    json_: JsonOpt = False,
+) -> None:
+    """Solve a file over a grid of parameter values; one row per point, saved as it finishes."""
+    from gamespec.studies.sweep import parse_range
+    from gamespec.studies.sweep import sweep as run_sweep
+
+    load(file, set_ or [])
+    ranges = [parse_range(p) for p in param]
+    rows = run_sweep(file, ranges, out=out, overrides=tuple(set_ or []), backend=backend, workers=workers)
+    if json_:
+        sys.stdout.write(json.dumps(rows, indent=2) + "\n")
+        return
+    names = [name for name, _ in ranges]
+    table = Table(title=f"sweep of {file.name}")
+    for col in [*names, "status", "objective", "t_final", "solve_time_s"]:
+        table.add_column(col, justify="right")
+    for row in rows:
+        table.add_row(*(_fmt(row.get(c)) for c in [*names, "status", "objective", "t_final", "solve_time_s"]))
+    console.print(table)
+    failed = [r for r in rows if r["status"] not in ("optimal", "feasible")]
+    if failed:
+        print(f"error: {len(failed)} of {len(rows)} points did not solve", file=sys.stderr)
+        raise typer.Exit(1)
+
+
+@app.command()
 def show(
     file: FileArg,
     transformed: Annotated[bool, typer.Option(help="Print the spec the backend actually solves.")] = False,

@@ -158,4 +158,5 @@ def load(path: str | Path, overrides: Iterable[str] = ()) -> SpecBase:
     data = apply_overrides(read_file(path), overrides)
     spec = spec_from_dict(data, source=str(path))
     spec._source = str(path)
+    spec._file_hash = hashlib.sha256(Path(path).read_bytes()).hexdigest()[:16]
     return spec

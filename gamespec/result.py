@@ -38,12 +38,14 @@ class Status(StrEnum):
 
 
 class Provenance(BaseModel):
-    """Where a Result came from: the spec's hash, its file, package versions, when."""
+    """Where a Result came from: the spec's hash (after overrides), its file and the file's hash,
+    package versions, when."""
 
     model_config = ConfigDict(extra="allow")
 
     spec_hash: str = ""
     source: str = ""
+    file_hash: str = ""
     versions: dict[str, str] = Field(default_factory=dict)
     created: str = ""
 

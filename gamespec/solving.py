@@ -10,6 +10,7 @@ from __future__ import annotations
 import datetime as _dt
 import time
 from dataclasses import dataclass
+from functools import cache
 from importlib.metadata import PackageNotFoundError, version
 from pathlib import Path
 from typing import Any
@@ -40,15 +41,21 @@ def backend_name(spec: SpecBase, backend: str | None = None) -> str:
     return name
 
 
-def _versions(backend: Backend) -> dict[str, str]:
+@cache
+def _core_versions() -> dict[str, str]:
     found = {}
     for dist in ("gamespec", "numpy", "scipy", "sympy", "pydantic"):
         try:
             found[dist] = version(dist)
         except PackageNotFoundError:
             continue
-    found[f"backend:{backend.name}"] = registry.distribution("gamespec.backends", backend.name)
     return found
+
+
+def _versions(backend: Backend) -> dict[str, str]:
+    return _core_versions() | {
+        f"backend:{backend.name}": registry.distribution("gamespec.backends", backend.name)
+    }
 
 
 @dataclass
@@ -75,6 +82,7 @@ class Solver:
         provenance = Provenance(
             spec_hash=spec_hash(self.spec),
             source=self.spec.source,
+            file_hash=self.spec.file_hash,
             versions=_versions(self.backend),
             created=_dt.datetime.now(_dt.UTC).isoformat(timespec="seconds"),
         )

@@ -40,11 +40,17 @@ class SpecBase(StrictModel):
 
     default_backend: ClassVar[str] = ""
     _source: str = PrivateAttr("<spec>")
+    _file_hash: str = PrivateAttr("")
 
     @property
     def source(self) -> str:
         """The file this spec was loaded from, or ``<spec>``."""
         return self._source
+
+    @property
+    def file_hash(self) -> str:
+        """SHA-256 (first 16 hex digits) of the file this spec was loaded from, or ``""``."""
+        return self._file_hash
 
     def required_features(self) -> frozenset[str]:
         """Features a backend must declare to take this spec (e.g. ``free_final_time``)."""

@@ -27,7 +27,7 @@ from gamespec.result import Result
 from gamespec.specs.base import StrictModel
 from gamespec.specs.ocp import OptimalControlSpec
 from gamespec_pyomo.model import build_model
-from gamespec_pyomo.solvers import PRINT_LEVEL, find_executable, iterations_in, status_of
+from gamespec_pyomo.solvers import PRINT_LEVEL, find_executable, iterations_in, solver_seconds_in, status_of
 
 
 class PyomoOptions(StrictModel):
@@ -163,6 +163,7 @@ class PyomoModel(CompiledModel):
                 "executable": self.executable.path,
                 "termination_condition": termination,
                 "process_time_s": results.solver.time,
+                "solver_time_s": solver_seconds_in(log),
             },
         )
 

@@ -41,6 +41,7 @@ PRINT_LEVEL = {"ripopt": 1, "ipopt": 3}
 """The lowest print level at which each executable still reports its iteration count."""
 
 _ITERATIONS = re.compile(r"^\s*(?:iterations:|Number of Iterations\.*:)\s*(\d+)", re.MULTILINE)
+_SECONDS = re.compile(r"^\s*(?:wall_time:|Total seconds in IPOPT\s*=)\s*([0-9.eE+-]+)", re.MULTILINE)
 
 
 @dataclass(frozen=True)
@@ -104,3 +105,10 @@ def iterations_in(log: str) -> int | None:
     """The iteration count printed by ripopt (``iterations: N``) or Ipopt (``Number of Iterations``)."""
     match = _ITERATIONS.search(log)
     return int(match.group(1)) if match else None
+
+
+def solver_seconds_in(log: str) -> float | None:
+    """The solver's own wall time, printed by ripopt (``wall_time: 0.16s``) or Ipopt 3.14 (``Total
+    seconds in IPOPT = 0.16``): the solve time less NL writing and process start."""
+    match = _SECONDS.search(log)
+    return float(match.group(1)) if match else None

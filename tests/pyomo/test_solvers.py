@@ -6,8 +6,10 @@ import pytest
 from gamespec_pyomo import solvers
 from gamespec_pyomo.backend import PyomoBackend
 
+import gamespec
 from gamespec.errors import BackendError
 from gamespec.result import Status
+from tests.conftest import PROBLEMS
 
 
 def _path_with(monkeypatch, *names: str) -> None:
@@ -58,9 +60,17 @@ def test_status_map(termination: str, message: str, status: Status) -> None:
     assert solvers.status_of(termination, message) is status
 
 
-def test_iteration_count_from_either_log() -> None:
-    ripopt = "ripopt 0.8.2: Optimal after 8 iterations\n--- ripopt diagnostics ---\niterations: 8\n"
-    ipopt = "EXIT: Optimal Solution Found.\nNumber of Iterations....: 15\n"
-    assert solvers.iterations_in(ripopt) == 8
-    assert solvers.iterations_in(ipopt) == 15
+def test_iterations_and_seconds_from_either_log() -> None:
+    ripopt = "ripopt 0.8.2: Optimal after 8 iterations\n--- ripopt diagnostics ---\n"
+    ripopt += "iterations: 8\nwall_time: 0.161s\n"
+    ipopt = "Number of Iterations....: 15\n\nTotal seconds in IPOPT                               = 0.012\n"
+    assert (solvers.iterations_in(ripopt), solvers.solver_seconds_in(ripopt)) == (8, 0.161)
+    assert (solvers.iterations_in(ipopt), solvers.solver_seconds_in(ipopt)) == (15, 0.012)
     assert solvers.iterations_in("no count here") is None
+    assert solvers.solver_seconds_in("no time here") is None
+
+
+def test_a_real_solve_reports_iterations_and_solver_time() -> None:
+    result = gamespec.solve(PROBLEMS / "ch6" / "zermelo_min_time.yaml", "pyomo")
+    assert result.iterations is not None and result.iterations > 0
+    assert 0 < result.solver_stats["solver_time_s"] <= result.solve_time_s

@@ -156,3 +156,12 @@ def test_backends_command_names_the_executable(cli) -> None:
     code, out, _ = cli("backends")
     assert code == 0
     assert PyomoBackend.available().reason.split()[0] in out
+
+
+def test_an_infeasible_problem_is_a_failed_result_with_exit_1(cli) -> None:
+    """|x2| <= t, so x1(t_f) <= t_f + rho t_f^2 / 2 = 0.4 < 2 for t_f <= 0.2: no feasible point."""
+    too_short = gamespec.solve(gamespec.load(MIN_TIME, ["problem.time.bounds=[0.05, 0.2]"]), "pyomo")
+    assert not too_short.ok
+    code, _, err = cli("solve", MIN_TIME, "--backend", "pyomo", "--set", "problem.time.bounds=[0.05, 0.2]")
+    assert code == 1
+    assert len(err.strip().splitlines()) == 1

@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import os
+
 import pytest
 from gamespec_pyomo import solvers
 from gamespec_pyomo.backend import PyomoBackend
@@ -74,3 +76,17 @@ def test_a_real_solve_reports_iterations_and_solver_time() -> None:
     result = gamespec.solve(PROBLEMS / "ch6" / "zermelo_min_time.yaml", "pyomo")
     assert result.iterations is not None and result.iterations > 0
     assert 0 < result.solver_stats["solver_time_s"] <= result.solve_time_s
+
+
+def test_an_ipopt_on_path_is_used_by_default(tmp_path, monkeypatch) -> None:
+    """ripopt speaks Ipopt's AMPL interface, so a link named ``ipopt`` stands in for an Ipopt
+    install: auto picks it and Pyomo drives it through its ipopt plugin."""
+    (tmp_path / "ipopt").symlink_to(solvers.find_executable("ripopt").path)
+    monkeypatch.setenv("PATH", f"{tmp_path}{os.pathsep}{os.environ['PATH']}")
+    path = PROBLEMS / "ch6" / "zermelo_min_time.yaml"
+    on_path = gamespec.solve(path, "pyomo")
+    bundled = gamespec.solve(path, "pyomo", options={"solver": "ripopt"})
+    assert on_path.solver_stats["solver"] == "ipopt"
+    assert on_path.solver_stats["executable"] == str(tmp_path / "ipopt")
+    assert bundled.solver_stats["solver"] == "ripopt"
+    assert on_path.objective == pytest.approx(bundled.objective, rel=1e-10)

@@ -145,6 +145,7 @@ class PyomoModel(CompiledModel):
         loaded = self._load(results)
         self._solved = self._solved or loaded
         termination = str(results.solver.termination_condition)
+        # Pyomo's SOL reader stores the solver's message with ':' escaped as '\x3a'.
         message = str(results.solver.message or termination).replace("\\x3a", ":")
         X, U, T = self._values()
         return tr.result(

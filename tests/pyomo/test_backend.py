@@ -165,3 +165,27 @@ def test_an_infeasible_problem_is_a_failed_result_with_exit_1(cli) -> None:
     code, _, err = cli("solve", MIN_TIME, "--backend", "pyomo", "--set", "problem.time.bounds=[0.05, 0.2]")
     assert code == 1
     assert len(err.strip().splitlines()) == 1
+
+
+@pytest.mark.parametrize("backend", ["casadi", "pyomo"])
+def test_parameter_free_regulator_matches_the_riccati_closed_form(backend: str) -> None:
+    """min ∫(x² + u²) dt, x' = u, x(0) = 1 on [0, T], x(T) free: the Riccati equation p' = p² - 1,
+    p(T) = 0 gives p(t) = tanh(T - t), J = tanh(T) and u = -tanh(T - t) x."""
+    spec = gamespec.spec_from_dict(
+        {
+            "kind": "optimal_control",
+            "name": "scalar_regulator",
+            "problem": {
+                "states": {"x": {"initial": 1.0}},
+                "controls": {"u": {}},
+                "dynamics": {"x": "u"},
+                "objective": {"lagrange": "x**2 + u**2"},
+                "time": {"final": 1.0},
+            },
+            "method": {"intervals": 10, "degree": 3},
+        }
+    )
+    result = gamespec.solve(spec, backend)
+    assert result.objective == pytest.approx(np.tanh(1.0), rel=1e-7)
+    x = np.interp(result.control_time, result.time, result.states["x"])
+    np.testing.assert_allclose(result.controls["u"], -np.tanh(1.0 - result.control_time) * x, atol=1e-4)

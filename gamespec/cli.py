@@ -124,7 +124,7 @@ def compare(
     console.print(comparison_table(rows, f"{spec.name}: backend comparison"))
     console.print(LEGEND, style="dim", highlight=False)
     for note in row_notes(rows):
-        console.print(note, highlight=False)
+        console.print(note, markup=False, highlight=False)
 
 
 @app.command()

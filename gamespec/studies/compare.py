@@ -13,6 +13,7 @@ from typing import Any
 
 from rich import box
 from rich.console import Console
+from rich.markup import escape
 from rich.table import Table
 
 from gamespec.errors import BackendError, GamespecError
@@ -116,7 +117,7 @@ def comparison_table(rows: list[dict[str, Any]], title: str) -> Table:
     for key, header, _ in COLUMNS:
         table.add_column(header, justify="left" if key in ("backend", "status") else "right")
     for row in rows:
-        cells = [_cell(row.get(key), fmt) for key, _, fmt in COLUMNS]
+        cells = [escape(_cell(row.get(key), fmt)) for key, _, fmt in COLUMNS]
         colour = "green" if row.get("status") == "optimal" else "yellow"
         cells[1] = f"[{colour}]{cells[1]}[/{colour}]"
         table.add_row(*cells)

@@ -27,7 +27,14 @@ from gamespec.result import Result
 from gamespec.specs.base import StrictModel
 from gamespec.specs.ocp import OptimalControlSpec
 from gamespec_pyomo.model import build_model
-from gamespec_pyomo.solvers import PRINT_LEVEL, find_executable, iterations_in, solver_seconds_in, status_of
+from gamespec_pyomo.solvers import (
+    PRINT_LEVEL,
+    find_executable,
+    iterations_in,
+    pyomo_solver,
+    solver_seconds_in,
+    status_of,
+)
 
 
 class PyomoOptions(StrictModel):
@@ -59,7 +66,7 @@ class PyomoModel(CompiledModel):
         self.options = options
         self.executable = find_executable(options.solver)
         self.model = build_model(self.tr, self.tr.ocp.parameter_values())
-        self.solver = pyo.SolverFactory(self.executable.name, executable=self.executable.path)
+        self.solver = pyomo_solver(self.executable)
         self._solved = False
 
     def _set_bounds(self, b: Bounds) -> None:
@@ -182,15 +189,15 @@ class PyomoBackend(Backend):
     @classmethod
     def available(cls) -> Availability:
         try:
-            from pyomo.environ import SolverFactory
             from pyomo.version import version
+
+            exe = find_executable("auto")
+            runs = pyomo_solver(exe).available(exception_flag=False)
         except ImportError as err:
             return Availability(False, f"pyomo does not import: {err}")
-        try:
-            exe = find_executable("auto")
         except BackendError as err:
             return Availability(False, str(err))
-        if not SolverFactory(exe.name, executable=exe.path).available(exception_flag=False):
+        if not runs:
             return Availability(False, f"{exe.name} at {exe.path} does not run")
         return Availability(True, f"pyomo {version} with {exe.name} ({exe.origin})")
 

@@ -14,6 +14,7 @@ import shutil
 from dataclasses import dataclass
 from importlib.metadata import PackageNotFoundError, version
 from pathlib import Path
+from typing import Any
 
 from gamespec.errors import BackendError
 from gamespec.result import Status
@@ -90,6 +91,16 @@ def find_executable(choice: str = "auto") -> Executable:
         }
         raise BackendError(why[choice])
     return exe
+
+
+def pyomo_solver(exe: Executable) -> Any:
+    """Pyomo's NL-file solver for ``exe``: the ``ripopt`` plugin (registered by importing
+    pyomo_ripopt) or Pyomo's own ``ipopt`` plugin, both AMPL-interface solvers."""
+    from pyomo.environ import SolverFactory
+
+    if exe.name == "ripopt" and importlib.util.find_spec("pyomo_ripopt") is not None:
+        importlib.import_module("pyomo_ripopt")
+    return SolverFactory(exe.name, executable=exe.path)
 
 
 def status_of(termination: str, message: str) -> Status:

@@ -100,8 +100,8 @@ COLUMNS: list[tuple[str, str, Callable[[Any], str]]] = [
 """Row key, header and format of each column of the comparison table (fits 80 columns)."""
 
 LEGEND = (
-    "build, solve: wall time in ms; viol: max constraint violation; defect: max gap of an RK4 "
-    "re-integration; gap: |J - J*| / |J*| to the best optimal objective J*."
+    "build, solve: wall time in ms; viol: max constraint violation; defect: max dynamics defect, "
+    "recomputed without the solver; gap: |J - J*| / |J*| to the best optimal objective J*."
 )
 
 

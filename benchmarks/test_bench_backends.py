@@ -12,7 +12,7 @@ import pytest
 
 import gamespec
 from gamespec.solving import compile_spec
-from tests.pyomo.test_parity import OCP_FILES
+from tests.pyomo.cases import OCP_FILES
 
 BACKENDS = ("casadi", "pyomo")
 COLD = {"warm_start": False}

@@ -4,11 +4,8 @@ final time from a parameter, the trapezoidal scheme), status mapping and refusal
 
 from __future__ import annotations
 
-import copy
-
 import numpy as np
 import pytest
-import yaml
 from gamespec_pyomo.backend import PyomoBackend
 
 import gamespec
@@ -16,28 +13,11 @@ from gamespec.ocp.transcription import Transcription
 from gamespec.result import Status
 from gamespec.solving import compile_spec
 from tests.conftest import PROBLEMS
+from tests.pyomo.cases import CONSTRAINED, atan2_file
 
 MIN_TIME = PROBLEMS / "ch6" / "zermelo_min_time.yaml"
 MAX_RANGE = PROBLEMS / "ch6" / "zermelo_max_range.yaml"
 EVASION = PROBLEMS / "ch2" / "one_on_one_pure_evasion.yaml"
-
-CONSTRAINED = {
-    "kind": "optimal_control",
-    "name": "double_integrator_speed_limit",
-    "problem": {
-        "parameters": {"vmax": 1.2, "tf": 1.0},
-        "states": {"x": {"initial": 0.0}, "v": {"initial": 0.0, "final": 0.0}},
-        "controls": {"a": {"lower": -20, "upper": 20}},
-        "dynamics": {"x": "v", "v": "a"},
-        "objective": {"lagrange": "a**2 + 0.1*t*v", "mayer": "0.5*(x_f - 1)**2"},
-        "time": {"final": "tf"},
-        "path_constraints": ["v <= vmax"],
-        "boundary_constraints": ["x_f >= 0.9"],
-    },
-    "method": {"scheme": "radau", "intervals": 15, "degree": 3},
-}
-"""A minimum-energy double integrator with an active speed limit, an active end constraint, a
-time-dependent integrand and a parameter final time: everything the shipped files leave out."""
 
 
 def test_constrained_problem_agrees_with_casadi() -> None:
@@ -128,17 +108,9 @@ def test_unknown_solver_option_value_is_a_spec_error(cli) -> None:
     assert "solver.options.pyomo.solver" in err
 
 
-def _atan2_file(tmp_path):
-    data = copy.deepcopy(CONSTRAINED)
-    data["problem"]["dynamics"]["v"] = "(5 + v)*atan2(a, 5 + v)"
-    path = tmp_path / "atan2.yaml"
-    path.write_text(yaml.safe_dump(data))
-    return path
-
-
 def test_atan2_is_refused_with_exit_2(cli, tmp_path) -> None:
     """Pyomo has no atan2: the backend says so in one line, exit code 2, no traceback."""
-    code, _, err = cli("solve", _atan2_file(tmp_path), "--backend", "pyomo")
+    code, _, err = cli("solve", atan2_file(tmp_path), "--backend", "pyomo")
     assert code == 2
     assert "atan2" in err and "Traceback" not in err
     assert len(err.strip().splitlines()) == 1

@@ -7,7 +7,6 @@ import io
 import json
 
 import pytest
-import yaml
 from gamespec_pyomo import solvers
 from rich.console import Console
 
@@ -16,7 +15,7 @@ from gamespec.errors import BackendError
 from gamespec.result import Result
 from gamespec.studies.compare import compare_backends, comparison_table, parse_backend_list
 from tests.conftest import PROBLEMS
-from tests.pyomo.test_backend import CONSTRAINED
+from tests.pyomo.cases import atan2_file
 
 MAX_RANGE = PROBLEMS / "ch6" / "zermelo_max_range.yaml"
 KEYS = {
@@ -74,11 +73,7 @@ def test_reasons_are_printed_under_the_table(cli, monkeypatch) -> None:
 
 
 def test_a_backend_that_cannot_take_the_problem_gets_a_row(cli, tmp_path) -> None:
-    data = dict(CONSTRAINED, problem=dict(CONSTRAINED["problem"]))
-    data["problem"]["dynamics"] = {"x": "v", "v": "(5 + v)*atan2(a, 5 + v)"}
-    path = tmp_path / "atan2.yaml"
-    path.write_text(yaml.safe_dump(data))
-    code, out, _ = cli("compare", path, "--backends", "pyomo,casadi", "--json")
+    code, out, _ = cli("compare", atan2_file(tmp_path), "--backends", "pyomo,casadi", "--json")
     assert code == 0
     pyomo, casadi = json.loads(out)
     assert pyomo["status"] == "unsupported" and "atan2" in pyomo["reason"]

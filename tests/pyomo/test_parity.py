@@ -9,11 +9,8 @@ import numpy as np
 import pytest
 
 import gamespec
-from gamespec.loader import read_file
 from gamespec.result import Result
-from tests.conftest import PROBLEMS
-
-OCP_FILES = sorted(p for p in PROBLEMS.rglob("*.yaml") if read_file(p).get("kind") == "optimal_control")
+from tests.pyomo.cases import OCP_FILES
 
 
 def _close(a: dict[str, np.ndarray], b: dict[str, np.ndarray], rel: float) -> None:

@@ -21,7 +21,13 @@ from gamespec.errors import GamespecError
 from gamespec.loader import load
 from gamespec.pursuit.cli import pursuit_app
 from gamespec.result import Result
-from gamespec.studies.compare import compare_backends, parse_backend_list
+from gamespec.studies.compare import (
+    LEGEND,
+    compare_backends,
+    comparison_table,
+    parse_backend_list,
+    row_notes,
+)
 
 app = typer.Typer(
     add_completion=False,
@@ -117,27 +123,10 @@ def compare(
     if json_:
         sys.stdout.write(json.dumps(rows, indent=2) + "\n")
         return
-    columns = [
-        "backend",
-        "status",
-        "objective",
-        "t_final",
-        "build_time_s",
-        "solve_time_s",
-        "iterations",
-        "max_constraint_violation",
-        "max_defect",
-        "relative_gap",
-    ]
-    table = Table(title=f"{spec.name}: backend comparison")
-    for col in columns:
-        table.add_column(col, justify="left" if col in ("backend", "status") else "right")
-    for row in rows:
-        if row.get("reason"):
-            table.add_row(row["backend"], "[yellow]unsupported[/yellow]", row["reason"])
-        else:
-            table.add_row(*(_fmt(row.get(c)) for c in columns))
-    console.print(table)
+    console.print(comparison_table(rows, f"{spec.name}: backend comparison"))
+    console.print(LEGEND, style="dim", highlight=False)
+    for note in row_notes(rows):
+        console.print(note, markup=False, highlight=False)
 
 
 @app.command()

@@ -94,7 +94,7 @@ class CasadiModel(CompiledModel):
         U = ca.SX.sym("U", nu, k)
         T = ca.SX.sym("T") if tr.free_time else None
         p_all = ca.SX.sym("p_all", npar + (0 if tr.free_time else 1))
-        params = p_all[:npar]
+        params = p_all[:npar, :]
         horizon = T if tr.free_time else p_all[npar]
         t_eval = tr.t0 + horizon * ca.DM(grid.eval_tau).T
         F, Lv, G = point(X[:, grid.eval_index.tolist()], U, t_eval, params)

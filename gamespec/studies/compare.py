@@ -6,10 +6,15 @@ its reason instead of stopping the study.
 
 from __future__ import annotations
 
+import math
+from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
+from rich import box
 from rich.console import Console
+from rich.markup import escape
+from rich.table import Table
 
 from gamespec.errors import BackendError, GamespecError
 from gamespec.specs.base import SpecBase
@@ -62,3 +67,68 @@ def compare_backends(
             if r.get("objective") is not None:
                 r["relative_gap"] = abs(r["objective"] - ref) / max(abs(ref), 1e-12)
     return rows
+
+
+def _number(value: float) -> str:
+    return f"{value:.6g}"
+
+
+def _milliseconds(value: float) -> str:
+    return f"{value * 1e3:.1f}"
+
+
+def _magnitude(value: float) -> str:
+    return "0" if value == 0 else f"{value:.0e}"
+
+
+def _gap(value: float) -> str:
+    return "0" if value == 0 else f"{value:.1e}"
+
+
+COLUMNS: list[tuple[str, str, Callable[[Any], str]]] = [
+    ("backend", "backend", str),
+    ("status", "status", str),
+    ("objective", "objective", _number),
+    ("t_final", "t_f", _number),
+    ("build_time_s", "build", _milliseconds),
+    ("solve_time_s", "solve", _milliseconds),
+    ("iterations", "iter", str),
+    ("max_constraint_violation", "viol", _magnitude),
+    ("max_defect", "defect", _magnitude),
+    ("relative_gap", "gap", _gap),
+]
+"""Row key, header and format of each column of the comparison table (fits 80 columns)."""
+
+LEGEND = (
+    "build, solve: wall time in ms; viol: max constraint violation; defect: max dynamics defect, "
+    "recomputed without the solver; gap: |J - J*| / |J*| to the best optimal objective J*."
+)
+
+
+def _cell(value: Any, fmt: Callable[[Any], str]) -> str:
+    if value is None or (isinstance(value, float) and not math.isfinite(value)):
+        return "—"
+    return fmt(value)
+
+
+def comparison_table(rows: list[dict[str, Any]], title: str) -> Table:
+    """The rows of :func:`compare_backends` as one compact table (reasons go in :func:`row_notes`)."""
+    table = Table(title=title, box=box.SIMPLE_HEAD, show_edge=False, padding=0)
+    for key, header, _ in COLUMNS:
+        table.add_column(header, justify="left" if key in ("backend", "status") else "right")
+    for row in rows:
+        cells = [escape(_cell(row.get(key), fmt)) for key, _, fmt in COLUMNS]
+        colour = "green" if row.get("status") == "optimal" else "yellow"
+        cells[1] = f"[{colour}]{cells[1]}[/{colour}]"
+        table.add_row(*cells)
+    return table
+
+
+def row_notes(rows: list[dict[str, Any]]) -> list[str]:
+    """One line per row that is not optimal: the backend's reason, or the solver's message."""
+    notes = []
+    for row in rows:
+        if row.get("status") != "optimal":
+            why = row.get("reason") or row.get("message") or "no message"
+            notes.append(f"{row['backend']}: {why}")
+    return notes

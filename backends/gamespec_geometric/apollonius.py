@@ -1,0 +1,172 @@
+"""Apollonius circles (CB) and Apollonius curves (PP) of pursuers against one evader (thesis §3.3).
+
+Everything is vectorized over the pursuers: positions are ``(n, 2)`` arrays, the evader a ``(2,)``
+array, pursuer speeds ``(n,)`` (heterogeneous teams, §3.5) and the evader speed a scalar.
+
+*CB.* The Apollonius circle of pursuer ``i`` is the locus ``|X - e| / v = |X - p_i| / u_i``; its disk
+holds the evader. With ``rho = v / u_i`` its centre is ``(e - rho**2 p_i) / (1 - rho**2)`` and its
+radius ``rho |p_i - e| / (1 - rho**2)`` (§3.3; the thesis prints ``rho`` instead of ``rho**2`` in the
+centre, which is a misprint: only ``rho**2`` puts the circle through ``T_i``). The point of the circle
+closest to the evader is ``T_i = (e + rho p_i) / (1 + rho)``, at distance ``v |p_i - e| / (u_i + v)``.
+
+*PP.* Against a non-maneuvering evader with heading ``phi`` measured from the line of sight (pursuer
+to evader), pure pursuit captures after ``t_f = r0 (u + v cos phi) / (u**2 - v**2)`` (eq. 3.24), so
+the Apollonius curve is the limaçon ``r(phi) = A + B cos phi`` around the evader with
+``A = v u r0 / (u**2 - v**2)`` and ``B = v**2 r0 / (u**2 - v**2)``. It is non-convex when ``u < 2 v``;
+its convex hull, the *refined* Apollonius curve (§3.3.1), replaces the dimple facing the pursuer by
+the bitangent line ``x = -A**2 / (4 B)`` (in line-of-sight coordinates), which touches the limaçon
+where ``cos phi = -A / (2 B)``.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+FloatArray = np.ndarray
+
+
+@dataclass(frozen=True)
+class ApolloniusCircles:
+    """The Apollonius circles of ``n`` pursuers against one evader: centres, radii, closest points."""
+
+    centers: FloatArray
+    radii: FloatArray
+    closest_points: FloatArray
+
+
+def speed_ratios(pursuer_speeds: FloatArray, evader_speed: float) -> FloatArray:
+    """``rho_i = v / u_i`` for each pursuer (below 1 by eq. 3.29)."""
+    return evader_speed / np.asarray(pursuer_speeds, dtype=float)
+
+
+def apollonius_circles(
+    pursuers: FloatArray, evader: FloatArray, pursuer_speeds: FloatArray, evader_speed: float
+) -> ApolloniusCircles:
+    """Centre, radius and closest point ``T_i`` of every pursuer's Apollonius circle (§3.3, §3.5)."""
+    rho = speed_ratios(pursuer_speeds, evader_speed)[:, None]
+    distance = np.linalg.norm(pursuers - evader, axis=1)
+    centers = (evader - rho**2 * pursuers) / (1.0 - rho**2)
+    radii = rho[:, 0] * distance / (1.0 - rho[:, 0] ** 2)
+    closest = (evader + rho * pursuers) / (1.0 + rho)
+    return ApolloniusCircles(centers, radii, closest)
+
+
+def circle_radial_distance(
+    circles: ApolloniusCircles, evader: FloatArray, directions: FloatArray
+) -> FloatArray:
+    """Distance from the evader to each circle along each direction angle: shape ``(n, len(directions))``.
+
+    The evader is inside every Apollonius disk, so each ray leaves each disk exactly once.
+    """
+    unit = np.stack([np.cos(directions), np.sin(directions)], axis=-1)
+    offset = evader - circles.centers
+    along = offset @ unit.T
+    inside = circles.radii[:, None] ** 2 - np.sum(offset**2, axis=1)[:, None]
+    return -along + np.sqrt(along**2 + inside)
+
+
+def pp_capture_time(
+    initial_distance: FloatArray, heading: FloatArray, pursuer_speed: FloatArray, evader_speed: float
+) -> FloatArray:
+    """Time for pure pursuit to capture a non-maneuvering evader (eq. 3.24).
+
+    ``heading`` is the evader's heading measured from the initial line of sight (pursuer → evader).
+    """
+    u = np.asarray(pursuer_speed, dtype=float)
+    return initial_distance * (u + evader_speed * np.cos(heading)) / (u**2 - evader_speed**2)
+
+
+def _limacon_coefficients(
+    initial_distance: FloatArray, pursuer_speed: FloatArray, evader_speed: float
+) -> tuple[FloatArray, FloatArray]:
+    """``A`` and ``B`` of the Apollonius curve ``r(phi) = A + B cos phi`` (``v t_f`` from eq. 3.24)."""
+    u = np.asarray(pursuer_speed, dtype=float)
+    scale = evader_speed * initial_distance / (u**2 - evader_speed**2)
+    return scale * u, scale * evader_speed
+
+
+def pp_curve_radius(
+    initial_distance: FloatArray, heading: FloatArray, pursuer_speed: FloatArray, evader_speed: float
+) -> FloatArray:
+    """Distance from the evader to its Apollonius curve at line-of-sight heading ``heading`` (eq. 3.24)."""
+    return evader_speed * pp_capture_time(initial_distance, heading, pursuer_speed, evader_speed)
+
+
+def tangent_heading(
+    initial_distance: FloatArray, pursuer_speed: FloatArray, evader_speed: float
+) -> FloatArray:
+    """Line-of-sight heading where the refined curve leaves the limaçon (``pi``: no dimple, ``u >= 2 v``)."""
+    a, b = _limacon_coefficients(initial_distance, pursuer_speed, evader_speed)
+    return np.arccos(np.clip(-a / (2.0 * b), -1.0, 1.0))
+
+
+def refined_pp_radius(
+    initial_distance: FloatArray, heading: FloatArray, pursuer_speed: FloatArray, evader_speed: float
+) -> FloatArray:
+    """Distance from the evader to the refined (convex-hull) Apollonius curve (§3.3.1).
+
+    On the convex part of the limaçon this is eq. 3.24; across the dimple it is the bitangent line
+    ``r cos phi = -A**2 / (4 B)``. All arguments broadcast together.
+    """
+    a, b = _limacon_coefficients(initial_distance, pursuer_speed, evader_speed)
+    curve = a + b * np.cos(heading)
+    dimpled = a < 2.0 * b
+    on_chord = dimpled & (np.cos(heading) < -a / (2.0 * b))
+    with np.errstate(divide="ignore", invalid="ignore"):
+        chord = -(a**2) / (4.0 * b * np.cos(heading))
+    return np.where(on_chord, chord, curve)
+
+
+def cb_reach(
+    initial_distance: FloatArray, pursuer_speed: FloatArray, evader_speed: float
+) -> tuple[FloatArray, FloatArray]:
+    """Nearest and farthest distance from the evader to each Apollonius circle.
+
+    ``v r0 / (u + v)`` at ``T_i`` and ``|O_i - e| + d_i = v r0 / (u - v)`` across from it (§3.3).
+    """
+    u = np.asarray(pursuer_speed, dtype=float)
+    return evader_speed * initial_distance / (u + evader_speed), evader_speed * initial_distance / (
+        u - evader_speed
+    )
+
+
+def refined_pp_reach(
+    initial_distance: FloatArray, pursuer_speed: FloatArray, evader_speed: float
+) -> tuple[FloatArray, FloatArray]:
+    """Nearest and farthest distance from the evader to each refined Apollonius curve.
+
+    The farthest is ``A + B`` (heading straight away, eq. 3.24); the nearest is the bitangent's
+    distance ``A**2 / (4 B)`` when the limaçon has a dimple, else ``A - B`` (heading at the pursuer).
+    """
+    a, b = _limacon_coefficients(initial_distance, pursuer_speed, evader_speed)
+    return np.where(a < 2.0 * b, a**2 / (4.0 * b), a - b), a + b
+
+
+def line_of_sight_angles(pursuers: FloatArray, evader: FloatArray) -> FloatArray:
+    """Angle of the line of sight from each pursuer to the evader (eq. 3.17)."""
+    delta = evader - pursuers
+    return np.arctan2(delta[:, 1], delta[:, 0])
+
+
+def refined_pp_polygons(
+    pursuers: FloatArray,
+    evader: FloatArray,
+    pursuer_speeds: FloatArray,
+    evader_speed: float,
+    samples: int = 64,
+) -> FloatArray:
+    """Convex polygons inscribed in the refined Apollonius curves: shape ``(n, samples, 2)``, CCW.
+
+    The vertices lie on the convex arc of each limaçon (eq. 3.24), evenly spaced in line-of-sight
+    heading; the closing edge is the bitangent chord across the dimple when there is one, else a
+    chord of the same angular step. The polygons converge to the refined curves as ``samples`` grows.
+    """
+    distance = np.linalg.norm(pursuers - evader, axis=1)
+    speeds = np.broadcast_to(np.asarray(pursuer_speeds, dtype=float), distance.shape)
+    half_width = np.minimum(tangent_heading(distance, speeds, evader_speed), np.pi * (samples - 1) / samples)
+    heading = half_width[:, None] * np.linspace(-1.0, 1.0, samples)[None, :]
+    radius = pp_curve_radius(distance[:, None], heading, speeds[:, None], evader_speed)
+    angle = line_of_sight_angles(pursuers, evader)[:, None] + heading
+    return evader + radius[..., None] * np.stack([np.cos(angle), np.sin(angle)], axis=-1)

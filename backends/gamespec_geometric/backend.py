@@ -1,0 +1,120 @@
+"""The ``geometric`` backend: simulates ``pursuit_scenario`` specs with AVAA / A2 allocation.
+
+Only NumPy and SciPy are needed, so it is always available. Options (``solver.options.geometric``):
+``active_check`` (``fast`` or ``reference``: AAPC for CB, edge clipping for PP) and ``pp_samples``
+(vertices of the polygons inscribed in the refined Apollonius curves).
+"""
+
+from __future__ import annotations
+
+import time
+from typing import ClassVar, Literal
+
+from pydantic import Field
+
+from gamespec.backend import Availability, Backend, CompiledModel
+from gamespec.errors import SpecError
+from gamespec.loader import spec_from_dict
+from gamespec.result import Result, Status
+from gamespec.specs.base import SpecBase, StrictModel
+from gamespec_geometric.simulation import Trajectories, simulate
+from gamespec_geometric.spec import PursuitScenarioSpec
+
+
+class GeometricOptions(StrictModel):
+    """Options of the geometric backend."""
+
+    active_check: Literal["fast", "reference"] = "fast"
+    pp_samples: int = Field(64, ge=8, description="Vertices of each refined Apollonius polygon (PP).")
+
+
+class CompiledScenario(CompiledModel):
+    """A scenario ready to simulate; ``parameters`` may override ``capture_radius``, ``time_step``
+    and ``horizon``."""
+
+    TUNABLE: ClassVar[tuple[str, ...]] = ("capture_radius", "time_step", "horizon")
+
+    def __init__(self, spec: PursuitScenarioSpec, options: GeometricOptions) -> None:
+        self.spec = spec
+        self.options = options
+
+    def solve(self, parameters: dict[str, float] | None = None, guess: Result | None = None) -> Result:
+        """Simulate (``guess`` is not used: the simulation has no iterate to warm-start)."""
+        unknown = set(parameters or {}) - set(self.TUNABLE)
+        if unknown:
+            raise SpecError(
+                f"unknown parameter(s) {', '.join(sorted(unknown))} (tunable: {', '.join(self.TUNABLE)})",
+                field="parameters",
+            )
+        spec = self.spec
+        if parameters:
+            spec = spec_from_dict({**spec.model_dump(), **parameters}, source=spec.source)
+        start = time.perf_counter()
+        run = simulate(spec, method=self.options.active_check, samples=self.options.pp_samples)
+        return scenario_result(spec, run, time.perf_counter() - start)
+
+
+def allocation_changes(run: Trajectories) -> list[dict[str, object]]:
+    """The allocation history, one entry per step where the allocation changed."""
+    changes: list[dict[str, object]] = []
+    previous = None
+    for k in range(len(run.time) - 1):
+        row = run.allocation[k].tolist()
+        if row != previous:
+            changes.append({"step": k, "t": float(run.time[k]), "assignment": row})
+            previous = row
+    return changes
+
+
+def scenario_result(spec: PursuitScenarioSpec, run: Trajectories, seconds: float) -> Result:
+    """The Result of a simulation: trajectories, capture times and capturers, allocation history."""
+    missed = [j for j, c in enumerate(run.capture_times) if c is None]
+    last = max((c for c in run.capture_times if c is not None), default=None)
+    if missed:
+        status = Status.TIME_LIMIT
+        message = f"{len(missed)} of {len(run.capture_times)} evaders not captured by t = {spec.horizon:g}"
+    else:
+        status = Status.FEASIBLE
+        message = f"all {len(run.capture_times)} evaders captured by t = {last:.4g}"
+    return Result(
+        status=status,
+        message=message,
+        objective=last if not missed else None,
+        t_final=last if not missed else float(run.time[-1]),
+        solve_time_s=seconds,
+        iterations=len(run.time) - 1,
+        time=run.time,
+        states={"pursuers": run.pursuers, "evaders": run.evaders},
+        arrays={"allocation": run.allocation, "allocation_rounds": run.rounds},
+        checks={
+            "shortest_time_max_increase": run.shortest_time_increase,
+            "shortest_pair_unassigned_steps": float(run.shortest_pair_unassigned),
+        },
+        metrics={
+            "capture_times": run.capture_times,
+            "capturers": run.capturers,
+            "allocation_history": allocation_changes(run),
+            "algorithm": spec.algorithm,
+            "pursuit_strategy": spec.pursuers.strategy,
+            "pursuer_speeds": spec.pursuers.speeds().tolist(),
+            "evader_speeds": spec.evaders.speeds().tolist(),
+            "capture_radius": spec.capture_radius,
+        },
+    )
+
+
+class GeometricBackend(Backend):
+    """Multi-agent simulation with Apollonius-based allocation (thesis chapter 3)."""
+
+    name: ClassVar[str] = "geometric"
+    kinds: ClassVar[frozenset[str]] = frozenset({"pursuit_scenario"})
+    options_model: ClassVar[type[StrictModel]] = GeometricOptions
+
+    @classmethod
+    def available(cls) -> Availability:
+        """Always available: the backend needs NumPy and SciPy only."""
+        return Availability(True, "numpy and scipy")
+
+    def _compile(self, spec: SpecBase, options: StrictModel) -> CompiledModel:
+        assert isinstance(spec, PursuitScenarioSpec) and isinstance(options, GeometricOptions)
+        return CompiledScenario(spec, options)

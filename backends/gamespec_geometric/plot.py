@@ -1,0 +1,134 @@
+"""Plots of a ``pursuit_scenario`` Result (thesis Figs. 3.5–3.7).
+
+``trajectories.png``: paths, initial Apollonius circles (CB) or refined Apollonius curves (PP) of
+every evader, and the Voronoi cells of the initial pursuer positions. ``snapshots.png``: three
+instants as in Fig. 3.7 with Voronoi cells, active pursuers (blue squares), redundant ones (cyan),
+free evaders (red triangles) and captured ones (magenta). With ``animate``, ``scenario.gif`` (and
+``scenario.mp4`` when ffmpeg is installed).
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import matplotlib
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt
+import numpy as np
+from matplotlib import animation
+from matplotlib.axes import Axes
+from scipy.spatial import QhullError, Voronoi, voronoi_plot_2d
+
+from gamespec.result import Result
+from gamespec_geometric.apollonius import apollonius_circles, line_of_sight_angles, refined_pp_radius
+
+_FRAMES = 60
+
+
+def _voronoi(ax: Axes, points: np.ndarray) -> None:
+    """Voronoi cells of the pursuers, when there are enough distinct ones to draw them."""
+    if len(points) < 3:
+        return
+    try:
+        diagram = Voronoi(points)
+    except QhullError:
+        return
+    voronoi_plot_2d(
+        diagram, ax=ax, show_points=False, show_vertices=False, line_colors="0.75", line_width=0.8
+    )
+
+
+def _capture_regions(ax: Axes, result: Result) -> None:
+    """Initial Apollonius circles (CB) or refined Apollonius curves (PP) around each evader."""
+    pursuers = result.states["pursuers"][0]
+    u = np.asarray(result.metrics["pursuer_speeds"])
+    angles = np.linspace(-np.pi, np.pi, 361)
+    for evader, v in zip(result.states["evaders"][0], result.metrics["evader_speeds"], strict=True):
+        if result.metrics["pursuit_strategy"] == "cb":
+            circles = apollonius_circles(pursuers, evader, u, v)
+            for center, radius in zip(circles.centers, circles.radii, strict=True):
+                ax.add_patch(plt.Circle(center, radius, fill=False, lw=0.6, color="0.55"))
+            continue
+        distance = np.linalg.norm(pursuers - evader, axis=1)
+        radius = refined_pp_radius(distance[:, None], angles[None, :], u[:, None], v)
+        direction = line_of_sight_angles(pursuers, evader)[:, None] + angles[None, :]
+        ax.plot(
+            (evader[0] + radius * np.cos(direction)).T,
+            (evader[1] + radius * np.sin(direction)).T,
+            lw=0.6,
+            color="0.55",
+        )
+
+
+def _frame(ax: Axes, result: Result, k: int, limits: tuple[np.ndarray, np.ndarray]) -> None:
+    """Players at step ``k``: trails, Voronoi cells, active/redundant pursuers, free/captured evaders."""
+    pursuers, evaders = result.states["pursuers"], result.states["evaders"]
+    ax.clear()
+    _voronoi(ax, pursuers[k])
+    ax.plot(pursuers[: k + 1, :, 0], pursuers[: k + 1, :, 1], color="tab:blue", lw=0.8, alpha=0.6)
+    ax.plot(evaders[: k + 1, :, 0], evaders[: k + 1, :, 1], color="tab:red", lw=0.8, alpha=0.6)
+    active = result.arrays["allocation"][k] >= 0
+    ax.plot(*pursuers[k][active].T, "s", color="blue", ms=6, label="active")
+    ax.plot(*pursuers[k][~active].T, "s", color="cyan", ms=6, label="redundant")
+    t = result.time[k]
+    caught = np.array([c is not None and c <= t for c in result.metrics["capture_times"]])
+    ax.plot(*evaders[k][~caught].T, "^", color="red", ms=7, label="evader")
+    ax.plot(*evaders[k][caught].T, "^", color="magenta", ms=7, label="captured")
+    ax.set_xlim(limits[0][0], limits[1][0])
+    ax.set_ylim(limits[0][1], limits[1][1])
+    ax.set_aspect("equal")
+    ax.set_title(f"t = {t:.2f}")
+
+
+def _limits(result: Result) -> tuple[np.ndarray, np.ndarray]:
+    everyone = np.concatenate(
+        [result.states["pursuers"].reshape(-1, 2), result.states["evaders"].reshape(-1, 2)]
+    )
+    low, high = everyone.min(axis=0), everyone.max(axis=0)
+    pad = 0.08 * float(np.max(high - low)) + 0.5
+    return low - pad, high + pad
+
+
+def plot_scenario(result: Result, output_dir: Path, *, animate: bool = False) -> list[Path]:
+    """Write the scenario's figures (and animation) into ``output_dir``; return their paths."""
+    output_dir = Path(output_dir)
+    output_dir.mkdir(parents=True, exist_ok=True)
+    limits = _limits(result)
+    last = len(result.time) - 1
+    written = []
+
+    fig, ax = plt.subplots(figsize=(7, 7))
+    _frame(ax, result, last, limits)
+    _capture_regions(ax, result)
+    ax.set_title(f"{result.problem}: trajectories and initial Apollonius regions")
+    ax.legend(loc="upper right", fontsize=8)
+    written.append(output_dir / "trajectories.png")
+    fig.savefig(written[-1], dpi=120)
+    plt.close(fig)
+
+    fig, axes = plt.subplots(1, 3, figsize=(15, 5.2))
+    for ax, k in zip(axes, (0, last // 2, last), strict=True):
+        _frame(ax, result, k, limits)
+    axes[0].legend(loc="upper right", fontsize=8)
+    written.append(output_dir / "snapshots.png")
+    fig.savefig(written[-1], dpi=110)
+    plt.close(fig)
+
+    if animate:
+        written.extend(_animate(result, output_dir, limits))
+    return written
+
+
+def _animate(result: Result, output_dir: Path, limits: tuple[np.ndarray, np.ndarray]) -> list[Path]:
+    """GIF (Pillow) and, when ffmpeg is installed, MP4 of the game, at most ``_FRAMES`` frames."""
+    frames = np.unique(np.linspace(0, len(result.time) - 1, _FRAMES).astype(int))
+    fig, ax = plt.subplots(figsize=(6, 6))
+    movie = animation.FuncAnimation(fig, lambda k: _frame(ax, result, int(k), limits), frames=frames)
+    written = [output_dir / "scenario.gif"]
+    movie.save(written[0], writer=animation.PillowWriter(fps=15))
+    if animation.writers.is_available("ffmpeg"):
+        written.append(output_dir / "scenario.mp4")
+        movie.save(written[1], writer=animation.FFMpegWriter(fps=15))
+    plt.close(fig)
+    return written

@@ -1,0 +1,190 @@
+"""The ``pursuit_scenario`` kind: a multi-pursuer multi-evader game in the plane (thesis §3.1–3.5).
+
+Pursuers move with constant speeds ``u_i`` and follow constant bearing (``cb``, eq. 3.3) or pure
+pursuit (``pp``); evaders move with constant speeds ``v_j`` and follow one of three strategies:
+``blind`` evasion (a heading drawn at random from a set at every switching time, §3.3.2),
+``pure_evasion`` (away from the nearest pursuer) or a ``fixed`` heading. Headings are numbers or
+constant expressions such as ``-pi/4``. The scenario is simulated with time step ``time_step`` up
+to ``horizon``; an evader is captured when a pursuer comes within ``capture_radius`` (eq. 3.5).
+"""
+
+from __future__ import annotations
+
+from typing import Annotated, ClassVar, Literal
+
+import numpy as np
+from pydantic import Field, FiniteFloat, field_validator, model_validator
+
+from gamespec.errors import ExpressionError, SpecError
+from gamespec.expressions import parse
+from gamespec.specs.base import SpecBase, StrictModel
+
+Position = tuple[FiniteFloat, FiniteFloat]
+PositiveFloat = Annotated[float, Field(gt=0, allow_inf_nan=False)]
+
+
+def _constant(value: object) -> object:
+    """A heading given as a constant expression (e.g. ``3*pi/4``) read into radians; other values are
+    left to the field's type check."""
+    if not isinstance(value, str):
+        return value
+    try:
+        number = parse(value, {}).evalf()
+    except ExpressionError as err:
+        raise ValueError(str(err)) from None
+    if not number.is_real or not number.is_finite:
+        raise ValueError(f"heading {value!r} is not a finite real number")
+    return float(number)
+
+
+Heading = Annotated[
+    float | str,
+    Field(allow_inf_nan=False, description="Radians: a number or a constant expression like '-pi/4'."),
+]
+"""Read into a float by :func:`_constant` before validation."""
+
+
+class FixedHeading(StrictModel):
+    """A non-maneuvering evader: one heading for the whole game."""
+
+    type: Literal["fixed"] = "fixed"
+    heading: Heading
+
+    @field_validator("heading", mode="before")
+    @classmethod
+    def _read(cls, value: object) -> object:
+        return _constant(value)
+
+
+class PureEvasion(StrictModel):
+    """Run straight away from the nearest pursuer, re-aimed at every time step."""
+
+    type: Literal["pure_evasion"] = "pure_evasion"
+
+
+class BlindEvasion(StrictModel):
+    """Blind evasion with switching headings (§3.3.2): every ``switch_period`` a heading drawn from
+    ``headings`` with a seeded random generator."""
+
+    type: Literal["blind"] = "blind"
+    headings: list[Heading] = Field(min_length=1)
+    switch_period: PositiveFloat = 1.0
+    seed: int = 0
+
+    @field_validator("headings", mode="before")
+    @classmethod
+    def _read(cls, value: object) -> object:
+        return [_constant(v) for v in value] if isinstance(value, list) else value
+
+
+EvaderStrategy = Annotated[FixedHeading | PureEvasion | BlindEvasion, Field(discriminator="type")]
+
+
+def _positions(value: list[Position], team: str) -> list[Position]:
+    if not value:
+        raise ValueError(f"the {team} team is empty: give at least one position")
+    return value
+
+
+class PursuerTeam(StrictModel):
+    """Pursuer positions, speeds (one for all or one each) and pursuit strategy."""
+
+    positions: list[Position]
+    speed: PositiveFloat | list[PositiveFloat] = 1.0
+    strategy: Literal["cb", "pp"] = "cb"
+
+    @field_validator("positions")
+    @classmethod
+    def _not_empty(cls, value: list[Position]) -> list[Position]:
+        return _positions(value, "pursuer")
+
+    def speeds(self) -> np.ndarray:
+        """Speed of each pursuer, ``(n,)``."""
+        return np.broadcast_to(np.asarray(self.speed, dtype=float), (len(self.positions),)).copy()
+
+
+class EvaderTeam(StrictModel):
+    """Evader positions, speeds (one for all or one each) and strategies (one for all or one each)."""
+
+    positions: list[Position]
+    speed: PositiveFloat | list[PositiveFloat] = 0.6
+    strategy: EvaderStrategy | list[EvaderStrategy] = Field(default_factory=PureEvasion)
+
+    @field_validator("positions")
+    @classmethod
+    def _not_empty(cls, value: list[Position]) -> list[Position]:
+        return _positions(value, "evader")
+
+    def speeds(self) -> np.ndarray:
+        """Speed of each evader, ``(m,)``."""
+        return np.broadcast_to(np.asarray(self.speed, dtype=float), (len(self.positions),)).copy()
+
+    def strategies(self) -> list[FixedHeading | PureEvasion | BlindEvasion]:
+        """Strategy of each evader."""
+        if isinstance(self.strategy, list):
+            return list(self.strategy)
+        return [self.strategy] * len(self.positions)
+
+
+class PursuitScenarioSpec(SpecBase):
+    """A multi-pursuer multi-evader scenario simulated with AVAA / A2 allocation (thesis chapter 3).
+
+    ``allocation`` is ``avaa`` (§3.4, nearest-evader tie-break), ``a2`` (§3.5, soonest-capture
+    tie-break) or ``auto`` (``avaa`` for homogeneous teams, ``a2`` otherwise).
+    """
+
+    kind: Literal["pursuit_scenario"] = "pursuit_scenario"
+    pursuers: PursuerTeam
+    evaders: EvaderTeam
+    capture_radius: PositiveFloat = 0.1
+    time_step: PositiveFloat = 0.01
+    horizon: PositiveFloat = 50.0
+    allocation: Literal["auto", "avaa", "a2"] = "auto"
+
+    default_backend: ClassVar[str] = "geometric"
+
+    @model_validator(mode="after")
+    def _consistent(self) -> PursuitScenarioSpec:
+        for team, field in ((self.pursuers, "pursuers"), (self.evaders, "evaders")):
+            if isinstance(team.speed, list) and len(team.speed) != len(team.positions):
+                raise SpecError(
+                    f"{len(team.speed)} speeds for {len(team.positions)} positions", field=f"{field}.speed"
+                )
+        strategy = self.evaders.strategy
+        if isinstance(strategy, list) and len(strategy) != len(self.evaders.positions):
+            raise SpecError(
+                f"{len(strategy)} strategies for {len(self.evaders.positions)} evaders",
+                field="evaders.strategy",
+            )
+        slowest, fastest = self.pursuers.speeds().min(), self.evaders.speeds().max()
+        if slowest <= fastest:
+            raise SpecError(
+                f"speeds violate eq. 3.29: the slowest pursuer ({slowest:g}) must be faster than the "
+                f"fastest evader ({fastest:g})",
+                field="pursuers.speed",
+            )
+        self._check_distinct()
+        if self.time_step > self.horizon:
+            raise SpecError("time_step must not exceed the horizon", field="time_step")
+        return self
+
+    def _check_distinct(self) -> None:
+        """Coincident players make the Apollonius circles degenerate: refuse them by name."""
+        players = np.array(self.pursuers.positions + self.evaders.positions, dtype=float)
+        n = len(self.pursuers.positions)
+        names = [f"pursuer {i}" for i in range(n)] + [f"evader {j}" for j in range(len(players) - n)]
+        gaps = np.linalg.norm(players[:, None, :] - players[None, :, :], axis=2)
+        gaps[np.diag_indices(len(players))] = np.inf
+        same = np.argwhere(gaps <= 1e-12 * (1.0 + np.abs(players).max()))
+        if len(same):
+            a, b = same[0]
+            field = "pursuers.positions" if b < n else "evaders.positions"
+            raise SpecError(f"{names[a]} and {names[b]} coincide at {tuple(players[a])}", field=field)
+
+    @property
+    def algorithm(self) -> Literal["avaa", "a2"]:
+        """The allocation algorithm to run (``auto`` resolved by whether the teams are homogeneous)."""
+        if self.allocation != "auto":
+            return self.allocation
+        homogeneous = np.ptp(self.pursuers.speeds()) == 0 and np.ptp(self.evaders.speeds()) == 0
+        return "avaa" if homogeneous else "a2"

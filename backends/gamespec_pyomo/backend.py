@@ -1,0 +1,205 @@
+"""The ``pyomo`` backend: an ``optimal_control`` spec as a Pyomo model, solved by an NLP executable
+through AMPL NL/SOL files (the bundled ``ripopt``, or ``ipopt`` when one is on PATH).
+
+The model (:mod:`gamespec_pyomo.model`) is the CasADi backend's discretization written in Pyomo and
+is built once. A re-solve sets the parameter Params and the bounds, starts from the last solution
+(or from a guess Result of any backend) and writes a fresh NL file: Pyomo's NL interface has no
+persistent solver, so NL writing counts in the solve time. Costates come from the defect
+multipliers the SOL file returns (Suffix ``dual``), as in the CasADi backend.
+"""
+
+from __future__ import annotations
+
+import logging
+import math
+import tempfile
+import time
+from pathlib import Path
+from typing import Any, ClassVar, Literal
+
+import numpy as np
+from pydantic import Field
+
+from gamespec.backend import Availability, Backend, CompiledModel
+from gamespec.errors import BackendError
+from gamespec.ocp.transcription import Bounds, Transcription
+from gamespec.result import Result
+from gamespec.specs.base import StrictModel
+from gamespec.specs.ocp import OptimalControlSpec
+from gamespec_pyomo.model import build_model
+from gamespec_pyomo.solvers import (
+    PRINT_LEVEL,
+    find_executable,
+    iterations_in,
+    pyomo_solver,
+    solver_seconds_in,
+    status_of,
+)
+
+
+class PyomoOptions(StrictModel):
+    """Options block ``solver.options.pyomo``."""
+
+    solver: Literal["auto", "ripopt", "ipopt"] = Field(
+        "auto", description="NLP executable: auto takes ipopt on PATH, else the bundled ripopt."
+    )
+    tol: float = Field(1e-8, gt=0, description="The solver's tol.")
+    max_iter: int = Field(3000, ge=1)
+    options: dict[str, Any] = Field(
+        default_factory=dict, description="Further solver options (key=value on its command line)."
+    )
+    warm_start: bool = Field(True, description="Re-solves start from the previous solution.")
+
+
+def _bound(value: float) -> float | None:
+    return float(value) if math.isfinite(value) else None
+
+
+class PyomoModel(CompiledModel):
+    """The Pyomo model and the solver that runs on it, built once."""
+
+    def __init__(self, spec: OptimalControlSpec, options: PyomoOptions) -> None:
+        import pyomo.environ as pyo
+
+        self.pyo = pyo
+        self.tr = Transcription(spec)
+        self.options = options
+        self.executable = find_executable(options.solver)
+        self.model = build_model(self.tr, self.tr.ocp.parameter_values())
+        self.solver = pyomo_solver(self.executable)
+        self._solved = False
+
+    def _set_bounds(self, b: Bounds) -> None:
+        m = self.model
+        for (i, n), var in m.X.items():
+            var.setlb(_bound(b.x_lower[i, n]))
+            var.setub(_bound(b.x_upper[i, n]))
+        for (j, c), var in m.U.items():
+            var.setlb(_bound(b.u_lower[j, c]))
+            var.setub(_bound(b.u_upper[j, c]))
+        if self.tr.free_time:
+            m.T.setlb(b.t_lower)
+            m.T.setub(b.t_upper)
+        else:
+            m.T.set_value(b.t_lower)
+
+    def _set_start(self, X: np.ndarray, U: np.ndarray, T: float, b: Bounds) -> None:
+        m = self.model
+        X = np.clip(X, b.x_lower, b.x_upper)
+        U = np.clip(U, b.u_lower, b.u_upper)
+        for (i, n), var in m.X.items():
+            var.set_value(float(X[i, n]))
+        for (j, c), var in m.U.items():
+            var.set_value(float(U[j, c]))
+        if self.tr.free_time:
+            m.T.set_value(float(np.clip(T, b.t_lower, b.t_upper)))
+
+    def _values(self) -> tuple[np.ndarray, np.ndarray, float]:
+        m, tr = self.model, self.tr
+        X = np.array([[m.X[i, n].value for n in range(tr.grid.n_nodes)] for i in range(tr.n_x)], float)
+        k = len(tr.grid.eval_index)
+        U = np.array([[m.U[j, c].value for c in range(k)] for j in range(tr.n_u)], float).reshape(tr.n_u, k)
+        return X, U, float(self.pyo.value(m.T))
+
+    def _defect_multipliers(self) -> np.ndarray | None:
+        m = self.model
+        if not all(con in m.dual for con in m.defect.values()):
+            return None
+        rows = len(m.defect) // self.tr.n_x
+        return np.array([[m.dual[m.defect[i, r]] for r in range(rows)] for i in range(self.tr.n_x)])
+
+    def _run(self) -> tuple[Any, str]:
+        """Write the NL file, run the executable, read the SOL file; the results and the log."""
+        from pyomo.common.errors import ApplicationError
+
+        name = self.executable.name
+        opts = {"tol": self.options.tol, "max_iter": self.options.max_iter, "print_level": PRINT_LEVEL[name]}
+        with tempfile.TemporaryDirectory(prefix="gamespec-pyomo-") as tmp:
+            log = Path(tmp) / "solver.log"
+            try:
+                results = self.solver.solve(
+                    self.model, options=opts | self.options.options, logfile=str(log), load_solutions=False
+                )
+            except ApplicationError as err:
+                raise BackendError(f"{name} failed to run: {err}") from None
+            return results, log.read_text()
+
+    def _load(self, results: Any) -> bool:
+        """Load the solution when the SOL file has one (Pyomo's warning about a non-optimal status
+        is dropped: the Result carries that status)."""
+        from pyomo.common.log import LoggingIntercept
+
+        if len(results.solution) == 0:
+            return False
+        with LoggingIntercept(level=logging.WARNING, module="pyomo.core"):
+            self.model.solutions.load_from(results)
+        return True
+
+    def solve(self, parameters: dict[str, float] | None = None, guess: Result | None = None) -> Result:
+        tr, m = self.tr, self.model
+        params = tr.ocp.parameter_values(parameters)
+        for name, value in params.items():
+            m.p[name] = value
+        b = tr.bounds(params)
+        self._set_bounds(b)
+        if guess is not None or not (self._solved and self.options.warm_start):
+            start = tr.guess(params, guess)
+            self._set_start(start.X, start.U, start.T, b)
+        m.dual.clear()
+        tic = time.perf_counter()
+        results, log = self._run()
+        elapsed = time.perf_counter() - tic
+        loaded = self._load(results)
+        self._solved = self._solved or loaded
+        termination = str(results.solver.termination_condition)
+        # Pyomo's SOL reader stores the solver's message with ':' escaped as '\x3a'.
+        message = str(results.solver.message or termination).replace("\\x3a", ":")
+        X, U, T = self._values()
+        return tr.result(
+            X=X,
+            U=U,
+            T=T,
+            objective=float(self.pyo.value(m.objective)) * tr.ocp.sign if loaded else None,
+            params=params,
+            status=status_of(termination, message),
+            message=message,
+            solve_time_s=elapsed,
+            iterations=iterations_in(log),
+            defect_multipliers=self._defect_multipliers() if loaded else None,
+            solver_stats={
+                "solver": self.executable.name,
+                "executable": self.executable.path,
+                "termination_condition": termination,
+                "process_time_s": results.solver.time,
+                "solver_time_s": solver_seconds_in(log),
+            },
+        )
+
+
+class PyomoBackend(Backend):
+    """Direct collocation (LGR or trapezoidal) as a Pyomo model, solved by ripopt or ipopt."""
+
+    name: ClassVar[str] = "pyomo"
+    kinds: ClassVar[frozenset[str]] = frozenset({"optimal_control"})
+    features: ClassVar[frozenset[str]] = frozenset(
+        {"ode", "free_final_time", "path_constraints", "boundary_constraints"}
+    )
+    options_model = PyomoOptions
+
+    @classmethod
+    def available(cls) -> Availability:
+        try:
+            from pyomo.version import version
+
+            exe = find_executable("auto")
+            runs = pyomo_solver(exe).available(exception_flag=False)
+        except ImportError as err:
+            return Availability(False, f"pyomo does not import: {err}")
+        except BackendError as err:
+            return Availability(False, str(err))
+        if not runs:
+            return Availability(False, f"{exe.name} at {exe.path} does not run")
+        return Availability(True, f"pyomo {version} with {exe.name} ({exe.origin})")
+
+    def _compile(self, spec: OptimalControlSpec, options: PyomoOptions) -> PyomoModel:
+        return PyomoModel(spec, options)

@@ -1,0 +1,127 @@
+"""A :class:`~gamespec.ocp.transcription.Transcription` as a Pyomo model: the explicit collocation
+of :mod:`gamespec.ocp.collocation`, row for row the NLP the CasADi backend builds, so both backends
+solve the identical discretization.
+
+Variables ``X[i, node]``, ``U[j, point]`` and the horizon ``T``, a Var when the final time is free
+(time scaling ``t = t0 + tau * T``) and a mutable Param otherwise. The problem's parameters are
+mutable Params indexed by name, so a re-solve changes values, not the model. Constraints: the
+defects ``D X - T W F(X, U, t) = 0``, path constraints at every evaluation point and boundary
+constraints over the end values; objective ``Phi + T q^T L`` in minimization form.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Mapping
+from typing import Any
+
+import numpy as np
+
+from gamespec.errors import UnsupportedFeature
+from gamespec.expressions import Relation
+from gamespec.ocp.transcription import Transcription
+from gamespec.ocp.translate import Library, translate
+
+
+def _minimum(a: Any, b: Any) -> Any:
+    return 0.5 * (a + b - abs(a - b))
+
+
+def _maximum(a: Any, b: Any) -> Any:
+    return 0.5 * (a + b + abs(a - b))
+
+
+def _no_atan2(y: Any, x: Any) -> Any:
+    raise UnsupportedFeature(
+        "backend 'pyomo' cannot take atan2: Pyomo's expressions have no atan2, and ripopt "
+        "differentiates the conditional (Expr_if) form wrongly; use the casadi backend"
+    )
+
+
+def pyomo_library() -> Library:
+    """Pyomo's intrinsic functions by gamespec's names (min/max through ``abs``, which the NL
+    format has; no atan2)."""
+    import pyomo.environ as pyo
+
+    return Library(
+        functions={
+            "sin": pyo.sin,
+            "cos": pyo.cos,
+            "tan": pyo.tan,
+            "asin": pyo.asin,
+            "acos": pyo.acos,
+            "atan": pyo.atan,
+            "atan2": _no_atan2,
+            "exp": pyo.exp,
+            "log": pyo.log,
+            "sqrt": pyo.sqrt,
+            "abs": abs,
+            "tanh": pyo.tanh,
+            "min": _minimum,
+            "max": _maximum,
+        }
+    )
+
+
+def _finite(value: float) -> float | None:
+    return value if math.isfinite(value) else None
+
+
+def _relation(rel: Relation, expr: Any) -> Any:
+    """A Pyomo constraint body for ``lower <= expr <= upper`` (an equality when they coincide)."""
+    if rel.is_equality:
+        return expr == rel.lower
+    return (_finite(rel.lower), expr, _finite(rel.upper))
+
+
+def build_model(tr: Transcription, params: Mapping[str, float]) -> Any:
+    """The Pyomo ``ConcreteModel`` of ``tr`` with the Params set to ``params`` and a dual Suffix."""
+    import pyomo.environ as pyo
+
+    ocp, grid = tr.ocp, tr.grid
+    lib = pyomo_library()
+    D, W, q = grid.matrices
+    k = len(grid.eval_index)
+    m = pyo.ConcreteModel(name=tr.spec.name)
+    m.p = pyo.Param(ocp.parameters, mutable=True, initialize=dict(params))
+    m.X = pyo.Var(range(tr.n_x), range(grid.n_nodes), initialize=0.0)
+    m.U = pyo.Var(range(tr.n_u), range(k), initialize=0.0)
+    if tr.free_time:
+        m.T = pyo.Var(initialize=1.0)
+    else:
+        m.T = pyo.Param(mutable=True, initialize=1.0)
+    symbols = {s: m.p[name] for s, name in zip(ocp.p, ocp.parameters, strict=True)}
+
+    F = np.empty((tr.n_x, k), dtype=object)
+    L = []
+    path = []
+    for col, (node, tau) in enumerate(zip(grid.eval_index, grid.eval_tau, strict=True)):
+        values = symbols | {ocp.t: tr.t0 + tau * m.T}
+        values |= {s: m.X[i, int(node)] for i, s in enumerate(ocp.x)}
+        values |= {s: m.U[j, col] for j, s in enumerate(ocp.u)}
+        F[:, col] = [translate(f, values, lib) for f in ocp.dynamics]
+        L.append(translate(ocp.lagrange, values, lib))
+        path.append([_relation(r, translate(r.expr, values, lib)) for r in ocp.path])
+
+    def defect(_m: Any, i: int, row: int) -> Any:
+        dx = sum(v * m.X[i, int(c)] for c, v in _row(D, row))
+        return dx - m.T * sum(v * F[i, int(c)] for c, v in _row(W, row)) == 0
+
+    m.defect = pyo.Constraint(range(tr.n_x), range(D.shape[0]), rule=defect)
+    m.path = pyo.Constraint(range(len(ocp.path)), range(k), rule=lambda _m, r, col: path[col][r])
+
+    ends = symbols | {ocp.tf: tr.t0 + m.T}
+    ends |= {s: m.X[i, 0] for i, s in enumerate(ocp.x0)}
+    ends |= {s: m.X[i, grid.n_nodes - 1] for i, s in enumerate(ocp.xf)}
+    boundary = [_relation(r, translate(r.expr, ends, lib)) for r in ocp.boundary]
+    m.boundary = pyo.Constraint(range(len(boundary)), rule=lambda _m, r: boundary[r])
+    running = sum(float(w) * term for w, term in zip(q, L, strict=True))
+    m.objective = pyo.Objective(expr=translate(ocp.mayer, ends, lib) + m.T * running)
+    m.dual = pyo.Suffix(direction=pyo.Suffix.IMPORT)
+    return m
+
+
+def _row(matrix: Any, row: int) -> zip:
+    """Column indices and values of one row of a CSR matrix."""
+    lo, hi = matrix.indptr[row], matrix.indptr[row + 1]
+    return zip(matrix.indices[lo:hi], matrix.data[lo:hi], strict=True)

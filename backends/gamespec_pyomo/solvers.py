@@ -1,0 +1,125 @@
+"""The NLP executables the Pyomo backend drives through AMPL NL/SOL files, and their statuses.
+
+No pip package ships Ipopt's executable, but ``pyomo-ripopt`` bundles ``ripopt``, an interior-point
+solver with the same AMPL interface, options and return statuses. ``auto`` takes an ``ipopt``
+executable on PATH when there is one and the bundled ``ripopt`` otherwise.
+"""
+
+from __future__ import annotations
+
+import importlib.util
+import os
+import re
+import shutil
+from dataclasses import dataclass
+from importlib.metadata import PackageNotFoundError, version
+from pathlib import Path
+from typing import Any
+
+from gamespec.errors import BackendError
+from gamespec.result import Status
+
+SOLVERS = ("ripopt", "ipopt")
+
+STATUS_MAP: dict[str, Status] = {
+    "optimal": Status.OPTIMAL,
+    "locallyOptimal": Status.OPTIMAL,
+    "globallyOptimal": Status.OPTIMAL,
+    "feasible": Status.FEASIBLE,
+    "infeasible": Status.INFEASIBLE,
+    "locallyInfeasible": Status.INFEASIBLE,
+    "unbounded": Status.UNBOUNDED,
+    "maxIterations": Status.ITERATION_LIMIT,
+    "maxEvaluations": Status.ITERATION_LIMIT,
+    "maxTimeLimit": Status.TIME_LIMIT,
+    "internalSolverError": Status.NUMERICAL_ERROR,
+    "solverFailure": Status.ERROR,
+    "error": Status.ERROR,
+}
+"""Pyomo's ``TerminationCondition`` (read from the SOL file's solve code) → gamespec's Status."""
+
+PRINT_LEVEL = {"ripopt": 1, "ipopt": 3}
+"""The lowest print level at which each executable still reports its iteration count."""
+
+_ITERATIONS = re.compile(r"^\s*(?:iterations:|Number of Iterations\.*:)\s*(\d+)", re.MULTILINE)
+_SECONDS = re.compile(r"^\s*(?:wall_time:|Total seconds in IPOPT\s*=)\s*([0-9.eE+-]+)", re.MULTILINE)
+
+
+@dataclass(frozen=True)
+class Executable:
+    """An NLP solver executable: its Pyomo solver name, its path and where it came from."""
+
+    name: str
+    path: str
+    origin: str
+
+
+def _bundled_ripopt() -> Executable | None:
+    spec = importlib.util.find_spec("pyomo_ripopt")
+    if spec is None or spec.origin is None:
+        return None
+    path = Path(spec.origin).parent / "bin" / "ripopt"
+    if not (path.is_file() and os.access(path, os.X_OK)):
+        return None
+    try:
+        release = version("pyomo-ripopt")
+    except PackageNotFoundError:
+        release = "?"
+    return Executable("ripopt", str(path), f"bundled with pyomo-ripopt {release}")
+
+
+def _on_path(name: str) -> Executable | None:
+    path = shutil.which(name)
+    return Executable(name, path, "on PATH") if path else None
+
+
+def find_executable(choice: str = "auto") -> Executable:
+    """The executable for ``choice`` (``auto``, ``ripopt`` or ``ipopt``); BackendError saying why
+    there is none."""
+    found = {"ipopt": _on_path("ipopt"), "ripopt": _bundled_ripopt() or _on_path("ripopt")}
+    if choice == "auto":
+        exe = found["ipopt"] or found["ripopt"]
+    elif choice in SOLVERS:
+        exe = found[choice]
+    else:
+        raise BackendError(f"unknown Pyomo NLP solver {choice!r} (use auto, {', '.join(SOLVERS)})")
+    if exe is None:
+        why = {
+            "auto": "pyomo-ripopt's bundled ripopt is missing and no ipopt or ripopt is on PATH",
+            "ripopt": "pyomo-ripopt's bundled ripopt is missing and none is on PATH",
+            "ipopt": "no ipopt executable on PATH (pip ships none; the bundled ripopt is solver 'ripopt')",
+        }
+        raise BackendError(why[choice])
+    return exe
+
+
+def pyomo_solver(exe: Executable) -> Any:
+    """Pyomo's NL-file solver for ``exe``: the ``ripopt`` plugin (registered by importing
+    pyomo_ripopt) or Pyomo's own ``ipopt`` plugin, both AMPL-interface solvers."""
+    from pyomo.environ import SolverFactory
+
+    if exe.name == "ripopt" and importlib.util.find_spec("pyomo_ripopt") is not None:
+        importlib.import_module("pyomo_ripopt")
+    return SolverFactory(exe.name, executable=exe.path)
+
+
+def status_of(termination: str, message: str) -> Status:
+    """gamespec's Status for a Pyomo termination condition; Ipopt's (and ripopt's) 'Solved To
+    Acceptable Level' has an optimal solve code but is only feasible to the acceptable tolerances."""
+    status = STATUS_MAP.get(termination, Status.ERROR)
+    if status is Status.OPTIMAL and "acceptable level" in message.lower():
+        return Status.FEASIBLE
+    return status
+
+
+def iterations_in(log: str) -> int | None:
+    """The iteration count printed by ripopt (``iterations: N``) or Ipopt (``Number of Iterations``)."""
+    match = _ITERATIONS.search(log)
+    return int(match.group(1)) if match else None
+
+
+def solver_seconds_in(log: str) -> float | None:
+    """The solver's own wall time, printed by ripopt (``wall_time: 0.16s``) or Ipopt 3.14 (``Total
+    seconds in IPOPT = 0.16``): the solve time less NL writing and process start."""
+    match = _SECONDS.search(log)
+    return float(match.group(1)) if match else None

@@ -1,0 +1,1 @@
+"""qpsolvers backend plugin (ProxSuite's proxqp by default; any installed qpsolvers solver by name)."""

@@ -1,0 +1,59 @@
+"""Monte Carlo check of a solution: sample ``x_0`` and the noise, run the closed loop, and compare the
+sample mean and covariance with the propagated ones (eq. 4.18 and 4.54).
+
+The players use ``u_k = ū_k + K_k y_k``, ``v_k = v̄_k + L_k y_k`` with ``y`` the noise-only state of
+eq. 4.52, simulated alongside ``x`` with the same draws.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from gamespec.lqgame.game import LQGame, Strategies
+
+
+def simulate(game: LQGame, strategies: Strategies, samples: int, seed: int = 0) -> np.ndarray:
+    """Closed-loop trajectories of eq. 4.1 for ``samples`` draws, as an array (samples, N+1, n)."""
+    rng = np.random.default_rng(seed)
+    x = rng.multivariate_normal(game.mu0, game.Sigma0, size=samples, method="eigh")
+    y = x - game.mu0
+    out = np.empty((samples, game.N + 1, game.n))
+    out[:, 0] = x
+    for k in range(game.N):
+        u = strategies.U[k] + y @ strategies.K[k].T
+        v = strategies.V[k] + y @ strategies.L[k].T
+        noise = rng.standard_normal((samples, game.r)) @ game.D[k].T
+        x = x @ game.A[k].T + u @ game.B[k].T + v @ game.C[k].T + noise
+        y = y @ game.A[k].T + noise
+        out[:, k + 1] = x
+    return out
+
+
+@dataclass(frozen=True)
+class SampleAgreement:
+    """Largest deviations of sample statistics from the predicted ones, in standard errors."""
+
+    mean_z: float
+    covariance_z: float
+
+
+def agreement(trajectories: np.ndarray, mean: np.ndarray, covariance: np.ndarray) -> SampleAgreement:
+    """Largest ``|sample − predicted| / standard error`` over steps and entries.
+
+    Standard errors for ``M`` Gaussian samples: ``sqrt(Σ_ii / M)`` for a mean, and
+    ``sqrt((Σ_ii Σ_jj + Σ_ij²) / M)`` for a covariance entry. Entries with zero predicted spread
+    (e.g. a deterministic start) are compared on an absolute floor of 1e-12.
+    """
+    M = trajectories.shape[0]
+    sample_mean = trajectories.mean(axis=0)
+    centred = trajectories - sample_mean
+    sample_cov = np.einsum("sti,stj->tij", centred, centred) / (M - 1)
+    var = np.einsum("tii->ti", covariance)
+    mean_se = np.sqrt(np.maximum(var, 1e-24) / M)
+    cov_se = np.sqrt((var[:, :, None] * var[:, None, :] + covariance**2 + 1e-24) / M)
+    return SampleAgreement(
+        mean_z=float(np.max(np.abs(sample_mean - mean) / mean_se)),
+        covariance_z=float(np.max(np.abs(sample_cov - covariance) / cov_se)),
+    )

@@ -1,0 +1,184 @@
+"""What every backend of the ``lq_stochastic_game`` kind shares: the game built once, and the Result.
+
+A backend supplies the mean steering solution (a QP, section 4.3) and the covariance gains
+(eq. 4.59 or Algorithm 2, section 4.4); :func:`assemble` joins them by Props. 7–8
+(``U = Ū + K y``), recomputes the terminal statistics, the closed-form gap, the Monte Carlo check,
+and packs the Result.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from gamespec.lqgame.checks import Assumptions, check_assumptions
+from gamespec.lqgame.covariance import CovarianceGame, vector_to_gains
+from gamespec.lqgame.game import LQGame, Strategies
+from gamespec.lqgame.lifting import Lifted, lift
+from gamespec.lqgame.mean_steering import MeanGame
+from gamespec.lqgame.montecarlo import agreement, simulate
+from gamespec.result import Result, Status
+
+
+@dataclass
+class GameModel:
+    """A game with its lifted matrices, mean and covariance games and assumption checks, built once."""
+
+    game: LQGame
+    lifted: Lifted
+    mean: MeanGame
+    covariance: CovarianceGame
+    assumptions: Assumptions
+
+    @classmethod
+    def build(cls, game: LQGame) -> GameModel:
+        lifted = lift(game)
+        mean = MeanGame(game, lifted)
+        covariance = CovarianceGame(game, lifted)
+        return cls(game, lifted, mean, covariance, check_assumptions(mean, covariance))
+
+    def assumption_failure(self) -> str | None:
+        """Why the game violates the convexity–concavity assumptions of chapter 4, or None."""
+        a = self.assumptions
+        if not a.saddle_condition:
+            return f"eq. 4.27 fails: λ_min(S̄ − 𝒞ᵀQ̄𝒞) = {a.stopper_concavity_min_eig:.3g} ≤ 0"
+        if a.covariance_convexity_min_eig <= 0:
+            return "J_Σ is not strictly convex in K (Σ_s ⊗ (ℬᵀQ̄ℬ + R̄) on the gain structure)"
+        if a.covariance_concavity_max_eig >= 0:
+            return "J_Σ is not strictly concave in L (Σ_s ⊗ (𝒞ᵀQ̄𝒞 − S̄) on the gain structure)"
+        return None
+
+    def unreachable_mean(self) -> str | None:
+        """Lemma 11's verdict on the terminal mean as a message, or None when it can be reached."""
+        reach = self.assumptions.reachability
+        if reach.reachable:
+            return None
+        return (
+            f"terminal mean unreachable in the upper game (Lemma 11): rank 𝒢 = {reach.rank}, "
+            f"state components {reach.unreachable_components} cannot be steered "
+            f"(residual {reach.residual:.3g}); mean shown reaches the target's reachable part"
+        )
+
+
+@dataclass
+class MeanOutcome:
+    """Stacked mean inputs ``Ū``, ``V̄`` and how the solve went."""
+
+    U: np.ndarray
+    V: np.ndarray
+    status: Status
+    message: str = ""
+    iterations: int | None = None
+    solve_time_s: float = 0.0
+
+
+@dataclass
+class CovarianceOutcome:
+    """Vectorized gains ``κ``, ``ℓ`` (see :mod:`gamespec.lqgame.covariance`) and how they were found."""
+
+    kappa: np.ndarray
+    ell: np.ndarray
+    status: Status
+    method: str
+    message: str = ""
+    iterations: int = 0
+    history: list[tuple[float, float]] = field(default_factory=list)
+    min_covariance_scaling: float | None = None
+    solve_time_s: float = 0.0
+
+
+def unconstrained_covariance(model: GameModel, note: str = "") -> CovarianceOutcome:
+    """The UCSG gains of eq. 4.59 (closed form)."""
+    kappa, ell = model.covariance.unconstrained_saddle()
+    return CovarianceOutcome(kappa, ell, Status.OPTIMAL, "unconstrained saddle (eq. 4.59)", note)
+
+
+def fallback_mean(model: GameModel, status: Status, message: str) -> MeanOutcome:
+    """Prop. 10's closed form (least squares where 𝒢 is deficient) with a failed status."""
+    U, V = model.mean.upper_game()
+    return MeanOutcome(U, V, status, message)
+
+
+def _combined_status(mean: MeanOutcome, cov: CovarianceOutcome) -> Status:
+    """The first failed part's status; else ``feasible`` if either part is, else ``optimal``."""
+    for status in (mean.status, cov.status):
+        if not status.ok:
+            return status
+    return Status.OPTIMAL if Status.FEASIBLE not in (mean.status, cov.status) else Status.FEASIBLE
+
+
+def assemble(
+    model: GameModel,
+    mean: MeanOutcome,
+    cov: CovarianceOutcome,
+    state_names: list[str],
+    samples: int,
+    seed: int,
+) -> Result:
+    """The Result of one solve, with checks recomputed from the strategies (not from the solver)."""
+    game = model.game
+    N, n = game.N, game.n
+    K = vector_to_gains(cov.kappa, game.m, n)
+    L = vector_to_gains(cov.ell, game.ell, n)
+    strategies = Strategies(mean.U.reshape(N, game.m), mean.V.reshape(N, game.ell), K, L)
+    means = model.mean.trajectory(mean.U, mean.V)
+    covariances = model.covariance.state_covariances(K, L)
+    closed_U, _ = model.mean.upper_game()
+    checks: dict[str, float | None] = {
+        "mean_closed_form_gap": float(np.max(np.abs(mean.U - closed_U))),
+        "stopper_response_gap": float(np.max(np.abs(cov.ell - model.covariance.stopper_response(cov.kappa)))),
+    }
+    metrics: dict[str, object] = {
+        "terminal_mean": means[-1].tolist(),
+        "terminal_covariance": covariances[-1].tolist(),
+        "iterations": cov.iterations,
+        "covariance_game": cov.method,
+        "convergence_history": [list(h) for h in cov.history],
+        "mean_payoff": model.mean.payoff(mean.U, mean.V),
+        "covariance_payoff": model.covariance.payoff(cov.kappa, cov.ell),
+        **model.assumptions.as_metrics(),
+    }
+    arrays: dict[str, np.ndarray] = {"mean": means, "covariance": covariances, "K": K, "L": L}
+    if game.muN is not None:
+        given = ~np.isnan(game.muN)
+        metrics["target_mean"] = [float(v) if ok else None for v, ok in zip(game.muN, given, strict=True)]
+        checks["terminal_mean_error"] = float(np.max(np.abs(means[-1][given] - game.muN[given]), initial=0.0))
+        arrays["target_mean"] = game.muN
+    if game.SigmaN is not None:
+        metrics["target_covariance"] = game.SigmaN.tolist()
+        excess = np.linalg.eigvalsh(covariances[-1] - game.SigmaN).max()
+        checks["terminal_covariance_violation"] = float(max(excess, 0.0))
+        arrays["target_covariance"] = game.SigmaN
+    violations = [checks[k] for k in ("terminal_mean_error", "terminal_covariance_violation") if k in checks]
+    if violations:
+        checks["max_constraint_violation"] = max(violations)
+    if cov.min_covariance_scaling is not None:
+        metrics["min_covariance_scaling"] = cov.min_covariance_scaling
+    if cov.history:
+        arrays["convergence_history"] = np.array(cov.history)
+    if samples > 1:
+        trajectories = simulate(game, strategies, samples, seed)
+        fit = agreement(trajectories, means, covariances)
+        checks["monte_carlo_mean_z"] = fit.mean_z
+        checks["monte_carlo_covariance_z"] = fit.covariance_z
+        metrics["monte_carlo"] = {"samples": samples, "seed": seed}
+        arrays["samples"] = trajectories
+    time = np.arange(N + 1) * game.dt
+    controls = {f"u{i + 1}": strategies.U[:, i] for i in range(game.m)}
+    controls |= {f"v{i + 1}": strategies.V[:, i] for i in range(game.ell)}
+    return Result(
+        status=_combined_status(mean, cov),
+        message="; ".join(m for m in (mean.message, cov.message) if m),
+        objective=metrics["mean_payoff"] + metrics["covariance_payoff"],
+        t_final=float(time[-1]),
+        solve_time_s=mean.solve_time_s + cov.solve_time_s,
+        iterations=cov.iterations,
+        time=time,
+        control_time=time[:-1],
+        states={name: means[:, i] for i, name in enumerate(state_names)},
+        controls=controls,
+        arrays=arrays,
+        checks=checks,
+        metrics=metrics,
+    )

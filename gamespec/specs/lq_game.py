@@ -1,0 +1,309 @@
+"""The ``lq_stochastic_game`` kind: the discrete-time LQ stochastic game of eq. 4.1 (chapter 4).
+
+A file gives the model either in discrete form (``A, B, C, D``, each constant or ``per_step``) or as
+a continuous model (``A, B, C`` and the noise input) discretized with step ``step`` by a zero-order
+hold (eq. 4.70); the weights ``Q, R, S`` (eq. 4.4, constant or per step); the initial Gaussian; and
+optionally the controller's terminal mean and covariance (eq. 4.11). A ``null`` entry of the
+terminal mean leaves that component free. Every matrix entry is a number or an expression over
+``parameters``; a matrix is a list of rows, ``{diag: [...]}`` or ``{identity: scale}`` (square:
+n × n for ``A, B, C, D``, ``Q`` and the covariances, m × m for ``R``, ℓ × ℓ for ``S``).
+:meth:`LQGameSpec.game` evaluates all of it into an :class:`~gamespec.lqgame.game.LQGame`.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+from typing import Literal
+
+import numpy as np
+import sympy as sp
+from pydantic import Field, model_validator
+
+from gamespec.errors import ExpressionError, SpecError
+from gamespec.expressions import RESERVED, parse, symbol
+from gamespec.lqgame.game import LQGame, zero_order_hold
+from gamespec.specs.base import SpecBase, StrictModel
+
+Value = float | str
+"""A number, or an expression over the problem's parameters."""
+
+
+class Diagonal(StrictModel):
+    """A diagonal matrix."""
+
+    diag: list[Value] = Field(min_length=1)
+
+
+class Identity(StrictModel):
+    """``scale · I`` of the size the slot needs."""
+
+    identity: Value = 1.0
+
+
+MatrixValue = list[list[Value]] | Diagonal | Identity
+
+
+class PerStep(StrictModel):
+    """One matrix per step k = 0 … N−1."""
+
+    per_step: list[MatrixValue] = Field(min_length=1)
+
+
+StepMatrix = MatrixValue | PerStep
+
+
+class DiscreteModel(StrictModel):
+    """``x_{k+1} = A_k x_k + B_k u_k + C_k v_k + D_k w_k`` (eq. 4.1)."""
+
+    A: StepMatrix
+    B: StepMatrix
+    C: StepMatrix
+    D: StepMatrix
+
+
+class ContinuousModel(StrictModel):
+    """``ẋ = A x + B u + C v + noise · w`` held constant over each ``step`` (eq. 4.68–4.70)."""
+
+    A: MatrixValue
+    B: MatrixValue
+    C: MatrixValue
+    noise: MatrixValue
+    step: Value
+
+
+class CostWeights(StrictModel):
+    """Weights of the payoff eq. 4.4: state ``Q``, controller ``R`` and stopper ``S``."""
+
+    Q: StepMatrix
+    R: StepMatrix
+    S: StepMatrix
+
+
+class InitialDistribution(StrictModel):
+    """``x_0 ~ N(mean, covariance)``."""
+
+    mean: list[Value] = Field(min_length=1)
+    covariance: MatrixValue
+
+
+class TerminalTarget(StrictModel):
+    """The controller's terminal target ``x_N ~ N(mean, covariance)`` (eq. 4.11); each part optional."""
+
+    mean: list[Value | None] | None = None
+    covariance: MatrixValue | None = None
+
+
+class LQGameProblem(StrictModel):
+    """The mathematics of the game."""
+
+    parameters: dict[str, float] = Field(default_factory=dict)
+    horizon: int = Field(ge=1, le=10_000, description="Number of steps N.")
+    states: list[str] | None = Field(None, description="State names (default x1, x2, ...).")
+    discrete: DiscreteModel | None = None
+    continuous: ContinuousModel | None = None
+    cost: CostWeights
+    initial: InitialDistribution
+    terminal: TerminalTarget = Field(default_factory=TerminalTarget)
+
+    @model_validator(mode="after")
+    def _one_model(self) -> LQGameProblem:
+        if (self.discrete is None) == (self.continuous is None):
+            raise ValueError("give exactly one of 'discrete' and 'continuous'")
+        for name in self.parameters:
+            if not name.isidentifier() or name in RESERVED:
+                raise ValueError(f"{name!r} cannot be a parameter name (reserved or not an identifier)")
+        if self.states is not None and len(self.states) != len(self.initial.mean):
+            raise ValueError(f"{len(self.states)} state names for {len(self.initial.mean)} states")
+        return self
+
+
+class MonteCarloSpec(StrictModel):
+    """Closed-loop samples drawn after the solve (0 to skip)."""
+
+    samples: int = Field(100, ge=0, le=1_000_000)
+    seed: int = 0
+
+
+class LQMethodSpec(StrictModel):
+    """Stopping rule of the Jacobi procedure (Algorithm 2) and the Monte Carlo check."""
+
+    tolerance: float = Field(1e-5, gt=0, description="Bound on ε_k and ε_ℓ (section 4.5).")
+    max_iterations: int = Field(100, ge=1)
+    monte_carlo: MonteCarloSpec = Field(default_factory=MonteCarloSpec)
+
+
+class LQGameSpec(SpecBase):
+    """An LQ stochastic game with one-sided terminal mean/covariance constraints (chapter 4)."""
+
+    kind: Literal["lq_stochastic_game"] = "lq_stochastic_game"
+    problem: LQGameProblem
+    method: LQMethodSpec = Field(default_factory=LQMethodSpec)
+
+    default_backend = "cvxpy"
+
+    @model_validator(mode="after")
+    def _evaluates(self) -> LQGameSpec:
+        self.game()
+        return self
+
+    def required_features(self) -> frozenset[str]:
+        """Every backend of this kind must solve the mean game; the terminal covariance is not
+        required, so that the ``qp`` backend (which does not enforce it, and says so in its
+        Result) can still solve and compare the mean game of any file."""
+        return frozenset({"mean_steering"})
+
+    @property
+    def state_names(self) -> list[str]:
+        """The declared state names, or x1, x2, ..."""
+        n = len(self.problem.initial.mean)
+        return self.problem.states or [f"x{i + 1}" for i in range(n)]
+
+    def game(self, parameters: Mapping[str, float] | None = None) -> LQGame:
+        """The numeric game for the file's parameter values, updated by ``parameters``."""
+        unknown = set(parameters or {}) - set(self.problem.parameters)
+        if unknown:
+            raise SpecError(f"unknown parameter(s) {sorted(unknown)}", field="problem.parameters")
+        values = {**self.problem.parameters, **(parameters or {})}
+        return _Evaluator(self.problem, values).game()
+
+
+class _Evaluator:
+    """Evaluates a problem's entries for given parameter values (parse, then substitute; no eval)."""
+
+    def __init__(self, problem: LQGameProblem, values: Mapping[str, float]) -> None:
+        self.problem = problem
+        self.symbols = {name: symbol(name) for name in values}
+        self.substitution = {symbol(name): sp.Float(v) for name, v in values.items()}
+
+    def scalar(self, value: Value, field: str) -> float:
+        if not isinstance(value, str):
+            return float(value)
+        try:
+            number = parse(value, self.symbols).xreplace(self.substitution)
+            result = complex(number)
+        except ExpressionError as err:
+            raise SpecError(str(err), field=f"problem.{field}") from None
+        except (TypeError, ValueError):
+            raise SpecError(f"{value!r} does not evaluate to a number", field=f"problem.{field}") from None
+        if result.imag != 0 or not np.isfinite(result.real):
+            raise SpecError(f"{value!r} evaluates to {result}", field=f"problem.{field}")
+        return result.real
+
+    def vector(self, values: list[Value], field: str) -> np.ndarray:
+        return np.array([self.scalar(v, f"{field}.{i}") for i, v in enumerate(values)])
+
+    def matrix(self, value: MatrixValue, size: int, field: str) -> np.ndarray:
+        if isinstance(value, Identity):
+            return self.scalar(value.identity, f"{field}.identity") * np.eye(size)
+        if isinstance(value, Diagonal):
+            return np.diag(self.vector(value.diag, f"{field}.diag"))
+        widths = {len(row) for row in value}
+        if len(widths) != 1 or 0 in widths:
+            raise SpecError("rows must be non-empty and of equal length", field=f"problem.{field}")
+        return np.array(
+            [[self.scalar(v, f"{field}.{i}.{j}") for j, v in enumerate(row)] for i, row in enumerate(value)]
+        )
+
+    def shaped(self, value: MatrixValue, rows: int, cols: int | None, field: str) -> np.ndarray:
+        M = self.matrix(value, rows, field)
+        if M.shape[0] != rows or (cols is not None and M.shape[1] != cols):
+            want = f"{rows}×{cols}" if cols is not None else f"{rows} rows"
+            raise SpecError(f"expected {want}, got {M.shape[0]}×{M.shape[1]}", field=f"problem.{field}")
+        return M
+
+    def steps(self, value: StepMatrix, rows: int, cols: int | None, field: str) -> np.ndarray:
+        """(N, rows, cols): one matrix repeated, or the ``per_step`` list (of length N)."""
+        N = self.problem.horizon
+        if isinstance(value, PerStep):
+            if len(value.per_step) != N:
+                raise SpecError(
+                    f"per_step needs {N} matrices (one per step), got {len(value.per_step)}",
+                    field=f"problem.{field}.per_step",
+                )
+            first = self.shaped(value.per_step[0], rows, cols, f"{field}.per_step.0")
+            rest = [
+                self.shaped(m, rows, first.shape[1], f"{field}.per_step.{k}")
+                for k, m in enumerate(value.per_step[1:], start=1)
+            ]
+            return np.stack([first, *rest])
+        return np.repeat(self.shaped(value, rows, cols, field)[None], N, axis=0)
+
+    def dynamics(self, n: int) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, float]:
+        p = self.problem
+        if p.discrete is not None:
+            d = p.discrete
+            return (
+                self.steps(d.A, n, n, "discrete.A"),
+                self.steps(d.B, n, None, "discrete.B"),
+                self.steps(d.C, n, None, "discrete.C"),
+                self.steps(d.D, n, None, "discrete.D"),
+                1.0,
+            )
+        c = p.continuous
+        dt = self.scalar(c.step, "continuous.step")
+        if dt <= 0:
+            raise SpecError("the step must be positive", field="problem.continuous.step")
+        A, (B, C, D) = zero_order_hold(
+            self.shaped(c.A, n, n, "continuous.A"),
+            [
+                self.shaped(m, n, None, f"continuous.{k}")
+                for k, m in (("B", c.B), ("C", c.C), ("noise", c.noise))
+            ],
+            dt,
+        )
+        N = p.horizon
+        A, B, C, D = (np.repeat(M[None], N, axis=0) for M in (A, B, C, D))
+        return A, B, C, D, dt
+
+    def covariance(self, value: MatrixValue, n: int, field: str) -> np.ndarray:
+        M = self.shaped(value, n, n, field)
+        if not np.allclose(M, M.T) or np.linalg.eigvalsh(M).min() < -1e-12 * max(1.0, np.abs(M).max()):
+            raise SpecError("a covariance must be symmetric positive semidefinite", field=f"problem.{field}")
+        return M
+
+    def game(self) -> LQGame:
+        p = self.problem
+        mu0 = self.vector(p.initial.mean, "initial.mean")
+        n = mu0.size
+        A, B, C, D, dt = self.dynamics(n)
+        m, ell = B.shape[2], C.shape[2]
+        Q = self.steps(p.cost.Q, n, n, "cost.Q")
+        R = self.steps(p.cost.R, m, m, "cost.R")
+        S = self.steps(p.cost.S, ell, ell, "cost.S")
+        for name, W, strict in (("Q", Q, False), ("R", R, True), ("S", S, True)):
+            eig = min(np.linalg.eigvalsh((M + M.T) / 2).min() for M in W)
+            if eig < 0 or (strict and eig == 0):
+                need = "positive definite" if strict else "positive semidefinite"
+                raise SpecError(f"{name}_k must be {need} (eq. 4.4)", field=f"problem.cost.{name}")
+        muN = None
+        if p.terminal.mean is not None:
+            if len(p.terminal.mean) != n:
+                raise SpecError(f"expected {n} entries", field="problem.terminal.mean")
+            muN = np.array(
+                [
+                    np.nan if v is None else self.scalar(v, f"terminal.mean.{i}")
+                    for i, v in enumerate(p.terminal.mean)
+                ]
+            )
+        SigmaN = None
+        if p.terminal.covariance is not None:
+            SigmaN = self.covariance(p.terminal.covariance, n, "terminal.covariance")
+            if np.linalg.eigvalsh(SigmaN).min() <= 0:
+                raise SpecError(
+                    "the terminal covariance must be positive definite (Lemma 13)",
+                    field="problem.terminal.covariance",
+                )
+        return LQGame(
+            A=A,
+            B=B,
+            C=C,
+            D=D,
+            Q=Q,
+            R=R,
+            S=S,
+            mu0=mu0,
+            Sigma0=self.covariance(p.initial.covariance, n, "initial.covariance"),
+            muN=muN,
+            SigmaN=SigmaN,
+            dt=dt,
+        )

@@ -1,0 +1,122 @@
+"""Covariance steering (section 4.4): the vectorized payoff against eq. 4.56, the UCSG of eq. 4.59,
+the players' CVXPY problems against closed forms, Algorithm 2 against the terminal constraint eq. 4.61,
+and the smallest achievable scaling of Σ_N when the constraint cannot be met."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from gamespec_cvxpy.backend import CovariancePlayers, CvxpyOptions
+from scipy.linalg import sqrtm
+
+from gamespec.lqgame.covariance import lift_gains, vector_to_gains
+from gamespec.lqgame.solution import GameModel
+from gamespec.result import Status
+from tests.lqgame.conftest import random_game
+
+
+def _direct_payoff(model: GameModel, kappa: np.ndarray, ell: np.ndarray) -> float:
+    """eq. 4.56 written out with the block matrices of eq. 4.55."""
+    g, lifted = model.game, model.lifted
+    K = lift_gains(vector_to_gains(kappa, g.m, g.n))
+    L = lift_gains(vector_to_gains(ell, g.ell, g.n))
+    M = np.eye(lifted.Sigma_s.shape[0]) + lifted.B @ K + lifted.C @ L
+    return float(np.trace((M.T @ lifted.Q @ M + K.T @ lifted.R @ K - L.T @ lifted.S @ L) @ lifted.Sigma_s))
+
+
+def _random_gains(model: GameModel, seed: int) -> tuple[np.ndarray, np.ndarray]:
+    rng = np.random.default_rng(seed)
+    return rng.standard_normal(model.covariance.g_K.size), rng.standard_normal(model.covariance.g_L.size)
+
+
+def test_quadratic_form_is_eq_4_56(model: GameModel):
+    kappa, ell = _random_gains(model, 0)
+    assert model.covariance.payoff(kappa, ell) == pytest.approx(_direct_payoff(model, kappa, ell), rel=1e-10)
+
+
+def test_unconstrained_saddle_is_stationary_and_a_saddle(model: GameModel):
+    """eq. 4.59: the gradient of eq. 4.56 in the free gain entries vanishes (central differences are
+    exact for a quadratic); J_Σ rises along K and falls along L."""
+    kappa, ell = model.covariance.unconstrained_saddle()
+    z = np.concatenate([kappa, ell])
+    split = kappa.size
+
+    def J(v: np.ndarray) -> float:
+        return _direct_payoff(model, v[:split], v[split:])
+
+    h = 1e-4
+    gradient = [(J(z + h * e) - J(z - h * e)) / (2 * h) for e in np.eye(z.size)]
+    np.testing.assert_allclose(gradient, 0, atol=1e-7)
+    rng = np.random.default_rng(1)
+    value = J(z)
+    for _ in range(10):
+        step = rng.standard_normal(z.size)
+        assert J(np.concatenate([kappa + step[:split], ell])) >= value
+        assert J(np.concatenate([kappa, ell + step[split:]])) <= value
+
+
+def test_terminal_map_is_the_scaled_terminal_factor(model: GameModel):
+    """``vec W = w_0 + T_WK κ + T_WL ℓ`` equals ``Σ_N^{-1/2} E_N (I + ℬK + 𝒞L) F`` (eq. 4.62)."""
+    g, lifted = model.game, model.lifted
+    kappa, ell = _random_gains(model, 2)
+    w0, T_K, T_L = model.covariance.terminal_map()
+    K = lift_gains(vector_to_gains(kappa, g.m, g.n))
+    L = lift_gains(vector_to_gains(ell, g.ell, g.n))
+    M = np.eye(lifted.Sigma_s.shape[0]) + lifted.B @ K + lifted.C @ L
+    W = np.linalg.inv(np.real(sqrtm(g.SigmaN))) @ lifted.terminal(M) @ lifted.F
+    np.testing.assert_allclose(w0 + T_K @ kappa + T_L @ ell, W.T.ravel(), atol=1e-10)
+
+
+def test_cvxpy_stopper_problem_matches_the_closed_form(model: GameModel):
+    players = CovariancePlayers(model, CvxpyOptions())
+    kappa, _ = _random_gains(model, 3)
+    status, ell = players.stopper_step(kappa)
+    assert status is Status.OPTIMAL
+    np.testing.assert_allclose(ell, model.covariance.stopper_response(kappa), atol=1e-6)
+
+
+@pytest.mark.parametrize("seed", [0, 1])
+def test_jacobi_meets_the_terminal_constraint(seed: int):
+    """Algorithm 2 with a target tighter than the UCSG reaches (halfway to the least scaling the
+    controller can meet): Σ_N(K, L) ⪯ Σ_N (eq. 4.61), the stopper's last gains are its best response
+    to the controller's, and the constrained controller pays at least the unconstrained value."""
+    loose = GameModel.build(random_game(seed))
+    kappa, ell = loose.covariance.unconstrained_saddle()
+    g = loose.game
+    free = loose.covariance.state_covariances(
+        vector_to_gains(kappa, g.m, g.n), vector_to_gains(ell, g.ell, g.n)
+    )
+    probe = CovariancePlayers(GameModel.build(type(g)(**{**g.__dict__, "SigmaN": free[-1]})), CvxpyOptions())
+    probe.controller_step(ell)
+    gamma = probe.smallest_scaling()
+    assert gamma < 1
+    target = (1 + gamma) / 2 * free[-1]
+    model = GameModel.build(type(g)(**{**g.__dict__, "SigmaN": target}))
+    outcome = CovariancePlayers(model, CvxpyOptions()).solve(tolerance=1e-7, max_iterations=200)
+    assert outcome.status.ok and outcome.iterations > 0
+    reached = model.covariance.state_covariances(
+        vector_to_gains(outcome.kappa, g.m, g.n), vector_to_gains(outcome.ell, g.ell, g.n)
+    )[-1]
+    assert np.linalg.eigvalsh(target - reached).min() >= -1e-6
+    np.testing.assert_allclose(outcome.ell, model.covariance.stopper_response(outcome.kappa), atol=1e-5)
+    assert model.covariance.payoff(outcome.kappa, outcome.ell) >= loose.covariance.payoff(kappa, ell) - 1e-9
+
+
+def test_smallest_scaling_is_tight():
+    """When Σ_N is out of reach, γ* is the least scaling the controller can meet: γ*(1 + δ) Σ_N is
+    feasible for its first Jacobi step, γ*(1 − δ) Σ_N is not, and γ* is at least the share of the
+    last step's noise, which no gain can remove."""
+    g = random_game(6)
+    last_noise = g.D[-1] @ g.D[-1].T
+    SigmaN = 0.5 * last_noise + 1e-4 * np.eye(g.n)
+    model = GameModel.build(type(g)(**{**g.__dict__, "SigmaN": SigmaN}))
+    outcome = CovariancePlayers(model, CvxpyOptions()).solve(tolerance=1e-7, max_iterations=50)
+    assert outcome.status is Status.INFEASIBLE
+    gamma = outcome.min_covariance_scaling
+    root_inv = np.linalg.inv(np.real(sqrtm(SigmaN)))
+    assert gamma >= np.linalg.eigvalsh(root_inv @ last_noise @ root_inv).max() * (1 - 1e-6)
+    _, ell0 = model.covariance.unconstrained_saddle()
+    for factor, feasible in ((1 + 1e-3, True), (1 - 1e-3, False)):
+        scaled = GameModel.build(type(g)(**{**g.__dict__, "SigmaN": factor * gamma * SigmaN}))
+        status, _ = CovariancePlayers(scaled, CvxpyOptions()).controller_step(ell0)
+        assert status.ok is feasible

@@ -141,3 +141,12 @@ def test_analytic_backend_refuses_relay(cli) -> None:
     code, _, err = cli("solve", FILES[3], "--backend", "analytic")
     assert code == 2
     assert "relay" in err
+
+
+def test_generated_problem_solves_on_every_ocp_backend() -> None:
+    """The generated eq. 2.21 problem is a plain optimal_control spec: pyomo agrees with casadi."""
+    casadi = gamespec.solve(FILES[2], "casadi")
+    pyomo = gamespec.solve(FILES[2], "pyomo")
+    assert pyomo.ok
+    assert pyomo.t_final == pytest.approx(casadi.t_final, rel=1e-6)
+    assert pyomo.metrics["capturing_set"] == casadi.metrics["capturing_set"] == ["P1", "P2"]

@@ -104,10 +104,8 @@ def to_ocp(spec: EngagementSpec) -> tuple[OptimalControlSpec, EngagementInverse]
 
 
 def heading_law(red: Reduction, result: Result) -> HeadingLaw:
-    """The OCP's evader heading as a feedback-free law θ_E(t) for re-simulation.
-
-    In the line-of-sight frame θ_E = θ(t) + φ_1, φ_1 read from the simulated positions.
-    """
+    """The OCP's evader heading as a law for re-simulation: θ_E(t) interpolated in the fixed frame;
+    θ(t) + φ_1 in the line-of-sight frame, φ_1 read from the simulated positions."""
     tc = np.asarray(result.control_time if result.control_time is not None else result.time)
     control = np.asarray(result.controls[red.control])
     if red.frame == "fixed":

@@ -39,7 +39,7 @@ def _solve(path, backend: str | None) -> float:
 def test_ocp_solve(benchmark, case: str) -> None:
     """Load, generate the reduced OCP and its guess, build the NLP, solve, re-simulate."""
     benchmark.group = case
-    benchmark.pedantic(_solve, args=(CASES[case], None), rounds=3, warmup_rounds=1)
+    benchmark.pedantic(_solve, args=(CASES[case], "casadi"), rounds=3, warmup_rounds=1)
 
 
 @pytest.mark.parametrize("case", ANALYTIC)

@@ -40,24 +40,30 @@ def _voronoi(ax: Axes, points: np.ndarray) -> None:
 
 
 def _capture_regions(ax: Axes, result: Result) -> None:
-    """Initial Apollonius circles (CB) or refined Apollonius curves (PP) around each evader."""
+    """Initial Apollonius circles (CB) or refined Apollonius curves (PP) of the pursuers allocated
+    to each evader at t = 0 (one colour per evader; redundant pursuers' regions are left out)."""
     pursuers = result.states["pursuers"][0]
     u = np.asarray(result.metrics["pursuer_speeds"])
+    allocated = result.arrays["allocation"][0]
     angles = np.linspace(-np.pi, np.pi, 361)
-    for evader, v in zip(result.states["evaders"][0], result.metrics["evader_speeds"], strict=True):
+    evaders = zip(result.states["evaders"][0], result.metrics["evader_speeds"], strict=True)
+    for j, (evader, v) in enumerate(evaders):
+        mine = allocated == j
+        colour = plt.get_cmap("tab10")(j % 10)
         if result.metrics["pursuit_strategy"] == "cb":
-            circles = apollonius_circles(pursuers, evader, u, v)
+            circles = apollonius_circles(pursuers[mine], evader, u[mine], v)
             for center, radius in zip(circles.centers, circles.radii, strict=True):
-                ax.add_patch(plt.Circle(center, radius, fill=False, lw=0.6, color="0.55"))
+                ax.add_patch(plt.Circle(center, radius, fill=False, lw=0.7, color=colour, alpha=0.7))
             continue
-        distance = np.linalg.norm(pursuers - evader, axis=1)
-        radius = refined_pp_radius(distance[:, None], angles[None, :], u[:, None], v)
-        direction = line_of_sight_angles(pursuers, evader)[:, None] + angles[None, :]
+        distance = np.linalg.norm(pursuers[mine] - evader, axis=1)
+        radius = refined_pp_radius(distance[:, None], angles[None, :], u[mine][:, None], v)
+        direction = line_of_sight_angles(pursuers[mine], evader)[:, None] + angles[None, :]
         ax.plot(
             (evader[0] + radius * np.cos(direction)).T,
             (evader[1] + radius * np.sin(direction)).T,
-            lw=0.6,
-            color="0.55",
+            lw=0.7,
+            color=colour,
+            alpha=0.7,
         )
 
 
@@ -101,7 +107,7 @@ def plot_scenario(result: Result, output_dir: Path, *, animate: bool = False) ->
     fig, ax = plt.subplots(figsize=(7, 7))
     _frame(ax, result, last, limits)
     _capture_regions(ax, result)
-    ax.set_title(f"{result.problem}: trajectories and initial Apollonius regions")
+    ax.set_title(f"{result.problem}: paths, initial Apollonius regions")
     ax.legend(loc="upper right", fontsize=8)
     written.append(output_dir / "trajectories.png")
     fig.savefig(written[-1], dpi=120)

@@ -106,3 +106,17 @@ def test_several_pursuers_can_beat_every_constant_heading() -> None:
     assert len(plan.headings) == 2
     assert simulated == pytest.approx(plan.capture_time, rel=1e-8)
     assert simulated > constant.capture_time + 0.1
+
+
+@given(st.floats(0.5, 3.5), st.floats(-1.5, 1.5), st.sampled_from([0.6, 1.0, 2.0]))
+@settings(max_examples=20, deadline=None, suppress_health_check=[HealthCheck.filter_too_much])
+def test_two_pursuers_in_n_one_heading_and_simultaneous_capture(x: float, y: float, u2: float) -> None:
+    """Theorem 1 over N: the exact optimum (the linear program) uses one heading, and both pursuers
+    capture at t_c; the thesis's constant heading is optimal here."""
+    assume(regions.classify("cb", [0, 0], np.array([x, y]), [1, 0], 1.0, u2, 0.5) == "N")
+    players = two_pursuers((x, y), "cb", u2=u2, eps=1e-9)
+    plan = cb.optimal_evasion(players)
+    times = cb.capture_times(players, plan.headings)[0]
+    assert len(plan.headings) == 1
+    assert times[0] == pytest.approx(times[1], rel=1e-6)
+    assert plan.capture_time == pytest.approx(cb.best_constant_heading(players).capture_time, rel=1e-9)

@@ -10,7 +10,7 @@ from __future__ import annotations
 import pytest
 
 import gamespec
-from gamespec.pursuit import study
+from gamespec.result import Status
 from tests.conftest import PROBLEMS
 
 CASES = {
@@ -52,6 +52,6 @@ def test_analytic(benchmark, case: str) -> None:
 @pytest.mark.slow
 def test_table_2_1_study_serial(benchmark, tmp_path) -> None:
     """All 720 points of the shipped study file, one process, from an empty store."""
-    spec = study.load_study(PROBLEMS / "ch2" / "pure_pursuit_suboptimal_study.yaml")
-    table = benchmark.pedantic(study.run, args=(spec, tmp_path / "run"), kwargs={"progress": False}, rounds=1)
-    assert all(row["solved"] == row["points"] for row in table)
+    spec = gamespec.load(PROBLEMS / "ch2" / "pure_pursuit_suboptimal_study.yaml", [f"store={tmp_path}"])
+    result = benchmark.pedantic(gamespec.solve, args=(spec,), rounds=1)
+    assert result.status == Status.OPTIMAL, result.message

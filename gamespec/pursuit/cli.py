@@ -13,26 +13,50 @@ from rich.table import Table
 
 pursuit_app = typer.Typer(no_args_is_help=True, help="Pursuit-evasion studies (thesis ch. 2–3).")
 
+TABLE_COLUMNS = ("v", "points", "solved", "average_variation_percent", "maximum_variation_percent")
+
 
 @pursuit_app.command()
 def study(
-    file: Annotated[Path, typer.Argument(help="Study file (study: pure_pursuit_suboptimal_vs_optimal).")],
-    out: Annotated[Path, typer.Option(help="Folder for the per-point results (a rerun resumes).")],
-    workers: Annotated[int, typer.Option(min=1, help="Local processes.")] = 1,
+    file: Annotated[Path, typer.Argument(help="Problem file of kind pursuit_suboptimal_study.")],
+    out: Annotated[
+        Path | None,
+        typer.Option(help="Save the Result and table_2_1.png here, and the points in OUT/points."),
+    ] = None,
+    workers: Annotated[int | None, typer.Option(min=1, help="Local processes (default: the file's).")] = None,
+    set_: Annotated[
+        list[str] | None, typer.Option("--set", help="Override a value: dotted.path=value (repeatable).")
+    ] = None,
     json_: Annotated[bool, typer.Option("--json", help="Print the table as JSON on stdout.")] = False,
 ) -> None:
-    """Table 2.1: suboptimal (eq. 2.27) against optimal evasion from two pure-pursuit pursuers."""
-    from gamespec.pursuit.study import load_study, run
+    """Table 2.1: `gamespec solve` on a pursuit_suboptimal_study file, printed as the table.
 
-    table = run(load_study(file), out, workers=workers)
+    Resumes from the file's ``store`` (or OUT/points); the Result is the one `gamespec solve` gives.
+    """
+    from gamespec.errors import SpecError
+    from gamespec.loader import load
+    from gamespec.plotting import plot_result
+    from gamespec.solving import solve
+
+    overrides = [*(set_ or []), *([f"store={out / 'points'}"] if out is not None else [])]
+    spec = load(file, overrides)
+    if spec.kind != "pursuit_suboptimal_study":
+        raise SpecError(f"expected kind 'pursuit_suboptimal_study', got {spec.kind!r}", field="kind")
+    options = {"progress": True} | ({"workers": workers} if workers is not None else {})
+    result = solve(spec, options=options)
+    if out is not None:
+        result.save(out)
+        plot_result(result, out)
+    table = result.metrics.get("table", [])
     if json_:
         sys.stdout.write(json.dumps(table, indent=2) + "\n")
-        return
-    view = Table(title=f"Table 2.1 — {file.name} (percentage variation of t_c)")
-    columns = ["v", "points", "solved", "average_variation_percent", "maximum_variation_percent"]
-    for col in columns:
-        view.add_column(col.replace("_variation_percent", " [%]"), justify="right")
-    for row in table:
-        view.add_row(*(f"{row[c]:.4g}" if isinstance(row[c], float) else str(row[c]) for c in columns))
-    Console().print(view)
-    Console(stderr=True).print(f"wrote {out / 'table.json'} and {out / 'table_2_1.png'}")
+    else:
+        view = Table(title=f"Table 2.1 — {file.name} (percentage variation of t_c)")
+        for col in TABLE_COLUMNS:
+            view.add_column(col.replace("_variation_percent", " [%]"), justify="right")
+        for row in table:
+            view.add_row(*(f"{row[c]:.4g}" if isinstance(row[c], float) else str(row[c]) for c in TABLE_COLUMNS))
+        Console().print(view)
+    Console(stderr=True).print(f"{result.status.value}: {result.message}", highlight=False)
+    if not result.ok:
+        raise typer.Exit(1)

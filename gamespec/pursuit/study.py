@@ -18,80 +18,26 @@ variation 100 (t_opt − t_sub)/t_opt. Points are saved as they finish (a rerun 
 
 from __future__ import annotations
 
+import hashlib
 import json
 from dataclasses import dataclass
 from functools import cache
-from pathlib import Path
-from typing import Any, Literal
+from typing import Any
 
 import numpy as np
-from pydantic import Field, ValidationError
 
-from gamespec.errors import SpecError
-from gamespec.loader import format_validation_error, read_file
 from gamespec.pursuit import pure_pursuit
 from gamespec.pursuit.reduced import observe, reduce
 from gamespec.pursuit.regions import classify
 from gamespec.pursuit.report import capture_gap, resimulate
 from gamespec.pursuit.simulation import Players
 from gamespec.result import Result, Status
-from gamespec.specs.base import StrictModel
 from gamespec.specs.engagement import EngagementSpec
-from gamespec.specs.ocp import MethodSpec
-from gamespec.studies.executors import executor
-from gamespec.studies.runner import run_study
-from gamespec.studies.store import ResultStore
+from gamespec.specs.suboptimal_study import SuboptimalStudySpec
 from gamespec.transforms.engagement import heading_law, to_ocp
 
 DEFECT_TOL = 1e-3
 """Largest re-integrated defect (``checks.max_defect``) of an accepted optimal solution."""
-
-
-class StudyGrid(StrictModel):
-    """The grid of (r2(0), ψ(0)) per speed (see module doc)."""
-
-    angles: int = Field(16, ge=1, description="Values of psi(0), evenly spread, none on P1's ray.")
-    fractions: int = Field(9, ge=1, description="Values of r2(0) per angle, between F and E.")
-
-
-class SuboptimalStudySpec(StrictModel):
-    """A study file: ``study: pure_pursuit_suboptimal_vs_optimal`` and its settings."""
-
-    study: Literal["pure_pursuit_suboptimal_vs_optimal"]
-    name: str = "table_2_1"
-    description: str = ""
-    r1: float = Field(1.0, gt=0)
-    u: float = Field(1.0, gt=0)
-    speeds: list[float] = Field(default_factory=lambda: [0.3, 0.4, 0.5, 0.6, 0.7], min_length=1)
-    capture_radius: float = Field(0.001, gt=0)
-    grid: StudyGrid = Field(default_factory=StudyGrid)
-    method: MethodSpec = Field(default_factory=lambda: MethodSpec(intervals=40, grading=10.0))
-    refinements: list[dict[str, float]] = Field(
-        default_factory=lambda: [{"intervals": 80}, {"intervals": 60, "grading": 100}],
-        description="Changes to method tried in turn when a solution fails the defect check.",
-    )
-    backend: str = Field("casadi", description="OCP backend for the optimal solutions.")
-
-    def methods(self) -> tuple[str, ...]:
-        """The method, then each refinement applied to it, as validated JSON (tried in turn)."""
-        base = self.method.model_dump()
-        steps = [self.method, *(MethodSpec.model_validate(base | r) for r in self.refinements)]
-        return tuple(m.model_dump_json() for m in steps)
-
-
-def load_study(path: str | Path) -> SuboptimalStudySpec:
-    """Read and validate a study file."""
-    try:
-        spec = SuboptimalStudySpec.model_validate(read_file(path))
-    except ValidationError as err:
-        raise format_validation_error(err, SuboptimalStudySpec, str(path)) from None
-    if any(not 0 < v < spec.u for v in spec.speeds):
-        raise SpecError(f"every speed must lie in (0, u = {spec.u})", field="speeds", source=str(path))
-    try:
-        spec.methods()
-    except ValidationError as err:
-        raise format_validation_error(err, MethodSpec, f"{path}: refinements") from None
-    return spec
 
 
 @dataclass(frozen=True)
@@ -109,7 +55,11 @@ class StudyPoint:
 
     @property
     def key(self) -> str:
-        return f"v={self.v:.6g},r2={self.r2:.9g},psi={self.psi:.9g}"
+        """The point's name in the result store; the hash of everything else it is solved with
+        (r1, u, capture radius, methods, backend) keeps an edited file from reusing stale points."""
+        setup = json.dumps([self.r1, self.u, self.eps, self.methods, self.backend])
+        digest = hashlib.sha256(setup.encode()).hexdigest()[:12]
+        return f"v={self.v:.6g},r2={self.r2:.9g},psi={self.psi:.9g},setup={digest}"
 
 
 def ray_bounds(d: float, u: float, v: float, psi: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -135,7 +85,7 @@ def study_points(spec: SuboptimalStudySpec) -> dict[str, StudyPoint]:
                 if classify("pp", [0.0, 0.0], p2, [spec.r1, 0.0], spec.u, spec.u, v) != "N":
                     continue
                 point = StudyPoint(
-                    v, float(r2), float(psi), spec.r1, spec.u, spec.capture_radius, methods, spec.backend
+                    v, float(r2), float(psi), spec.r1, spec.u, spec.capture_radius, methods, spec.ocp_backend
                 )
                 points[point.key] = point
     return points
@@ -233,44 +183,4 @@ def summarize(rows: list[dict[str, Any]]) -> list[dict[str, Any]]:
                 "suboptimal_better": int(np.sum(solved < 0)),
             }
         )
-    return table
-
-
-def plot_study(rows: list[dict[str, Any]], table: list[dict[str, Any]], path: Path) -> Path:
-    """Percentage variation per point against v, with the average and maximum of Table 2.1."""
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
-    fig, ax = plt.subplots(figsize=(6, 4))
-    solved = [r for r in rows if "variation_percent" in r]
-    ax.scatter([r["v"] for r in solved], [r["variation_percent"] for r in solved], s=8, alpha=0.4)
-    speeds = [t["v"] for t in table]
-    ax.plot(speeds, [t["average_variation_percent"] for t in table], "o-", label="average")
-    ax.plot(speeds, [t["maximum_variation_percent"] for t in table], "s--", label="maximum")
-    ax.set(xlabel="evader speed v", ylabel="100 (t_opt − t_sub)/t_opt  [%]", title="Table 2.1")
-    ax.legend()
-    fig.savefig(path, dpi=120, bbox_inches="tight")
-    plt.close(fig)
-    return path
-
-
-def run(spec: SuboptimalStudySpec, out: Path, *, workers: int = 1, progress: bool = True) -> list[dict]:
-    """Run (or resume) the study into ``out``; return the Table 2.1 rows, also written to
-    ``out/table.json`` with a plot ``out/table_2_1.png``."""
-    out = Path(out)
-    points = study_points(spec)
-    values = run_study(
-        points,
-        evaluate,
-        ResultStore(out / "points"),
-        executor=executor(workers),
-        description=spec.name,
-        show_progress=progress,
-    )
-    rows = list(values.values())
-    table = summarize(rows)
-    (out / "table.json").write_text(json.dumps(table, indent=2))
-    plot_study(rows, table, out / "table_2_1.png")
     return table

@@ -1,21 +1,26 @@
-"""The Table 2.1 study: its grid lies in N, points are saved as they finish, a rerun resumes."""
+"""The Table 2.1 study (kind ``pursuit_suboptimal_study``): its grid lies in N, it runs through
+``gamespec solve``, points are saved as they finish, a rerun resumes, the status says what failed."""
 
 from __future__ import annotations
 
 import json
+from typing import Any
 
 import numpy as np
 import pytest
 
 import gamespec
 from gamespec.pursuit import regions, study
+from gamespec.pursuit.study import StudyPoint
 from tests.conftest import PROBLEMS
 
 STUDY = PROBLEMS / "ch2" / "pure_pursuit_suboptimal_study.yaml"
+TINY = ["--set", "speeds=[0.5]", "--set", "grid.angles=2", "--set", "grid.fractions=2"]
+"""One speed, two angles, two fractions: four points."""
 
 
 def test_shipped_grid_spans_n_only() -> None:
-    spec = study.load_study(STUDY)
+    spec = gamespec.load(STUDY)
     points = study.study_points(spec)
     assert len(points) == len(spec.speeds) * spec.grid.angles * spec.grid.fractions
     for p in points.values():
@@ -39,39 +44,96 @@ def test_ray_bounds_are_the_region_boundaries(v: float) -> None:
     assert np.all(region(1.01 * outer) == "D2")
 
 
-def test_study_saves_points_and_resumes(tmp_path, monkeypatch, cli) -> None:
-    file = tmp_path / "study.yaml"
-    file.write_text(
-        "study: pure_pursuit_suboptimal_vs_optimal\nspeeds: [0.5]\ngrid: {angles: 2, fractions: 1}\n"
-    )
-    code, out, err = cli("pursuit", "study", file, "--out", tmp_path / "run", "--json")
+def test_shipped_file_validates(cli) -> None:
+    code, _, err = cli("validate", STUDY)
     assert code == 0, err
-    table = json.loads(out)
-    assert table[0]["points"] == table[0]["solved"] == 2
-    assert table[0]["average_variation_percent"] >= 0.0
-    assert len(list((tmp_path / "run" / "points").glob("*.json"))) == 2
-    assert (tmp_path / "run" / "table_2_1.png").exists()
 
-    def must_not_run(point):
+
+def test_solve_saves_points_resumes_and_plots(tmp_path, monkeypatch, cli) -> None:
+    store, run = tmp_path / "points", tmp_path / "run"
+    args = ("solve", STUDY, *TINY, "--set", f"store={store}", "--out", run, "--json")
+    code, out, err = cli(*args)
+    assert code == 0, err
+    first = json.loads(out)
+    assert first["status"] == "optimal"
+    assert first["metrics"]["points"] == first["metrics"]["solved"] == first["metrics"]["computed"] == 4
+    assert len(list(store.glob("*.json"))) == 4
+    row = first["metrics"]["table"][0]
+    assert row["points"] == row["solved"] == 4
+    variation = np.array(first["arrays"]["variation_percent"])
+    assert row["average_variation_percent"] == pytest.approx(variation.mean())
+    assert row["maximum_variation_percent"] == pytest.approx(variation.max())
+
+    def must_not_run(point: StudyPoint) -> dict[str, Any]:
         raise AssertionError("a saved point was solved again")
 
     monkeypatch.setattr(study, "evaluate", must_not_run)
-    assert study.run(study.load_study(file), tmp_path / "run", progress=False) == table
+    code, out, err = cli(*args)
+    assert code == 0, err
+    again = json.loads(out)
+    assert again["metrics"]["computed"] == 0
+    assert again["metrics"]["table"] == first["metrics"]["table"]
+
+    code, out, err = cli("plot", run)
+    assert code == 0, err
+    assert (run / "table_2_1.png").exists()
+
+    code, out, err = cli("pursuit", "study", STUDY, *TINY, "--out", tmp_path, "--json")
+    assert code == 0, err
+    assert json.loads(out) == first["metrics"]["table"]
+
+
+def _solved_when_psi_positive(point: StudyPoint) -> dict[str, Any]:
+    """A stand-in for :func:`study.evaluate`: the points with ψ(0) > 0 get a (made-up) optimum."""
+    row = {"v": point.v, "r2": point.r2, "psi": point.psi, "t_suboptimal": 1.0, "max_defect": 0.0}
+    if point.psi > 0:
+        row |= {"t_optimal": 1.0, "variation_percent": 0.0}
+        row |= {"simultaneous_capture_gap": 0.0, "resimulated_capture_time_error": 0.0}
+    return row
+
+
+def test_points_left_out_make_the_result_feasible(tmp_path, monkeypatch, cli) -> None:
+    monkeypatch.setattr(study, "evaluate", _solved_when_psi_positive)
+    code, out, err = cli("solve", STUDY, *TINY, "--set", f"store={tmp_path}", "--json")
+    assert code == 0, err
+    result = json.loads(out)
+    assert result["status"] == "feasible"
+    assert "2 of 4 points left out" in result["message"]
+    assert result["metrics"]["table"][0]["solved"] == 2
+
+
+def test_no_point_solved_is_an_error(tmp_path, monkeypatch, cli) -> None:
+    monkeypatch.setattr(study, "evaluate", _solved_when_psi_positive)
+    code, _, err = cli("solve", STUDY, *TINY, "--set", "grid.angles=1", "--set", f"store={tmp_path}")
+    assert code == 1
+    assert "none of the 2 points solved" in err
+
+
+def test_an_edited_setup_does_not_reuse_points() -> None:
+    """Point keys carry a hash of r1, u, capture radius, methods and backend."""
+    spec = gamespec.load(STUDY, ["speeds=[0.5]", "grid.angles=2", "grid.fractions=1"])
+    keys = set(study.study_points(spec))
+    for change in ("capture_radius=0.002", "method.intervals=50", "ocp_backend=pyomo"):
+        edited = gamespec.load(STUDY, ["speeds=[0.5]", "grid.angles=2", "grid.fractions=1", change])
+        assert keys.isdisjoint(study.study_points(edited)), change
 
 
 def test_study_rows_compare_to_a_full_solve() -> None:
     """A study point's optimum (compiled once, re-solved with new parameters) equals a fresh solve
     of the same engagement, and its suboptimal time equals the analytic backend's."""
-    spec = study.load_study(STUDY)
-    point = next(iter(study.study_points(spec).values()))
+    point = next(iter(study.study_points(gamespec.load(STUDY)).values()))
     row = study.evaluate(point)
     engagement = study.point_engagement(point)
     assert row["t_optimal"] == pytest.approx(gamespec.solve(engagement).t_final, rel=1e-6)
     assert row["t_suboptimal"] == pytest.approx(gamespec.solve(engagement, "analytic").t_final, rel=1e-9)
 
 
-def test_bad_study_file_names_the_field(tmp_path) -> None:
-    file = tmp_path / "study.yaml"
-    file.write_text("study: pure_pursuit_suboptimal_vs_optimal\nspeeds: [1.5]\n")
-    with pytest.raises(gamespec.SpecError, match="speeds"):
-        study.load_study(file)
+@pytest.mark.parametrize(
+    ("override", "field"),
+    [("speeds=[1.5]", "speeds"), ("refinements=[{intervals: 0}]", "refinements")],
+)
+def test_bad_study_file_names_the_field(cli, override: str, field: str) -> None:
+    code, _, err = cli("validate", STUDY, "--set", override)
+    assert code == 2
+    assert len(err.strip().splitlines()) == 1
+    assert field in err

@@ -16,6 +16,12 @@ pursuit_app = typer.Typer(no_args_is_help=True, help="Pursuit-evasion studies (t
 TABLE_COLUMNS = ("v", "points", "solved", "average_variation_percent", "maximum_variation_percent")
 
 
+def _cell(value: object) -> str:
+    if value is None:
+        return "—"
+    return f"{value:.4g}" if isinstance(value, float) else str(value)
+
+
 @pursuit_app.command()
 def study(
     file: Annotated[Path, typer.Argument(help="Problem file of kind pursuit_suboptimal_study.")],
@@ -55,7 +61,7 @@ def study(
         for col in TABLE_COLUMNS:
             view.add_column(col.replace("_variation_percent", " [%]"), justify="right")
         for row in table:
-            view.add_row(*(f"{row[c]:.4g}" if isinstance(row[c], float) else str(row[c]) for c in TABLE_COLUMNS))
+            view.add_row(*(_cell(row[c]) for c in TABLE_COLUMNS))
         Console().print(view)
     Console(stderr=True).print(f"{result.status.value}: {result.message}", highlight=False)
     if not result.ok:

@@ -33,8 +33,12 @@ from gamespec.studies.store import ResultStore
 POINT_ARRAYS = ("v", "r2", "psi", "t_suboptimal", "t_optimal", "variation_percent")
 """Per-point values copied into ``Result.arrays`` (the plot's scatter)."""
 
-POINT_CHECKS = ("simultaneous_capture_gap", "resimulated_capture_time_error", "max_defect")
-"""Per-point checks whose maximum over the solved points goes into ``Result.checks``."""
+POINT_CHECKS = {
+    "max_simultaneous_capture_gap": "simultaneous_capture_gap",
+    "max_resimulated_capture_time_error": "resimulated_capture_time_error",
+    "max_defect": "max_defect",
+}
+"""``Result.checks`` entry → the per-point check whose maximum over the solved points it holds."""
 
 
 class StudyOptions(StrictModel):
@@ -73,12 +77,13 @@ class StudyModel(CompiledModel):
         rows = [values[key] for key in points]
         solved = [r for r in rows if "variation_percent" in r]
         status, message = _outcome(len(rows), len(solved))
+        reused = len(rows) - computed
         return Result(
             status=status,
-            message=f"{message} ({computed} computed now, {len(rows) - computed} read from {self.spec.store})",
+            message=f"{message} ({computed} computed now, {reused} read from {self.spec.store})",
             solve_time_s=time.perf_counter() - tic,
-            arrays={name: np.array([r.get(name, np.nan) for r in rows], dtype=float) for name in POINT_ARRAYS},
-            checks={f"max_{name.removeprefix('max_')}": max((r[name] for r in solved), default=None) for name in POINT_CHECKS},
+            arrays={name: np.array([r.get(name, np.nan) for r in rows]) for name in POINT_ARRAYS},
+            checks={name: max((r[key] for r in solved), default=None) for name, key in POINT_CHECKS.items()},
             metrics={
                 "table": study.summarize(rows),
                 "points": len(rows),

@@ -38,9 +38,8 @@ import numpy as np
 from scipy.spatial import ConvexHull, QhullError
 
 from gamespec.errors import SpecError
+from gamespec.pursuit.apollonius import ApolloniusCircles, apollonius_circles
 from gamespec_geometric.apollonius import (
-    ApolloniusCircles,
-    apollonius_circles,
     cb_reach,
     refined_pp_polygons,
     refined_pp_reach,

@@ -3,11 +3,9 @@
 Everything is vectorized over the pursuers: positions are ``(n, 2)`` arrays, the evader a ``(2,)``
 array, pursuer speeds ``(n,)`` (heterogeneous teams, §3.5) and the evader speed a scalar.
 
-*CB.* The Apollonius circle of pursuer ``i`` is the locus ``|X - e| / v = |X - p_i| / u_i``; its disk
-holds the evader. With ``rho = v / u_i`` its centre is ``(e - rho**2 p_i) / (1 - rho**2)`` and its
-radius ``rho |p_i - e| / (1 - rho**2)`` (§3.3; the thesis prints ``rho`` instead of ``rho**2`` in the
-centre, which is a misprint: only ``rho**2`` puts the circle through ``T_i``). The point of the circle
-closest to the evader is ``T_i = (e + rho p_i) / (1 + rho)``, at distance ``v |p_i - e| / (u_i + v)``.
+*CB.* The Apollonius circle of pursuer ``i`` (:mod:`gamespec.pursuit.apollonius`) is the locus
+``|X - e| / v = |X - p_i| / u_i``; its disk holds the evader, and its point closest to the evader,
+``T_i``, lies at distance ``v |p_i - e| / (u_i + v)``.
 
 *PP.* Against a non-maneuvering evader with heading ``phi`` measured from the line of sight (pursuer
 to evader), pure pursuit captures after ``t_f = r0 (u + v cos phi) / (u**2 - v**2)`` (eq. 3.24), so
@@ -20,37 +18,12 @@ where ``cos phi = -A / (2 B)``.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
-
 import numpy as np
 
+from gamespec.pursuit.apollonius import ApolloniusCircles
+from gamespec.pursuit.pure_pursuit import pursuit_time
+
 FloatArray = np.ndarray
-
-
-@dataclass(frozen=True)
-class ApolloniusCircles:
-    """The Apollonius circles of ``n`` pursuers against one evader: centres, radii, closest points."""
-
-    centers: FloatArray
-    radii: FloatArray
-    closest_points: FloatArray
-
-
-def speed_ratios(pursuer_speeds: FloatArray, evader_speed: float) -> FloatArray:
-    """``rho_i = v / u_i`` for each pursuer (below 1 by eq. 3.29)."""
-    return evader_speed / np.asarray(pursuer_speeds, dtype=float)
-
-
-def apollonius_circles(
-    pursuers: FloatArray, evader: FloatArray, pursuer_speeds: FloatArray, evader_speed: float
-) -> ApolloniusCircles:
-    """Centre, radius and closest point ``T_i`` of every pursuer's Apollonius circle (§3.3, §3.5)."""
-    rho = speed_ratios(pursuer_speeds, evader_speed)[:, None]
-    distance = np.linalg.norm(pursuers - evader, axis=1)
-    centers = (evader - rho**2 * pursuers) / (1.0 - rho**2)
-    radii = rho[:, 0] * distance / (1.0 - rho[:, 0] ** 2)
-    closest = (evader + rho * pursuers) / (1.0 + rho)
-    return ApolloniusCircles(centers, radii, closest)
 
 
 def circle_radial_distance(
@@ -67,17 +40,6 @@ def circle_radial_distance(
     return -along + np.sqrt(along**2 + inside)
 
 
-def pp_capture_time(
-    initial_distance: FloatArray, heading: FloatArray, pursuer_speed: FloatArray, evader_speed: float
-) -> FloatArray:
-    """Time for pure pursuit to capture a non-maneuvering evader (eq. 3.24).
-
-    ``heading`` is the evader's heading measured from the initial line of sight (pursuer → evader).
-    """
-    u = np.asarray(pursuer_speed, dtype=float)
-    return initial_distance * (u + evader_speed * np.cos(heading)) / (u**2 - evader_speed**2)
-
-
 def _limacon_coefficients(
     initial_distance: FloatArray, pursuer_speed: FloatArray, evader_speed: float
 ) -> tuple[FloatArray, FloatArray]:
@@ -91,7 +53,7 @@ def pp_curve_radius(
     initial_distance: FloatArray, heading: FloatArray, pursuer_speed: FloatArray, evader_speed: float
 ) -> FloatArray:
     """Distance from the evader to its Apollonius curve at line-of-sight heading ``heading`` (eq. 3.24)."""
-    return evader_speed * pp_capture_time(initial_distance, heading, pursuer_speed, evader_speed)
+    return evader_speed * pursuit_time(initial_distance, heading, pursuer_speed, evader_speed)
 
 
 def tangent_heading(

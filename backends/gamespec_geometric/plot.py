@@ -20,8 +20,9 @@ from matplotlib import animation
 from matplotlib.axes import Axes
 from scipy.spatial import QhullError, Voronoi, voronoi_plot_2d
 
+from gamespec.pursuit.apollonius import apollonius_circles
 from gamespec.result import Result
-from gamespec_geometric.apollonius import apollonius_circles, line_of_sight_angles, refined_pp_radius
+from gamespec_geometric.apollonius import line_of_sight_angles, refined_pp_radius
 
 _FRAMES = 60
 

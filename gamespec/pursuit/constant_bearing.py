@@ -22,6 +22,7 @@ from scipy.optimize import linprog
 
 from gamespec.errors import UnsupportedFeature
 from gamespec.pursuit import headings
+from gamespec.pursuit.apollonius import apollonius_circles
 from gamespec.pursuit.simulation import HeadingLaw, Players
 
 GRID = 1441
@@ -117,17 +118,6 @@ def optimal_evasion(players: Players) -> EvasionPlan:
     return EvasionPlan(np.angle(np.exp(1j * heads)), durations, duals)
 
 
-def apollonius_circle(p: np.ndarray, e: np.ndarray, u: float, v: float) -> tuple[np.ndarray, float]:
-    """Centre and radius of the Apollonius circle of pursuer ``p`` and evader ``e``: |x − e| = ρ|x − p|.
-
-    With ρ = v/u the centre is (e − ρ² p)/(1 − ρ²) and the radius ρ‖p − e‖/(1 − ρ²) (§2.3.1 and
-    §3.3, where the centre is printed with ρ in place of ρ²).
-    """
-    rho = v / u
-    centre = (np.asarray(e) - rho**2 * np.asarray(p)) / (1 - rho**2)
-    return centre, rho * float(np.linalg.norm(np.subtract(p, e))) / (1 - rho**2)
-
-
 def apollonius_heading(players: Players) -> float | None:
     """Heading toward the farther intersection of the two pursuers' Apollonius circles (Fig. 2.7).
 
@@ -135,10 +125,8 @@ def apollonius_heading(players: Players) -> float | None:
     """
     if len(players.names) != 2:
         raise UnsupportedFeature("the Apollonius construction of Fig. 2.7 is for two pursuers")
-    (c1, a), (c2, b) = (
-        apollonius_circle(p, players.evader, u, players.v)
-        for p, u in zip(players.positions, players.speeds, strict=True)
-    )
+    circles = apollonius_circles(players.positions, players.evader, players.speeds, players.v)
+    (c1, c2), (a, b) = circles.centers, circles.radii
     d = float(np.linalg.norm(c2 - c1))
     if d > a + b or d < abs(a - b) or d == 0:
         return None

@@ -18,7 +18,9 @@ from gamespec.pursuit.simulation import HeadingLaw, Players, Trajectory, simulat
 
 
 def pursuit_time(r0: np.ndarray, theta: np.ndarray, u: np.ndarray, v: float) -> np.ndarray:
-    """t_p = r_0 (u + v cos θ)/(u² − v²): pure-pursuit capture time of a constant heading (eq. 2.5)."""
+    """t_p = r_0 (u + v cos θ)/(u² − v²): pure-pursuit capture time of a constant heading θ measured
+    from the initial line of sight (eq. 2.5; eq. 3.24, whose v t_p is the Apollonius curve)."""
+    u = np.asarray(u, dtype=float)
     return r0 * (u + v * np.cos(theta)) / (u**2 - v**2)
 
 

@@ -17,6 +17,7 @@ from typing import Literal
 import numpy as np
 
 from gamespec.errors import UnsupportedFeature
+from gamespec.pursuit.apollonius import apollonius_circles
 from gamespec.pursuit.pure_pursuit import pursuit_time
 
 Region = Literal["D1", "D2", "N"]
@@ -60,9 +61,10 @@ def cb_circle_c1(d: float, u1: float, u2: float, v: float) -> tuple[np.ndarray, 
 
 
 def cb_circle_c2(d: float, u1: float, u2: float, v: float) -> tuple[np.ndarray, float]:
-    """C2: centre (d + (u2 − v)(d − x_a)/v, 0), radius r_a (u2 − v)/v — the D1 boundary (eq. 2.4)."""
-    xa = u1**2 * d / (u1**2 - v**2)
-    ra = u1 * v * d / (u1**2 - v**2)
+    """C2: centre (d + (u2 − v)(d − x_a)/v, 0), radius r_a (u2 − v)/v — the D1 boundary (eq. 2.4),
+    (x_a, 0) and r_a being the centre and radius of P1's Apollonius circle."""
+    apollonius = apollonius_circles(np.zeros((1, 2)), np.array([d, 0.0]), np.array([u1]), v)
+    xa, ra = apollonius.centers[0, 0], apollonius.radii[0]
     return np.array([d + (u2 - v) * (d - xa) / v, 0.0]), ra * (u2 - v) / v
 
 

@@ -4,11 +4,9 @@ from __future__ import annotations
 
 import numpy as np
 from gamespec_geometric.apollonius import (
-    apollonius_circles,
     cb_reach,
     circle_radial_distance,
     line_of_sight_angles,
-    pp_capture_time,
     pp_curve_radius,
     refined_pp_polygons,
     refined_pp_radius,
@@ -19,6 +17,8 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from gamespec.loader import spec_from_dict
+from gamespec.pursuit.apollonius import apollonius_circles
+from gamespec.pursuit.pure_pursuit import pursuit_time
 from tests.geometric.helpers import random_team
 
 SEEDS = st.integers(0, 2**32 - 1)
@@ -100,7 +100,7 @@ def test_eq_3_24_pure_pursuit_capture_time_matches_simulation() -> None:
     radius = step = 5e-3
     for heading in (0.3, 2.0, -2.8):
         captured, sight = _duel("pp", heading, radius, step)
-        exact = pp_capture_time(np.hypot(4.0, 1.0), sight, 1.0, 0.6)
+        exact = pursuit_time(np.hypot(4.0, 1.0), sight, 1.0, 0.6)
         assert exact - radius / (1.0 - 0.6) - 4 * step <= captured <= exact + 4 * step
 
 

@@ -21,6 +21,7 @@ from __future__ import annotations
 import numpy as np
 
 from gamespec.pursuit.apollonius import ApolloniusCircles
+from gamespec.pursuit.bearing import line_of_sight_angles
 from gamespec.pursuit.pure_pursuit import pursuit_time
 
 FloatArray = np.ndarray
@@ -104,12 +105,6 @@ def refined_pp_reach(
     """
     a, b = _limacon_coefficients(initial_distance, pursuer_speed, evader_speed)
     return np.where(a < 2.0 * b, a**2 / (4.0 * b), a - b), a + b
-
-
-def line_of_sight_angles(pursuers: FloatArray, evader: FloatArray) -> FloatArray:
-    """Angle of the line of sight from each pursuer to the evader (eq. 3.17)."""
-    delta = evader - pursuers
-    return np.arctan2(delta[:, 1], delta[:, 0])
 
 
 def refined_pp_polygons(

@@ -21,8 +21,9 @@ from matplotlib.axes import Axes
 from scipy.spatial import QhullError, Voronoi, voronoi_plot_2d
 
 from gamespec.pursuit.apollonius import apollonius_circles
+from gamespec.pursuit.bearing import line_of_sight_angles
 from gamespec.result import Result
-from gamespec_geometric.apollonius import line_of_sight_angles, refined_pp_radius
+from gamespec_geometric.apollonius import refined_pp_radius
 
 _FRAMES = 60
 

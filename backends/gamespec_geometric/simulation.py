@@ -17,6 +17,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from gamespec.pursuit.bearing import constant_bearing_headings, line_of_sight_angles
 from gamespec_geometric.active import Method
 from gamespec_geometric.allocation import UNASSIGNED, allocate, tie_break_cost
 from gamespec_geometric.spec import BlindEvasion, FixedHeading, PureEvasion, PursuitScenarioSpec
@@ -74,11 +75,10 @@ def pursuer_headings(
     strategy: str,
 ) -> np.ndarray:
     """Heading of each pursuer at its target: pure pursuit, or constant bearing from eq. 3.3."""
-    sight = targets - pursuers
-    los = np.arctan2(sight[:, 1], sight[:, 0])
+    los = line_of_sight_angles(pursuers, targets)
     if strategy == "pp":
         return los
-    return los + np.arcsin(target_speeds / pursuer_speeds * np.sin(target_headings - los))
+    return constant_bearing_headings(los, pursuer_speeds, target_speeds, target_headings)
 
 
 def first_contact(relative: np.ndarray, motion: np.ndarray, radius: float) -> np.ndarray:

@@ -14,6 +14,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.integrate import solve_ivp
 
+from gamespec.pursuit.bearing import constant_bearing_headings, line_of_sight_angles
 from gamespec.specs.engagement import EngagementSpec
 
 HeadingLaw = Callable[[float, np.ndarray, np.ndarray], float]
@@ -56,8 +57,7 @@ class Players:
 
     def los_angles(self) -> np.ndarray:
         """Initial line-of-sight angles φ_i(0) = atan2(y_E − y_i, x_E − x_i) (eq. 3.17)."""
-        d = self.evader - self.positions
-        return np.arctan2(d[:, 1], d[:, 0])
+        return line_of_sight_angles(self.positions, self.evader)
 
     def subset(self, indices: list[int]) -> Players:
         """The same engagement with only the pursuers at ``indices``."""
@@ -79,12 +79,10 @@ def pursuer_velocities(players: Players, P: np.ndarray, E: np.ndarray, theta_E: 
     PP: θ_i = φ_i. CB: u_i sin(θ_i − φ_i) = v sin(θ_E − φ_i) with cos(θ_i − φ_i) > 0, so that the
     distance decreases (eq. 3.3). Stationary: at rest.
     """
-    d = E - P
-    phi = np.arctan2(d[:, 1], d[:, 0])
+    phi = line_of_sight_angles(P, E)
     speeds = players.speeds
-    ratio = np.divide(players.v * np.sin(theta_E - phi), speeds, out=np.zeros_like(phi), where=speeds > 0)
     cb = np.array([s == "cb" for s in players.strategies])
-    heading = phi + np.where(cb, np.arcsin(np.clip(ratio, -1.0, 1.0)), 0.0)
+    heading = np.where(cb, constant_bearing_headings(phi, speeds, players.v, theta_E), phi)
     return speeds[:, None] * np.column_stack([np.cos(heading), np.sin(heading)])
 
 

@@ -6,7 +6,6 @@ import numpy as np
 from gamespec_geometric.apollonius import (
     cb_reach,
     circle_radial_distance,
-    line_of_sight_angles,
     pp_curve_radius,
     refined_pp_polygons,
     refined_pp_radius,
@@ -18,6 +17,7 @@ from hypothesis import strategies as st
 
 from gamespec.loader import spec_from_dict
 from gamespec.pursuit.apollonius import apollonius_circles
+from gamespec.pursuit.bearing import line_of_sight_angles
 from gamespec.pursuit.pure_pursuit import pursuit_time
 from tests.geometric.helpers import random_team
 

@@ -13,7 +13,14 @@ from __future__ import annotations
 from typing import Annotated, ClassVar, Literal
 
 import numpy as np
-from pydantic import Field, FiniteFloat, field_validator, model_validator
+from pydantic import (
+    Field,
+    FiniteFloat,
+    ValidationError,
+    ValidatorFunctionWrapHandler,
+    field_validator,
+    model_validator,
+)
 
 from gamespec.errors import ExpressionError, SpecError
 from gamespec.expressions import parse
@@ -80,44 +87,50 @@ class BlindEvasion(StrictModel):
 EvaderStrategy = Annotated[FixedHeading | PureEvasion | BlindEvasion, Field(discriminator="type")]
 
 
-def _positions(value: list[Position], team: str) -> list[Position]:
-    if not value:
-        raise ValueError(f"the {team} team is empty: give at least one position")
-    return value
+class Team(StrictModel):
+    """Positions and speeds (one for all or one each) of one team; ``role`` names it in errors."""
 
-
-class PursuerTeam(StrictModel):
-    """Pursuer positions, speeds (one for all or one each) and pursuit strategy."""
-
+    role: ClassVar[str]
     positions: list[Position]
+    speed: PositiveFloat | list[PositiveFloat]
+
+    @field_validator("positions")
+    @classmethod
+    def _not_empty(cls, value: list[Position]) -> list[Position]:
+        if not value:
+            raise ValueError(f"the {cls.role} team is empty: give at least one position")
+        return value
+
+    @field_validator("speed", mode="wrap")
+    @classmethod
+    def _positive(cls, value: object, handler: ValidatorFunctionWrapHandler) -> object:
+        """One error at ``speed`` itself, not one per member of the union (``speed.constrained-float``)."""
+        try:
+            return handler(value)
+        except ValidationError:
+            raise ValueError(
+                f"{cls.role} speed must be a positive number or a list of them, got {value!r}"
+            ) from None
+
+    def speeds(self) -> np.ndarray:
+        """Speed of each member, ``(len(positions),)``."""
+        return np.broadcast_to(np.asarray(self.speed, dtype=float), (len(self.positions),)).copy()
+
+
+class PursuerTeam(Team):
+    """Pursuer positions, speeds and pursuit strategy."""
+
+    role: ClassVar[str] = "pursuer"
     speed: PositiveFloat | list[PositiveFloat] = 1.0
     strategy: Literal["cb", "pp"] = "cb"
 
-    @field_validator("positions")
-    @classmethod
-    def _not_empty(cls, value: list[Position]) -> list[Position]:
-        return _positions(value, "pursuer")
 
-    def speeds(self) -> np.ndarray:
-        """Speed of each pursuer, ``(n,)``."""
-        return np.broadcast_to(np.asarray(self.speed, dtype=float), (len(self.positions),)).copy()
+class EvaderTeam(Team):
+    """Evader positions, speeds and strategies (one for all or one each)."""
 
-
-class EvaderTeam(StrictModel):
-    """Evader positions, speeds (one for all or one each) and strategies (one for all or one each)."""
-
-    positions: list[Position]
+    role: ClassVar[str] = "evader"
     speed: PositiveFloat | list[PositiveFloat] = 0.6
     strategy: EvaderStrategy | list[EvaderStrategy] = Field(default_factory=PureEvasion)
-
-    @field_validator("positions")
-    @classmethod
-    def _not_empty(cls, value: list[Position]) -> list[Position]:
-        return _positions(value, "evader")
-
-    def speeds(self) -> np.ndarray:
-        """Speed of each evader, ``(m,)``."""
-        return np.broadcast_to(np.asarray(self.speed, dtype=float), (len(self.positions),)).copy()
 
     def strategies(self) -> list[FixedHeading | PureEvasion | BlindEvasion]:
         """Strategy of each evader."""
@@ -179,7 +192,8 @@ class PursuitScenarioSpec(SpecBase):
         if len(same):
             a, b = same[0]
             field = "pursuers.positions" if b < n else "evaders.positions"
-            raise SpecError(f"{names[a]} and {names[b]} coincide at {tuple(players[a])}", field=field)
+            where = tuple(players[a].tolist())
+            raise SpecError(f"{names[a]} and {names[b]} coincide at {where}", field=field)
 
     @property
     def algorithm(self) -> Literal["avaa", "a2"]:

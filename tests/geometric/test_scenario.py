@@ -166,7 +166,13 @@ def _write(tmp_path: Path, changes: dict) -> Path:
             {"evaders.positions": [[0.0, 3.0], [-8.0, -7.0]]},
             ["pursuer 0 and evader 1 coincide", "evaders.positions"],
         ),
-        ({"pursuers.positions": [[1.0, 1.0], [1.0, 1.0]]}, ["pursuer 0 and pursuer 1 coincide"]),
+        (
+            {"pursuers.positions": [[1.0, 1.0], [1.0, 1.0]]},
+            ["pursuer 0 and pursuer 1 coincide at (1.0, 1.0)"],
+        ),
+        ({"pursuers.speed": -1.0}, ["pursuers.speed: pursuer speed must be a positive number"]),
+        ({"pursuers.speed": [1.0] * 9 + [0.0]}, ["pursuers.speed: ", "got [1.0"]),
+        ({"evaders.speed": -0.5}, ["evaders.speed: evader speed must be a positive number"]),
         ({"evaders.speed": 1.0}, ["eq. 3.29", "pursuers.speed"]),
         ({"pursuers.speed": [1.0, 0.5]}, ["2 speeds for 10 positions", "pursuers.speed"]),
         ({"pursuers.positions": []}, ["pursuer team is empty", "pursuers.positions"]),
@@ -180,5 +186,6 @@ def test_bad_scenario_exits_2_with_the_reason(cli, tmp_path: Path, changes: dict
     assert code == 2
     lines = err.strip().splitlines()
     assert len(lines) == 1 and "Traceback" not in err
+    assert "np.float64" not in lines[0] and "constrained-float" not in lines[0]
     for needle in needles:
         assert needle in lines[0], (needle, lines[0])

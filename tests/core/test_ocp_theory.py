@@ -132,3 +132,25 @@ def test_result_round_trip_and_guess_from_result(tmp_path) -> None:
     cold = gamespec.solve(gamespec.load(ZERMELO_TIME, ["method.intervals=30"]))
     assert seeded.iterations < cold.iterations
     assert seeded.objective == pytest.approx(cold.objective, rel=1e-7)
+
+
+@pytest.mark.parametrize(("scheme", "degree"), [("radau", 1), ("radau", 2), ("radau", 3), ("trapezoidal", 1)])
+def test_minimum_energy_transfer_closed_form(tmp_path, scheme, degree) -> None:
+    """min ∫ u² dt, x' = u, x(0) = 0, x(1) = 1: u = 1, J = 1, and the costate λ = -2u = -2 (from
+    H = u² + λu); the Lagrange quadrature of every scheme must integrate it exactly."""
+    path = tmp_path / "energy.yaml"
+    path.write_text(
+        "kind: optimal_control\n"
+        "problem:\n"
+        "  states: {x: {initial: 0, final: 1}}\n"
+        "  controls: {u: {}}\n"
+        "  dynamics: {x: u}\n"
+        "  objective: {lagrange: u**2}\n"
+        f"method: {{scheme: {scheme}, degree: {degree}, intervals: 5}}\n"
+    )
+    result = gamespec.solve(path)
+    assert result.status == gamespec.Status.OPTIMAL
+    assert result.objective == pytest.approx(1.0, abs=1e-8)
+    assert np.allclose(result.controls["u"], 1.0, atol=1e-8)
+    if scheme == "radau":
+        assert np.allclose(result.costates["lambda_x"], -2.0, atol=1e-7)

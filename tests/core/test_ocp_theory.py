@@ -74,7 +74,10 @@ def test_radau_error_falls_with_degree() -> None:
 
 
 def test_two_on_one_capture_is_simultaneous_with_zero_hamiltonian() -> None:
-    """Theorem 2 and eqs. 2.22–2.23: r1(t_c) = r2(t_c) = eps and H = 0 along the optimal arc."""
+    """Theorem 2 and eqs. 2.22–2.23: r1(t_c) = r2(t_c) = eps and the thesis' H = -1 + λᵀf = 0
+    along the optimal arc. gamespec states the cost in Mayer form (maximize t_f, i.e. minimize
+    -t_f), whose Hamiltonian λᵀf equals -dΦ/dt_f = 1 on the arc: the same condition, which
+    ``hamiltonian_end_error`` measures."""
     result = gamespec.solve(TWO_ON_ONE)
     eps = result.parameters["eps"]
     assert result.status == gamespec.Status.OPTIMAL

@@ -52,7 +52,8 @@ def study(
     result = solve(spec, options=options)
     if out is not None:
         result.save(out)
-        plot_result(result, out)
+        for path in plot_result(result, out):
+            Console(stderr=True).print(f"wrote {out / 'result.json'} and {path}", highlight=False)
     table = result.metrics.get("table", [])
     if json_:
         sys.stdout.write(json.dumps(table, indent=2) + "\n")

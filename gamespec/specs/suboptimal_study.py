@@ -16,6 +16,9 @@ from pydantic import Field, ValidationError, ValidationInfo, field_validator
 from gamespec.specs.base import SpecBase, StrictModel
 from gamespec.specs.ocp import MethodSpec
 
+MethodChange = dict[str, int | float | str]
+"""Fields of :class:`MethodSpec` to change (e.g. ``{intervals: 80}``)."""
+
 
 class StudyGrid(StrictModel):
     """The grid of (r2(0), ψ(0)) per speed (see :mod:`gamespec.pursuit.study`)."""
@@ -39,7 +42,7 @@ class SuboptimalStudySpec(SpecBase):
     capture_radius: float = Field(0.001, gt=0)
     grid: StudyGrid = Field(default_factory=StudyGrid)
     method: MethodSpec = Field(default_factory=lambda: MethodSpec(intervals=40, grading=10.0))
-    refinements: list[dict[str, float]] = Field(
+    refinements: list[MethodChange] = Field(
         default_factory=lambda: [{"intervals": 80}, {"intervals": 60, "grading": 100}],
         description="Changes to method tried in turn when a solution fails the defect check.",
     )
@@ -62,7 +65,9 @@ class SuboptimalStudySpec(SpecBase):
 
     @field_validator("refinements")
     @classmethod
-    def _refinements_are_methods(cls, refinements: list[dict[str, float]], info: ValidationInfo):
+    def _refinements_are_methods(
+        cls, refinements: list[MethodChange], info: ValidationInfo
+    ) -> list[MethodChange]:
         method = info.data.get("method")
         for i, change in enumerate(refinements):
             try:

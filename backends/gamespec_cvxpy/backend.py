@@ -18,20 +18,11 @@ from typing import Any, ClassVar
 
 import numpy as np
 
-from gamespec.backend import Availability, Backend, CompiledModel
-from gamespec.errors import BackendError
+from gamespec.lqgame.backend import LQBackend, LQCompiledModel, LQSolverOptions
 from gamespec.lqgame.covariance import gains_to_vector, jacobi
-from gamespec.lqgame.solution import (
-    CovarianceOutcome,
-    GameModel,
-    LQCompiledModel,
-    LQSolverOptions,
-    MeanOutcome,
-    fallback_mean,
-)
+from gamespec.lqgame.solution import CovarianceOutcome, GameModel, MeanOutcome, fallback_mean
 from gamespec.result import Result, Status
-from gamespec.specs.base import SpecBase, StrictModel
-from gamespec.specs.lq_game import LQGameSpec
+from gamespec.specs.base import StrictModel
 
 STATUS_MAP = {
     "optimal": Status.OPTIMAL,
@@ -242,31 +233,17 @@ class CvxpyModel(LQCompiledModel):
         return self.players.solve(method.tolerance, method.max_iterations, self._start_gains(guess))
 
 
-class CvxpyBackend(Backend):
+class CvxpyBackend(LQBackend):
     """CVXPY with a conic solver chosen by name (``solver: CLARABEL``, ``SCS``, ...)."""
 
     name: ClassVar[str] = "cvxpy"
-    kinds: ClassVar[frozenset[str]] = frozenset({"lq_stochastic_game"})
     features: ClassVar[frozenset[str]] = frozenset({"mean_steering", "covariance_constraint"})
     options_model: ClassVar[type[StrictModel]] = CvxpyOptions
+    library: ClassVar[str] = "cvxpy"
+    model_class: ClassVar[type[LQCompiledModel]] = CvxpyModel
 
     @classmethod
-    def available(cls) -> Availability:
-        try:
-            import cvxpy as cp
-        except ImportError as err:
-            return Availability(False, f"cvxpy does not import: {err}")
-        return Availability(True, f"cvxpy {cp.__version__}; solvers {', '.join(cp.installed_solvers())}")
-
-    def _compile(self, spec: SpecBase, options: StrictModel) -> CompiledModel:
+    def installed_solvers(cls) -> list[str]:
         import cvxpy as cp
 
-        assert isinstance(spec, LQGameSpec) and isinstance(options, CvxpyOptions)
-        installed = cp.installed_solvers()
-        if options.solver.upper() not in installed:
-            raise BackendError(
-                f"conic solver {options.solver!r} is not installed for cvxpy "
-                f"(installed: {', '.join(installed)})"
-            )
-        options = options.model_copy(update={"solver": options.solver.upper()})
-        return CvxpyModel(spec, options)
+        return list(cp.installed_solvers())

@@ -16,12 +16,10 @@ from typing import ClassVar
 import numpy as np
 from scipy.sparse import csc_matrix
 
-from gamespec.backend import Availability, Backend, CompiledModel
-from gamespec.errors import BackendError
-from gamespec.lqgame.solution import LQCompiledModel, LQSolverOptions, MeanOutcome, fallback_mean
+from gamespec.lqgame.backend import LQBackend, LQCompiledModel, LQSolverOptions
+from gamespec.lqgame.solution import MeanOutcome, fallback_mean
 from gamespec.result import Result, Status
-from gamespec.specs.base import SpecBase, StrictModel
-from gamespec.specs.lq_game import LQGameSpec
+from gamespec.specs.base import StrictModel
 
 
 class QpOptions(LQSolverOptions):
@@ -72,33 +70,17 @@ class QpModel(LQCompiledModel):
         return MeanOutcome(U, self.model.mean.stopper_response(U), Status.OPTIMAL, solve_time_s=seconds)
 
 
-class QpBackend(Backend):
+class QpBackend(LQBackend):
     """qpsolvers with a QP solver chosen by name (``solver: proxqp``, ``osqp``, ``clarabel``, ...)."""
 
     name: ClassVar[str] = "qp"
-    kinds: ClassVar[frozenset[str]] = frozenset({"lq_stochastic_game"})
     features: ClassVar[frozenset[str]] = frozenset({"mean_steering"})
     options_model: ClassVar[type[StrictModel]] = QpOptions
+    library: ClassVar[str] = "qpsolvers"
+    model_class: ClassVar[type[LQCompiledModel]] = QpModel
 
     @classmethod
-    def available(cls) -> Availability:
-        try:
-            import qpsolvers
-        except ImportError as err:
-            return Availability(False, f"qpsolvers does not import: {err}")
-        if not qpsolvers.available_solvers:
-            return Availability(False, "qpsolvers finds no QP solver")
-        return Availability(
-            True, f"qpsolvers {qpsolvers.__version__}; solvers {', '.join(qpsolvers.available_solvers)}"
-        )
-
-    def _compile(self, spec: SpecBase, options: StrictModel) -> CompiledModel:
+    def installed_solvers(cls) -> list[str]:
         import qpsolvers
 
-        assert isinstance(spec, LQGameSpec) and isinstance(options, QpOptions)
-        if options.solver not in qpsolvers.available_solvers:
-            raise BackendError(
-                f"QP solver {options.solver!r} is not installed for qpsolvers "
-                f"(installed: {', '.join(qpsolvers.available_solvers)})"
-            )
-        return QpModel(spec, options)
+        return list(qpsolvers.available_solvers)

@@ -1,24 +1,17 @@
 """What every backend of the ``lq_stochastic_game`` kind shares: the game built once, and the Result.
 
-:class:`LQCompiledModel` is the compiled model of every such backend: it builds the game for the
-effective parameter values (rebuilt when they change), reports a violated assumption of chapter 4
-as a failed Result, applies Lemma 11 before the mean QP, and joins the backend's mean steering
-solution (a QP, section 4.3) and covariance gains (eq. 4.59 or Algorithm 2, section 4.4) with
-:func:`assemble` by Props. 7–8 (``U = Ū + K y``), which recomputes the terminal statistics, the
-closed-form gap and the Monte Carlo check. A backend supplies only its solver hooks.
+A backend supplies the mean steering solution (a QP, section 4.3) and the covariance gains
+(eq. 4.59 or Algorithm 2, section 4.4); :func:`assemble` joins them by Props. 7–8
+(``U = Ū + K y``), recomputes the terminal statistics, the closed-form gap, the Monte Carlo check,
+and packs the Result. :mod:`gamespec.lqgame.backend` drives these steps for every backend.
 """
 
 from __future__ import annotations
 
-from abc import abstractmethod
 from dataclasses import dataclass, field
-from typing import Any
 
 import numpy as np
-from pydantic import Field
 
-from gamespec.backend import CompiledModel
-from gamespec.errors import BackendError
 from gamespec.lqgame.checks import Assumptions, check_assumptions
 from gamespec.lqgame.covariance import CovarianceGame, vector_to_gains
 from gamespec.lqgame.game import LQGame, Strategies
@@ -26,8 +19,6 @@ from gamespec.lqgame.lifting import Lifted, lift
 from gamespec.lqgame.mean_steering import MeanGame
 from gamespec.lqgame.montecarlo import agreement, simulate
 from gamespec.result import Result, Status
-from gamespec.specs.base import StrictModel
-from gamespec.specs.lq_game import LQGameSpec
 
 
 @dataclass
@@ -195,74 +186,3 @@ def assemble(
         checks=checks,
         metrics=metrics,
     )
-
-
-class LQSolverOptions(StrictModel):
-    """An LQ backend's options block: the solver's name and its keyword arguments."""
-
-    solver: str
-    solver_options: dict[str, Any] = Field(default_factory=dict)
-
-    def rejected(self, err: Exception) -> BackendError:
-        """The solver's complaint about ``solver_options`` as a one-line error."""
-        reason = str(err).splitlines()[0] if str(err) else type(err).__name__
-        return BackendError(f"{self.solver} rejected solver_options {self.solver_options}: {reason}")
-
-
-class LQCompiledModel(CompiledModel):
-    """The game built for the effective parameter values (the file's, updated by ``parameters``);
-    a solve whose values differ from those of the last build rebuilds the game and the backend's
-    model, so a solve without ``parameters`` is always the file's problem.
-
-    Hooks: :meth:`_build_solver` (the backend's modelling objects for ``self.model``),
-    :meth:`_solve_mean_qp` (the upper game eq. 4.43 of a reachable target) and
-    :meth:`_solve_covariance` (by default the UCSG closed form, eq. 4.59).
-    """
-
-    def __init__(self, spec: LQGameSpec, options: LQSolverOptions) -> None:
-        self.spec = spec
-        self.options = options
-        self._build(dict(spec.problem.parameters))
-
-    def _build(self, values: dict[str, float]) -> None:
-        self.model = GameModel.build(self.spec.game(values))
-        self.values = values
-        self.failure = self.model.assumption_failure()
-        if self.failure is None:
-            self._build_solver()
-
-    @abstractmethod
-    def _build_solver(self) -> None:
-        """Build the backend's modelling objects for ``self.model`` (which meets the assumptions)."""
-
-    @abstractmethod
-    def _solve_mean_qp(self, guess: Result | None) -> MeanOutcome:
-        """The controller's upper game eq. 4.43 (its target reachable by Lemma 11)."""
-
-    def _solve_covariance(self, guess: Result | None) -> CovarianceOutcome:
-        """The covariance game; the UCSG closed form (eq. 4.59) unless a backend does more."""
-        return unconstrained_covariance(self.model)
-
-    def solve_mean(self, guess: Result | None = None) -> MeanOutcome:
-        """The mean game alone: Lemma 11's verdict, then the backend's QP."""
-        unreachable = self.model.unreachable_mean()
-        if unreachable:
-            return fallback_mean(self.model, Status.INFEASIBLE, unreachable)
-        return self._solve_mean_qp(guess)
-
-    def solve(self, parameters: dict[str, float] | None = None, guess: Result | None = None) -> Result:
-        """Rebuild if the effective parameter values changed, then the mean and covariance games."""
-        values = {**self.spec.problem.parameters, **(parameters or {})}
-        if values != self.values:
-            self._build(values)
-        if self.failure:
-            result = Result(
-                status=Status.ERROR, message=self.failure, metrics=self.model.assumptions.as_metrics()
-            )
-        else:
-            carlo = self.spec.method.monte_carlo
-            mean, cov = self.solve_mean(guess), self._solve_covariance(guess)
-            result = assemble(self.model, mean, cov, self.spec.state_names, carlo.samples, carlo.seed)
-        return result.model_copy(
-            update={"parameters": values, "solver_stats": {"solver": self.options.solver}}
-        )

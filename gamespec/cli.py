@@ -20,7 +20,7 @@ from gamespec import registry
 from gamespec.errors import GamespecError
 from gamespec.loader import load
 from gamespec.pursuit.cli import pursuit_app
-from gamespec.result import Result
+from gamespec.result import Result, writable_folder
 from gamespec.studies.compare import (
     LEGEND,
     compare_backends,
@@ -73,6 +73,8 @@ def solve(
     from gamespec.solving import solve as run_solve
 
     spec = load(file, set_ or [])
+    if out is not None:
+        writable_folder(out)
     with err_console.status(f"solving {spec.name} ...", spinner="dots"):
         result = run_solve(spec, backend)
     if out is not None:
@@ -119,14 +121,19 @@ def compare(
     """Solve one file on several backends with the same discretization; one table."""
     spec = load(file, set_ or [])
     entries = parse_backend_list(backends)
+    if out is not None:
+        writable_folder(out)
     rows = compare_backends(spec, entries, out=out, progress=err_console)
     if json_:
         sys.stdout.write(json.dumps(rows, indent=2) + "\n")
-        return
-    console.print(comparison_table(rows, f"{spec.name}: backend comparison"))
-    console.print(LEGEND, style="dim", highlight=False)
-    for note in row_notes(rows):
-        console.print(note, markup=False, highlight=False)
+    else:
+        console.print(comparison_table(rows, f"{spec.name}: backend comparison"))
+        console.print(LEGEND, style="dim", highlight=False)
+        for note in row_notes(rows):
+            console.print(note, markup=False, highlight=False)
+    if not any(row.get("status") in ("optimal", "feasible") for row in rows):
+        print(f"error: {spec.name}: no backend solved the problem", file=sys.stderr)
+        raise typer.Exit(1)
 
 
 @app.command()
@@ -194,10 +201,8 @@ def plot(
     """Draw a saved Result (states, controls, paths; kind-specific figures)."""
     from gamespec.plotting import plot_result
 
-    if not result.exists():
-        raise GamespecError(f"{result}: no such result")
     loaded = Result.load(result)
-    folder = out or (result if result.is_dir() else result.parent)
+    folder = writable_folder(out or (result if result.is_dir() else result.parent))
     for path in plot_result(loaded, folder, animate=animate):
         console.print(f"wrote {path}")
 

@@ -33,7 +33,8 @@ class ExpressionError(GamespecError):
         self.reason = reason
         self.column = column
         at = f" at column {column + 1}" if column is not None else ""
-        super().__init__(f"expression {expression!r}{at}: {reason}")
+        shown = expression if len(expression) <= 80 else expression[:77] + "..."
+        super().__init__(f"expression {shown!r}{at}: {reason}")
 
 
 class BackendError(GamespecError):

@@ -37,12 +37,14 @@ CONSTANTS: dict[str, sp.Expr] = {"pi": sp.pi}
 RESERVED = frozenset(FUNCTIONS) | frozenset(CONSTANTS) | {"t"}
 TIME = sp.Symbol("t", real=True)
 
+MAX_NODES = 2_000
+"""Largest number of syntax-tree nodes in one expression."""
+
 _BINARY = {
     ast.Add: lambda a, b: a + b,
     ast.Sub: lambda a, b: a - b,
     ast.Mult: lambda a, b: a * b,
     ast.Div: lambda a, b: a / b,
-    ast.Pow: lambda a, b: a**b,
 }
 
 
@@ -73,8 +75,10 @@ class _Translator:
                 raise self.fail(node, f"function {node.id!r} used without arguments")
             known = ", ".join(sorted(self.symbols)) or "none"
             raise self.fail(node, f"undefined symbol {node.id!r} (declared: {known})")
+        if isinstance(node, ast.BinOp) and isinstance(node.op, ast.Pow):
+            return self.power(node)
         if isinstance(node, ast.BinOp) and type(node.op) in _BINARY:
-            return _BINARY[type(node.op)](self(node.left), self(node.right))
+            return self.finite(node, _BINARY[type(node.op)](self(node.left), self(node.right)))
         if isinstance(node, ast.UnaryOp) and isinstance(node.op, ast.USub | ast.UAdd):
             value = self(node.operand)
             return -value if isinstance(node.op, ast.USub) else value
@@ -83,6 +87,26 @@ class _Translator:
         if isinstance(node, ast.Compare):
             raise self.fail(node, "comparisons are only allowed in constraints")
         raise self.fail(node, f"{type(node).__name__} is not allowed")
+
+    def power(self, node: ast.BinOp) -> sp.Expr:
+        """``a ** b``; a power of two numbers is computed in floating point, so that towers such
+        as ``9**9**9`` fail fast instead of being expanded exactly."""
+        base, exponent = self(node.left), self(node.right)
+        if base.is_number and exponent.is_number:
+            try:
+                value = float(base) ** float(exponent)
+            except (OverflowError, ZeroDivisionError, TypeError):
+                raise self.fail(node, "number out of range") from None
+            if isinstance(value, complex):
+                raise self.fail(node, "power of a negative number is not real")
+            return self.finite(node, sp.Float(value) if value != int(value) else sp.Integer(int(value)))
+        return self.finite(node, base**exponent)
+
+    def finite(self, node: ast.AST, value: sp.Expr) -> sp.Expr:
+        """Refuse results SymPy already knows to be infinite, undefined or complex (``1/0``)."""
+        if value.has(sp.zoo, sp.oo, -sp.oo, sp.nan, sp.I):
+            raise self.fail(node, "is infinite, undefined or not real")
+        return value
 
     def call(self, node: ast.Call) -> sp.Expr:
         if not isinstance(node.func, ast.Name):
@@ -94,7 +118,7 @@ class _Translator:
         arity, func = FUNCTIONS[node.func.id]
         if len(node.args) != arity:
             raise self.fail(node, f"{node.func.id} takes {arity} argument(s), got {len(node.args)}")
-        return func(*(self(a) for a in node.args))
+        return self.finite(node, func(*(self(a) for a in node.args)))
 
 
 def _parse_tree(text: str) -> ast.expr:
@@ -107,12 +131,20 @@ def _parse_tree(text: str) -> ast.expr:
     except SyntaxError as err:
         col = (err.offset - 1) if err.offset else None
         raise ExpressionError(text, f"syntax error: {err.msg}", col) from None
+    except (RecursionError, MemoryError, ValueError):
+        raise ExpressionError(text[:40] + "...", "expression nested too deeply") from None
+    if sum(1 for _ in ast.walk(tree)) > MAX_NODES:
+        raise ExpressionError(text[:40] + "...", f"expression has more than {MAX_NODES} parts")
     return tree.body
 
 
 def parse(text: str | float, symbols: Mapping[str, sp.Expr]) -> sp.Expr:
     """Parse an expression over ``symbols`` (name → SymPy expression) into SymPy (no comparisons)."""
-    return _Translator(str(text), symbols)(_parse_tree(text))
+    tree = _parse_tree(text)
+    try:
+        return _Translator(str(text), symbols)(tree)
+    except RecursionError:
+        raise ExpressionError(str(text)[:40] + "...", "expression nested too deeply") from None
 
 
 @dataclass(frozen=True)
@@ -159,5 +191,7 @@ def parse_relation(text: str, symbols: Mapping[str, sp.Expr]) -> Relation:
         lo_f, hi_f = float(lo), float(hi)
         if ops[0] in (ast.GtE, ast.Gt):
             lo_f, hi_f = hi_f, lo_f
+        if lo_f > hi_f:
+            raise tr.fail(node, f"empty range: {lo_f:g} > {hi_f:g}")
         return Relation(mid, lo_f, hi_f)
     raise tr.fail(node, "a constraint is one comparison or a chain lo <= expr <= hi")

@@ -157,6 +157,4 @@ def load(path: str | Path, overrides: Iterable[str] = ()) -> SpecBase:
     """Read, override and validate a problem file into its spec."""
     data = apply_overrides(read_file(path), overrides)
     spec = spec_from_dict(data, source=str(path))
-    spec._source = str(path)
-    spec._file_hash = hashlib.sha256(Path(path).read_bytes()).hexdigest()[:16]
-    return spec
+    return spec.with_source(str(path), hashlib.sha256(Path(path).read_bytes()).hexdigest()[:16])

@@ -9,12 +9,15 @@ from __future__ import annotations
 
 import json
 import math
+import zipfile
 from enum import StrEnum
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 from pydantic import BaseModel, ConfigDict, Field, field_serializer, field_validator
+
+from gamespec.errors import GamespecError, SpecError
 
 ArrayDict = dict[str, np.ndarray]
 
@@ -131,8 +134,7 @@ class Result(BaseModel):
 
     def save(self, directory: str | Path) -> Path:
         """Write ``result.json`` (scalars, metrics) and ``arrays.npz`` (every array) into ``directory``."""
-        out = Path(directory)
-        out.mkdir(parents=True, exist_ok=True)
+        out = writable_folder(directory)
         (out / "result.json").write_text(self.to_json(arrays=False))
         packed: dict[str, np.ndarray] = {}
         for field in _ARRAY_FIELDS:
@@ -146,11 +148,21 @@ class Result(BaseModel):
 
     @classmethod
     def load(cls, path: str | Path) -> Result:
-        """Read a Result saved by :meth:`save` (a folder or its ``result.json``), or a ``--json`` dump."""
-        path = Path(path)
+        """Read a Result saved by :meth:`save` (a folder or its ``result.json``), or a ``--json`` dump;
+        a SpecError saying why when it cannot."""
+        try:
+            return cls._load(Path(path))
+        except (OSError, ValueError, KeyError, zipfile.BadZipFile) as err:
+            reason = err.strerror if isinstance(err, OSError) and err.strerror else str(err).splitlines()[0]
+            raise SpecError(f"not a readable Result: {reason}", source=str(path)) from None
+
+    @classmethod
+    def _load(cls, path: Path) -> Result:
         folder = path if path.is_dir() else path.parent
         json_file = path / "result.json" if path.is_dir() else path
         data = json.loads(json_file.read_text())
+        if not isinstance(data, dict):
+            raise ValueError("the JSON does not hold a mapping")
         npz = folder / "arrays.npz"
         if npz.exists() and json_file.name == "result.json":
             with np.load(npz) as packed:
@@ -161,6 +173,19 @@ class Result(BaseModel):
                     else:
                         data[field] = packed[key]
         return cls.model_validate(data)
+
+
+def writable_folder(directory: str | Path) -> Path:
+    """``directory``, created if needed; a GamespecError when it cannot be written to."""
+    out = Path(directory)
+    try:
+        out.mkdir(parents=True, exist_ok=True)
+        probe = out / ".gamespec-write-test"
+        probe.touch()
+        probe.unlink()
+    except OSError as err:
+        raise GamespecError(f"{out}: cannot write there ({err.strerror or err})") from None
+    return out
 
 
 _ARRAY_FIELDS = {"time", "control_time", "states", "controls", "costates", "arrays"}

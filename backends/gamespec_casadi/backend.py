@@ -15,6 +15,7 @@ import numpy as np
 from pydantic import Field
 
 from gamespec.backend import Availability, Backend, CompiledModel
+from gamespec.errors import BackendError
 from gamespec.ocp.transcription import Guess, Transcription
 from gamespec.ocp.translate import Library, translate
 from gamespec.result import Result, Status
@@ -73,6 +74,8 @@ class CasadiModel(CompiledModel):
     def __init__(self, spec: OptimalControlSpec, options: CasadiOptions) -> None:
         import casadi as ca
 
+        if not ca.has_nlpsol(options.solver):
+            raise BackendError(f"casadi has no NLP solver plugin {options.solver!r}")
         self.ca = ca
         self.tr = tr = Transcription(spec)
         self.options = options
@@ -155,8 +158,10 @@ class CasadiModel(CompiledModel):
         elapsed = time.perf_counter() - tic
         stats = self.solver.stats()
         native = stats.get("return_status", "unknown")
+        status = STATUS_MAP.get(native, Status.ERROR)
         w = np.asarray(sol["x"]).ravel()
-        self._last = w
+        if status.ok:
+            self._last = w
         X, U, T = self._unpack(w, b.t_lower)
         nx = self.shape[0]
         nu_def = np.asarray(sol["lam_g"]).ravel()[: self.n_defects].reshape((nx, -1), order="F")
@@ -164,9 +169,9 @@ class CasadiModel(CompiledModel):
             X=X,
             U=U,
             T=T,
-            objective=float(sol["f"]) * tr.ocp.sign,
+            objective=float(sol["f"]) * tr.ocp.sign if status.ok else None,
             params=params,
-            status=STATUS_MAP.get(native, Status.ERROR),
+            status=status,
             message=native,
             solve_time_s=elapsed,
             iterations=int(stats.get("iter_count", 0)),

@@ -103,7 +103,7 @@ def max_constraint_violation(
     worst += [_relation_violation(r, running, t_eval.shape) for r in tr.ocp.path]
     ends = _end_values(tr, X, T, params)
     worst += [_relation_violation(r, ends, ()) for r in tr.ocp.boundary]
-    return max(worst)
+    return float(np.max(worst))
 
 
 def _end_values(tr: Transcription, X: np.ndarray, T: float, params: Mapping[str, float]) -> dict:

@@ -106,12 +106,19 @@ class Grid:
         return np.arange(self.intervals + 1) * self.points_per_interval
 
     @cached_property
+    def radau_weights(self) -> np.ndarray:
+        """Weights of the d-point Radau quadrature on [0, 1] (interpolation through the collocation
+        points alone; exact to degree 2d - 2, and 1 for d = 1, i.e. backward Euler)."""
+        return lagrange_matrices(radau_points(self.degree))[1]
+
+    @cached_property
     def matrices(self) -> tuple[sps.csr_matrix, sps.csr_matrix, np.ndarray]:
         """``(D, W, q)``: defects ``D X - T W F`` and the Lagrange quadrature weights ``q``."""
         h = np.diff(self.breaks)
         d = self.points_per_interval
         if self.scheme == "radau":
-            deriv, weights = lagrange_matrices(self.local_points)
+            deriv, _ = lagrange_matrices(self.local_points)
+            weights = self.radau_weights
             block = deriv[:, 1:].T
             rows, cols, vals = [], [], []
             for k in range(self.intervals):
@@ -123,7 +130,7 @@ class Grid:
             dmat = sps.csr_matrix((vals, (rows, cols)), shape=(self.intervals * d, self.n_nodes))
             scale = np.repeat(h, d)
             wmat = sps.diags(scale).tocsr()
-            q = np.repeat(h, d) * np.tile(weights[1:], self.intervals)
+            q = np.repeat(h, d) * np.tile(weights, self.intervals)
             return dmat, wmat, q
         k = np.arange(self.intervals)
         dmat = sps.csr_matrix(
@@ -138,5 +145,4 @@ class Grid:
         """Per LGR defect row, the factor turning a defect multiplier into a costate estimate:
         ``lambda = -nu / w_j`` with w_j the Radau weight of the point, from the Lagrangian
         ``J + nu^T g`` with ``g = D X - T W F`` (defined for the Radau scheme only)."""
-        _, weights = lagrange_matrices(self.local_points)
-        return -1.0 / np.tile(weights[1:], self.intervals)
+        return -1.0 / np.tile(self.radau_weights, self.intervals)

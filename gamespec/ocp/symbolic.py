@@ -6,6 +6,7 @@ Everything is stated for minimization: ``J = sign * (Mayer + integral of Lagrang
 
 from __future__ import annotations
 
+import math
 from collections.abc import Mapping
 from dataclasses import dataclass
 from functools import cached_property
@@ -14,10 +15,7 @@ import sympy as sp
 
 from gamespec.errors import SpecError
 from gamespec.expressions import TIME, Relation, parse, parse_relation, symbol
-from gamespec.ocp.translate import numeric
-from gamespec.specs.ocp import OptimalControlSpec
-
-INF = float("inf")
+from gamespec.specs.ocp import EvaluatedValues, OptimalControlSpec
 
 
 @dataclass(frozen=True)
@@ -126,33 +124,27 @@ class SymbolicOcp:
                 raise SpecError(
                     f"unknown parameter {name!r} (declared: {', '.join(values) or 'none'})",
                     field="problem.parameters",
+                    source=self.spec.source,
                 )
+            if not math.isfinite(float(value)):
+                raise SpecError(f"parameter {name!r} must be finite, got {value}", source=self.spec.source)
             values[name] = float(value)
         return values
-
-    def value(self, raw: float | str | None, params: Mapping[str, float], default: float) -> float:
-        """A bound or fixed value (number or parameter expression) as a float."""
-        if raw is None:
-            return default
-        if isinstance(raw, int | float):
-            return float(raw)
-        return numeric(parse(raw, self._params), {symbol(k): v for k, v in params.items()})
 
     def state_bounds(
         self, params: Mapping[str, float]
     ) -> list[tuple[float, float, float | None, float | None]]:
         """Per state: ``(lower, upper, initial, final)`` as floats (initial/final None when free)."""
-        out = []
-        for spec in self.spec.problem.states.values():
-            fixed = [None if v is None else self.value(v, params, 0.0) for v in (spec.initial, spec.final)]
-            out.append((self.value(spec.lower, params, -INF), self.value(spec.upper, params, INF), *fixed))
-        return out
+        return self._evaluated(params).states
 
     def control_bounds(self, params: Mapping[str, float]) -> list[tuple[float, float]]:
-        return [
-            (self.value(c.lower, params, -INF), self.value(c.upper, params, INF))
-            for c in self.spec.problem.controls.values()
-        ]
+        return self._evaluated(params).controls
+
+    def _evaluated(self, params: Mapping[str, float]) -> EvaluatedValues:
+        try:
+            return self.spec.problem.evaluate(params)
+        except SpecError as err:
+            raise SpecError(err.reason, field=err.field, source=self.spec.source) from None
 
     def final_time(self, params: Mapping[str, float]) -> tuple[float, float, float]:
         """``(lower, upper, guess)`` of the final time (lower == upper when it is fixed)."""
@@ -161,7 +153,5 @@ class SymbolicOcp:
             lo, hi = time.bounds
             guess = self.spec.guess.t_final or time.guess or 0.5 * (lo + hi)
             return lo, hi, guess
-        tf = self.value(time.final, params, 1.0)
-        if tf <= time.initial:
-            raise SpecError("final time must be after the initial time", field="problem.time.final")
+        tf = self._evaluated(params).t_final
         return tf, tf, tf

@@ -88,8 +88,8 @@ class Transcription:
         if previous is None and self.spec.guess.result:
             try:
                 previous = Result.load(self.spec.guess.result)
-            except (OSError, ValueError) as err:
-                raise SpecError(f"cannot read guess result: {err}", field="guess.result") from None
+            except SpecError as err:
+                raise SpecError(err.reason, field="guess.result", source=self.spec.source) from None
         if previous is not None and previous.time is not None and previous.states:
             return self._guess_from_result(previous)
         *_, tf_guess = self.ocp.final_time(params)
@@ -132,7 +132,7 @@ class Transcription:
         try:
             expr = parse(raw, symbols)
         except ExpressionError as err:
-            raise SpecError(str(err), field=field) from None
+            raise SpecError(str(err), field=field, source=self.spec.source) from None
         values = {symbol(k): v for k, v in params.items()} | {symbol("tau"): tau}
         return np.broadcast_to(np.asarray(translate(expr, values, NUMPY), dtype=float), tau.shape).copy()
 
@@ -143,7 +143,9 @@ class Transcription:
         missing = [n for n in self.ocp.states if n not in previous.states]
         missing += [n for n in self.ocp.controls if n not in previous.controls]
         if missing:
-            raise SpecError(f"guess result lacks {', '.join(missing)}", field="guess.result")
+            raise SpecError(
+                f"guess result lacks {', '.join(missing)}", field="guess.result", source=self.spec.source
+            )
         X = np.array([np.interp(self.grid.nodes, tau_prev, previous.states[n]) for n in self.ocp.states])
         tc = np.asarray(previous.control_time if previous.control_time is not None else t)
         tau_c = (tc - t[0]) / span

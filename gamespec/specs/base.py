@@ -47,6 +47,12 @@ class SpecBase(StrictModel):
         """The file this spec was loaded from, or ``<spec>``."""
         return self._source
 
+    def with_source(self, source: str, file_hash: str) -> SpecBase:
+        """Record the file this spec was read from (and its hash) for reports and provenance."""
+        self._source = source
+        self._file_hash = file_hash
+        return self
+
     @property
     def file_hash(self) -> str:
         """SHA-256 (first 16 hex digits) of the file this spec was loaded from, or ``""``."""
@@ -55,3 +61,8 @@ class SpecBase(StrictModel):
     def required_features(self) -> frozenset[str]:
         """Features a backend must declare to take this spec (e.g. ``free_final_time``)."""
         return frozenset()
+
+    @property
+    def objective_sense(self) -> str:
+        """``minimize`` or ``maximize``: which objective is better, for comparisons."""
+        return "minimize"

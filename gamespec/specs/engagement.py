@@ -61,6 +61,11 @@ class EngagementSpec(SpecBase):
 
     default_backend = "casadi"
 
+    @property
+    def objective_sense(self) -> str:
+        """The evader maximizes the capture time."""
+        return "maximize"
+
     @model_validator(mode="after")
     def _consistent(self) -> EngagementSpec:
         names = [p.name for p in self.pursuers]

@@ -8,16 +8,22 @@ symbols it may use, so a typo stops at load time with the field that holds it.
 
 from __future__ import annotations
 
+import math
+from collections.abc import Mapping
+from dataclasses import dataclass
 from typing import Literal
 
-from pydantic import Field, field_validator, model_validator
+from pydantic import Field, FiniteFloat, field_validator, model_validator
 
 from gamespec.errors import ExpressionError, SpecError
 from gamespec.expressions import RESERVED, parse, parse_relation, symbol
+from gamespec.ocp.translate import numeric
 from gamespec.specs.base import SpecBase, StrictModel
 
-Value = float | str
-"""A number, or an expression over the problem's parameters."""
+Value = FiniteFloat | str
+"""A finite number, or an expression over the problem's parameters."""
+
+INF = math.inf
 
 
 class StateSpec(StrictModel):
@@ -47,10 +53,10 @@ class ObjectiveSpec(StrictModel):
 class TimeSpec(StrictModel):
     """Initial time, and the final time: a value, or ``free`` within ``bounds`` from ``guess``."""
 
-    initial: float = 0.0
+    initial: FiniteFloat = 0.0
     final: Value | Literal["free"] = 1.0
-    bounds: tuple[float, float] | None = None
-    guess: float | None = None
+    bounds: tuple[FiniteFloat, FiniteFloat] | None = None
+    guess: FiniteFloat | None = None
 
     @model_validator(mode="after")
     def _free_needs_bounds(self) -> TimeSpec:
@@ -72,7 +78,7 @@ class TimeSpec(StrictModel):
 class OcpProblem(StrictModel):
     """The mathematics of an optimal-control problem."""
 
-    parameters: dict[str, float] = Field(default_factory=dict)
+    parameters: dict[str, FiniteFloat] = Field(default_factory=dict)
     states: dict[str, StateSpec]
     controls: dict[str, ControlSpec] = Field(default_factory=dict)
     dynamics: dict[str, Value]
@@ -106,7 +112,54 @@ class OcpProblem(StrictModel):
             )
             raise ValueError(f"dynamics must give one equation per state: {what.strip()}")
         self._check_expressions()
+        self.evaluate(self.parameters)
         return self
+
+    def evaluate(self, params: Mapping[str, float]) -> EvaluatedValues:
+        """Bounds, fixed end values and a fixed final time as floats for these parameter values;
+        a SpecError naming the field when one is not finite, a lower bound exceeds its upper
+        bound, or a fixed value lies outside its bounds."""
+        symbols = {n: symbol(n) for n in self.parameters}
+        values = {symbol(k): float(v) for k, v in params.items()}
+
+        def number(raw: float | str | None, default: float, field: str) -> float:
+            if raw is None:
+                return default
+            if isinstance(raw, str):
+                raw = numeric(parse(raw, symbols), values)
+            if not math.isfinite(raw):
+                raise SpecError(f"evaluates to {raw} (a finite number is needed)", field=f"problem.{field}")
+            return float(raw)
+
+        states = []
+        for name, st in self.states.items():
+            lo = number(st.lower, -INF, f"states.{name}.lower")
+            hi = number(st.upper, INF, f"states.{name}.upper")
+            ends = [
+                None if v is None else number(v, 0.0, f"states.{name}.{k}")
+                for k, v in (("initial", st.initial), ("final", st.final))
+            ]
+            _ordered(lo, hi, f"states.{name}")
+            for key, value in zip(("initial", "final"), ends, strict=True):
+                if value is not None and not lo <= value <= hi:
+                    raise SpecError(
+                        f"{value:g} lies outside [{lo:g}, {hi:g}]", field=f"problem.states.{name}.{key}"
+                    )
+            states.append((lo, hi, *ends))
+        controls = []
+        for name, c in self.controls.items():
+            lo, hi = (
+                number(c.lower, -INF, f"controls.{name}.lower"),
+                number(c.upper, INF, f"controls.{name}.upper"),
+            )
+            _ordered(lo, hi, f"controls.{name}")
+            controls.append((lo, hi))
+        t_final = None
+        if not self.time.free:
+            t_final = number(self.time.final, 1.0, "time.final")
+            if t_final <= self.time.initial:
+                raise SpecError("final time must be after the initial time", field="problem.time.final")
+        return EvaluatedValues(states, controls, t_final)
 
     def _check_expressions(self) -> None:
         params = {n: symbol(n) for n in self.parameters}
@@ -140,6 +193,21 @@ class OcpProblem(StrictModel):
                 raise SpecError(str(err), field=f"problem.{field}") from None
 
 
+@dataclass(frozen=True)
+class EvaluatedValues:
+    """Per state ``(lower, upper, initial, final)`` (initial/final None when free), per control
+    ``(lower, upper)``, and the fixed final time (None when free)."""
+
+    states: list[tuple[float, float, float | None, float | None]]
+    controls: list[tuple[float, float]]
+    t_final: float | None
+
+
+def _ordered(lower: float, upper: float, field: str) -> None:
+    if lower > upper:
+        raise SpecError(f"lower bound {lower:g} exceeds upper bound {upper:g}", field=f"problem.{field}")
+
+
 class MethodSpec(StrictModel):
     """Transcription: Legendre–Gauss–Radau collocation of ``degree`` on ``intervals``, or trapezoidal.
 
@@ -150,7 +218,7 @@ class MethodSpec(StrictModel):
     scheme: Literal["radau", "trapezoidal"] = "radau"
     intervals: int = Field(40, ge=1, le=100_000)
     degree: int = Field(3, ge=1, le=12)
-    grading: float = Field(1.0, gt=0)
+    grading: FiniteFloat = Field(1.0, gt=0, le=1e4)
 
 
 class GuessSpec(StrictModel):
@@ -160,7 +228,7 @@ class GuessSpec(StrictModel):
 
     states: dict[str, Value] = Field(default_factory=dict)
     controls: dict[str, Value] = Field(default_factory=dict)
-    t_final: float | None = None
+    t_final: FiniteFloat | None = None
     result: str | None = None
 
 
@@ -181,6 +249,10 @@ class OptimalControlSpec(SpecBase):
             if unknown:
                 raise ValueError(f"guess.{group} names undeclared {group}: {sorted(unknown)}")
         return self
+
+    @property
+    def objective_sense(self) -> str:
+        return self.problem.objective.sense
 
     def required_features(self) -> frozenset[str]:
         p = self.problem

@@ -55,18 +55,30 @@ def compare_backends(
         except GamespecError as err:
             rows.append({"backend": label, "status": "unsupported", "reason": str(err)})
             continue
+        except Exception as err:  # a backend's own failure must not stop the study
+            rows.append({"backend": label, "status": "error", "reason": f"{type(err).__name__}: {err}"})
+            continue
         if out is not None:
             result.save(Path(out) / label.replace(":", "_"))
         rows.append({**result.summary(), "backend": label})
-    best = [r["objective"] for r in rows if r.get("status") == "optimal" and r.get("objective") is not None]
-    sense = getattr(getattr(spec, "problem", None), "objective", None)
-    maximize = getattr(sense, "sense", "minimize") == "maximize"
+    best = [r["objective"] for r in rows if _trusted(r)]
     if best:
-        ref = max(best) if maximize else min(best)
+        ref = max(best) if spec.objective_sense == "maximize" else min(best)
         for r in rows:
             if r.get("objective") is not None:
                 r["relative_gap"] = abs(r["objective"] - ref) / max(abs(ref), 1e-12)
     return rows
+
+
+FEASIBILITY_TOL = 1e-6
+"""Largest constraint violation of a row whose objective may serve as the reference J*."""
+
+
+def _trusted(row: dict[str, Any]) -> bool:
+    """An optimal row with an objective and no constraint violation beyond the tolerance."""
+    violation = row.get("max_constraint_violation")
+    feasible = violation is None or (math.isfinite(violation) and violation <= FEASIBILITY_TOL)
+    return row.get("status") == "optimal" and row.get("objective") is not None and feasible
 
 
 def _number(value: float) -> str:
@@ -101,7 +113,8 @@ COLUMNS: list[tuple[str, str, Callable[[Any], str]]] = [
 
 LEGEND = (
     "build, solve: wall time in ms; viol: max constraint violation; defect: max dynamics defect, "
-    "recomputed without the solver; gap: |J - J*| / |J*| to the best optimal objective J*."
+    "recomputed without the solver; gap: |J - J*| / |J*| to the best optimal objective J* among "
+    "rows with no constraint violation above 1e-6."
 )
 
 

@@ -21,14 +21,16 @@ def run_study(
     executor: Executor | None = None,
     description: str = "study",
     show_progress: bool = True,
+    accept: Callable[[Any], bool] | None = None,
 ) -> dict[str, Any]:
     """Evaluate ``fn(point)`` for every ``key → point`` not yet in ``store``; return all values.
     The progress bar goes to stderr, so stdout stays clean for ``--json``.
 
-    ``fn`` must return JSON-able data. Values already stored are reused, so an interrupted study
-    resumes where it stopped.
+    ``fn`` must return JSON-able data. Values already stored are reused (those ``accept`` takes,
+    when given; the others are computed again), so an interrupted study resumes where it stopped.
     """
-    done = store.done()
+    saved = store.items()
+    done = {key for key, value in saved.items() if accept is None or accept(value)}
     todo = [(key, point) for key, point in points.items() if key not in done]
     runner = executor or SerialExecutor()
     columns = (TextColumn("{task.description}"), BarColumn(), MofNCompleteColumn(), TimeRemainingColumn())

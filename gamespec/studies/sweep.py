@@ -2,6 +2,8 @@
 
 Each process compiles the spec once and re-solves it with new parameter values (warm-started from
 the previous point); every finished point goes into a :class:`ResultStore`, so a sweep resumes.
+Points are keyed by the backend, the hash of the (overridden) spec and the parameter values, so a
+folder shared by different sweeps never mixes them up; failed points are solved again on a rerun.
 """
 
 from __future__ import annotations
@@ -72,11 +74,16 @@ def sweep(
     show_progress: bool = True,
 ) -> list[dict[str, Any]]:
     """Solve ``path`` on the Cartesian product of ``ranges``; rows in grid order."""
+    from gamespec.loader import load, spec_hash
+    from gamespec.solving import backend_name
+
+    spec = load(path, overrides)
+    problem = f"{backend_name(spec, backend)}/{spec_hash(spec)}"
     names = [name for name, _ in ranges]
     points = {}
     for values in itertools.product(*(vals for _, vals in ranges)):
         params = tuple(zip(names, values, strict=True))
-        key = ",".join(f"{n}={v:.12g}" for n, v in params)
+        key = problem + ":" + ",".join(f"{n}={v:.12g}" for n, v in params)
         points[key] = SweepJob(str(path), tuple(overrides), backend, params)
     rows = run_study(
         points,
@@ -85,5 +92,6 @@ def sweep(
         executor=executor(workers),
         description=f"sweep {Path(path).stem}",
         show_progress=show_progress,
+        accept=lambda row: row["status"] in ("optimal", "feasible"),
     )
     return list(rows.values())

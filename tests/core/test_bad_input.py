@@ -160,3 +160,76 @@ def _to_toml(data: dict, prefix: str = "") -> str:
         else:
             scalars.append(f"{key} = {json.dumps(value)}\n")
     return "".join(scalars) + "".join(tables)
+
+
+@pytest.mark.parametrize(
+    ("edit", "needles"),
+    [
+        (
+            lambda d: d["problem"]["controls"].update(u={"lower": "pi", "upper": "-pi"}),
+            ["controls.u", "exceeds"],
+        ),
+        (lambda d: d["problem"]["states"]["x2"].update(lower=1, upper=-1), ["states.x2", "exceeds"]),
+        (lambda d: d["problem"]["states"]["x1"].update(upper=-1), ["states.x1.initial", "outside"]),
+        (
+            lambda d: d["problem"].update(path_constraints=["3 <= x1 <= 1"]),
+            ["path_constraints.0", "empty range"],
+        ),
+        (lambda d: d["problem"]["parameters"].update(rho=float("nan")), ["problem.parameters.rho", "finite"]),
+        (lambda d: d["method"].update(grading=float("inf")), ["method.grading"]),
+        (lambda d: d["problem"]["controls"]["u"].update(upper="pi/0"), ["controls.u.upper", "infinite"]),
+        (lambda d: d["problem"]["dynamics"].update(x2="9**9**9"), ["dynamics.x2", "out of range"]),
+        (
+            lambda d: d["problem"]["dynamics"].update(x2="-" * 3000 + "u"),
+            ["dynamics.x2", "nested too deeply"],
+        ),
+    ],
+)
+def test_values_that_cannot_be_solved_are_refused_at_load(cli, tmp_path, edit, needles) -> None:
+    data = _base()
+    edit(data)
+    code, _, err = cli("validate", _write(tmp_path, data))
+    _assert_one_line(code, err, "p.yaml", *needles)
+
+
+def test_a_parameter_override_that_empties_a_bound_is_exit_2(cli) -> None:
+    code, _, err = cli(
+        "solve", ZERMELO, "--set", "problem.parameters.xf=-1", "--set", "problem.states.x1.lower=0"
+    )
+    _assert_one_line(code, err, "zermelo_min_time.yaml", "states.x1.final", "outside")
+
+
+@pytest.mark.parametrize("content", [None, "{}", '{"a": 1}', "[1, 2]", "not json"])
+def test_plot_of_something_that_is_not_a_result(cli, tmp_path, content) -> None:
+    target = tmp_path / "run"
+    target.mkdir()
+    if content is not None:
+        (target / "result.json").write_text(content)
+    code, _, err = cli("plot", target)
+    _assert_one_line(code, err, "not a readable Result")
+
+
+def test_plot_of_a_corrupt_array_file(cli, tmp_path) -> None:
+    code, _, _ = cli("solve", ZERMELO, "--out", tmp_path / "run")
+    assert code == 0
+    (tmp_path / "run" / "arrays.npz").write_bytes(b"garbage")
+    code, _, err = cli("plot", tmp_path / "run")
+    _assert_one_line(code, err, "not a readable Result")
+
+
+def test_out_that_cannot_be_written_is_refused_before_solving(cli, tmp_path) -> None:
+    blocker = tmp_path / "file"
+    blocker.write_text("x")
+    code, out, err = cli("solve", ZERMELO, "--out", blocker)
+    _assert_one_line(code, err, "cannot write there")
+    assert out == ""
+
+
+def test_compare_survives_a_backend_error_and_fails_when_nothing_solved(cli) -> None:
+    code, out, err = cli("compare", ZERMELO, "--backends", "casadi,casadi:nosuchsolver", "--json")
+    rows = json.loads(out)
+    assert code == 0
+    assert [r["status"] for r in rows] == ["optimal", "unsupported"]
+    assert "nosuchsolver" in rows[1]["reason"]
+    code, _, err = cli("compare", ZERMELO, "--backends", "nosuch")
+    assert code == 1 and "no backend solved" in err.strip().splitlines()[-1]

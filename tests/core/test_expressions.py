@@ -113,3 +113,18 @@ def test_relation_needs_a_comparison_and_numeric_outer_terms() -> None:
 def test_symbols_are_real() -> None:
     assert parse("x", SYMBOLS).is_real
     assert sp.simplify(parse("sqrt(x**2)", SYMBOLS) - sp.Abs(symbol("x"))) == 0
+
+
+@pytest.mark.parametrize(
+    "text", ["9**9**9", "sin(x)**2**2**2**2**2**2**2", "1/0", "log(0)", "sqrt(-1)", "(-2)**0.5"]
+)
+def test_numbers_that_are_not_finite_reals_are_rejected_fast(text: str) -> None:
+    with pytest.raises(ExpressionError):
+        parse(text, SYMBOLS)
+
+
+def test_deep_nesting_is_an_expression_error() -> None:
+    with pytest.raises(ExpressionError, match=r"nested too deeply|parts"):
+        parse("-" * 5000 + "x", SYMBOLS)
+    with pytest.raises(ExpressionError):
+        parse("+".join(["x"] * 3000), SYMBOLS)

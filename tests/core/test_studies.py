@@ -69,3 +69,30 @@ def test_bad_sweep_range_is_exit_2(cli, tmp_path) -> None:
         "sweep", PROBLEMS / "ch2" / "one_on_one_pure_evasion.yaml", "--param", "v=a:b", "--out", tmp_path
     )
     assert code == 2 and "cannot read the values" in err
+
+
+def test_sweep_folder_shared_by_different_problems_keeps_them_apart(cli, tmp_path) -> None:
+    import json
+
+    from tests.conftest import PROBLEMS
+
+    path = PROBLEMS / "ch2" / "one_on_one_pure_evasion.yaml"
+    base = ("sweep", path, "--param", "v=0.4,0.6", "--out", tmp_path, "--json")
+    _, first, _ = cli(*base)
+    _, moved, _ = cli(*base, "--set", "problem.parameters.r0=2.0")
+    for a, b in zip(json.loads(first), json.loads(moved), strict=True):
+        assert b["t_final"] == pytest.approx((2.0 - 0.001) / (1.0 - b["v"]), abs=1e-6)
+        assert a["t_final"] == pytest.approx((1.0 - 0.001) / (1.0 - a["v"]), abs=1e-6)
+
+
+def test_failed_points_are_solved_again_on_a_rerun(tmp_path) -> None:
+    store = ResultStore(tmp_path)
+    store.put("x=1", {"status": "error"})
+    values = run_study(
+        {"x=1": 1},
+        lambda x: {"status": "optimal", "x": x},
+        store,
+        show_progress=False,
+        accept=lambda v: v["status"] == "optimal",
+    )
+    assert values == {"x=1": {"status": "optimal", "x": 1}}

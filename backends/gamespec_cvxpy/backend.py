@@ -17,22 +17,12 @@ import warnings
 from typing import Any, ClassVar
 
 import numpy as np
-from pydantic import Field
 
-from gamespec.backend import Availability, Backend, CompiledModel
-from gamespec.errors import BackendError
+from gamespec.lqgame.backend import LQBackend, LQCompiledModel, LQSolverOptions
 from gamespec.lqgame.covariance import gains_to_vector, jacobi
-from gamespec.lqgame.solution import (
-    CovarianceOutcome,
-    GameModel,
-    MeanOutcome,
-    assemble,
-    fallback_mean,
-    unconstrained_covariance,
-)
+from gamespec.lqgame.solution import CovarianceOutcome, GameModel, MeanOutcome, fallback_mean
 from gamespec.result import Result, Status
-from gamespec.specs.base import SpecBase, StrictModel
-from gamespec.specs.lq_game import LQGameSpec
+from gamespec.specs.base import StrictModel
 
 STATUS_MAP = {
     "optimal": Status.OPTIMAL,
@@ -46,11 +36,10 @@ STATUS_MAP = {
 }
 
 
-class CvxpyOptions(StrictModel):
+class CvxpyOptions(LQSolverOptions):
     """Options of the ``cvxpy`` backend: the conic solver's name and its keyword arguments."""
 
     solver: str = "CLARABEL"
-    solver_options: dict[str, Any] = Field(default_factory=dict)
 
 
 class _Problem:
@@ -73,10 +62,7 @@ class _Problem:
         except cp.SolverError:
             return Status.NUMERICAL_ERROR
         except (TypeError, ValueError) as err:
-            reason = str(err).splitlines()[0]
-            raise BackendError(
-                f"{self.options.solver} rejected solver_options {self.options.solver_options}: {reason}"
-            ) from None
+            raise self.options.rejected(err) from None
         finally:
             self.seconds += time.perf_counter() - start
         return STATUS_MAP.get(self.problem.status, Status.ERROR)
@@ -96,11 +82,20 @@ class MeanProblem:
         self.problem = _Problem(cp.Problem(objective, constraints), options)
 
     def solve(self, model: GameModel) -> MeanOutcome:
+        start = self.problem.seconds
         status = self.problem.solve()
+        reported = f"mean QP: solver reported {self.problem.problem.status}"
         if self.U.value is None or not status.ok:
-            return fallback_mean(model, status, f"mean QP: {self.problem.problem.status}")
+            return fallback_mean(model, status, reported)
         U = np.asarray(self.U.value)
-        return MeanOutcome(U, model.mean.stopper_response(U), status, solve_time_s=self.problem.seconds)
+        return MeanOutcome(
+            U,
+            model.mean.stopper_response(U),
+            status,
+            message=reported if status is Status.FEASIBLE else "",
+            iterations=self.problem.problem.solver_stats.num_iters,
+            solve_time_s=self.problem.seconds - start,
+        )
 
 
 class CovariancePlayers:
@@ -134,17 +129,28 @@ class CovariancePlayers:
             options,
         )
         self.scaling = _Problem(cp.Problem(cp.Minimize(cp.sigma_max(W))), options)
+        self.steps = {"stopper": 0, "controller": 0}
+        self.inaccurate = {"stopper": "", "controller": ""}
+
+    def _step(self, player: str, problem: _Problem, variable: Any) -> tuple[Status, np.ndarray | None]:
+        """Solve one player's problem; remember the step when the solver was only inaccurate."""
+        status = problem.solve()
+        self.steps[player] += 1
+        self.inaccurate[player] = (
+            f"{player} step {self.steps[player]}: solver reported {problem.problem.status}"
+            if status is Status.FEASIBLE
+            else ""
+        )
+        return status, (np.asarray(variable.value) if status.ok else None)
 
     def stopper_step(self, kappa: np.ndarray) -> tuple[Status, np.ndarray | None]:
         self.c_L.value = self.model.covariance.stopper_linear_term(kappa)
-        status = self.stopper.solve()
-        return status, (np.asarray(self.ell.value) if status.ok else None)
+        return self._step("stopper", self.stopper, self.ell)
 
     def controller_step(self, ell: np.ndarray) -> tuple[Status, np.ndarray | None]:
         self.c_K.value = self.model.covariance.controller_linear_term(ell)
         self.offset.value = self.w0 + self.T_WL @ ell
-        status = self.controller.solve()
-        return status, (np.asarray(self.kappa.value) if status.ok else None)
+        return self._step("controller", self.controller, self.kappa)
 
     def smallest_scaling(self) -> float | None:
         """``min_K ‖W‖₂²`` for the current parameters: the least ``γ`` with ``Σ_N(K) ⪯ γ Σ_N``."""
@@ -162,6 +168,7 @@ class CovariancePlayers:
         """Algorithm 2 from ``start_gains`` ``(K, L)`` (arrays (N, m, n), (N, ℓ, n)), or else from the
         UCSG saddle point (the thesis leaves ``K_0, L_0`` open)."""
         start = self.seconds
+        self.steps = dict.fromkeys(self.steps, 0)
         if start_gains is None:
             kappa0, ell0 = self.model.covariance.unconstrained_saddle()
         else:
@@ -189,28 +196,25 @@ class CovariancePlayers:
             )
         elif not run.status.ok:
             outcome.message = f"Jacobi stopped: {run.failed_step or 'iteration limit'} ({run.status.value})"
+        elif run.status is Status.FEASIBLE:
+            outcome.message = "; ".join(note for note in self.inaccurate.values() if note)
         outcome.solve_time_s = self.seconds - start
         return outcome
 
 
-class CvxpyModel(CompiledModel):
-    """The game built once; new parameter values rebuild the matrices and the CVXPY problems."""
+class CvxpyModel(LQCompiledModel):
+    """The mean QP and, with a terminal covariance, both players' problems of Algorithm 2."""
 
-    def __init__(self, spec: LQGameSpec, options: CvxpyOptions) -> None:
-        self.spec = spec
-        self.options = options
-        self._build(None)
+    options: CvxpyOptions
 
-    def _build(self, parameters: dict[str, float] | None) -> None:
-        self.parameters = dict(parameters or {})
-        self.model = GameModel.build(self.spec.game(parameters))
-        self.failure = self.model.assumption_failure()
-        if self.failure:
-            return
+    def _build_solver(self) -> None:
         self.mean = MeanProblem(self.model, self.options)
         self.players = (
             CovariancePlayers(self.model, self.options) if self.model.game.SigmaN is not None else None
         )
+
+    def _solve_mean_qp(self, guess: Result | None) -> MeanOutcome:
+        return self.mean.solve(self.model)
 
     def _start_gains(self, guess: Result | None) -> tuple[np.ndarray, np.ndarray] | None:
         """A previous Result's gains as Algorithm 2's start, when they fit this game."""
@@ -221,60 +225,25 @@ class CvxpyModel(CompiledModel):
         fits = K.shape == (g.N, g.m, g.n) and L.shape == (g.N, g.ell, g.n)
         return (K, L) if fits else None
 
-    def solve(self, parameters: dict[str, float] | None = None, guess: Result | None = None) -> Result:
-        """Mean QP, then Algorithm 2 (warm-started from ``guess``'s gains) or the UCSG closed form."""
-        if parameters and parameters != self.parameters:
-            self._build(parameters)
-        if self.failure:
-            return Result(
-                status=Status.ERROR, message=self.failure, metrics=self.model.assumptions.as_metrics()
-            )
-        unreachable = self.model.unreachable_mean()
-        mean = (
-            fallback_mean(self.model, Status.INFEASIBLE, unreachable)
-            if unreachable
-            else self.mean.solve(self.model)
-        )
+    def _solve_covariance(self, guess: Result | None) -> CovarianceOutcome:
+        """Algorithm 2 (warm-started from ``guess``'s gains) or, without Σ_N, the UCSG closed form."""
+        if self.players is None:
+            return super()._solve_covariance(guess)
         method = self.spec.method
-        cov = (
-            self.players.solve(method.tolerance, method.max_iterations, self._start_gains(guess))
-            if self.players is not None
-            else unconstrained_covariance(self.model)
-        )
-        values = {**self.spec.problem.parameters, **self.parameters}
-        result = assemble(
-            self.model, mean, cov, self.spec.state_names, method.monte_carlo.samples, method.monte_carlo.seed
-        )
-        return result.model_copy(
-            update={"parameters": values, "solver_stats": {"solver": self.options.solver}}
-        )
+        return self.players.solve(method.tolerance, method.max_iterations, self._start_gains(guess))
 
 
-class CvxpyBackend(Backend):
+class CvxpyBackend(LQBackend):
     """CVXPY with a conic solver chosen by name (``solver: CLARABEL``, ``SCS``, ...)."""
 
     name: ClassVar[str] = "cvxpy"
-    kinds: ClassVar[frozenset[str]] = frozenset({"lq_stochastic_game"})
     features: ClassVar[frozenset[str]] = frozenset({"mean_steering", "covariance_constraint"})
     options_model: ClassVar[type[StrictModel]] = CvxpyOptions
+    library: ClassVar[str] = "cvxpy"
+    model_class: ClassVar[type[LQCompiledModel]] = CvxpyModel
 
     @classmethod
-    def available(cls) -> Availability:
-        try:
-            import cvxpy as cp
-        except ImportError as err:
-            return Availability(False, f"cvxpy does not import: {err}")
-        return Availability(True, f"cvxpy {cp.__version__}; solvers {', '.join(cp.installed_solvers())}")
-
-    def _compile(self, spec: SpecBase, options: StrictModel) -> CompiledModel:
+    def installed_solvers(cls) -> list[str]:
         import cvxpy as cp
 
-        assert isinstance(spec, LQGameSpec) and isinstance(options, CvxpyOptions)
-        installed = cp.installed_solvers()
-        if options.solver.upper() not in installed:
-            raise BackendError(
-                f"conic solver {options.solver!r} is not installed for cvxpy "
-                f"(installed: {', '.join(installed)})"
-            )
-        options = options.model_copy(update={"solver": options.solver.upper()})
-        return CvxpyModel(spec, options)
+        return list(cp.installed_solvers())

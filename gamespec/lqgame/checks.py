@@ -6,6 +6,11 @@
   values, and whether ``μ_N`` can be reached in the upper game; when not, the directions of the
   state space (and the state components) it cannot reach;
 - section 4.4: ``Σ_s ⊗ (ℬᵀQ̄ℬ + R̄) ≻ 0`` and ``Σ_s ⊗ (𝒞ᵀQ̄𝒞 − S̄) ≺ 0`` on the gain structure.
+
+Extreme eigenvalues within roundoff of zero are reported as zero, so a singular matrix (the
+boundary case of a strict inequality) fails its check rather than passing on a rounding error.
+Without eq. 4.27 the stopper has no best response (eq. 4.39b), so ``𝒢`` and Lemma 11 are not
+computed.
 """
 
 from __future__ import annotations
@@ -36,7 +41,7 @@ class Assumptions:
 
     stopper_concavity_min_eig: float
     controllability_rank: int
-    reachability: Reachability
+    reachability: Reachability | None
     covariance_convexity_min_eig: float
     covariance_concavity_max_eig: float
 
@@ -46,26 +51,38 @@ class Assumptions:
         return self.stopper_concavity_min_eig > 0
 
     def as_metrics(self) -> dict[str, object]:
-        """The checks as JSON-able metrics."""
-        reach = self.reachability
-        return {
+        """The checks as JSON-able metrics (without Lemma 11's when eq. 4.27 fails)."""
+        metrics: dict[str, object] = {
             "assumption_4_27_min_eig": self.stopper_concavity_min_eig,
             "controllability_rank": self.controllability_rank,
-            "relative_controllability_rank": reach.rank,
-            "relative_controllability_singular_values": reach.singular_values,
-            "mean_target_reachable": reach.reachable,
-            "mean_target_residual": reach.residual,
-            "unreachable_directions": reach.unreachable_directions,
-            "unreachable_components": reach.unreachable_components,
             "covariance_convexity_min_eig": self.covariance_convexity_min_eig,
             "covariance_concavity_max_eig": self.covariance_concavity_max_eig,
         }
+        reach = self.reachability
+        if reach is not None:
+            metrics |= {
+                "relative_controllability_rank": reach.rank,
+                "relative_controllability_singular_values": reach.singular_values,
+                "mean_target_reachable": reach.reachable,
+                "mean_target_residual": reach.residual,
+                "unreachable_directions": reach.unreachable_directions,
+                "unreachable_components": reach.unreachable_components,
+            }
+        return metrics
 
 
 def _rank_tolerance(singular_values: np.ndarray, shape: tuple[int, int]) -> float:
     """numpy's default rank tolerance: ``σ_max · max(shape) · eps``."""
     top = singular_values.max() if singular_values.size else 0.0
     return top * max(shape) * np.finfo(float).eps
+
+
+def extreme_eigenvalue(M: np.ndarray, largest: bool = False) -> float:
+    """The smallest (or largest) eigenvalue of the symmetric ``M``; zero when within roundoff of
+    it (``|λ| ≤ size · eps · max|λ|``, numpy's rank tolerance)."""
+    eigenvalues = np.linalg.eigvalsh(M)
+    value = float(eigenvalues[-1] if largest else eigenvalues[0])
+    return 0.0 if abs(value) <= _rank_tolerance(np.abs(eigenvalues), M.shape) else value
 
 
 def reachability(mean: MeanGame) -> Reachability:
@@ -104,10 +121,11 @@ def reachability(mean: MeanGame) -> Reachability:
 def check_assumptions(mean: MeanGame, covariance: CovarianceGame) -> Assumptions:
     """All assumption checks of chapter 4 for one game."""
     BN = mean.lifted.terminal(mean.lifted.B)
+    stopper_concavity = extreme_eigenvalue(-mean.H_vv)
     return Assumptions(
-        stopper_concavity_min_eig=float(np.linalg.eigvalsh(-mean.H_vv).min()),
+        stopper_concavity_min_eig=stopper_concavity,
         controllability_rank=int(np.linalg.matrix_rank(BN)),
-        reachability=reachability(mean),
-        covariance_convexity_min_eig=float(np.linalg.eigvalsh(covariance.H_KK).min()),
-        covariance_concavity_max_eig=float(np.linalg.eigvalsh(covariance.H_LL).max()),
+        reachability=reachability(mean) if stopper_concavity > 0 else None,
+        covariance_convexity_min_eig=extreme_eigenvalue(covariance.H_KK),
+        covariance_concavity_max_eig=extreme_eigenvalue(covariance.H_LL, largest=True),
     )

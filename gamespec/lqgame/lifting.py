@@ -24,11 +24,11 @@ class Lifted:
     B: np.ndarray
     C: np.ndarray
     D: np.ndarray
+    F: np.ndarray
+    Sigma_s: np.ndarray
     Q: np.ndarray
     R: np.ndarray
     S: np.ndarray
-    Sigma_s: np.ndarray
-    F: np.ndarray
     N: int
     n: int
 

@@ -3,7 +3,7 @@
 A backend supplies the mean steering solution (a QP, section 4.3) and the covariance gains
 (eq. 4.59 or Algorithm 2, section 4.4); :func:`assemble` joins them by Props. 7–8
 (``U = Ū + K y``), recomputes the terminal statistics, the closed-form gap, the Monte Carlo check,
-and packs the Result.
+and packs the Result. :mod:`gamespec.lqgame.backend` drives these steps for every backend.
 """
 
 from __future__ import annotations
@@ -52,7 +52,7 @@ class GameModel:
     def unreachable_mean(self) -> str | None:
         """Lemma 11's verdict on the terminal mean as a message, or None when it can be reached."""
         reach = self.assumptions.reachability
-        if reach.reachable:
+        if reach is None or reach.reachable:
             return None
         return (
             f"terminal mean unreachable in the upper game (Lemma 11): rank 𝒢 = {reach.rank}, "
@@ -82,7 +82,7 @@ class CovarianceOutcome:
     status: Status
     method: str
     message: str = ""
-    iterations: int = 0
+    iterations: int | None = None
     history: list[tuple[float, float]] = field(default_factory=list)
     min_covariance_scaling: float | None = None
     solve_time_s: float = 0.0
@@ -116,7 +116,11 @@ def assemble(
     samples: int,
     seed: int,
 ) -> Result:
-    """The Result of one solve, with checks recomputed from the strategies (not from the solver)."""
+    """The Result of one solve, with checks recomputed from the strategies (not from the solver).
+
+    ``iterations`` is Algorithm 2's count when it ran, else the mean QP solver's count (None when
+    the solver does not say); ``metrics.iterations`` is Algorithm 2's count alone.
+    """
     game = model.game
     N, n = game.N, game.n
     K = vector_to_gains(cov.kappa, game.m, n)
@@ -173,7 +177,7 @@ def assemble(
         objective=metrics["mean_payoff"] + metrics["covariance_payoff"],
         t_final=float(time[-1]),
         solve_time_s=mean.solve_time_s + cov.solve_time_s,
-        iterations=cov.iterations,
+        iterations=cov.iterations if cov.iterations is not None else mean.iterations,
         time=time,
         control_time=time[:-1],
         states={name: means[:, i] for i, name in enumerate(state_names)},

@@ -4,7 +4,9 @@ A file gives the model either in discrete form (``A, B, C, D``, each constant or
 a continuous model (``A, B, C`` and the noise input) discretized with step ``step`` by a zero-order
 hold (eq. 4.70); the weights ``Q, R, S`` (eq. 4.4, constant or per step); the initial Gaussian; and
 optionally the controller's terminal mean and covariance (eq. 4.11). A ``null`` entry of the
-terminal mean leaves that component free. Every matrix entry is a number or an expression over
+terminal mean leaves that component free. A terminal covariance makes the file require the
+``covariance_constraint`` feature (the constrained covariance game, eq. 4.62), which only backends
+that solve that SDP declare. Every matrix entry is a number or an expression over
 ``parameters``; a matrix is a list of rows, ``{diag: [...]}`` or ``{identity: scale}`` (square:
 n × n for ``A, B, C, D``, ``Q`` and the covariances, m × m for ``R``, ℓ × ℓ for ``S``).
 :meth:`LQGameSpec.game` evaluates all of it into an :class:`~gamespec.lqgame.game.LQGame`.
@@ -12,12 +14,13 @@ n × n for ``A, B, C, D``, ``Q`` and the covariances, m × m for ``R``, ℓ × �
 
 from __future__ import annotations
 
+from collections import Counter
 from collections.abc import Mapping
 from typing import Literal
 
 import numpy as np
 import sympy as sp
-from pydantic import Field, model_validator
+from pydantic import Field, field_validator, model_validator
 
 from gamespec.errors import ExpressionError, SpecError
 from gamespec.expressions import RESERVED, parse, symbol
@@ -105,6 +108,14 @@ class LQGameProblem(StrictModel):
     initial: InitialDistribution
     terminal: TerminalTarget = Field(default_factory=TerminalTarget)
 
+    @field_validator("states")
+    @classmethod
+    def _distinct_states(cls, states: list[str] | None) -> list[str] | None:
+        repeated = sorted(name for name, count in Counter(states or []).items() if count > 1)
+        if repeated:
+            raise ValueError(f"state names must be distinct; repeated: {', '.join(repeated)}")
+        return states
+
     @model_validator(mode="after")
     def _one_model(self) -> LQGameProblem:
         if (self.discrete is None) == (self.continuous is None):
@@ -113,7 +124,11 @@ class LQGameProblem(StrictModel):
             if not name.isidentifier() or name in RESERVED:
                 raise ValueError(f"{name!r} cannot be a parameter name (reserved or not an identifier)")
         if self.states is not None and len(self.states) != len(self.initial.mean):
-            raise ValueError(f"{len(self.states)} state names for {len(self.initial.mean)} states")
+            raise SpecError(
+                f"expected {len(self.states)} entries (one per name in problem.states), "
+                f"got {len(self.initial.mean)}",
+                field="problem.initial.mean",
+            )
         return self
 
 
@@ -147,9 +162,11 @@ class LQGameSpec(SpecBase):
         return self
 
     def required_features(self) -> frozenset[str]:
-        """Every backend of this kind must solve the mean game; the terminal covariance is not
-        required, so that the ``qp`` backend (which does not enforce it, and says so in its
-        Result) can still solve and compare the mean game of any file."""
+        """``mean_steering`` always; ``covariance_constraint`` when the file sets a terminal
+        covariance (the relaxed constraint eq. 4.61–4.62, an SDP), so a backend that cannot
+        enforce it (``qp``) refuses the file instead of returning gains that miss ``Σ_N``."""
+        if self.problem.terminal.covariance is not None:
+            return frozenset({"mean_steering", "covariance_constraint"})
         return frozenset({"mean_steering"})
 
     @property

@@ -15,34 +15,25 @@ Z_BOUND = 5.0
 """Largest z-score accepted among a few hundred compared entries (a 5σ miss has odds ~1e-6 each)."""
 
 
-def _strategies(model: GameModel) -> Strategies:
+def _sampled(game_seed: int, sample_seed: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """4000 closed-loop samples of a random game under its saddle-point strategies, with the
+    propagated means (eq. 4.18) and covariances (eq. 4.54)."""
+    model = GameModel.build(random_game(game_seed, N=6))
     g = model.game
     U, V = model.mean.upper_game()
     kappa, ell = model.covariance.unconstrained_saddle()
-    return Strategies(
-        U.reshape(g.N, g.m),
-        V.reshape(g.N, g.ell),
-        vector_to_gains(kappa, g.m, g.n),
-        vector_to_gains(ell, g.ell, g.n),
-    )
+    K, L = vector_to_gains(kappa, g.m, g.n), vector_to_gains(ell, g.ell, g.n)
+    samples = simulate(g, Strategies(U.reshape(g.N, g.m), V.reshape(g.N, g.ell), K, L), 4000, sample_seed)
+    return samples, model.mean.trajectory(U, V), model.covariance.state_covariances(K, L)
 
 
 def test_samples_match_propagated_statistics():
-    model = GameModel.build(random_game(9, N=6))
-    strategies = _strategies(model)
-    samples = simulate(model.game, strategies, samples=4000, seed=1)
-    means = model.mean.trajectory(strategies.U.ravel(), strategies.V.ravel())
-    covs = model.covariance.state_covariances(strategies.K, strategies.L)
-    fit = agreement(samples, means, covs)
+    fit = agreement(*_sampled(9, 1))
     assert fit.mean_z < Z_BOUND
     assert fit.covariance_z < Z_BOUND
 
 
 def test_agreement_catches_a_wrong_prediction():
-    model = GameModel.build(random_game(10, N=6))
-    strategies = _strategies(model)
-    samples = simulate(model.game, strategies, samples=4000, seed=2)
-    means = model.mean.trajectory(strategies.U.ravel(), strategies.V.ravel())
-    covs = model.covariance.state_covariances(strategies.K, strategies.L)
+    samples, means, covs = _sampled(10, 2)
     assert agreement(samples, means, 1.3 * covs).covariance_z > Z_BOUND
     assert agreement(samples, means + 0.1 * np.sqrt(covs[:, 0, 0])[:, None], covs).mean_z > Z_BOUND

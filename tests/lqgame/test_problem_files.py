@@ -1,5 +1,5 @@
-"""The chapter 4 problem files solve as they are, on both backend families, and the CLI compares
-and plots them."""
+"""The chapter 4 problem files solve as they are, on the backends that take them (``qp`` refuses a
+terminal covariance), and the CLI compares and plots them."""
 
 from __future__ import annotations
 
@@ -9,6 +9,7 @@ import numpy as np
 import pytest
 
 import gamespec
+from gamespec.errors import UnsupportedFeature
 from gamespec.result import Status
 from tests.conftest import PROBLEMS
 
@@ -27,11 +28,16 @@ def solved() -> dict[str, gamespec.Result]:
     return {p.stem: gamespec.solve(p) for p in sorted(CH4.glob("*.yaml"))}
 
 
+COVARIANCE_FILES = ["test_example", "test_example_large_noise", "missile_endgame"]
+
+
 def test_each_file_has_the_documented_metrics(solved):
-    assert set(solved) == {"test_example", "test_example_large_noise", "missile_endgame"}
-    for result in solved.values():
-        assert result.backend == "cvxpy"
-        assert all(key in result.metrics for key in METRICS)
+    assert set(solved) == {*COVARIANCE_FILES, "test_example_mean_steering"}
+    for name, result in solved.items():
+        spec = gamespec.load(CH4 / f"{name}.yaml")
+        assert result.backend == spec.solver.backend
+        assert all(key in result.metrics for key in METRICS if key != "target_covariance")
+        assert ("target_covariance" in result.metrics) == (spec.problem.terminal.covariance is not None)
 
 
 def test_example_meets_both_targets(solved):
@@ -77,16 +83,42 @@ def test_missile_with_the_thesis_target_names_the_unreachable_component():
     assert "Lemma 11" in result.message
 
 
-@pytest.mark.parametrize("name", ["test_example", "test_example_large_noise", "missile_endgame"])
-@pytest.mark.parametrize("solver", ["proxqp", "clarabel"])
-def test_qp_backend_mean_agrees_with_cvxpy(solved, name: str, solver: str):
-    """The mean game through qpsolvers matches the CVXPY QP; the unenforced covariance is said."""
-    result = gamespec.solve(CH4 / f"{name}.yaml", "qp", options={"solver": solver})
-    assert result.status is Status.OPTIMAL
-    assert "not enforced" in result.message
-    reference = solved[name].arrays["mean"]
-    scale = np.abs(reference).max()
-    np.testing.assert_allclose(result.arrays["mean"], reference, atol=1e-5 * scale)
+@pytest.mark.parametrize("name", COVARIANCE_FILES)
+def test_qp_refuses_a_terminal_covariance(cli, name: str):
+    """A QP solver cannot enforce eq. 4.62: the qp backend says so instead of returning gains
+    that miss Σ_N."""
+    with pytest.raises(UnsupportedFeature, match="covariance_constraint"):
+        gamespec.compile_spec(CH4 / f"{name}.yaml", "qp")
+    code, out, err = cli("solve", CH4 / f"{name}.yaml", "--backend", "qp", "--json")
+    assert code == 2 and out == ""
+    assert len(err.strip().splitlines()) == 1 and "covariance_constraint" in err
+
+
+@pytest.mark.parametrize("solver", ["proxqp", "clarabel", "osqp"])
+def test_qp_and_cvxpy_agree_on_the_mean_steering_game(solver: str):
+    """§4.5.1 without Σ_N on qpsolvers and on CVXPY: the same mean, gains and payoff, and the mean
+    reaches its target."""
+    result = gamespec.solve(CH4 / "test_example_mean_steering.yaml", "qp", options={"solver": solver})
+    reference = gamespec.solve(CH4 / "test_example_mean_steering.yaml", "cvxpy")
+    for r in (result, reference):
+        assert r.status is Status.OPTIMAL, r.message
+        assert r.checks["terminal_mean_error"] < 1e-6
+    assert result.iterations is None
+    scale = np.abs(reference.arrays["mean"]).max()
+    np.testing.assert_allclose(result.arrays["mean"], reference.arrays["mean"], atol=1e-6 * scale)
+    np.testing.assert_allclose(result.arrays["K"], reference.arrays["K"], atol=1e-9)
+    assert result.objective == pytest.approx(reference.objective, rel=1e-6)
+
+
+def test_mean_steering_is_the_mean_of_the_constrained_game(solved):
+    """Prop. 8: the terminal covariance does not change the mean game, so §4.5.1 with and without
+    Σ_N steer the same mean."""
+    with_covariance = solved["test_example"].arrays["mean"]
+    np.testing.assert_allclose(
+        solved["test_example_mean_steering"].arrays["mean"],
+        with_covariance,
+        atol=1e-6 * np.abs(with_covariance).max(),
+    )
 
 
 def test_compare_across_conic_solvers(cli):
@@ -101,7 +133,7 @@ def test_compare_across_conic_solvers(cli):
 
 def test_compare_across_qp_solvers(cli):
     backends = "qp:proxqp,qp:osqp,qp:clarabel"
-    code, out, _ = cli("compare", CH4 / "missile_endgame.yaml", "--backends", backends, "--json")
+    code, out, _ = cli("compare", CH4 / "test_example_mean_steering.yaml", "--backends", backends, "--json")
     rows = json.loads(out)
     assert code == 0
     assert all(r["status"] == "optimal" for r in rows)
@@ -131,6 +163,7 @@ def test_guess_warm_starts_the_jacobi_procedure(solved):
 @pytest.mark.parametrize("backend", ["cvxpy", "qp"])
 def test_bad_solver_options_are_one_line_errors(cli, backend: str):
     setting = f"solver.options.{backend}.solver_options.bogus=1"
-    code, _, err = cli("solve", CH4 / "missile_endgame.yaml", "--backend", backend, "--set", setting)
+    path = CH4 / "test_example_mean_steering.yaml"
+    code, _, err = cli("solve", path, "--backend", backend, "--set", setting)
     assert code == 2
     assert "bogus" in err and "Traceback" not in err

@@ -37,7 +37,14 @@ def test_expressions_are_evaluated_with_the_parameters():
     np.testing.assert_allclose(game.Sigma0, np.diag([0.1, 0.1]))
     np.testing.assert_allclose(spec.game({"dt": 1.0}).A[0], [[1, 1], [0, 1]])
     assert spec.state_names == ["x1", "x2"]
-    assert spec.required_features() == {"mean_steering"}
+
+
+def test_a_terminal_covariance_requires_the_covariance_constraint():
+    """Only a backend that enforces eq. 4.62 may take a file with ``terminal.covariance``."""
+    assert spec_from_dict(_data()).required_features() == {"mean_steering"}
+    assert spec_from_dict(_data(terminal={"mean": [0, 0]})).required_features() == {"mean_steering"}
+    constrained = spec_from_dict(_data(terminal={"covariance": {"identity": 0.5}}))
+    assert constrained.required_features() == {"mean_steering", "covariance_constraint"}
 
 
 def test_per_step_matrices():
@@ -95,6 +102,12 @@ def test_null_terminal_mean_entries_are_free():
             "semidefinite",
         ),
         ({"terminal": {"mean": [0]}}, "problem.terminal.mean", "expected 2"),
+        ({"states": ["x", "x"]}, "problem.states", "repeated: x"),
+        (
+            {"states": ["a", "b", "c"]},
+            "problem.initial.mean",
+            "expected 3 entries (one per name in problem.states), got 2",
+        ),
         ({"terminal": {"covariance": {"diag": [1, 0]}}}, "problem.terminal.covariance", "positive definite"),
         (
             {"continuous": {"A": [[0]], "B": [[0]], "C": [[0]], "noise": [[0]], "step": 1}},

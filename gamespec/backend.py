@@ -49,9 +49,10 @@ class Backend(ABC):
     options_model: ClassVar[type[StrictModel]] = NoOptions
 
     @classmethod
-    @abstractmethod
     def available(cls) -> Availability:
-        """Whether the backend's libraries import here, with the reason when they do not."""
+        """Whether the backend's libraries import here, with the reason when they do not (a backend
+        that needs nothing beyond gamespec's own dependencies keeps this default)."""
+        return Availability(True, "needs nothing beyond gamespec's dependencies")
 
     def unsupported(self, spec: SpecBase) -> str | None:
         """Why this backend cannot take ``spec``, or None when it can."""

@@ -14,9 +14,9 @@ from typing import Any, ClassVar
 import numpy as np
 from pydantic import Field
 
-from gamespec.backend import Availability, Backend, CompiledModel
+from gamespec.backend import Availability, CompiledModel
 from gamespec.errors import BackendError
-from gamespec.ocp.transcription import Guess, Transcription
+from gamespec.ocp.transcription import CollocationBackend, Guess, Transcription
 from gamespec.ocp.translate import Library, translate
 from gamespec.result import Result, Status
 from gamespec.specs.base import StrictModel
@@ -48,24 +48,7 @@ class CasadiOptions(StrictModel):
 
 
 def _library(ca) -> Library:
-    return Library(
-        functions={
-            "sin": ca.sin,
-            "cos": ca.cos,
-            "tan": ca.tan,
-            "asin": ca.asin,
-            "acos": ca.acos,
-            "atan": ca.atan,
-            "atan2": ca.atan2,
-            "exp": ca.exp,
-            "log": ca.log,
-            "sqrt": ca.sqrt,
-            "abs": ca.fabs,
-            "tanh": ca.tanh,
-            "min": ca.fmin,
-            "max": ca.fmax,
-        }
-    )
+    return Library.from_namespace(ca, abs=ca.fabs, min=ca.fmin, max=ca.fmax)
 
 
 class CasadiModel(CompiledModel):
@@ -180,14 +163,10 @@ class CasadiModel(CompiledModel):
         )
 
 
-class CasadiBackend(Backend):
+class CasadiBackend(CollocationBackend):
     """Direct collocation (LGR or trapezoidal) on CasADi with IPOPT."""
 
     name: ClassVar[str] = "casadi"
-    kinds: ClassVar[frozenset[str]] = frozenset({"optimal_control"})
-    features: ClassVar[frozenset[str]] = frozenset(
-        {"ode", "free_final_time", "path_constraints", "boundary_constraints"}
-    )
     options_model = CasadiOptions
 
     @classmethod

@@ -12,7 +12,7 @@ from typing import ClassVar, Literal
 
 from pydantic import Field
 
-from gamespec.backend import Availability, Backend, CompiledModel
+from gamespec.backend import Backend, CompiledModel
 from gamespec.errors import SpecError
 from gamespec.loader import spec_from_dict
 from gamespec.result import Result, Status
@@ -109,11 +109,6 @@ class GeometricBackend(Backend):
     name: ClassVar[str] = "geometric"
     kinds: ClassVar[frozenset[str]] = frozenset({"pursuit_scenario"})
     options_model: ClassVar[type[StrictModel]] = GeometricOptions
-
-    @classmethod
-    def available(cls) -> Availability:
-        """Always available: the backend needs NumPy and SciPy only."""
-        return Availability(True, "numpy and scipy")
 
     def _compile(self, spec: SpecBase, options: StrictModel) -> CompiledModel:
         assert isinstance(spec, PursuitScenarioSpec) and isinstance(options, GeometricOptions)

@@ -20,9 +20,9 @@ from typing import Any, ClassVar, Literal
 import numpy as np
 from pydantic import Field
 
-from gamespec.backend import Availability, Backend, CompiledModel
+from gamespec.backend import Availability, CompiledModel
 from gamespec.errors import BackendError
-from gamespec.ocp.transcription import Bounds, Transcription
+from gamespec.ocp.transcription import Bounds, CollocationBackend, Transcription
 from gamespec.result import Result
 from gamespec.specs.base import StrictModel
 from gamespec.specs.ocp import OptimalControlSpec
@@ -176,14 +176,10 @@ class PyomoModel(CompiledModel):
         )
 
 
-class PyomoBackend(Backend):
+class PyomoBackend(CollocationBackend):
     """Direct collocation (LGR or trapezoidal) as a Pyomo model, solved by ripopt or ipopt."""
 
     name: ClassVar[str] = "pyomo"
-    kinds: ClassVar[frozenset[str]] = frozenset({"optimal_control"})
-    features: ClassVar[frozenset[str]] = frozenset(
-        {"ode", "free_final_time", "path_constraints", "boundary_constraints"}
-    )
     options_model = PyomoOptions
 
     @classmethod

@@ -43,24 +43,7 @@ def pyomo_library() -> Library:
     format has; no atan2)."""
     import pyomo.environ as pyo
 
-    return Library(
-        functions={
-            "sin": pyo.sin,
-            "cos": pyo.cos,
-            "tan": pyo.tan,
-            "asin": pyo.asin,
-            "acos": pyo.acos,
-            "atan": pyo.atan,
-            "atan2": _no_atan2,
-            "exp": pyo.exp,
-            "log": pyo.log,
-            "sqrt": pyo.sqrt,
-            "abs": abs,
-            "tanh": pyo.tanh,
-            "min": _minimum,
-            "max": _maximum,
-        }
-    )
+    return Library.from_namespace(pyo, atan2=_no_atan2, abs=abs, min=_minimum, max=_maximum)
 
 
 def _finite(value: float) -> float | None:

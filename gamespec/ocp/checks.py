@@ -124,6 +124,7 @@ def hamiltonian(
     return running + np.sum(lam * f, axis=0)
 
 
+@np.errstate(all="ignore")
 def solution_checks(
     tr: Transcription,
     X: np.ndarray,
@@ -134,18 +135,6 @@ def solution_checks(
 ) -> dict[str, float | None]:
     """All checks that apply to this problem and solution (NaN where a value cannot be computed,
     e.g. a diverging re-integration of a failed solve)."""
-    with np.errstate(all="ignore"):
-        return _checks(tr, X, U, T, params, lam)
-
-
-def _checks(
-    tr: Transcription,
-    X: np.ndarray,
-    U: np.ndarray,
-    T: float,
-    params: Mapping[str, float],
-    lam: np.ndarray | None,
-) -> dict[str, float | None]:
     checks: dict[str, float | None] = {
         "max_constraint_violation": max_constraint_violation(tr, X, U, T, params),
         "max_defect": max_defect(tr, X, U, T, params),

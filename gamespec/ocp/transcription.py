@@ -9,9 +9,11 @@ from __future__ import annotations
 from collections.abc import Mapping
 from dataclasses import dataclass
 from functools import cached_property
+from typing import ClassVar
 
 import numpy as np
 
+from gamespec.backend import Backend
 from gamespec.errors import SpecError
 from gamespec.expressions import ExpressionError, parse, symbol
 from gamespec.ocp.checks import solution_checks
@@ -41,6 +43,16 @@ class Guess:
     X: np.ndarray
     U: np.ndarray
     T: float
+
+
+class CollocationBackend(Backend):
+    """Base of the backends that solve ``optimal_control`` specs by direct collocation of a
+    :class:`Transcription` (the same kinds and features for each of them)."""
+
+    kinds: ClassVar[frozenset[str]] = frozenset({"optimal_control"})
+    features: ClassVar[frozenset[str]] = frozenset(
+        {"ode", "free_final_time", "path_constraints", "boundary_constraints"}
+    )
 
 
 class Transcription:

@@ -25,6 +25,17 @@ class Library:
     functions: Mapping[str, Callable[..., Any]]
     power: Callable[[Any, Any], Any] = field(default=lambda a, b: a**b)
 
+    @classmethod
+    def from_namespace(
+        cls, namespace: Any, *, power: Callable[[Any, Any], Any] | None = None, **renamed: Callable[..., Any]
+    ) -> Library:
+        """The functions of :data:`gamespec.expressions.FUNCTIONS` taken from ``namespace`` by
+        the same name (``namespace.sin`` ...), except those given in ``renamed``."""
+        from gamespec.expressions import FUNCTIONS
+
+        functions = {name: renamed.get(name) or getattr(namespace, name) for name in FUNCTIONS}
+        return cls(functions) if power is None else cls(functions, power=power)
+
 
 _SYMPY_NAMES: dict[type, str] = {
     sp.sin: "sin",
@@ -42,23 +53,14 @@ _SYMPY_NAMES: dict[type, str] = {
     sp.Max: "max",
 }
 
-NUMPY = Library(
-    functions={
-        "sin": np.sin,
-        "cos": np.cos,
-        "tan": np.tan,
-        "asin": np.arcsin,
-        "acos": np.arccos,
-        "atan": np.arctan,
-        "atan2": np.arctan2,
-        "exp": np.exp,
-        "log": np.log,
-        "sqrt": np.sqrt,
-        "abs": np.abs,
-        "tanh": np.tanh,
-        "min": np.minimum,
-        "max": np.maximum,
-    },
+NUMPY = Library.from_namespace(
+    np,
+    asin=np.arcsin,
+    acos=np.arccos,
+    atan=np.arctan,
+    atan2=np.arctan2,
+    min=np.minimum,
+    max=np.maximum,
     power=np.power,
 )
 

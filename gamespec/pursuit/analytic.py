@@ -17,7 +17,7 @@ from __future__ import annotations
 import time
 from typing import ClassVar
 
-from gamespec.backend import Availability, Backend, CompiledModel
+from gamespec.backend import Backend, CompiledModel
 from gamespec.pursuit import constant_bearing, pure_pursuit
 from gamespec.pursuit.reduced import observe, reduce
 from gamespec.pursuit.report import engagement_report
@@ -80,10 +80,6 @@ class AnalyticBackend(Backend):
 
     name: ClassVar[str] = "analytic"
     kinds: ClassVar[frozenset[str]] = frozenset({"engagement"})
-
-    @classmethod
-    def available(cls) -> Availability:
-        return Availability(True, "numpy and scipy only")
 
     def unsupported(self, spec: SpecBase) -> str | None:
         reason = super().unsupported(spec)

@@ -20,7 +20,7 @@ from typing import ClassVar
 import numpy as np
 from pydantic import Field
 
-from gamespec.backend import Availability, Backend, CompiledModel
+from gamespec.backend import Backend, CompiledModel
 from gamespec.errors import UnsupportedFeature
 from gamespec.pursuit import study
 from gamespec.result import Result, Status
@@ -112,10 +112,6 @@ class StudyBackend(Backend):
     name: ClassVar[str] = "study"
     kinds: ClassVar[frozenset[str]] = frozenset({"pursuit_suboptimal_study"})
     options_model: ClassVar[type[StrictModel]] = StudyOptions
-
-    @classmethod
-    def available(cls) -> Availability:
-        return Availability(True, "runs its points on the file's ocp_backend")
 
     def _compile(self, spec: SuboptimalStudySpec, options: StudyOptions) -> StudyModel:
         from gamespec.solving import get_backend

@@ -108,10 +108,19 @@ def _model_in(annotation: Any) -> type[BaseModel] | None:
     return None
 
 
+_TYPE_TAGS = frozenset({"float", "int", "str", "bool", "list", "dict", "tuple", "none", "literal"})
+
+
+def _is_type_tag(part: object) -> bool:
+    """Pydantic adds the member of a union it tried to an error's location (``float``,
+    ``constrained-float``, ``list[float]``, ``function-after[...]``); users wrote none of those."""
+    return isinstance(part, str) and ("[" in part or "-" in part or part in _TYPE_TAGS)
+
+
 def format_validation_error(err: ValidationError, model: type[BaseModel], source: str) -> SpecError:
     """The first pydantic error as a SpecError with dotted location and a nearest-key hint."""
     first = err.errors()[0]
-    loc = tuple(p for p in first["loc"] if not (isinstance(p, str) and "[" in p))
+    loc = tuple(p for p in first["loc"] if not _is_type_tag(p))
     field = ".".join(str(p) for p in loc)
     reason = first["msg"]
     if first["type"] == "extra_forbidden":

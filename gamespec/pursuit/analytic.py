@@ -6,8 +6,10 @@
 - every pursuer on pure pursuit: the suboptimal constant heading of eq. 2.27, status ``feasible``
   (it is not the optimum of Proposition 1; the ``casadi`` backend solves that).
 
-Either way the capture time is read from the true dynamics (eq. 2.1) simulated under that plan,
-and the Result carries the same metrics as an OCP solution mapped back by
+Either way the capture time is read from the true dynamics (eq. 2.1) simulated under that plan
+(RK45); the ``resimulated_*`` checks come from an independent integration of the same plan
+(DOP853), and ``predicted_capture_time_error`` compares the constant-bearing closed form with the
+simulation. The Result carries the same metrics as an OCP solution mapped back by
 :class:`gamespec.transforms.engagement.EngagementToOcp`. Relay pursuit and mixed strategies need
 the OCP.
 """
@@ -21,7 +23,7 @@ from gamespec.backend import Backend, CompiledModel
 from gamespec.pursuit import constant_bearing, pure_pursuit
 from gamespec.pursuit.reduced import observe, reduce
 from gamespec.pursuit.report import engagement_report
-from gamespec.pursuit.simulation import Players
+from gamespec.pursuit.simulation import Players, simulate_to_capture
 from gamespec.result import Result, Status
 from gamespec.specs.base import SpecBase, StrictModel
 from gamespec.specs.engagement import EngagementSpec
@@ -53,13 +55,16 @@ class AnalyticModel(CompiledModel):
             law, predicted = choice.heading, choice.capture_time
             status, message = Status.FEASIBLE, "suboptimal constant heading of eq. 2.27 (§2.4.3)"
             extra = {"headings": [choice.heading]}
-        traj = pure_pursuit.simulate_heading(players, law)
+        traj = simulate_to_capture(players, law)
+        check = simulate_to_capture(players, law, method="DOP853")
         red = reduce(self.spec)
         observed = observe(red, traj)
         control = observed.pop(red.control)
         terminal = traj.distances()[-1]
-        metrics, checks, arrays = engagement_report(self.spec, players, terminal, traj.capture_time, traj)
+        metrics, checks, arrays = engagement_report(self.spec, players, terminal, traj.capture_time, check)
         metrics |= extra | {"predicted_capture_time": predicted}
+        if status == Status.OPTIMAL:
+            checks["predicted_capture_time_error"] = abs(predicted - traj.capture_time)
         return Result(
             status=status,
             message=message,

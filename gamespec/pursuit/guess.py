@@ -12,25 +12,21 @@ from __future__ import annotations
 import numpy as np
 
 from gamespec.pursuit import constant_bearing, pure_pursuit
-from gamespec.pursuit.simulation import Players, Trajectory
+from gamespec.pursuit.relay import voronoi_margin
+from gamespec.pursuit.simulation import Players, simulate_to_capture
 
 
-def voronoi_margin(traj: Trajectory, players: Players) -> np.ndarray:
-    """S(t) = ½(r_a² − r_s²) (eq. 2.36) for each stationary pursuer s, shape (k, n_stationary)."""
-    dist = traj.distances()
-    active = players.active
-    return 0.5 * (dist[:, active][:, :1] ** 2 - dist[:, ~active] ** 2)
-
-
-def best_simulated_heading(players: Players, samples: int = 48) -> float:
-    """The constant heading with the latest simulated capture that respects eq. 2.28 (pure evasion
-    from the first active pursuer when none does); a coarse integration is enough to rank them."""
-    best, latest = float(players.los_angles()[players.active][0]), -np.inf
+def ranked_simulated_headings(players: Players, samples: int = 48) -> list[float]:
+    """Constant headings on a grid of ``samples``, latest simulated capture first, keeping those that
+    respect eq. 2.28 (pure evasion from the first active pursuer when none does); a coarse
+    integration is enough to rank them."""
+    scored = []
     for heading in np.linspace(-np.pi, np.pi, samples, endpoint=False):
-        traj = pure_pursuit.simulate_heading(players, float(heading), rtol=1e-6)
-        if voronoi_margin(traj, players).max(initial=-np.inf) <= 0 and traj.capture_time > latest:
-            best, latest = float(heading), traj.capture_time
-    return best
+        traj = simulate_to_capture(players, float(heading), rtol=1e-6)
+        if voronoi_margin(traj, players).max(initial=-np.inf) <= 0:
+            scored.append((traj.capture_time, float(heading)))
+    ranked = [h for _, h in sorted(scored, reverse=True)]
+    return ranked or [float(players.los_angles()[players.active][0])]
 
 
 def default_heading(players: Players) -> float:
@@ -40,4 +36,4 @@ def default_heading(players: Players) -> float:
         return constant_bearing.best_constant_heading(players).heading
     if strategies == {"pp"}:
         return pure_pursuit.suboptimal_heading(players).heading
-    return best_simulated_heading(players)
+    return ranked_simulated_headings(players)[0]

@@ -14,7 +14,7 @@ import numpy as np
 
 from gamespec.errors import UnsupportedFeature
 from gamespec.pursuit.headings import HeadingChoice, best_constant_heading
-from gamespec.pursuit.simulation import HeadingLaw, Players, Trajectory, simulate
+from gamespec.pursuit.simulation import Players
 
 
 def pursuit_time(r0: np.ndarray, theta: np.ndarray, u: np.ndarray, v: float) -> np.ndarray:
@@ -38,10 +38,3 @@ def suboptimal_heading(players: Players) -> HeadingChoice:
     In a degenerate case eq. 2.27 has no useful solution and the result is pure evasion.
     """
     return best_constant_heading(lambda h: capture_times(players, h), players.los_angles())
-
-
-def simulate_heading(players: Players, heading: HeadingLaw | float, rtol: float = 1e-10) -> Trajectory:
-    """The true dynamics (eq. 2.1) under an evader heading (constant or a law), until capture."""
-    active = players.active
-    bound = float(np.max((players.distances()[active] - players.eps) / (players.speeds[active] - players.v)))
-    return simulate(players, heading, 1.01 * bound, rtol=rtol)

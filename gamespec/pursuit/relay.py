@@ -14,6 +14,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from gamespec.pursuit.regions import Frame
+from gamespec.pursuit.simulation import Players, Trajectory
 
 
 def thesis_frame(p_active: np.ndarray, p_stationary: np.ndarray) -> Frame:
@@ -117,3 +118,10 @@ def detect_arcs(
         switching_residual=float(switching[last]),
         los_heading_error=float(after.max()) if after.size else 0.0,
     )
+
+
+def voronoi_margin(traj: Trajectory, players: Players) -> np.ndarray:
+    """S(t) = ½(r_a² − r_s²) (eq. 2.36) for each stationary pursuer s, shape (k, n_stationary)."""
+    dist = traj.distances()
+    active = players.active
+    return 0.5 * (dist[:, active][:, :1] ** 2 - dist[:, ~active] ** 2)

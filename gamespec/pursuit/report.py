@@ -13,8 +13,8 @@ from typing import Any
 import numpy as np
 
 from gamespec.pursuit import regions
-from gamespec.pursuit.guess import voronoi_margin
-from gamespec.pursuit.simulation import HeadingLaw, Players, Trajectory, simulate
+from gamespec.pursuit.relay import voronoi_margin
+from gamespec.pursuit.simulation import Players, Trajectory
 from gamespec.specs.engagement import EngagementSpec
 
 CAPTURE_RTOL = 1e-3
@@ -40,11 +40,6 @@ def region_of_p2(spec: EngagementSpec, players: Players) -> str | None:
     p1, p2 = players.positions
     u1, u2 = players.speeds
     return str(regions.classify(players.strategies[0], p1, p2, players.evader, u1, u2, players.v))
-
-
-def resimulate(players: Players, law: HeadingLaw, t_final: float) -> Trajectory:
-    """The true dynamics under ``law``, run long enough to see capture after ``t_final``."""
-    return simulate(players, law, 1.5 * t_final + 1e-6)
 
 
 def engagement_report(

@@ -29,8 +29,8 @@ import numpy as np
 from gamespec.pursuit import pure_pursuit
 from gamespec.pursuit.reduced import observe, reduce
 from gamespec.pursuit.regions import classify
-from gamespec.pursuit.report import capture_gap, resimulate
-from gamespec.pursuit.simulation import Players
+from gamespec.pursuit.report import capture_gap
+from gamespec.pursuit.simulation import Players, simulate_to_capture
 from gamespec.result import Result, Status
 from gamespec.specs.engagement import EngagementSpec
 from gamespec.specs.suboptimal_study import SuboptimalStudySpec
@@ -138,7 +138,7 @@ def evaluate(point: StudyPoint) -> dict[str, Any]:
     players = Players.from_spec(spec)
     red = reduce(spec)
     choice = pure_pursuit.suboptimal_heading(players)
-    traj = pure_pursuit.simulate_heading(players, choice.heading)
+    traj = simulate_to_capture(players, choice.heading)
     observed = observe(red, traj)
     control = observed.pop(red.control)
     guess = Result(status=Status.FEASIBLE, time=traj.time, states=observed, controls={red.control: control})
@@ -158,7 +158,7 @@ def evaluate(point: StudyPoint) -> dict[str, Any]:
     if not (result.ok and row["max_defect"] < DEFECT_TOL):
         return row
     terminal = np.array([result.states[red.distance[i]][-1] for i in (0, 1)])
-    check = resimulate(players, heading_law(red, result), result.t_final)
+    check = simulate_to_capture(players, heading_law(red, result))
     return row | {
         "t_optimal": result.t_final,
         "variation_percent": 100.0 * (result.t_final - traj.capture_time) / result.t_final,

@@ -14,7 +14,7 @@ from __future__ import annotations
 from typing import Literal
 
 import numpy as np
-from pydantic import Field, model_validator
+from pydantic import Field, FiniteFloat, model_validator
 
 from gamespec.specs.base import SpecBase, StrictModel
 from gamespec.specs.ocp import MethodSpec
@@ -23,19 +23,23 @@ Strategy = Literal["cb", "pp", "stationary"]
 
 
 class PursuerSpec(StrictModel):
-    """One pursuer: its initial position, speed and navigation law."""
+    """One pursuer: its initial position, speed and navigation law.
+
+    A stationary pursuer's speed is unused and may be 0; a moving one must outrun the evader (checked
+    by :class:`EngagementSpec`, assumption A1), so it is > 0 there.
+    """
 
     name: str = Field(description="Label used in reports and plots (P1, P2, ...).")
-    position: tuple[float, float]
-    speed: float = Field(1.0, gt=0, description="Speed u_i; unused while the pursuer is stationary.")
+    position: tuple[FiniteFloat, FiniteFloat]
+    speed: FiniteFloat = Field(1.0, ge=0, description="Speed u_i; unused while the pursuer is stationary.")
     strategy: Strategy = Field(description="cb (constant bearing), pp (pure pursuit) or stationary.")
 
 
 class EvaderSpec(StrictModel):
     """The evader: its initial position and speed v."""
 
-    position: tuple[float, float]
-    speed: float = Field(gt=0)
+    position: tuple[FiniteFloat, FiniteFloat]
+    speed: FiniteFloat = Field(gt=0)
 
 
 class EngagementSpec(SpecBase):
@@ -50,10 +54,10 @@ class EngagementSpec(SpecBase):
     kind: Literal["engagement"] = "engagement"
     pursuers: list[PursuerSpec] = Field(min_length=1)
     evader: EvaderSpec
-    capture_radius: float = Field(0.001, gt=0, description="Capture radius ε.")
+    capture_radius: FiniteFloat = Field(0.001, gt=0, description="Capture radius ε.")
     frame: Literal["auto", "fixed", "line_of_sight"] = "auto"
     method: MethodSpec = Field(default_factory=MethodSpec)
-    guess_heading: float | None = Field(
+    guess_heading: FiniteFloat | None = Field(
         None,
         description="Constant inertial-frame evader heading simulated to capture as the OCP's initial "
         "guess; default: the best constant heading (eq. 2.27 for pure pursuit), see gamespec.pursuit.guess.",
@@ -82,9 +86,21 @@ class EngagementSpec(SpecBase):
                     f"pursuer {names[i]!r} must be faster than the evader (assumption A1): "
                     f"{self.pursuers[i].speed} <= {self.evader.speed}"
                 )
-        for p in self.pursuers:
-            if np.hypot(*np.subtract(p.position, self.evader.position)) <= self.capture_radius:
-                raise ValueError(f"pursuer {p.name!r} starts inside the capture radius")
+        distance = {
+            p.name: float(np.hypot(*np.subtract(p.position, self.evader.position))) for p in self.pursuers
+        }
+        for name, r in distance.items():
+            if r <= self.capture_radius:
+                raise ValueError(f"pursuer {name!r} starts inside the capture radius")
+        if self.is_relay:
+            r_active = distance[names[active[0]]]
+            for p in self.pursuers:
+                if p.strategy == "stationary" and distance[p.name] < r_active:
+                    raise ValueError(
+                        f"the evader starts inside the Voronoi cell of stationary pursuer {p.name!r} "
+                        f"(eq. 2.28 at t = 0): it is {distance[p.name]:.6g} from it and {r_active:.6g} "
+                        "from the active one"
+                    )
         if self.frame == "line_of_sight" and self.pursuers[0].strategy != "pp":
             raise ValueError("frame line_of_sight rotates with the first pursuer, which must be pp")
         return self

@@ -7,6 +7,15 @@ eq. 2.36 for relay pursuit) with, as initial guess, the default constant heading
 polynomials in normalized time. :meth:`EngagementToOcp.invert` re-simulates the true dynamics under
 the OCP's heading and adds the engagement metrics: capture time, capturing set, simultaneous-capture
 gap, region of P2, and for relay pursuit the three arcs and the switching condition (eqs. 2.41, 2.46).
+
+An ``optimal`` status from the NLP only says that a KKT point of the discretized problem was found;
+:func:`verify` keeps it only when the solution is also right for the engagement: the re-simulated
+capture time is no earlier than the guess heading's (which the evader can always achieve), agrees
+with the solution's t_f within :data:`RESIM_RTOL`, and the Hamiltonian (eq. 2.23: constant along an
+optimal path) varies by at most :data:`HAMILTONIAN_TOL`. When a check fails, :meth:`invert` re-solves
+the OCP from the :data:`RETRIES` best simulated constant headings (eq. 2.28 respected), keeps the
+verified solution with the latest capture, and otherwise reports the first solution as ``feasible``
+with the failed check in its message.
 """
 
 from __future__ import annotations
@@ -16,13 +25,12 @@ from typing import Any
 
 import numpy as np
 
-from gamespec.pursuit.guess import default_heading
-from gamespec.pursuit.pure_pursuit import simulate_heading
+from gamespec.pursuit.guess import default_heading, ranked_simulated_headings
 from gamespec.pursuit.reduced import Reduction, observe, reduce
 from gamespec.pursuit.relay import detect_arcs
-from gamespec.pursuit.report import engagement_report, resimulate
-from gamespec.pursuit.simulation import HeadingLaw, Players
-from gamespec.result import Result
+from gamespec.pursuit.report import engagement_report
+from gamespec.pursuit.simulation import HeadingLaw, Players, simulate_to_capture
+from gamespec.result import Result, Status
 from gamespec.specs.engagement import EngagementSpec
 from gamespec.specs.ocp import (
     ControlSpec,
@@ -41,13 +49,26 @@ GUESS_DEGREE = 5
 ARC_TOL = 1e-5
 """|S| below this counts as on the Voronoi boundary when splitting a relay path into arcs."""
 
+HAMILTONIAN_TOL = 1e-2
+"""Largest variation of H along a solution (eq. 2.23) that :func:`verify` accepts as optimal."""
+
+RESIM_RTOL = 1e-3
+"""Largest |re-simulated capture time − t_f| / t_f that :func:`verify` accepts as optimal; also the
+relative margin by which the re-simulated capture may fall short of the guess heading's."""
+
+RETRIES = 4
+"""Constant headings :meth:`EngagementToOcp.invert` re-solves from when a solution fails :func:`verify`."""
+
 
 @dataclass(frozen=True)
 class EngagementInverse:
-    """What :meth:`EngagementToOcp.invert` needs: the reduction and the players."""
+    """What :meth:`EngagementToOcp.invert` needs: the reduction, the players, the guess heading and
+    its simulated capture time (a lower bound on the optimum)."""
 
     reduction: Reduction
     players: Players
+    guess_heading: float
+    guess_capture_time: float
 
 
 def polynomial(tau: np.ndarray, values: np.ndarray) -> str:
@@ -70,7 +91,7 @@ def to_ocp(spec: EngagementSpec) -> tuple[OptimalControlSpec, EngagementInverse]
     red = reduce(spec)
     players = Players.from_spec(spec)
     heading = default_heading(players) if spec.guess_heading is None else spec.guess_heading
-    traj = simulate_heading(players, heading)
+    traj = simulate_to_capture(players, heading)
     tau = traj.time / traj.time[-1]
     observed = observe(red, traj)
     capture = set(red.capture_states)
@@ -100,7 +121,7 @@ def to_ocp(spec: EngagementSpec) -> tuple[OptimalControlSpec, EngagementInverse]
         method=spec.method,
         guess=guess,
     )
-    return ocp, EngagementInverse(red, players)
+    return ocp, EngagementInverse(red, players, heading, traj.capture_time)
 
 
 def heading_law(red: Reduction, result: Result) -> HeadingLaw:
@@ -135,6 +156,65 @@ def relay_arcs(red: Reduction, players: Players, result: Result) -> dict[str, fl
     return arcs.as_metrics()
 
 
+def verify(result: Result, inverse: EngagementInverse) -> str | None:
+    """The first engagement check a mapped-back ``result`` fails (see module doc), None if it passes."""
+    checks, t_f = result.checks, result.t_final
+    resimulated = checks.get("resimulated_capture_time")
+    if resimulated is None:
+        return "the re-simulated evader is not captured"
+    if resimulated < inverse.guess_capture_time * (1 - RESIM_RTOL):
+        return (
+            f"re-simulated capture time {resimulated:.6g} is earlier than the guess heading's "
+            f"{inverse.guess_capture_time:.6g}"
+        )
+    if abs(resimulated - t_f) > RESIM_RTOL * t_f:
+        return f"re-simulated capture time {resimulated:.6g} is not within {RESIM_RTOL:g} of t_f = {t_f:.6g}"
+    variation = checks.get("hamiltonian_variation")
+    if variation is not None and variation > HAMILTONIAN_TOL:
+        return f"hamiltonian_variation {variation:.3g} exceeds {HAMILTONIAN_TOL:g} (eq. 2.23)"
+    return None
+
+
+def report(result: Result, spec: EngagementSpec, inverse: EngagementInverse) -> Result:
+    """``result`` with the engagement metrics, checks and paths of its re-simulation."""
+    red, players = inverse.reduction, inverse.players
+    terminal = np.array([result.states[red.distance[i]][-1] for i in range(len(players.names))])
+    traj = simulate_to_capture(players, heading_law(red, result))
+    metrics, checks, arrays = engagement_report(spec, players, terminal, result.t_final, traj)
+    if spec.is_relay and int(np.sum(~players.active)) == 1:
+        metrics["arcs"] = relay_arcs(red, players, result)
+    metrics["frame"] = red.frame
+    return result.model_copy(
+        update={
+            "metrics": {**result.metrics, **metrics},
+            "checks": {**result.checks, **checks},
+            "arrays": {**result.arrays, **arrays},
+        }
+    )
+
+
+def resolve_from_headings(spec: EngagementSpec, inverse: EngagementInverse) -> Result | None:
+    """The verified solution with the latest capture among re-solves of the OCP from the
+    :data:`RETRIES` best simulated constant headings other than the guess; None if none verifies."""
+    from gamespec.solving import solve
+
+    best = None
+    for heading in ranked_simulated_headings(inverse.players)[: RETRIES + 1]:
+        if np.isclose(np.angle(np.exp(1j * (heading - inverse.guess_heading))), 0.0):
+            continue
+        retry = spec.model_copy(update={"guess_heading": heading})
+        ocp, retry_inverse = to_ocp(retry)
+        result = solve(ocp)
+        if not result.ok or result.t_final is None:
+            continue
+        result = report(result, spec, retry_inverse)
+        if verify(result, inverse) is None and (best is None or result.t_final > best.t_final):
+            best = result.model_copy(
+                update={"message": f"{result.message}; re-solved from heading {heading:.6g}"}
+            )
+    return best
+
+
 class EngagementToOcp(Transform):
     """Generate the reduced-state OCP of an engagement (see module doc)."""
 
@@ -148,17 +228,13 @@ class EngagementToOcp(Transform):
         result = super().invert(result, spec, inverse_data)
         if not result.ok or result.t_final is None:
             return result
-        red, players = inverse_data.reduction, inverse_data.players
-        terminal = np.array([result.states[red.distance[i]][-1] for i in range(len(players.names))])
-        traj = resimulate(players, heading_law(red, result), result.t_final)
-        metrics, checks, arrays = engagement_report(spec, players, terminal, result.t_final, traj)
-        if spec.is_relay and int(np.sum(~players.active)) == 1:
-            metrics["arcs"] = relay_arcs(red, players, result)
-        metrics["frame"] = red.frame
+        result = report(result, spec, inverse_data)
+        failed = verify(result, inverse_data)
+        if failed is None or result.status != Status.OPTIMAL:
+            return result
+        retried = resolve_from_headings(spec, inverse_data)
+        if retried is not None:
+            return super().invert(retried, spec, inverse_data)
         return result.model_copy(
-            update={
-                "metrics": {**result.metrics, **metrics},
-                "checks": {**result.checks, **checks},
-                "arrays": {**result.arrays, **arrays},
-            }
+            update={"status": Status.FEASIBLE, "message": f"not verified optimal: {failed}"}
         )

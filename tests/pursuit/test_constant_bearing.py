@@ -10,9 +10,8 @@ from hypothesis import strategies as st
 import gamespec
 from gamespec.pursuit import constant_bearing as cb
 from gamespec.pursuit import regions
-from gamespec.pursuit.pure_pursuit import simulate_heading
 from gamespec.pursuit.report import CAPTURE_RTOL
-from gamespec.pursuit.simulation import Players
+from gamespec.pursuit.simulation import Players, simulate_to_capture
 from tests.conftest import PROBLEMS
 from tests.pursuit.helpers import two_pursuers
 
@@ -43,7 +42,7 @@ def test_capture_times_match_the_true_dynamics() -> None:
     players = Players.from_spec(gamespec.load(MPSE))
     for heading in (-2.0, 0.3, 2.5):
         times = cb.capture_times(players, np.array([heading]))[0]
-        simulated = [simulate_heading(players.subset([i]), heading).capture_time for i in range(5)]
+        simulated = [simulate_to_capture(players.subset([i]), heading).capture_time for i in range(5)]
         assert np.allclose(times, simulated, rtol=1e-8)
 
 
@@ -102,7 +101,7 @@ def test_several_pursuers_can_beat_every_constant_heading() -> None:
     players = Players.from_spec(gamespec.load(MPSE))
     plan = cb.optimal_evasion(players)
     constant = cb.best_constant_heading(players)
-    simulated = simulate_heading(players, plan.law()).capture_time
+    simulated = simulate_to_capture(players, plan.law()).capture_time
     assert len(plan.headings) == 2
     assert simulated == pytest.approx(plan.capture_time, rel=1e-8)
     assert simulated > constant.capture_time + 0.1

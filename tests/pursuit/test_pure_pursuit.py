@@ -11,7 +11,7 @@ import gamespec
 from gamespec.pursuit import pure_pursuit as pp
 from gamespec.pursuit import regions
 from gamespec.pursuit.mpse import path_difference
-from gamespec.pursuit.simulation import Players
+from gamespec.pursuit.simulation import Players, simulate_to_capture
 from gamespec.transforms.engagement import to_ocp
 from tests.conftest import PROBLEMS
 from tests.pursuit.helpers import two_pursuers
@@ -24,7 +24,7 @@ TWO_ON_ONE = PROBLEMS / "ch2" / "pure_pursuit_two_on_one.yaml"
 def test_eq_2_5_is_the_simulated_capture_time(r0: float, heading: float, v: float) -> None:
     """t_p = r_0 (u + v cos θ)/(u² − v²) against eq. 2.1 integrated with point-like capture."""
     players = Players(("P",), np.array([[0.0, 0.0]]), np.array([1.0]), ("pp",), np.array([r0, 0.0]), v, 1e-7)
-    simulated = pp.simulate_heading(players, heading).capture_time
+    simulated = simulate_to_capture(players, heading).capture_time
     assert simulated == pytest.approx(pp.pursuit_time(r0, heading, 1.0, v), abs=1e-5)
 
 

@@ -8,8 +8,8 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from gamespec.pursuit import regions
-from gamespec.pursuit.pure_pursuit import simulate_heading
 from gamespec.pursuit.regions import Frame
+from gamespec.pursuit.simulation import simulate_to_capture
 from tests.pursuit.helpers import two_pursuers
 
 MARGIN = 0.02
@@ -18,7 +18,9 @@ MARGIN = 0.02
 
 def _capture_times(players, heading: float, rtol: float = 1e-10) -> np.ndarray:
     """Capture time of each pursuer alone against a constant evader heading (true dynamics)."""
-    return np.array([simulate_heading(players.subset([i]), heading, rtol).capture_time for i in (0, 1)])
+    return np.array(
+        [simulate_to_capture(players.subset([i]), heading, rtol=rtol).capture_time for i in (0, 1)]
+    )
 
 
 def _region_by_simulation(p2, strategy: str, u2: float) -> str | None:

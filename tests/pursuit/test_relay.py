@@ -7,9 +7,8 @@ import pytest
 
 import gamespec
 from gamespec.pursuit import relay
-from gamespec.pursuit.guess import voronoi_margin
-from gamespec.pursuit.pure_pursuit import simulate_heading
-from gamespec.pursuit.simulation import Players
+from gamespec.pursuit.relay import voronoi_margin
+from gamespec.pursuit.simulation import Players, simulate_to_capture
 from tests.conftest import PROBLEMS
 
 RELAY_PP = PROBLEMS / "ch2" / "relay_pure_pursuit.yaml"
@@ -36,7 +35,7 @@ def test_proposition_2_agrees_with_simulated_line_of_sight_evasion(strategy: str
     for x in np.linspace(-1.9, -1.05, 6):
         for y in np.linspace(-1.0, 1.0, 7):
             players = _relay_players((x, y), strategy)
-            margin = voronoi_margin(simulate_heading(players, players.los_angles()[0]), players).max()
+            margin = voronoi_margin(simulate_to_capture(players, players.los_angles()[0]), players).max()
             if abs(margin) < 1e-2:
                 continue
             expected = bool(margin > 0)
@@ -89,5 +88,5 @@ def test_evader_starts_in_the_region_of_non_degeneracy() -> None:
     spec = gamespec.load(RELAY_PP)
     players = Players.from_spec(spec)
     assert relay.is_nondegenerate(ACTIVE, GUARD, players.evader, 1.0, spec.evader.speed)
-    line_of_sight = simulate_heading(players, players.los_angles()[0])
+    line_of_sight = simulate_to_capture(players, players.los_angles()[0])
     assert voronoi_margin(line_of_sight, players).max() > 0

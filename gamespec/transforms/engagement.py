@@ -12,10 +12,12 @@ An ``optimal`` status from the NLP only says that a KKT point of the discretized
 :func:`verify` keeps it only when the solution is also right for the engagement: the re-simulated
 capture time is no earlier than the guess heading's (which the evader can always achieve), agrees
 with the solution's t_f within :data:`RESIM_RTOL`, and the Hamiltonian (eq. 2.23: constant along an
-optimal path) varies by at most :data:`HAMILTONIAN_TOL`. When a check fails, :meth:`invert` re-solves
-the OCP from the :data:`RETRIES` best simulated constant headings (eq. 2.28 respected), keeps the
-verified solution with the latest capture, and otherwise reports the first solution as ``feasible``
-with the failed check in its message.
+optimal path) varies by at most :data:`HAMILTONIAN_TOL`. When a check fails and the file gives no
+``guess_heading`` (an explicit one is the user's choice of starting point, kept as it is),
+:meth:`invert` re-solves the OCP from the :data:`RETRIES` best simulated constant headings (eq. 2.28
+respected) on the file's backend when it solves ``optimal_control`` (else the kind's default), keeps
+the verified solution with the latest capture, and otherwise reports the first solution as
+``feasible`` with the failed check in its message.
 """
 
 from __future__ import annotations
@@ -25,6 +27,7 @@ from typing import Any
 
 import numpy as np
 
+from gamespec import registry
 from gamespec.pursuit.guess import default_heading, ranked_simulated_headings
 from gamespec.pursuit.reduced import Reduction, observe, reduce
 from gamespec.pursuit.relay import detect_arcs
@@ -198,13 +201,16 @@ def resolve_from_headings(spec: EngagementSpec, inverse: EngagementInverse) -> R
     :data:`RETRIES` best simulated constant headings other than the guess; None if none verifies."""
     from gamespec.solving import solve
 
+    backend = spec.solver.backend
+    if backend is None or "optimal_control" not in registry.backend_class(backend).kinds:
+        backend = OptimalControlSpec.default_backend
     best = None
     for heading in ranked_simulated_headings(inverse.players)[: RETRIES + 1]:
         if np.isclose(np.angle(np.exp(1j * (heading - inverse.guess_heading))), 0.0):
             continue
         retry = spec.model_copy(update={"guess_heading": heading})
         ocp, retry_inverse = to_ocp(retry)
-        result = solve(ocp)
+        result = solve(ocp, backend)
         if not result.ok or result.t_final is None:
             continue
         result = report(result, spec, retry_inverse)
@@ -232,7 +238,7 @@ class EngagementToOcp(Transform):
         failed = verify(result, inverse_data)
         if failed is None or result.status != Status.OPTIMAL:
             return result
-        retried = resolve_from_headings(spec, inverse_data)
+        retried = None if spec.guess_heading is not None else resolve_from_headings(spec, inverse_data)
         if retried is not None:
             return super().invert(retried, spec, inverse_data)
         return result.model_copy(

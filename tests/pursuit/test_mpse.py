@@ -6,6 +6,7 @@ import pytest
 
 import gamespec
 from gamespec.pursuit.mpse import check_capturing_set, keep_pursuers
+from gamespec.transforms.engagement import RESIM_RTOL
 from tests.conftest import PROBLEMS
 
 MPSE_CB = PROBLEMS / "ch3" / "mpse_optimal_evasion_cb.yaml"
@@ -25,11 +26,15 @@ def test_dropping_pursuers_outside_the_capturing_set_changes_nothing(backend: st
 
 
 def test_ocp_and_linear_program_agree_on_capture_time_and_capturing_set() -> None:
-    """Eq. 3.2 generated for five pursuers, solved by collocation, against the exact program."""
+    """Eq. 3.2 generated for five pursuers, solved by collocation, against the exact program. The
+    program uses two headings; the collocated control alternates between them (a relaxed control),
+    which re-simulated need not capture at t_f: then the Result may not claim ``optimal``."""
     exact = gamespec.solve(MPSE_CB)
     ocp = gamespec.solve(MPSE_CB, "casadi")
     assert exact.backend == "analytic"
-    assert ocp.status == gamespec.Status.OPTIMAL
+    assert ocp.ok
+    if ocp.status == gamespec.Status.OPTIMAL:
+        assert ocp.checks["resimulated_capture_time_error"] <= RESIM_RTOL * ocp.t_final
     assert ocp.metrics["capturing_set"] == exact.metrics["capturing_set"]
     assert ocp.t_final == pytest.approx(exact.t_final, rel=1e-3)
     assert ocp.t_final <= exact.t_final * (1 + 1e-6)

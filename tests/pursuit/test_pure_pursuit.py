@@ -47,7 +47,8 @@ def test_suboptimal_heading_solves_eq_2_27_in_n_and_is_pure_evasion_in_d2(x: flo
         assert choice.heading == pytest.approx(0.0, abs=1e-12)
     else:
         assert region == "D1"
-        assert choice.heading == pytest.approx(players.los_angles()[1], abs=1e-12)
+        assert choice.heading == pytest.approx(players.los_angles()[1], abs=1e-6)
+        assert choice.capture_time == pytest.approx(players.distances()[1] / (1.0 - 0.5), rel=1e-9)
 
 
 def test_optimal_capture_is_simultaneous_with_zero_hamiltonian_and_beats_the_suboptimal() -> None:

@@ -14,6 +14,7 @@ from typing import Annotated
 import typer
 import yaml
 from rich.console import Console
+from rich.markup import escape
 from rich.table import Table
 
 from gamespec import registry
@@ -219,25 +220,26 @@ def schema(
 
 @app.command()
 def backends() -> None:
-    """List installed backends, whether each is available (and why not), kinds and features."""
-    table = Table(title="gamespec backends")
-    for col in ("name", "available", "kinds", "features", "from"):
-        table.add_column(col)
+    """List installed backends: whether each is available (and why not), its kinds and features."""
+    from rich import box
+
+    table = Table(title="gamespec backends", box=box.SIMPLE_HEAD, show_edge=False)
+    table.add_column("backend", no_wrap=True)
+    table.add_column("kinds")
+    table.add_column("available, features, package")
     for name in registry.names("gamespec.backends"):
         try:
             cls = registry.backend_class(name)
         except (ImportError, GamespecError) as err:
-            table.add_row(name, f"[red]no[/red]: cannot load ({err})", "", "", "")
+            table.add_row(name, "", f"[red]no[/red]: cannot load ({escape(str(err))})")
             continue
         avail = cls.available()
-        status = f"[green]yes[/green] {avail.reason}" if avail.ok else f"[red]no[/red]: {avail.reason}"
-        table.add_row(
-            name,
-            status,
-            ", ".join(sorted(cls.kinds)),
-            ", ".join(sorted(cls.features)),
-            registry.distribution("gamespec.backends", name),
-        )
+        status = "[green]yes[/green]" if avail.ok else "[red]no[/red]"
+        details = [f"{status}: {escape(avail.reason)}"]
+        if cls.features:
+            details.append(f"features: {', '.join(sorted(cls.features))}")
+        details.append(f"from {registry.distribution('gamespec.backends', name)}")
+        table.add_row(name, "\n".join(sorted(cls.kinds)), "\n".join(details), end_section=True)
     console.print(table)
 
 

@@ -17,10 +17,10 @@ from pydantic import Field
 from gamespec.backend import Availability, CompiledModel
 from gamespec.errors import BackendError
 from gamespec.ocp.transcription import CollocationBackend, Guess, Transcription
-from gamespec.ocp.translate import Library, translate
 from gamespec.result import Result, Status
 from gamespec.specs.base import StrictModel
 from gamespec.specs.ocp import OptimalControlSpec
+from gamespec.symbolic.translate import Library, translate
 
 STATUS_MAP = {
     "Solve_Succeeded": Status.OPTIMAL,

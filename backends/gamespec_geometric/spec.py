@@ -23,8 +23,8 @@ from pydantic import (
 )
 
 from gamespec.errors import ExpressionError, SpecError
-from gamespec.expressions import parse
 from gamespec.specs.base import SpecBase, StrictModel
+from gamespec.symbolic.language import parse
 
 Position = tuple[FiniteFloat, FiniteFloat]
 PositiveFloat = Annotated[float, Field(gt=0, allow_inf_nan=False)]

@@ -18,9 +18,9 @@ from typing import Any
 import numpy as np
 
 from gamespec.errors import UnsupportedFeature
-from gamespec.expressions import Relation
 from gamespec.ocp.transcription import Transcription
-from gamespec.ocp.translate import Library, translate
+from gamespec.symbolic.language import Relation
+from gamespec.symbolic.translate import Library, translate
 
 
 def _minimum(a: Any, b: Any) -> Any:

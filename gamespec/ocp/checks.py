@@ -16,8 +16,8 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from gamespec.expressions import Relation, symbol
-from gamespec.ocp.translate import NUMPY, translate
+from gamespec.symbolic.language import Relation, symbol
+from gamespec.symbolic.translate import NUMPY, translate
 
 if TYPE_CHECKING:
     from gamespec.ocp.transcription import Transcription

@@ -14,8 +14,8 @@ from functools import cached_property
 import sympy as sp
 
 from gamespec.errors import SpecError
-from gamespec.expressions import TIME, Relation, parse, parse_relation, symbol
 from gamespec.specs.ocp import EvaluatedValues, OptimalControlSpec
+from gamespec.symbolic.language import TIME, Relation, parse, parse_relation, symbol
 
 
 @dataclass(frozen=True)

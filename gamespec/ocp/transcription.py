@@ -15,13 +15,13 @@ import numpy as np
 
 from gamespec.backend import Backend
 from gamespec.errors import SpecError
-from gamespec.expressions import ExpressionError, parse, symbol
 from gamespec.ocp.checks import solution_checks
 from gamespec.ocp.collocation import Grid
 from gamespec.ocp.symbolic import SymbolicOcp
-from gamespec.ocp.translate import NUMPY, translate
 from gamespec.result import Result, Status
 from gamespec.specs.ocp import OptimalControlSpec
+from gamespec.symbolic.language import ExpressionError, parse, symbol
+from gamespec.symbolic.translate import NUMPY, translate
 
 
 @dataclass(frozen=True)

@@ -23,9 +23,9 @@ import sympy as sp
 from pydantic import Field, field_validator, model_validator
 
 from gamespec.errors import ExpressionError, SpecError
-from gamespec.expressions import RESERVED, parse, symbol
 from gamespec.lqgame.game import LQGame, zero_order_hold
 from gamespec.specs.base import SpecBase, StrictModel
+from gamespec.symbolic.language import RESERVED, parse, symbol
 
 Value = float | str
 """A number, or an expression over the problem's parameters."""

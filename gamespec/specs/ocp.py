@@ -2,7 +2,7 @@
 
 Three sections as in rockit: ``problem`` (what), ``method`` (transcription) and ``solver`` (which
 backend, with per-backend options), plus an optional ``guess``. Every expression is a string in the
-safe language of :mod:`gamespec.expressions`; this module checks that each one parses over the
+safe language of :mod:`gamespec.symbolic.language`; this module checks that each one parses over the
 symbols it may use, so a typo stops at load time with the field that holds it.
 """
 
@@ -16,9 +16,9 @@ from typing import Literal
 from pydantic import Field, FiniteFloat, field_validator, model_validator
 
 from gamespec.errors import ExpressionError, SpecError
-from gamespec.expressions import RESERVED, parse, parse_relation, symbol
-from gamespec.ocp.translate import numeric
 from gamespec.specs.base import SpecBase, StrictModel
+from gamespec.symbolic.language import RESERVED, parse, parse_relation, symbol
+from gamespec.symbolic.translate import numeric
 
 Value = FiniteFloat | str
 """A finite number, or an expression over the problem's parameters."""

@@ -6,8 +6,8 @@ import pytest
 import sympy as sp
 
 import gamespec
-from gamespec.expressions import parse, symbol
 from gamespec.specs.ocp import OptimalControlSpec
+from gamespec.symbolic.language import parse, symbol
 from gamespec.transforms.engagement import to_ocp
 from tests.conftest import PROBLEMS
 

@@ -8,11 +8,11 @@ from hypothesis import example, given, settings
 from hypothesis import strategies as st
 
 import gamespec
-from gamespec.expressions import parse, symbol
 from gamespec.pursuit import pure_pursuit as pp
 from gamespec.pursuit import regions
 from gamespec.pursuit.mpse import path_difference
 from gamespec.pursuit.simulation import Players, simulate_to_capture
+from gamespec.symbolic.language import parse, symbol
 from gamespec.transforms import engagement
 from gamespec.transforms.engagement import to_ocp
 from tests.conftest import PROBLEMS

@@ -11,8 +11,8 @@ from gamespec_pyomo.model import pyomo_library
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from gamespec.expressions import parse, symbol
-from gamespec.ocp.translate import NUMPY, translate
+from gamespec.symbolic.language import parse, symbol
+from gamespec.symbolic.translate import NUMPY, translate
 
 EXPRESSIONS = [
     "sin(x)*cos(y) - tan(x/4)",

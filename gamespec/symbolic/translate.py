@@ -20,7 +20,7 @@ from gamespec.errors import ExpressionError
 
 @dataclass(frozen=True)
 class Library:
-    """The target's elementary functions, by the names of :data:`gamespec.expressions.FUNCTIONS`."""
+    """The target's elementary functions, by the names of :data:`gamespec.symbolic.language.FUNCTIONS`."""
 
     functions: Mapping[str, Callable[..., Any]]
     power: Callable[[Any, Any], Any] = field(default=lambda a, b: a**b)
@@ -29,9 +29,9 @@ class Library:
     def from_namespace(
         cls, namespace: Any, *, power: Callable[[Any, Any], Any] | None = None, **renamed: Callable[..., Any]
     ) -> Library:
-        """The functions of :data:`gamespec.expressions.FUNCTIONS` taken from ``namespace`` by
+        """The functions of :data:`gamespec.symbolic.language.FUNCTIONS` taken from ``namespace`` by
         the same name (``namespace.sin`` ...), except those given in ``renamed``."""
-        from gamespec.expressions import FUNCTIONS
+        from gamespec.symbolic.language import FUNCTIONS
 
         functions = {name: renamed.get(name) or getattr(namespace, name) for name in FUNCTIONS}
         return cls(functions) if power is None else cls(functions, power=power)

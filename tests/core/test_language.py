@@ -10,8 +10,8 @@ from hypothesis import given
 from hypothesis import strategies as st
 
 from gamespec.errors import ExpressionError
-from gamespec.expressions import parse, parse_relation, symbol
-from gamespec.ocp.translate import numeric
+from gamespec.symbolic.language import parse, parse_relation, symbol
+from gamespec.symbolic.translate import numeric
 
 SYMBOLS = {n: symbol(n) for n in ("x", "y", "v")} | {"t": symbol("t")}
 

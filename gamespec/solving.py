@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import datetime as _dt
 import time
+from collections.abc import Mapping
 from dataclasses import dataclass
 from functools import cache
 from importlib.metadata import PackageNotFoundError, version
@@ -73,9 +74,15 @@ class Solver:
         """The spec the backend actually solves (after transforms)."""
         return self.transforms[-1][1] if self.transforms else self.spec
 
-    def solve(self, parameters: dict[str, float] | None = None, guess: Result | None = None) -> Result:
-        """Solve (again) with optional new parameter values and an optional guess Result."""
-        result = self.compiled.solve(parameters=parameters, guess=guess)
+    def solve(
+        self,
+        parameters: dict[str, float] | None = None,
+        guess: Result | None = None,
+        inputs: Mapping[str, Any] | None = None,
+    ) -> Result:
+        """Solve (again) with optional new parameter values, an optional guess Result and new grid
+        input values (see :meth:`CompiledModel.solve`)."""
+        result = self.compiled.solve(parameters=parameters, guess=guess, inputs=inputs)
         for transform, _new, inverse in reversed(self.transforms):
             original = self._source_spec_of(transform)
             result = transform.invert(result, original, inverse)

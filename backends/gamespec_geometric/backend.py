@@ -8,11 +8,12 @@ Only NumPy and SciPy are needed, so it is always available. Options (``solver.op
 from __future__ import annotations
 
 import time
-from typing import ClassVar, Literal
+from collections.abc import Mapping
+from typing import Any, ClassVar, Literal
 
 from pydantic import Field
 
-from gamespec.backend import Backend, CompiledModel
+from gamespec.backend import Backend, CompiledModel, refuse_inputs
 from gamespec.errors import SpecError
 from gamespec.loader import spec_from_dict
 from gamespec.result import Result, Status
@@ -38,8 +39,14 @@ class CompiledScenario(CompiledModel):
         self.spec = spec
         self.options = options
 
-    def solve(self, parameters: dict[str, float] | None = None, guess: Result | None = None) -> Result:
+    def solve(
+        self,
+        parameters: dict[str, float] | None = None,
+        guess: Result | None = None,
+        inputs: Mapping[str, Any] | None = None,
+    ) -> Result:
         """Simulate (``guess`` is not used: the simulation has no iterate to warm-start)."""
+        refuse_inputs(inputs, self.spec.kind)
         unknown = set(parameters or {}) - set(self.TUNABLE)
         if unknown:
             raise SpecError(

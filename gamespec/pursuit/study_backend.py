@@ -15,12 +15,13 @@ averages (no optimum passed the defect check), ``error`` when none solved.
 from __future__ import annotations
 
 import time
-from typing import ClassVar
+from collections.abc import Mapping
+from typing import Any, ClassVar
 
 import numpy as np
 from pydantic import Field
 
-from gamespec.backend import Backend, CompiledModel
+from gamespec.backend import Backend, CompiledModel, refuse_inputs
 from gamespec.errors import UnsupportedFeature
 from gamespec.pursuit import study
 from gamespec.result import Result, Status
@@ -59,7 +60,13 @@ class StudyModel(CompiledModel):
         self.spec = spec
         self.options = options
 
-    def solve(self, parameters: dict[str, float] | None = None, guess: Result | None = None) -> Result:
+    def solve(
+        self,
+        parameters: dict[str, float] | None = None,
+        guess: Result | None = None,
+        inputs: Mapping[str, Any] | None = None,
+    ) -> Result:
+        refuse_inputs(inputs, self.spec.kind)
         if parameters:
             raise UnsupportedFeature("a pursuit_suboptimal_study takes no parameters; edit the file")
         tic = time.perf_counter()

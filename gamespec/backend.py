@@ -31,6 +31,10 @@ class NoOptions(StrictModel):
     """Options block of a backend that takes none."""
 
 
+Inputs = Mapping[str, Any] | None
+"""Grid input values by name (see :mod:`gamespec.ocp.inputs`), or None for the spec's defaults."""
+
+
 class CompiledModel(ABC):
     """A spec compiled into a backend's own modelling objects, re-solvable without a rebuild."""
 
@@ -38,10 +42,7 @@ class CompiledModel(ABC):
 
     @abstractmethod
     def solve(
-        self,
-        parameters: dict[str, float] | None = None,
-        guess: Result | None = None,
-        inputs: Mapping[str, Any] | None = None,
+        self, parameters: dict[str, float] | None = None, guess: Result | None = None, inputs: Inputs = None
     ) -> Result:
         """Solve with optional new parameter values, an optional previous Result as a guess, and new
         values of grid inputs (``{name: values}``, one value per evaluation point, for kinds that

@@ -9,7 +9,6 @@ from __future__ import annotations
 
 import datetime as _dt
 import time
-from collections.abc import Mapping
 from dataclasses import dataclass
 from functools import cache
 from importlib.metadata import PackageNotFoundError, version
@@ -17,7 +16,7 @@ from pathlib import Path
 from typing import Any
 
 from gamespec import registry
-from gamespec.backend import Backend, CompiledModel
+from gamespec.backend import Backend, CompiledModel, Inputs
 from gamespec.errors import BackendError, UnsupportedFeature
 from gamespec.loader import load, spec_hash
 from gamespec.result import Provenance, Result
@@ -75,10 +74,7 @@ class Solver:
         return self.transforms[-1][1] if self.transforms else self.spec
 
     def solve(
-        self,
-        parameters: dict[str, float] | None = None,
-        guess: Result | None = None,
-        inputs: Mapping[str, Any] | None = None,
+        self, parameters: dict[str, float] | None = None, guess: Result | None = None, inputs: Inputs = None
     ) -> Result:
         """Solve (again) with optional new parameter values, an optional guess Result and new grid
         input values (see :meth:`CompiledModel.solve`)."""

@@ -10,15 +10,13 @@ with new values reuses the solver and warm-starts from the last solution.
 from __future__ import annotations
 
 import time
-from collections.abc import Mapping
 from typing import Any, ClassVar
 
 import numpy as np
 from pydantic import Field
 
-from gamespec.backend import Availability
+from gamespec.backend import Availability, Inputs
 from gamespec.errors import BackendError
-from gamespec.ocp.inputs import InputValue
 from gamespec.ocp.transcription import CollocationBackend, CollocationModel, Guess, Transcription
 from gamespec.result import Result, Status
 from gamespec.specs.base import StrictModel
@@ -129,10 +127,7 @@ class CasadiModel(CollocationModel):
         return X, U, T
 
     def solve(
-        self,
-        parameters: dict[str, float] | None = None,
-        guess: Result | None = None,
-        inputs: Mapping[str, InputValue] | None = None,
+        self, parameters: dict[str, float] | None = None, guess: Result | None = None, inputs: Inputs = None
     ) -> Result:
         tr = self.tr
         params = tr.ocp.parameter_values(parameters)

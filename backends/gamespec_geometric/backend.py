@@ -8,12 +8,11 @@ Only NumPy and SciPy are needed, so it is always available. Options (``solver.op
 from __future__ import annotations
 
 import time
-from collections.abc import Mapping
-from typing import Any, ClassVar, Literal
+from typing import ClassVar, Literal
 
 from pydantic import Field
 
-from gamespec.backend import Backend, CompiledModel, refuse_inputs
+from gamespec.backend import Backend, CompiledModel, Inputs, refuse_inputs
 from gamespec.errors import SpecError
 from gamespec.loader import spec_from_dict
 from gamespec.result import Result, Status
@@ -40,10 +39,7 @@ class CompiledScenario(CompiledModel):
         self.options = options
 
     def solve(
-        self,
-        parameters: dict[str, float] | None = None,
-        guess: Result | None = None,
-        inputs: Mapping[str, Any] | None = None,
+        self, parameters: dict[str, float] | None = None, guess: Result | None = None, inputs: Inputs = None
     ) -> Result:
         """Simulate (``guess`` is not used: the simulation has no iterate to warm-start)."""
         refuse_inputs(inputs, self.spec.kind)

@@ -14,16 +14,14 @@ import logging
 import math
 import tempfile
 import time
-from collections.abc import Mapping
 from pathlib import Path
 from typing import Any, ClassVar, Literal
 
 import numpy as np
 from pydantic import Field
 
-from gamespec.backend import Availability
+from gamespec.backend import Availability, Inputs
 from gamespec.errors import BackendError
-from gamespec.ocp.inputs import InputValue
 from gamespec.ocp.transcription import Bounds, CollocationBackend, CollocationModel, Transcription
 from gamespec.result import Result
 from gamespec.specs.base import StrictModel
@@ -138,10 +136,7 @@ class PyomoModel(CollocationModel):
         return True
 
     def solve(
-        self,
-        parameters: dict[str, float] | None = None,
-        guess: Result | None = None,
-        inputs: Mapping[str, InputValue] | None = None,
+        self, parameters: dict[str, float] | None = None, guess: Result | None = None, inputs: Inputs = None
     ) -> Result:
         tr, m = self.tr, self.model
         params = tr.ocp.parameter_values(parameters)

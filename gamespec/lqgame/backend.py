@@ -13,12 +13,11 @@ from __future__ import annotations
 
 import importlib
 from abc import abstractmethod
-from collections.abc import Mapping
 from typing import Any, ClassVar
 
 from pydantic import Field
 
-from gamespec.backend import Availability, Backend, CompiledModel, refuse_inputs
+from gamespec.backend import Availability, Backend, CompiledModel, Inputs, refuse_inputs
 from gamespec.errors import BackendError
 from gamespec.lqgame.solution import (
     CovarianceOutcome,
@@ -87,10 +86,7 @@ class LQCompiledModel(CompiledModel):
         return self._solve_mean_qp(guess)
 
     def solve(
-        self,
-        parameters: dict[str, float] | None = None,
-        guess: Result | None = None,
-        inputs: Mapping[str, Any] | None = None,
+        self, parameters: dict[str, float] | None = None, guess: Result | None = None, inputs: Inputs = None
     ) -> Result:
         """Rebuild if the effective parameter values changed, then the mean and covariance games."""
         refuse_inputs(inputs, self.spec.kind)

@@ -17,6 +17,7 @@
 from __future__ import annotations
 
 from collections.abc import Mapping
+from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
 import numpy as np
@@ -28,6 +29,17 @@ if TYPE_CHECKING:
     from gamespec.ocp.transcription import Transcription
 
 RK4_STEPS = 16
+
+
+@dataclass(frozen=True)
+class Trajectory:
+    """A transcribed solution: states ``X`` (n_x × nodes), controls ``U`` and grid inputs ``Win``
+    (n_u, n_w × evaluation points), the horizon ``T``."""
+
+    X: np.ndarray
+    U: np.ndarray
+    Win: np.ndarray
+    T: float
 
 
 def _dynamics(tr: Transcription, x, u, w, t: np.ndarray, params: Mapping[str, float]) -> np.ndarray:
@@ -64,15 +76,14 @@ def _per_interval(tr: Transcription, V: np.ndarray) -> np.ndarray:
     return np.stack([V[:, :-1], V[:, 1:]], axis=2)
 
 
-def max_defect(
-    tr: Transcription, X: np.ndarray, U: np.ndarray, Win: np.ndarray, T: float, params: Mapping[str, float]
-) -> float:
+def max_defect(tr: Transcription, sol: Trajectory, params: Mapping[str, float]) -> float:
     """Largest gap between an RK4 re-integration of each interval and the collocated state."""
+    X, T = sol.X, sol.T
     grid = tr.grid
     starts = grid.interval_start_index
     h = np.diff(grid.breaks) * T
     t0 = tr.t0 + T * grid.breaks[:-1]
-    Ui, Wi = _per_interval(tr, U), _per_interval(tr, Win)
+    Ui, Wi = _per_interval(tr, sol.U), _per_interval(tr, sol.Win)
     x = X[:, starts[:-1]].astype(float)
     ds = 1.0 / RK4_STEPS
 
@@ -101,15 +112,14 @@ def _relation_violation(rel: Relation, values: dict, shape: tuple[int, ...]) -> 
     return _violation(v, rel.lower, rel.upper)
 
 
-def max_constraint_violation(
-    tr: Transcription, X: np.ndarray, U: np.ndarray, Win: np.ndarray, T: float, params: Mapping[str, float]
-) -> float:
+def max_constraint_violation(tr: Transcription, sol: Trajectory, params: Mapping[str, float]) -> float:
     """Largest violation of bounds, fixed end values, path and boundary constraints."""
+    X, U, T = sol.X, sol.U, sol.T
     b = tr.bounds(params)
     worst = [_violation(X, b.x_lower, b.x_upper), _violation(U, b.u_lower, b.u_upper)]
     worst.append(_violation(np.array([T]), b.t_lower, b.t_upper))
     t_eval = tr.t0 + T * tr.grid.eval_tau
-    running = _values(tr, X[:, tr.grid.eval_index], U, Win, t_eval, params)
+    running = _values(tr, X[:, tr.grid.eval_index], U, sol.Win, t_eval, params)
     worst += [_relation_violation(r, running, t_eval.shape) for r in tr.ocp.path]
     ends = _end_values(tr, X, T, params)
     worst += [_relation_violation(r, ends, ()) for r in tr.ocp.boundary]
@@ -123,19 +133,13 @@ def _end_values(tr: Transcription, X: np.ndarray, T: float, params: Mapping[str,
 
 
 def hamiltonian(
-    tr: Transcription,
-    X: np.ndarray,
-    U: np.ndarray,
-    Win: np.ndarray,
-    T: float,
-    params: Mapping[str, float],
-    lam: np.ndarray,
+    tr: Transcription, sol: Trajectory, params: Mapping[str, float], lam: np.ndarray
 ) -> np.ndarray:
     """``H = sign*L + lambda^T f`` at the collocation points (eq. 2.22 in general form)."""
-    t_eval = tr.t0 + T * tr.grid.eval_tau
-    xe = X[:, tr.grid.eval_index]
-    f = _dynamics(tr, xe, U, Win, t_eval, params)
-    values = _values(tr, xe, U, Win, t_eval, params)
+    t_eval = tr.t0 + sol.T * tr.grid.eval_tau
+    xe = sol.X[:, tr.grid.eval_index]
+    f = _dynamics(tr, xe, sol.U, sol.Win, t_eval, params)
+    values = _values(tr, xe, sol.U, sol.Win, t_eval, params)
     running = np.broadcast_to(translate(tr.ocp.lagrange, values, NUMPY), t_eval.shape)
     return running + np.sum(lam * f, axis=0)
 
@@ -148,24 +152,18 @@ def _time_invariant(tr: Transcription, Win: np.ndarray) -> bool:
 
 @np.errstate(all="ignore")
 def solution_checks(
-    tr: Transcription,
-    X: np.ndarray,
-    U: np.ndarray,
-    Win: np.ndarray,
-    T: float,
-    params: Mapping[str, float],
-    lam: np.ndarray | None,
+    tr: Transcription, sol: Trajectory, params: Mapping[str, float], lam: np.ndarray | None
 ) -> dict[str, float | None]:
     """All checks that apply to this problem and solution (NaN where a value cannot be computed,
     e.g. a diverging re-integration of a failed solve)."""
     checks: dict[str, float | None] = {
-        "max_constraint_violation": max_constraint_violation(tr, X, U, Win, T, params),
-        "max_defect": max_defect(tr, X, U, Win, T, params),
+        "max_constraint_violation": max_constraint_violation(tr, sol, params),
+        "max_defect": max_defect(tr, sol, params),
     }
-    if lam is not None and _time_invariant(tr, Win):
-        H = hamiltonian(tr, X, U, Win, T, params, lam)
+    if lam is not None and _time_invariant(tr, sol.Win):
+        H = hamiltonian(tr, sol, params, lam)
         checks["hamiltonian_variation"] = float(np.max(np.abs(H - H.mean())))
         if tr.free_time:
-            end = translate(tr.ocp.hamiltonian_end_value, _end_values(tr, X, T, params), NUMPY)
+            end = translate(tr.ocp.hamiltonian_end_value, _end_values(tr, sol.X, sol.T, params), NUMPY)
             checks["hamiltonian_end_error"] = float(np.max(np.abs(H - float(end))))
     return checks

@@ -17,7 +17,7 @@ import numpy as np
 
 from gamespec.backend import Backend, CompiledModel
 from gamespec.errors import SpecError
-from gamespec.ocp.checks import solution_checks
+from gamespec.ocp.checks import Trajectory, solution_checks
 from gamespec.ocp.collocation import Grid
 from gamespec.ocp.inputs import InputGrid, InputValue, on_grid
 from gamespec.ocp.symbolic import SymbolicOcp
@@ -245,7 +245,7 @@ class Transcription:
         if defect_multipliers is not None and self.grid.scheme == "radau":
             lam = defect_multipliers * self.costate_rows[None, :]
             costates = {f"lambda_{n}": lam[i] for i, n in enumerate(self.ocp.states)}
-        checks = solution_checks(self, X, U, inputs, T, params, lam)
+        checks = solution_checks(self, Trajectory(X, U, inputs, T), params, lam)
         if lam is not None:
             arrays["costate_time"] = t_eval
         return Result(

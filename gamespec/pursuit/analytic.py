@@ -17,10 +17,9 @@ the OCP.
 from __future__ import annotations
 
 import time
-from collections.abc import Mapping
-from typing import Any, ClassVar
+from typing import ClassVar
 
-from gamespec.backend import Backend, CompiledModel, refuse_inputs
+from gamespec.backend import Backend, CompiledModel, Inputs, refuse_inputs
 from gamespec.pursuit import constant_bearing, pure_pursuit
 from gamespec.pursuit.reduced import observe, reduce
 from gamespec.pursuit.report import engagement_report
@@ -38,10 +37,7 @@ class AnalyticModel(CompiledModel):
         self.players = Players.from_spec(spec)
 
     def solve(
-        self,
-        parameters: dict[str, float] | None = None,
-        guess: Result | None = None,
-        inputs: Mapping[str, Any] | None = None,
+        self, parameters: dict[str, float] | None = None, guess: Result | None = None, inputs: Inputs = None
     ) -> Result:
         refuse_inputs(inputs, self.spec.kind)
         tic = time.perf_counter()

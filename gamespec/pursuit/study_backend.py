@@ -15,13 +15,12 @@ averages (no optimum passed the defect check), ``error`` when none solved.
 from __future__ import annotations
 
 import time
-from collections.abc import Mapping
-from typing import Any, ClassVar
+from typing import ClassVar
 
 import numpy as np
 from pydantic import Field
 
-from gamespec.backend import Backend, CompiledModel, refuse_inputs
+from gamespec.backend import Backend, CompiledModel, Inputs, refuse_inputs
 from gamespec.errors import UnsupportedFeature
 from gamespec.pursuit import study
 from gamespec.result import Result, Status
@@ -61,10 +60,7 @@ class StudyModel(CompiledModel):
         self.options = options
 
     def solve(
-        self,
-        parameters: dict[str, float] | None = None,
-        guess: Result | None = None,
-        inputs: Mapping[str, Any] | None = None,
+        self, parameters: dict[str, float] | None = None, guess: Result | None = None, inputs: Inputs = None
     ) -> Result:
         refuse_inputs(inputs, self.spec.kind)
         if parameters:

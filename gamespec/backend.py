@@ -49,7 +49,7 @@ class CompiledModel(ABC):
         declare inputs; see :mod:`gamespec.ocp.inputs`)."""
 
 
-def refuse_inputs(inputs: Mapping[str, Any] | None, kind: str) -> None:
+def refuse_inputs(inputs: Inputs, kind: str) -> None:
     """A SpecError naming the inputs when a model of ``kind``, which declares none, is given some."""
     if inputs:
         raise SpecError(

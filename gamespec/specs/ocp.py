@@ -9,7 +9,7 @@ symbols it may use, so a typo stops at load time with the field that holds it.
 from __future__ import annotations
 
 import math
-from collections.abc import Mapping
+from collections.abc import Callable, Mapping
 from dataclasses import dataclass
 from typing import Literal
 
@@ -221,7 +221,7 @@ class OcpProblem(StrictModel):
                 raise SpecError(reason, field=f"problem.{field}") from None
 
 
-def _inputs_in(read, text: str, symbols: dict, inputs: dict) -> list[str]:
+def _inputs_in(read: Callable, text: str, symbols: dict, inputs: dict) -> list[str]:
     """The grid inputs that ``text`` uses, when it parses once they are allowed (else none)."""
     if not inputs or set(inputs) <= set(symbols):
         return []

@@ -21,7 +21,7 @@ from gamespec import registry
 from gamespec.errors import GamespecError
 from gamespec.loader import load
 from gamespec.pursuit.cli import pursuit_app
-from gamespec.result import Result, writable_folder
+from gamespec.result import Result, status_ok, writable_folder
 from gamespec.studies.compare import (
     LEGEND,
     compare_backends,
@@ -132,7 +132,7 @@ def compare(
         console.print(LEGEND, style="dim", highlight=False)
         for note in row_notes(rows):
             console.print(note, markup=False, highlight=False)
-    if not any(row.get("status") in ("optimal", "feasible") for row in rows):
+    if not any(status_ok(row.get("status", "")) for row in rows):
         print(f"error: {spec.name}: no backend solved the problem", file=sys.stderr)
         raise typer.Exit(1)
 
@@ -164,7 +164,7 @@ def sweep(
     for row in rows:
         table.add_row(*(_fmt(row.get(c)) for c in [*names, "status", "objective", "t_final", "solve_time_s"]))
     console.print(table)
-    failed = [r for r in rows if r["status"] not in ("optimal", "feasible")]
+    failed = [r for r in rows if not status_ok(r["status"])]
     if failed:
         print(f"error: {len(failed)} of {len(rows)} points did not solve", file=sys.stderr)
         raise typer.Exit(1)

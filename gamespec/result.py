@@ -23,24 +23,49 @@ ArrayDict = dict[str, np.ndarray]
 
 
 class Status(StrEnum):
-    """Backend-independent outcome of a solve (each backend maps its native statuses here)."""
+    """Backend-independent outcome of a solve (each backend maps its native statuses here).
+
+    One meaning in every kind (the table in README.md, "Statuses", and ``docs/statuses.md``);
+    :attr:`ok` statuses exit 0, the others exit 1.
+    """
 
     OPTIMAL = "optimal"
+    """The solver proved (local) optimality; a closed form is optimal where it is the optimum."""
     FEASIBLE = "feasible"
+    """A usable solution with no optimality claim: acceptable-level stops, suboptimal strategies,
+    optima that failed a check; the message says why."""
+    SIMULATED = "simulated"
+    """A simulation ran to its end: every evader captured, or the horizon reached (escapes are a
+    result, listed in the metrics); nothing is optimized, so nothing is claimed optimal."""
     INFEASIBLE = "infeasible"
+    """No point meets the constraints (a target out of reach, a solver's infeasibility proof)."""
     UNBOUNDED = "unbounded"
+    """The objective improves without bound."""
     ITERATION_LIMIT = "iteration_limit"
+    """The solver, or a game's iteration, stopped at its iteration limit before converging."""
     NOT_CONVERGED = "not_converged"
     """An iteration stopped before its limit because it cannot converge: best responses that cycle
     or diverge (:mod:`gamespec.games.best_response`); the message says which."""
     TIME_LIMIT = "time_limit"
+    """The solver stopped at its wall-clock or CPU-time limit (never a simulation's horizon)."""
     NUMERICAL_ERROR = "numerical_error"
+    """The solver failed numerically (restoration failure, NaN, an ill-conditioned step)."""
     ERROR = "error"
+    """Anything else that left no solution; the message says what."""
 
     @property
     def ok(self) -> bool:
         """True for statuses that carry a usable solution."""
-        return self in (Status.OPTIMAL, Status.FEASIBLE)
+        return self in OK_STATUSES
+
+
+OK_STATUSES = frozenset({Status.OPTIMAL, Status.FEASIBLE, Status.SIMULATED})
+"""Statuses that carry a usable solution (exit code 0)."""
+
+
+def status_ok(value: str) -> bool:
+    """Whether a status written as text (a table row, a JSON Result) carries a usable solution."""
+    return value in {s.value for s in OK_STATUSES}
 
 
 class Provenance(BaseModel):

@@ -70,20 +70,22 @@ def allocation_changes(run: Trajectories) -> list[dict[str, object]]:
 
 
 def scenario_result(spec: PursuitScenarioSpec, run: Trajectories, seconds: float) -> Result:
-    """The Result of a simulation: trajectories, capture times and capturers, allocation history."""
-    missed = [j for j, c in enumerate(run.capture_times) if c is None]
+    """The Result of a simulation: trajectories, capture times and capturers, escapes, allocation
+    history. A finished simulation is ``simulated`` whether or not every evader was caught: an evader
+    still free at the horizon has escaped, which is an outcome of the game, not a failure."""
+    escaped = [j for j, c in enumerate(run.capture_times) if c is None]
+    caught = len(run.capture_times) - len(escaped)
     last = max((c for c in run.capture_times if c is not None), default=None)
-    if missed:
-        status = Status.TIME_LIMIT
-        message = f"{len(missed)} of {len(run.capture_times)} evaders not captured by t = {spec.horizon:g}"
+    if escaped:
+        names = ", ".join(f"E{j + 1}" for j in escaped)
+        message = f"{caught} of {len(run.capture_times)} evaders captured; {names} escaped to t = {spec.horizon:g}"
     else:
-        status = Status.FEASIBLE
         message = f"all {len(run.capture_times)} evaders captured by t = {last:.4g}"
     return Result(
-        status=status,
+        status=Status.SIMULATED,
         message=message,
-        objective=last if not missed else None,
-        t_final=last if not missed else float(run.time[-1]),
+        objective=last if not escaped else None,
+        t_final=last if not escaped else float(run.time[-1]),
         solve_time_s=seconds,
         iterations=len(run.time) - 1,
         time=run.time,
@@ -96,6 +98,7 @@ def scenario_result(spec: PursuitScenarioSpec, run: Trajectories, seconds: float
         metrics={
             "capture_times": run.capture_times,
             "capturers": run.capturers,
+            "escaped": escaped,
             "allocation_history": allocation_changes(run),
             "algorithm": spec.algorithm,
             "pursuit_strategy": spec.pursuers.strategy,

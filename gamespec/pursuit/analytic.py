@@ -4,7 +4,9 @@
   :func:`gamespec.pursuit.constant_bearing.optimal_evasion` (a linear program over headings; one
   constant heading in the cases of §2.4.1, possibly several in §3.2.1), status ``optimal``;
 - every pursuer on pure pursuit: the suboptimal constant heading of eq. 2.27, status ``feasible``
-  (it is not the optimum of Proposition 1; the ``casadi`` backend solves that).
+  (it is not the optimum of Proposition 1; the ``casadi`` backend solves that), except against one
+  pursuer, where the best constant heading is pure evasion along the line of sight, the optimum
+  (t_c = (r_0 − ε)/(u − v), Proposition 1 with one pursuer): status ``optimal``.
 
 Either way the capture time is read from the true dynamics (eq. 2.1) simulated under that plan
 (RK45); the ``resimulated_*`` checks come from an independent integration of the same plan
@@ -56,7 +58,12 @@ class AnalyticModel(CompiledModel):
         else:
             choice = pure_pursuit.suboptimal_heading(players)
             law, predicted = choice.heading, choice.capture_time
-            status, message = Status.FEASIBLE, "suboptimal constant heading of eq. 2.27 (§2.4.3)"
+            if int(players.active.sum()) == 1:
+                status, message = Status.OPTIMAL, "pure evasion along the line of sight: optimal against one pursuer"
+            else:
+                status, message = Status.FEASIBLE, (
+                    "suboptimal constant heading of eq. 2.27 (§2.4.3); --backend casadi solves Prop. 1's optimum"
+                )
             extra = {"headings": [choice.heading]}
         traj = simulate_to_capture(players, law)
         check = simulate_to_capture(players, law, method="DOP853")

@@ -76,7 +76,7 @@ def test_theorems_3_and_4_every_evader_is_captured(seed: int, n: int, m: int, he
     data = _scenario(seed, n, m, heterogeneous)
     data["horizon"] = capture_time_bound(data) + 1.0
     result = gamespec.solve(spec_from_dict(data))
-    assert result.status == gamespec.Status.FEASIBLE, result.message
+    assert result.status == gamespec.Status.SIMULATED, result.message
     assert all(t is not None for t in result.metrics["capture_times"])
     homogeneous = (
         np.ptp(result.metrics["pursuer_speeds"]) == 0 and np.ptp(result.metrics["evader_speeds"]) == 0
@@ -102,7 +102,7 @@ def test_redundant_pursuer_stays_redundant(seed: int, n: int, heterogeneous: boo
 @pytest.mark.parametrize("path", CH3, ids=lambda p: p.stem)
 def test_problem_file_solves_and_captures_everyone(path: Path) -> None:
     result = gamespec.solve(path)
-    assert result.status == gamespec.Status.FEASIBLE, result.message
+    assert result.status == gamespec.Status.SIMULATED, result.message
     capture_times = result.metrics["capture_times"]
     assert all(t is not None for t in capture_times)
     assert result.t_final == pytest.approx(max(capture_times))
@@ -120,7 +120,7 @@ def test_solve_json_save_load_and_plot(cli, tmp_path: Path) -> None:
     code, out, _ = cli("solve", path, "--json", "--out", tmp_path / "run")
     assert code == 0
     data = json.loads(out)
-    assert data["status"] == "feasible" and data["backend"] == "geometric"
+    assert data["status"] == "simulated" and data["backend"] == "geometric"
     assert len(data["metrics"]["capture_times"]) == 1 and data["metrics"]["allocation_history"]
     loaded = gamespec.Result.load(tmp_path / "run")
     assert np.array_equal(loaded.arrays["allocation"], gamespec.solve(path).arrays["allocation"])

@@ -78,7 +78,9 @@ def scenario_result(spec: PursuitScenarioSpec, run: Trajectories, seconds: float
     last = max((c for c in run.capture_times if c is not None), default=None)
     if escaped:
         names = ", ".join(f"E{j + 1}" for j in escaped)
-        message = f"{caught} of {len(run.capture_times)} evaders captured; {names} escaped to t = {spec.horizon:g}"
+        message = (
+            f"{caught} of {len(run.capture_times)} evaders captured; {names} escaped to t = {spec.horizon:g}"
+        )
     else:
         message = f"all {len(run.capture_times)} evaders captured by t = {last:.4g}"
     return Result(

@@ -59,10 +59,10 @@ class AnalyticModel(CompiledModel):
             choice = pure_pursuit.suboptimal_heading(players)
             law, predicted = choice.heading, choice.capture_time
             if int(players.active.sum()) == 1:
-                status, message = Status.OPTIMAL, "pure evasion along the line of sight: optimal against one pursuer"
+                status, message = Status.OPTIMAL, "pure evasion along the line of sight (optimal, one pursuer)"
             else:
                 status, message = Status.FEASIBLE, (
-                    "suboptimal constant heading of eq. 2.27 (§2.4.3); --backend casadi solves Prop. 1's optimum"
+                    "suboptimal constant heading of eq. 2.27 (§2.4.3); --backend casadi gives the optimum"
                 )
             extra = {"headings": [choice.heading]}
         traj = simulate_to_capture(players, law)

@@ -59,7 +59,7 @@ class AnalyticModel(CompiledModel):
             choice = pure_pursuit.suboptimal_heading(players)
             law, predicted = choice.heading, choice.capture_time
             if int(players.active.sum()) == 1:
-                status, message = Status.OPTIMAL, "pure evasion along the line of sight (optimal, one pursuer)"
+                status, message = Status.OPTIMAL, "pure evasion, optimal against one pursuer"
             else:
                 status, message = Status.FEASIBLE, (
                     "suboptimal constant heading of eq. 2.27 (§2.4.3); --backend casadi gives the optimum"

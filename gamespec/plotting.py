@@ -1,7 +1,9 @@
-"""Plots of ``optimal_control`` Results: states, controls and, for planar problems, the path.
+"""Plots of ``optimal_control`` Results: states, controls and, for declared planar pairs, the path.
 
 Plotters read Results only (never solver objects) and are registered per kind in the
-``gamespec.plotters`` entry-point group; :func:`plot_result` dispatches on ``result.kind``.
+``gamespec.plotters`` entry-point group; :func:`plot_result` dispatches on ``result.kind``. The
+planar pairs, units and path constraints come from ``metrics["plot"]`` (the file's ``plot``
+section, :mod:`gamespec.specs.plot`); a plane is drawn only when the file declares one.
 """
 
 from __future__ import annotations
@@ -9,9 +11,11 @@ from __future__ import annotations
 from pathlib import Path
 
 from gamespec import registry
+from gamespec.obstacles import circles
 from gamespec.result import Result
 
-PLANAR_PAIRS = (("x", "y"), ("x1", "x2"), ("x_E", "y_E"))
+LEGEND_RIGHT = {"loc": "upper left", "bbox_to_anchor": (1.02, 1.0), "borderaxespad": 0.0, "fontsize": "small"}
+"""Legend placement outside the axes, to their right, so that it never covers the data."""
 
 
 def _pyplot():
@@ -23,45 +27,85 @@ def _pyplot():
     return plt
 
 
+def headline(result: Result) -> str:
+    """``problem — backend, status, <headline number>``: the first line of every figure's title."""
+    number = ""
+    if result.objective is not None:
+        number = f", J = {result.objective:.6g}"
+    elif result.t_final is not None:
+        number = f", t_f = {result.t_final:.6g}"
+    return f"{result.problem} — {result.backend}, {result.status.value}{number}"
+
+
+def _label(name: str, units: dict[str, str]) -> str:
+    return f"{name} [{units[name]}]" if name in units else name
+
+
 def plot_trajectories(result: Result, output_dir: Path, *, animate: bool = False) -> list[Path]:
-    """States and controls against time, and the planar path when the states hold one."""
+    """States and controls against time, and the path of each declared planar pair."""
     plt = _pyplot()
     output_dir.mkdir(parents=True, exist_ok=True)
+    hint = result.metrics.get("plot", {})
+    units = hint.get("units", {})
     rows = 2 if result.controls else 1
-    fig, axes = plt.subplots(rows, 1, figsize=(7, 3.2 * rows), sharex=True, squeeze=False)
+    fig, axes = plt.subplots(rows, 1, figsize=(8, 3.2 * rows), sharex=True, squeeze=False)
     for name, values in result.states.items():
-        axes[0, 0].plot(result.time, values, label=name)
+        axes[0, 0].plot(result.time, values, label=_label(name, units))
     axes[0, 0].set_ylabel("states")
-    axes[0, 0].legend(loc="best")
+    axes[0, 0].legend(**LEGEND_RIGHT)
     if result.controls:
         tc = result.control_time if result.control_time is not None else result.time
         for name, values in result.controls.items():
-            axes[1, 0].plot(tc, values, ".-", label=name, markersize=3)
+            axes[1, 0].plot(tc, values, ".-", label=_label(name, units), markersize=3)
         axes[1, 0].set_ylabel("controls")
-        axes[1, 0].legend(loc="best")
-    axes[-1, 0].set_xlabel("t")
-    fig.suptitle(f"{result.problem} — {result.backend}, {result.status.value}, J = {result.objective:.6g}")
+        axes[1, 0].legend(**LEGEND_RIGHT)
+    axes[-1, 0].set_xlabel(_label("t", units))
+    title = headline(result)
+    if result.t_final is not None and result.objective is not None:
+        title += f", t_f = {result.t_final:.6g}"
+    fig.suptitle(title)
     fig.tight_layout()
     paths = [output_dir / f"{result.problem}_time.png"]
-    fig.savefig(paths[0], dpi=120)
+    fig.savefig(paths[0], dpi=120, bbox_inches="tight")
     plt.close(fig)
-    for xs, ys in PLANAR_PAIRS:
-        if xs in result.states and ys in result.states:
-            fig, ax = plt.subplots(figsize=(5.5, 5))
-            ax.plot(result.states[xs], result.states[ys], "-")
-            ax.plot(result.states[xs][0], result.states[ys][0], "o", label="start")
-            ax.plot(result.states[xs][-1], result.states[ys][-1], "s", label="end")
-            ax.set_xlabel(xs)
-            ax.set_ylabel(ys)
-            ax.set_aspect("equal", adjustable="datalim")
-            ax.legend(loc="best")
-            ax.grid(alpha=0.3)
-            path = output_dir / f"{result.problem}_path.png"
-            fig.savefig(path, dpi=120)
-            plt.close(fig)
-            paths.append(path)
-            break
+    pairs = [tuple(p) for p in hint.get("planar", [])]
+    if pairs:
+        paths.append(plot_plane(result, pairs, output_dir / f"{result.problem}_path.png"))
     return paths
+
+
+def plot_plane(result: Result, pairs: list[tuple[str, str]], path: Path) -> Path:
+    """The path of each planar pair (start ``o``, end ``s``) with the circular path constraints over
+    it: obstacles as grey disks, keep-in circles as dashed outlines (:mod:`gamespec.obstacles`)."""
+    plt = _pyplot()
+    hint = result.metrics.get("plot", {})
+    units = hint.get("units", {})
+    names = [*result.states, *result.controls, *(k.split("/", 1)[1] for k in result.arrays if "/" in k)]
+    fig, ax = plt.subplots(figsize=(6.5, 5))
+    for i, (xs, ys) in enumerate(pairs):
+        colour = f"C{i}"
+        x, y = result.states[xs], result.states[ys]
+        ax.plot(x, y, "-", color=colour, label=f"({xs}, {ys})")
+        ax.plot(x[0], y[0], "o", color=colour, label=f"start of ({xs}, {ys})")
+        ax.plot(x[-1], y[-1], "s", color=colour, label=f"end of ({xs}, {ys})")
+        for circle in circles(hint.get("path_constraints", []), (xs, ys), names, result.parameters):
+            if circle.keep_out:
+                patch = plt.Circle(circle.center, circle.radius, color="0.6", alpha=0.5, label=circle.text)
+            else:
+                patch = plt.Circle(
+                    circle.center, circle.radius, fill=False, ls="--", color="0.3", label=circle.text
+                )
+            ax.add_patch(patch)
+    ax.set_xlabel(", ".join(_label(p[0], units) for p in pairs))
+    ax.set_ylabel(", ".join(_label(p[1], units) for p in pairs))
+    ax.set_aspect("equal", adjustable="datalim")
+    ax.autoscale_view()
+    ax.grid(alpha=0.3)
+    ax.set_title(headline(result), fontsize="medium")
+    ax.legend(**LEGEND_RIGHT)
+    fig.savefig(path, dpi=120, bbox_inches="tight")
+    plt.close(fig)
+    return path
 
 
 def plot_result(result: Result, output_dir: Path, *, animate: bool = False) -> list[Path]:

@@ -263,6 +263,12 @@ class Transcription:
             arrays=arrays,
             parameters=dict(params),
             checks=checks,
+            metrics={
+                "plot": {
+                    **self.spec.plot.as_metrics(),
+                    "path_constraints": list(self.spec.problem.path_constraints),
+                }
+            },
             solver_stats=solver_stats or {},
         )
 

@@ -61,8 +61,9 @@ class AnalyticModel(CompiledModel):
             if int(players.active.sum()) == 1:
                 status, message = Status.OPTIMAL, "pure evasion, optimal against one pursuer"
             else:
-                status, message = Status.FEASIBLE, (
-                    "suboptimal constant heading of eq. 2.27 (§2.4.3); --backend casadi gives the optimum"
+                status, message = (
+                    Status.FEASIBLE,
+                    ("suboptimal constant heading of eq. 2.27 (§2.4.3); --backend casadi gives the optimum"),
                 )
             extra = {"headings": [choice.heading]}
         traj = simulate_to_capture(players, law)

@@ -17,6 +17,7 @@ from pydantic import Field, FiniteFloat, field_validator, model_validator
 
 from gamespec.errors import ExpressionError, SpecError
 from gamespec.specs.base import SpecBase, StrictModel
+from gamespec.specs.plot import PlotHint
 from gamespec.symbolic.language import RESERVED, parse, parse_relation, symbol
 from gamespec.symbolic.translate import numeric
 
@@ -279,6 +280,7 @@ class OptimalControlSpec(SpecBase):
     problem: OcpProblem
     method: MethodSpec = Field(default_factory=MethodSpec)
     guess: GuessSpec = Field(default_factory=GuessSpec)
+    plot: PlotHint = Field(default_factory=PlotHint)
 
     default_backend = "casadi"
 
@@ -288,6 +290,19 @@ class OptimalControlSpec(SpecBase):
             unknown = set(getattr(self.guess, group)) - set(getattr(self.problem, group))
             if unknown:
                 raise ValueError(f"guess.{group} names undeclared {group}: {sorted(unknown)}")
+        return self
+
+    @model_validator(mode="after")
+    def _plot_names(self) -> OptimalControlSpec:
+        states = set(self.problem.states)
+        for i, pair in enumerate(self.plot.planar):
+            unknown = [n for n in pair if n not in states]
+            if unknown:
+                raise SpecError(f"{', '.join(unknown)} is not a state", field=f"plot.planar.{i}")
+        named = {*self.problem.states, *self.problem.controls, "t"}
+        for name in self.plot.units:
+            if name not in named:
+                raise SpecError(f"{name!r} is not a state, a control or t", field=f"plot.units.{name}")
         return self
 
     @property

@@ -15,6 +15,7 @@ import numpy as np
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt
 
+from gamespec.plotting import LEGEND_RIGHT, headline
 from gamespec.pursuit import regions, relay
 from gamespec.result import Result
 from gamespec.specs.engagement import EngagementSpec
@@ -27,25 +28,42 @@ def _engagement(result: Result) -> EngagementSpec:
     return EngagementSpec.model_validate(result.metrics["engagement"])
 
 
-def _paths(result: Result, spec: EngagementSpec, ax) -> None:
+def _paths(result: Result, spec: EngagementSpec, ax, upto: int | None = None) -> list:
+    """The players' paths up to index ``upto`` (all of it by default); returns the current markers."""
+    last = len(result.arrays["path_time"]) if upto is None else upto + 1
+    captors = set(result.metrics.get("capturing_set", []))
+    markers = []
     for i, p in enumerate(spec.pursuers):
-        path = result.arrays[f"path_{p.name}"]
+        path = result.arrays[f"path_{p.name}"][:last]
         colour = PLAYER_COLOURS[i % len(PLAYER_COLOURS)]
         style = "s" if p.strategy == "stationary" else "-"
-        ax.plot(path[:, 0], path[:, 1], style, color=colour, label=f"{p.name} ({p.strategy})")
-        ax.plot(*path[0], "o", color=colour)
-    evader = result.arrays["path_evader"]
+        tag = " ∈ P*" if p.name in captors and upto is None else ""
+        ax.plot(path[:, 0], path[:, 1], style, color=colour, label=f"{p.name} ({p.strategy}){tag}")
+        ax.plot(*path[0], "o", color=colour, mfc="none")
+        markers += ax.plot(*path[-1], "o", color=colour)
+    evader = result.arrays["path_evader"][:last]
     ax.plot(evader[:, 0], evader[:, 1], "k-", label="evader")
-    ax.plot(*evader[0], "ko")
-    ax.plot(*evader[-1], "kx")
+    ax.plot(*evader[0], "ko", mfc="none", label="start (open circles)")
+    if upto is None:
+        markers += ax.plot(*evader[-1], "kx", ms=9, mew=2, label="capture point")
+    else:
+        markers += ax.plot(*evader[-1], "k^")
+    return markers
+
+
+def _outcome(result: Result) -> str:
+    """``t_c = …, P* = {…}``: the capture time and the capturing set (Definition 2)."""
+    captors = ", ".join(result.metrics.get("capturing_set", [])) or "—"
+    return f"t_c = {result.t_final:.4f}, P* = {{{captors}}}"
 
 
 def plot_paths(result: Result, spec: EngagementSpec, path: Path) -> Path:
     """The players' paths up to capture (x: capture point)."""
-    fig, ax = plt.subplots(figsize=(6, 5))
+    fig, ax = plt.subplots(figsize=(7.5, 5))
     _paths(result, spec, ax)
-    ax.set(xlabel="x", ylabel="y", title=f"{result.problem}: t_c = {result.t_final:.4f}", aspect="equal")
-    ax.legend(fontsize="small")
+    ax.set(xlabel="x", ylabel="y", aspect="equal")
+    ax.set_title(f"{headline(result)}\n{_outcome(result)}", fontsize="medium")
+    ax.legend(**LEGEND_RIGHT)
     fig.savefig(path, dpi=120, bbox_inches="tight")
     plt.close(fig)
     return path
@@ -74,7 +92,7 @@ def plot_regions(result: Result, spec: EngagementSpec, path: Path) -> Path | Non
         for name, point in vertices.items():
             ax.plot(*point, "k.")
             ax.annotate(name, point, textcoords="offset points", xytext=(4, 4))
-        ax.set_title("Region of non-degeneracy (Prop. 2)")
+        ax.set_title(f"{result.problem}: region of non-degeneracy N (Prop. 2, green)\n{_outcome(result)}")
     elif len(spec.pursuers) == 2 and spec.pursuers[0].strategy == spec.pursuers[1].strategy != "stationary":
         strategy = spec.pursuers[0].strategy
         u1, u2 = (p.speed for p in spec.pursuers)
@@ -89,60 +107,85 @@ def plot_regions(result: Result, spec: EngagementSpec, path: Path) -> Path | Non
         for name, points in curves.items():
             ax.plot(points[:, 0], points[:, 1], "k--", linewidth=0.8)
             ax.annotate(name, points[len(points) // 4], textcoords="offset points", xytext=(4, 4))
-        ax.set_title(f"Regions D1 (red), N (green), D2 (blue) for P2 ({strategy})")
+        ax.set_title(
+            f"{result.problem}: regions D1 (red), N (green), D2 (blue) for P2 ({strategy}), "
+            f"P2 in {result.metrics.get('region') or '—'}\n{_outcome(result)}"
+        )
     else:
         plt.close(fig)
         return None
     _paths(result, spec, ax)
     ax.set(xlabel="x", ylabel="y", aspect="equal")
-    ax.legend(fontsize="small", loc="upper right")
+    ax.title.set_fontsize("medium")
+    ax.legend(**LEGEND_RIGHT)
     fig.savefig(path, dpi=120, bbox_inches="tight")
     plt.close(fig)
     return path
 
 
 def plot_distances(result: Result, spec: EngagementSpec, path: Path) -> Path:
-    """r_i(t) (re-simulated), with r1 − r2 (Fig. 2.10b) or S = ½(r1² − r2²) (Fig. 2.14b)."""
+    """r_i(t) (re-simulated) against the capture radius ε and, with two or more pursuers, a second
+    panel: S = ½(r1² − r2²) for relay (Fig. 2.14b), else each r_i − min_j r_j (with two pursuers
+    |r1 − r2|, Fig. 2.10b), which vanishes at t_c for every pursuer of the capturing set."""
     t = result.arrays["path_time"]
     evader = result.arrays["path_evader"]
     dist = {p.name: np.linalg.norm(evader - result.arrays[f"path_{p.name}"], axis=1) for p in spec.pursuers}
-    fig, (top, bottom) = plt.subplots(2, 1, figsize=(6, 5), sharex=True)
-    for name, d in dist.items():
-        top.plot(t, d, label=f"r to {name}")
-    top.set(ylabel="distance")
-    top.legend(fontsize="small")
-    if len(spec.pursuers) == 2:
-        r1, r2 = dist.values()
+    rows = 2 if len(dist) > 1 else 1
+    fig, axes = plt.subplots(rows, 1, figsize=(7.5, 2.6 + 2.4 * rows), sharex=True, squeeze=False)
+    top = axes[0, 0]
+    for i, (name, d) in enumerate(dist.items()):
+        top.plot(t, d, color=PLAYER_COLOURS[i % len(PLAYER_COLOURS)], label=f"r to {name}")
+    top.axhline(spec.capture_radius, color="k", lw=0.8, ls=":", label=f"ε = {spec.capture_radius:g}")
+    top.set(ylabel="distance to the evader")
+    top.set_title(f"{headline(result)}\n{_outcome(result)}", fontsize="medium")
+    top.legend(**LEGEND_RIGHT)
+    if rows == 2:
+        bottom = axes[1, 0]
         if spec.is_relay:
-            bottom.plot(t, 0.5 * (r1**2 - r2**2))
+            r1, r2 = dist.values()
+            bottom.plot(t, 0.5 * (r1**2 - r2**2), color="k", label="S")
+            bottom.axhline(0.0, color="0.5", lw=0.6)
             bottom.set(ylabel="S = (r1² − r2²)/2")
+            arcs = result.metrics.get("arcs", {})
             for key in ("tau1", "tau2"):
-                if key in result.metrics.get("arcs", {}):
-                    bottom.axvline(result.metrics["arcs"][key], color="grey", linestyle=":")
+                if arcs.get(key) is not None:
+                    bottom.axvline(arcs[key], color="grey", linestyle=":", label=f"{key} = {arcs[key]:.4g}")
         else:
-            bottom.plot(t, r1 - r2)
-            bottom.set(ylabel="r1 − r2")
-    bottom.set(xlabel="t")
+            nearest = np.min(np.array(list(dist.values())), axis=0)
+            for i, (name, d) in enumerate(dist.items()):
+                bottom.plot(t, d - nearest, color=PLAYER_COLOURS[i % len(PLAYER_COLOURS)], label=name)
+            bottom.set(ylabel="r_i − min_j r_j")
+        bottom.legend(**LEGEND_RIGHT)
+    axes[-1, 0].set(xlabel="t")
     fig.savefig(path, dpi=120, bbox_inches="tight")
     plt.close(fig)
     return path
 
 
 def animate_paths(result: Result, spec: EngagementSpec, path: Path, frames: int = 60) -> Path:
-    """A GIF of the players moving to capture."""
+    """A GIF of the players moving to capture: paths grow frame by frame, with the time shown."""
     from matplotlib.animation import FuncAnimation, PillowWriter
 
-    fig, ax = plt.subplots(figsize=(5, 4))
-    _paths(result, spec, ax)
-    ax.set(aspect="equal")
-    names = [f"path_{p.name}" for p in spec.pursuers] + ["path_evader"]
-    dots = [ax.plot([], [], "o", color="k" if n == "path_evader" else "grey")[0] for n in names]
-    index = np.linspace(0, len(result.arrays["path_time"]) - 1, frames).astype(int)
+    fig, ax = plt.subplots(figsize=(8, 4.5))
+    fig.subplots_adjust(left=0.1, right=0.7)
+    everything = np.concatenate(
+        [result.arrays[k] for k in result.arrays if k.startswith("path_") and k != "path_time"]
+    )
+    lo, hi = everything.min(axis=0), everything.max(axis=0)
+    pad = 0.08 * float(np.max(hi - lo)) + 1e-3
+    time = result.arrays["path_time"]
+    index = np.linspace(0, len(time) - 1, frames).astype(int)
 
-    def update(k: int):
-        for dot, name in zip(dots, names, strict=True):
-            dot.set_data([result.arrays[name][index[k], 0]], [result.arrays[name][index[k], 1]])
-        return dots
+    def update(k: int) -> None:
+        ax.clear()
+        _paths(result, spec, ax, upto=int(index[k]))
+        ax.set(xlim=(lo[0] - pad, hi[0] + pad), ylim=(lo[1] - pad, hi[1] + pad), xlabel="x", ylabel="y")
+        ax.set_aspect("equal")
+        ax.set_title(
+            f"{result.problem} — {result.backend}: t = {time[index[k]]:.3f} of {_outcome(result)}",
+            fontsize="small",
+        )
+        ax.legend(**LEGEND_RIGHT)
 
     FuncAnimation(fig, update, frames=frames).save(path, writer=PillowWriter(fps=15))
     plt.close(fig)

@@ -27,7 +27,7 @@ def study(
     file: Annotated[Path, typer.Argument(help="Problem file of kind pursuit_suboptimal_study.")],
     out: Annotated[
         Path | None,
-        typer.Option(help="Save the Result and table_2_1.png here, and the points in OUT/points."),
+        typer.Option(help="Save the Result and variation.png here, and the points in OUT/points."),
     ] = None,
     workers: Annotated[int | None, typer.Option(min=1, help="Local processes (default: the file's).")] = None,
     set_: Annotated[
@@ -58,7 +58,7 @@ def study(
     if json_:
         sys.stdout.write(json.dumps(table, indent=2) + "\n")
     else:
-        view = Table(title=f"Table 2.1 — {file.name} (percentage variation of t_c)")
+        view = Table(title=f"{result.problem} — {file.name} (percentage variation of t_c)")
         for col in TABLE_COLUMNS:
             view.add_column(col.replace("_variation_percent", " [%]"), justify="right")
         for row in table:

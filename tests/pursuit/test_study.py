@@ -76,7 +76,7 @@ def test_solve_saves_points_resumes_and_plots(tmp_path, monkeypatch, cli) -> Non
 
     code, out, err = cli("plot", run)
     assert code == 0, err
-    assert (run / "table_2_1.png").exists()
+    assert (run / "variation.png").exists()
 
     code, out, err = cli("pursuit", "study", STUDY, *TINY, "--out", tmp_path, "--json")
     assert code == 0, err

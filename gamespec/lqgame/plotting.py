@@ -1,8 +1,9 @@
 """Plots of an ``lq_stochastic_game`` Result (registered as that kind's plotter).
 
 - ``ellipses.png``: the first two states' plane with the sampled closed-loop trajectories (gray),
-  the mean (blue) and its 3σ ellipses, and the initial and target 3σ ellipses (red), as in
-  Figs. 4.1–4.3;
+  the mean (blue) and its 3σ ellipses, the initial 3σ ellipse (red), the terminal one (thick blue)
+  and the target (green, dashed), as in Figs. 4.1–4.3, with a zoom on the terminal ellipse against
+  its target;
 - ``first_state.png``: the first state against the step with the samples, the mean and red 3σ bars
   at the initial and final steps, as in Fig. 4.5;
 - ``convergence.png``: ``ε_k`` and ``ε_ℓ`` per Jacobi iteration (Fig. 4.2(b)), when there are any;
@@ -21,6 +22,7 @@ import numpy as np
 from matplotlib.animation import FuncAnimation, PillowWriter
 from matplotlib.axes import Axes
 
+from gamespec.plotting import LEGEND_RIGHT, headline
 from gamespec.result import Result
 
 SIGMAS = 3.0
@@ -34,6 +36,61 @@ def ellipse_points(mean: np.ndarray, covariance: np.ndarray, sigmas: float = SIG
     return mean + sigmas * circle * np.sqrt(np.maximum(values, 0)) @ vectors.T
 
 
+def _target(result: Result) -> tuple[np.ndarray | None, np.ndarray | None]:
+    """The target mean (NaN entries, i.e. free ones, replaced by the terminal mean) and covariance
+    of the first two states, when the file gives them."""
+    means = result.arrays["mean"]
+    if "target_covariance" not in result.arrays and "target_mean" not in result.arrays:
+        return None, None
+    target = np.asarray(result.arrays.get("target_mean", means[-1]), dtype=float)
+    centre = np.where(np.isnan(target[:2]), means[-1, :2], target[:2])
+    covariance = result.arrays.get("target_covariance")
+    return centre, None if covariance is None else covariance[:2, :2]
+
+
+def _ends(ax: Axes, result: Result, *, legend: bool) -> None:
+    """The terminal 3σ ellipse (blue) against the target (green): what the controller had to meet."""
+    means, covs = result.arrays["mean"], result.arrays["covariance"]
+    ax.plot(
+        *ellipse_points(means[-1, :2], covs[-1, :2, :2]).T,
+        color="tab:blue",
+        lw=2.0,
+        label="terminal 3σ" if legend else None,
+    )
+    centre, covariance = _target(result)
+    if centre is not None:
+        ax.plot(*centre, "+", color="tab:green", ms=10, mew=2, label="target mean" if legend else None)
+        if covariance is not None:
+            ax.plot(
+                *ellipse_points(centre, covariance).T,
+                color="tab:green",
+                lw=1.6,
+                ls="--",
+                label="target 3σ" if legend else None,
+            )
+
+
+def _inset(ax: Axes, result: Result) -> None:
+    """A zoom on the terminal ellipse, its samples and the target ellipse (they are small)."""
+    means, covs = result.arrays["mean"], result.arrays["covariance"]
+    zoom = ax.inset_axes([1.06, 0.0, 0.38, 0.5])
+    if "samples" in result.arrays:
+        ends = result.arrays["samples"][:, -1, :2]
+        zoom.plot(ends[:, 0], ends[:, 1], ".", color="0.55", ms=2)
+    _ends(zoom, result, legend=False)
+    centre, covariance = _target(result)
+    spread = [ellipse_points(means[-1, :2], covs[-1, :2, :2])]
+    if centre is not None and covariance is not None:
+        spread.append(ellipse_points(centre, covariance))
+    points = np.concatenate(spread)
+    lo, hi = points.min(axis=0), points.max(axis=0)
+    pad = 0.15 * float(np.max(hi - lo)) + 1e-9
+    zoom.set(xlim=(lo[0] - pad, hi[0] + pad), ylim=(lo[1] - pad, hi[1] + pad))
+    zoom.set_title("step N (zoom)", fontsize=7)
+    zoom.tick_params(labelsize=6)
+    ax.indicate_inset_zoom(zoom, edgecolor="0.4")
+
+
 def _plane(ax: Axes, result: Result, upto: int | None = None) -> None:
     names = list(result.states)
     means, covs = result.arrays["mean"], result.arrays["covariance"]
@@ -41,22 +98,20 @@ def _plane(ax: Axes, result: Result, upto: int | None = None) -> None:
     if "samples" in result.arrays:
         for path in result.arrays["samples"][:, :last, :2]:
             ax.plot(path[:, 0], path[:, 1], color="0.75", lw=0.6)
+        ax.plot([], [], color="0.75", lw=0.6, label="Monte Carlo samples")
     ax.plot(means[:last, 0], means[:last, 1], color="tab:blue", lw=1.5, label="mean")
     for k in range(last):
-        ax.plot(*ellipse_points(means[k, :2], covs[k, :2, :2]).T, color="tab:blue", lw=0.8)
-    ax.plot(
-        *ellipse_points(means[0, :2], covs[0, :2, :2]).T, color="tab:red", lw=1.2, label="initial / target"
-    )
-    if "target_covariance" in result.arrays:
-        target = result.arrays.get("target_mean", means[-1])
-        centre = np.where(np.isnan(target[:2]), means[-1, :2], target[:2])
-        ax.plot(
-            *ellipse_points(centre, result.arrays["target_covariance"][:2, :2]).T, color="tab:red", lw=1.2
-        )
+        ax.plot(*ellipse_points(means[k, :2], covs[k, :2, :2]).T, color="tab:blue", lw=0.5, alpha=0.6)
+    ax.plot(*ellipse_points(means[0, :2], covs[0, :2, :2]).T, color="tab:red", lw=1.6, label="initial 3σ")
+    if upto is None or upto == len(means) - 1:
+        _ends(ax, result, legend=True)
     ax.set_xlabel(names[0])
     ax.set_ylabel(names[1])
-    ax.set_title(f"{result.problem}: {result.status.value}, 3σ ellipses")
-    ax.legend(loc="best", fontsize=8)
+    ax.set_title(
+        f"{headline(result)}\n3σ ellipses of ({names[0]}, {names[1]}), step {last - 1} of {len(means) - 1}",
+        fontsize="medium",
+    )
+    ax.legend(**LEGEND_RIGHT)
 
 
 def _first_state(ax: Axes, result: Result) -> None:
@@ -78,8 +133,8 @@ def _first_state(ax: Axes, result: Result) -> None:
     )
     ax.set_xlabel("step k")
     ax.set_ylabel(name)
-    ax.set_title(f"{result.problem}: {name} against the step")
-    ax.legend(loc="best", fontsize=8)
+    ax.set_title(f"{headline(result)}\n{name} against the step", fontsize="medium")
+    ax.legend(**LEGEND_RIGHT)
 
 
 def plot(result: Result, output_dir: Path, *, animate: bool = False) -> list[Path]:
@@ -93,10 +148,11 @@ def plot(result: Result, output_dir: Path, *, animate: bool = False) -> list[Pat
     if result.arrays["mean"].shape[1] >= 2:
         figures.insert(0, ("ellipses.png", _plane))
     for name, draw in figures:
-        fig, ax = plt.subplots(figsize=(6, 4.5))
+        fig, ax = plt.subplots(figsize=(8, 5))
         draw(ax, result)
-        fig.tight_layout()
-        fig.savefig(output_dir / name, dpi=120)
+        if draw is _plane:
+            _inset(ax, result)
+        fig.savefig(output_dir / name, dpi=120, bbox_inches="tight")
         plt.close(fig)
         written.append(output_dir / name)
     history = result.arrays.get("convergence_history")
@@ -105,14 +161,15 @@ def plot(result: Result, output_dir: Path, *, animate: bool = False) -> list[Pat
         ax.semilogy(np.arange(1, len(history) + 1), history[:, 0], "o-", label="ε_k")
         ax.semilogy(np.arange(1, len(history) + 1), history[:, 1], "s-", label="ε_ℓ")
         ax.set_xlabel("Jacobi iteration")
-        ax.set_title("Algorithm 2 convergence")
-        ax.legend()
-        fig.tight_layout()
-        fig.savefig(output_dir / "convergence.png", dpi=120)
+        ax.set_ylabel("change of the gains")
+        ax.set_title(f"{headline(result)}\nAlgorithm 2 convergence", fontsize="medium")
+        ax.legend(**LEGEND_RIGHT)
+        fig.savefig(output_dir / "convergence.png", dpi=120, bbox_inches="tight")
         plt.close(fig)
         written.append(output_dir / "convergence.png")
     if animate and result.arrays["mean"].shape[1] >= 2:
-        fig, ax = plt.subplots(figsize=(6, 4.5))
+        fig, ax = plt.subplots(figsize=(8.5, 5))
+        fig.subplots_adjust(left=0.1, right=0.7, top=0.85)
 
         def frame(k: int) -> None:
             ax.clear()

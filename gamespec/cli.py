@@ -20,7 +20,6 @@ from rich.table import Table
 from gamespec import registry
 from gamespec.errors import GamespecError
 from gamespec.loader import load
-from gamespec.pursuit.cli import pursuit_app
 from gamespec.result import Result, status_ok, writable_folder
 from gamespec.studies.compare import (
     LEGEND,
@@ -37,7 +36,8 @@ app = typer.Typer(
 )
 console = Console()
 err_console = Console(stderr=True)
-app.add_typer(pursuit_app, name="pursuit")
+for _command in registry.names("gamespec.commands"):
+    app.add_typer(registry.load("gamespec.commands", _command), name=_command)
 
 FileArg = Annotated[Path, typer.Argument(help="Problem file (.yaml, .toml or .json).")]
 SetOpt = Annotated[
@@ -100,14 +100,22 @@ def solve(
 
 
 def _print_summary(result: Result) -> None:
-    table = Table(title=f"{result.problem} on {result.backend}", show_header=False)
-    for key, value in result.summary().items():
-        if key in ("problem",) or value in (None, ""):
-            continue
-        table.add_row(key, _fmt(value))
+    """The kind's outcome first (:mod:`gamespec.summaries`), then status, timings and checks, then
+    the other scalar metrics; each key once."""
+    from gamespec.summaries import outcome
+
+    table = Table(title=f"{result.problem} on {result.backend}: {result.status.value}", show_header=False)
+    lead = outcome(result)
+    for key, value in lead:
+        table.add_row(escape(key), escape(_fmt(value)), style="bold")
+    if lead:
+        table.add_section()
+    general = {k: v for k, v in result.summary().items() if k != "problem" and v not in (None, "")}
+    for key, value in general.items():
+        table.add_row(key, escape(_fmt(value)))
     for key, value in result.metrics.items():
-        if isinstance(value, int | float | str):
-            table.add_row(key, _fmt(value))
+        if isinstance(value, int | float | str) and key not in general:
+            table.add_row(key, escape(_fmt(value)))
     console.print(table)
 
 
@@ -239,8 +247,27 @@ def backends() -> None:
         if cls.features:
             details.append(f"features: {', '.join(sorted(cls.features))}")
         details.append(f"from {registry.distribution('gamespec.backends', name)}")
-        table.add_row(name, "\n".join(sorted(cls.kinds)), "\n".join(details), end_section=True)
+        table.add_row(
+            name, "\n".join(_kinds_through_transforms(cls.kinds)), "\n".join(details), end_section=True
+        )
     console.print(table)
+
+
+def _kinds_through_transforms(kinds: frozenset[str]) -> list[str]:
+    """A backend's own kinds, then each kind that lowering transforms turn into one of them, with the
+    chain (``engagement (via engagement_to_ocp)``)."""
+    steps = {n: registry.load("gamespec.transforms", n) for n in registry.names("gamespec.transforms")}
+    via: dict[str, list[str]] = {k: [] for k in kinds}
+    frontier = list(kinds)
+    while frontier:
+        target = frontier.pop()
+        for name, step in steps.items():
+            if step.target_kind == target and step.source_kind not in via:
+                via[step.source_kind] = [name, *via[target]]
+                frontier.append(step.source_kind)
+    own = sorted(kinds)
+    lowered = sorted(k for k in via if k not in kinds)
+    return own + [f"{k} (via {' → '.join(via[k])})" for k in lowered]
 
 
 def run(argv: list[str] | None = None) -> int:

@@ -15,6 +15,7 @@ import numpy as np
 from gamespec.pursuit import regions
 from gamespec.pursuit.relay import voronoi_margin
 from gamespec.pursuit.simulation import Players, Trajectory
+from gamespec.result import Result
 from gamespec.specs.engagement import EngagementSpec
 
 CAPTURE_RTOL = 1e-3
@@ -64,3 +65,39 @@ def engagement_report(
     arrays = {"path_time": traj.time, "path_evader": traj.evader}
     arrays |= {f"path_{name}": traj.pursuers[:, i] for i, name in enumerate(players.names)}
     return metrics, checks, arrays
+
+
+def engagement_summary(result: Result) -> list[tuple[str, object]]:
+    """The rows that lead an engagement's solve summary: capture time, capturing set P*, terminal
+    distances, the region of P2, relay arcs with the switching residual (eqs. 2.41, 2.46), and a
+    hint when another backend answers the engagement better."""
+    m = result.metrics
+    if "capture_time" not in m:
+        return []
+    rows: list[tuple[str, object]] = [
+        ("capture time t_c", m["capture_time"]),
+        ("capturing set P*", ", ".join(m.get("capturing_set", [])) or "—"),
+    ]
+    rows += [(f"terminal distance to {n}", d) for n, d in m.get("terminal_distances", {}).items()]
+    rows += [
+        ("simultaneous capture gap", m.get("simultaneous_capture_gap")),
+        ("region of P2", m.get("region")),
+    ]
+    arcs = m.get("arcs") or {}
+    if arcs:
+        rows += [
+            ("arcs: interior, boundary, line of sight", _durations(arcs)),
+            ("switching times tau1, tau2", f"{arcs['tau1']:.6g}, {arcs['tau2']:.6g}"),
+            ("switching residual (eq. 2.46)", arcs["switching_residual"]),
+        ]
+    strategies = {p["strategy"] for p in m.get("engagement", {}).get("pursuers", [])}
+    if strategies == {"cb"} and result.backend != "analytic":
+        rows.append(("hint", "every pursuer is on constant bearing: --backend analytic solves it exactly"))
+    if strategies == {"pp"} and result.backend == "analytic" and result.status.value != "optimal":
+        rows.append(("hint", "--backend casadi solves the optimum of Prop. 1 (this is eq. 2.27's heading)"))
+    return [(k, v) for k, v in rows if v is not None]
+
+
+def _durations(arcs: dict[str, float]) -> str:
+    keys = ("interior_duration", "boundary_duration", "line_of_sight_duration")
+    return ", ".join(f"{arcs[k]:.4g}" for k in keys)

@@ -11,7 +11,7 @@ backend does not declare the ``covariance_constraint`` feature and refuses a fil
 from __future__ import annotations
 
 import time
-from typing import ClassVar
+from typing import TYPE_CHECKING, ClassVar
 
 import numpy as np
 from scipy.sparse import csc_matrix
@@ -20,6 +20,63 @@ from gamespec.lqgame.backend import LQBackend, LQCompiledModel, LQSolverOptions
 from gamespec.lqgame.solution import MeanOutcome, fallback_mean
 from gamespec.result import Result, Status
 from gamespec.specs.base import StrictModel
+
+if TYPE_CHECKING:
+    import qpsolvers
+
+
+QP_TOLERANCE = 1e-7
+"""Residuals (primal, dual, duality gap) allowed relative to the QP's data scale (see :func:`verdict`);
+above the defaults of the solvers qpsolvers wraps (1e-8 to 1e-9 in their own scaled norms)."""
+
+STATUS_MAP = {
+    "optimal": Status.OPTIMAL,
+    "primal_feasible": Status.FEASIBLE,
+    "infeasible_point": Status.NUMERICAL_ERROR,
+    "not_found": Status.NUMERICAL_ERROR,
+}
+"""qpsolvers' verdicts on a Solution (``found`` and ``is_optimal``) to our statuses. The mean QP is
+feasible by Lemma 11 (checked before it is solved), so a solver that finds no point failed
+numerically."""
+
+
+def data_scale(solution: qpsolvers.Solution) -> float:
+    """``max(1, ‖q‖∞, ‖b‖∞, ‖P x‖∞, |xᵀPx|)``: the size of the terms the residuals compare."""
+    P, q, _, _, _, b, _, _ = solution.problem.unpack()
+    x = solution.x
+    terms = [1.0, float(np.abs(q).max(initial=0.0))]
+    if b is not None:
+        terms.append(float(np.abs(b).max(initial=0.0)))
+    if x is not None:
+        Px = P @ x
+        terms += [float(np.abs(Px).max(initial=0.0)), abs(float(x @ Px))]
+    return max(terms)
+
+
+def verdict(solution: qpsolvers.Solution) -> str:
+    """A key of STATUS_MAP: qpsolvers' own ``found`` and ``is_optimal(eps)`` with
+    ``eps = QP_TOLERANCE · data_scale``; a found point whose primal residual alone is within eps is
+    ``primal_feasible``."""
+    if not solution.found or solution.x is None:
+        return "not_found"
+    eps = QP_TOLERANCE * data_scale(solution)
+    if solution.is_optimal(eps):
+        return "optimal"
+    return "primal_feasible" if solution.primal_residual() < eps else "infeasible_point"
+
+
+def residuals(solution: qpsolvers.Solution) -> dict[str, float | None]:
+    """qpsolvers' primal and dual residuals and duality gap (None where undefined), and the scale."""
+
+    def finite(value: float) -> float | None:
+        return float(value) if np.isfinite(value) else None
+
+    return {
+        "qp_primal_residual": finite(solution.primal_residual()),
+        "qp_dual_residual": finite(solution.dual_residual()),
+        "qp_duality_gap": finite(solution.duality_gap()),
+        "qp_data_scale": data_scale(solution),
+    }
 
 
 class QpOptions(LQSolverOptions):
@@ -50,24 +107,28 @@ class QpModel(LQCompiledModel):
         return np.column_stack(columns).ravel()
 
     def _solve_mean_qp(self, guess: Result | None) -> MeanOutcome:
-        """The QP, warm-started from ``guess``'s controls."""
+        """The QP, warm-started from ``guess``'s controls; its status from qpsolvers' residuals."""
         import qpsolvers
 
-        initvals = self._initial_controls(guess)
         start = time.perf_counter()
-        try:
-            solution = qpsolvers.solve_problem(
-                self.problem, solver=self.options.solver, initvals=initvals, **self.options.solver_options
-            )
-        except (TypeError, ValueError, qpsolvers.ParamError) as err:
-            raise self.options.rejected(err) from None
+        solution = qpsolvers.solve_problem(
+            self.problem,
+            solver=self.options.solver,
+            initvals=self._initial_controls(guess),
+            **self.options.solver_options,
+        )
         seconds = time.perf_counter() - start
-        if not solution.found or solution.x is None:
-            return fallback_mean(
-                self.model, Status.NUMERICAL_ERROR, f"{self.options.solver} found no solution"
-            )
+        key = verdict(solution)
+        status, checks = STATUS_MAP[key], residuals(solution)
+        if not status.ok:
+            outcome = fallback_mean(self.model, status, f"{self.options.solver}: {key.replace('_', ' ')}")
+            outcome.checks = checks
+            return outcome
         U = np.asarray(solution.x)
-        return MeanOutcome(U, self.model.mean.stopper_response(U), Status.OPTIMAL, solve_time_s=seconds)
+        message = "" if status is Status.OPTIMAL else f"{self.options.solver}: optimality not confirmed"
+        return MeanOutcome(
+            U, self.model.mean.stopper_response(U), status, message, solve_time_s=seconds, checks=checks
+        )
 
 
 class QpBackend(LQBackend):
@@ -84,3 +145,14 @@ class QpBackend(LQBackend):
         import qpsolvers
 
         return list(qpsolvers.available_solvers)
+
+    @classmethod
+    def probe_options(cls, options: LQSolverOptions) -> None:
+        """Solve ``min ½x² − x`` with the user's solver options."""
+        import qpsolvers
+
+        probe = qpsolvers.Problem(np.eye(1), -np.ones(1))
+        try:
+            qpsolvers.solve_problem(probe, solver=options.solver, **options.solver_options)
+        except (TypeError, ValueError, qpsolvers.ParamError) as err:
+            raise options.rejected(err) from None

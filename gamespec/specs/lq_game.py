@@ -140,10 +140,17 @@ class MonteCarloSpec(StrictModel):
 
 
 class LQMethodSpec(StrictModel):
-    """Stopping rule of the Jacobi procedure (Algorithm 2) and the Monte Carlo check."""
+    """The best-response iteration of the covariance game (Algorithm 2: scheme, stopping rule,
+    damping; :mod:`gamespec.games.best_response`) and the Monte Carlo check."""
 
     tolerance: float = Field(1e-5, gt=0, description="Bound on ε_k and ε_ℓ (section 4.5).")
     max_iterations: int = Field(100, ge=1)
+    scheme: Literal["jacobi", "gauss_seidel"] = Field(
+        "jacobi", description="jacobi (Algorithm 2) or gauss_seidel (the controller answers L_{i+1})."
+    )
+    damping: float = Field(
+        1.0, gt=0, le=1, description="Weight w of a new response: K_{i+1} = (1 − w) K_i + w BR (1: none)."
+    )
     monte_carlo: MonteCarloSpec = Field(default_factory=MonteCarloSpec)
 
 

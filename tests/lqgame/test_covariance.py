@@ -9,6 +9,7 @@ import pytest
 from gamespec_cvxpy.backend import CovariancePlayers, CvxpyOptions
 from scipy.linalg import sqrtm
 
+from gamespec.games.best_response import Settings
 from gamespec.lqgame.covariance import lift_gains, vector_to_gains
 from gamespec.lqgame.solution import GameModel
 from gamespec.result import Status
@@ -67,12 +68,27 @@ def test_terminal_map_is_the_scaled_terminal_factor(model: GameModel):
     np.testing.assert_allclose(w0 + T_K @ kappa + T_L @ ell, W.T.ravel(), atol=1e-10)
 
 
-def test_cvxpy_stopper_problem_matches_the_closed_form(model: GameModel):
-    players = CovariancePlayers(model, CvxpyOptions())
-    kappa, _ = _random_gains(model, 3)
-    status, ell = players.stopper_step(kappa)
-    assert status is Status.OPTIMAL
-    np.testing.assert_allclose(ell, model.covariance.stopper_response(kappa), atol=1e-6)
+def test_whitened_controller_step_is_the_unscaled_problems_minimizer(model: GameModel):
+    """The controller's SDP in whitened gains (``κ = R⁻¹z``, :mod:`gamespec.lqgame.scaling`) has
+    the minimizer of eq. 4.56 under eq. 4.62 written in the gains themselves (a strictly convex
+    problem: one minimizer), here with a target halfway between the UCSG's Σ_N and zero."""
+    import cvxpy as cp
+
+    g = model.game
+    kappa0, ell = model.covariance.unconstrained_saddle()
+    free = model.covariance.state_covariances(
+        vector_to_gains(kappa0, g.m, g.n), vector_to_gains(ell, g.ell, g.n)
+    )
+    tight = GameModel.build(type(g)(**{**g.__dict__, "SigmaN": 0.9 * free[-1] + 1e-3 * np.eye(g.n)}))
+    cov = tight.covariance
+    kappa, report = CovariancePlayers(tight, CvxpyOptions()).controller_step(ell)
+    assert report.status is Status.OPTIMAL
+    w0, T_K, T_L = cov.terminal_map()
+    x = cp.Variable(kappa.size)
+    W = cp.reshape(w0 + T_L @ ell + T_K @ x, (g.n, w0.size // g.n), order="F")
+    payoff = cp.quad_form(x, cp.psd_wrap(cov.H_KK)) + 2 * cov.controller_linear_term(ell) @ x
+    cp.Problem(cp.Minimize(payoff), [cp.sigma_max(W) <= 1]).solve(solver="CLARABEL")
+    np.testing.assert_allclose(kappa, x.value, atol=1e-5 * max(1.0, np.abs(x.value).max()))
 
 
 @pytest.mark.parametrize("seed", [0, 1])
@@ -92,7 +108,7 @@ def test_jacobi_meets_the_terminal_constraint(seed: int):
     assert gamma < 1
     target = (1 + gamma) / 2 * free[-1]
     model = GameModel.build(type(g)(**{**g.__dict__, "SigmaN": target}))
-    outcome = CovariancePlayers(model, CvxpyOptions()).solve(tolerance=1e-7, max_iterations=200)
+    outcome = CovariancePlayers(model, CvxpyOptions()).solve(Settings(tolerance=1e-7, max_iterations=200))
     assert outcome.status.ok and outcome.iterations > 0
     reached = model.covariance.state_covariances(
         vector_to_gains(outcome.kappa, g.m, g.n), vector_to_gains(outcome.ell, g.ell, g.n)
@@ -110,7 +126,7 @@ def test_smallest_scaling_is_tight():
     last_noise = g.D[-1] @ g.D[-1].T
     SigmaN = 0.5 * last_noise + 1e-4 * np.eye(g.n)
     model = GameModel.build(type(g)(**{**g.__dict__, "SigmaN": SigmaN}))
-    outcome = CovariancePlayers(model, CvxpyOptions()).solve(tolerance=1e-7, max_iterations=50)
+    outcome = CovariancePlayers(model, CvxpyOptions()).solve(Settings(tolerance=1e-7, max_iterations=50))
     assert outcome.status is Status.INFEASIBLE
     gamma = outcome.min_covariance_scaling
     root_inv = np.linalg.inv(np.real(sqrtm(SigmaN)))
@@ -118,5 +134,5 @@ def test_smallest_scaling_is_tight():
     _, ell0 = model.covariance.unconstrained_saddle()
     for factor, feasible in ((1 + 1e-3, True), (1 - 1e-3, False)):
         scaled = GameModel.build(type(g)(**{**g.__dict__, "SigmaN": factor * gamma * SigmaN}))
-        status, _ = CovariancePlayers(scaled, CvxpyOptions()).controller_step(ell0)
-        assert status.ok is feasible
+        _, report = CovariancePlayers(scaled, CvxpyOptions()).controller_step(ell0)
+        assert report.status.ok is feasible

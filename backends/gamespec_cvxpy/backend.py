@@ -6,10 +6,10 @@ and the controller's best response under the relaxed terminal constraint eq. 4.6
 eq. 4.62 (``σ_max(W) ≤ 1``, an SDP in whitened gains, :mod:`gamespec.lqgame.scaling`), built once
 with ``cp.Parameter``s and re-solved every iteration. A step the solver fails on numerically is
 retried on ``fallback_solver`` when the options name one, and otherwise stops the run with the last
-iterate and the status ``numerical_error``. When the controller's problem is infeasible, a third problem on the same
-parameters, ``min σ_max(W)``, gives the smallest achievable scaling ``γ* = σ²`` of ``Σ_N``. Without
-a terminal covariance the covariance game is the UCSG closed form (eq. 4.59). cvxpy is imported
-only when this backend is used.
+iterate and the status ``numerical_error``. When the controller's problem is infeasible, a second
+problem on the same parameters, ``min σ_max(W)``, gives the smallest achievable scaling
+``γ* = σ²`` of ``Σ_N``. Without a terminal covariance the covariance game is the UCSG closed form
+(eq. 4.59). cvxpy is imported only when this backend is used.
 """
 
 from __future__ import annotations
@@ -25,7 +25,7 @@ from gamespec.errors import BackendError
 from gamespec.games.best_response import Settings, StepReport
 from gamespec.lqgame.backend import LQBackend, LQCompiledModel, LQSolverOptions
 from gamespec.lqgame.covariance import CONTROLLER, STOPPER, algorithm_2, gains_to_vector
-from gamespec.lqgame.scaling import Whitening
+from gamespec.lqgame.scaling import ControllerScaling
 from gamespec.lqgame.solution import CovarianceOutcome, GameModel, MeanOutcome, fallback_mean
 from gamespec.result import Result, Status
 from gamespec.specs.base import StrictModel
@@ -42,51 +42,83 @@ STATUS_MAP = {
 }
 
 
+RETRY_SOLVER_OPTIONS: dict[str, dict[str, Any]] = {"CLARABEL": {"chordal_decomposition_enable": False}}
+"""Settings of a second attempt at a step a solver fails on numerically (the same tolerances).
+Clarabel splits the PSD cone of eq. 4.62 by chordal decomposition, a heuristic whose interior point
+can stall where the controller cannot steer some terminal states (the rows of ``W`` it leaves
+constant, e.g. the target's acceleration in the missile endgame); on the whole cone it reports
+``optimal`` or ``infeasible``."""
+
+
 class CvxpyOptions(LQSolverOptions):
-    """Options of the ``cvxpy`` backend: the conic solver's name and its keyword arguments, and an
-    optional second solver for a step the first fails on numerically."""
+    """Options of the ``cvxpy`` backend: the conic solver's name and its keyword arguments, how to
+    retry a step it fails on numerically, and an optional second solver for such a step."""
 
     solver: str = "CLARABEL"
+    retry_solver_options: dict[str, Any] | None = Field(
+        None,
+        description="solver_options added for a second attempt at a step the solver fails on "
+        "numerically; default: RETRY_SOLVER_OPTIONS for the solver (none for most solvers), {} to disable.",
+    )
     fallback_solver: str | None = Field(
         None,
-        description="Solver (default settings) that retries a step the solver fails numerically; "
+        description="Solver (default settings) that takes a step both attempts failed on numerically; "
         "none by default, so a failure is reported rather than hidden.",
     )
+
+    @property
+    def retry(self) -> dict[str, Any]:
+        """The solver options of the second attempt (empty: no second attempt)."""
+        if self.retry_solver_options is not None:
+            return self.retry_solver_options
+        return RETRY_SOLVER_OPTIONS.get(self.solver.upper(), {})
 
 
 class _Problem:
     """A CVXPY problem re-solved with new parameter values; returns our Status (an inaccurate
     solution is ``feasible``, so cvxpy's warning about it is not repeated). A numerical failure is
-    retried once on ``fallback_solver`` when the options name one; ``note`` says so."""
+    retried with the options' ``retry`` settings, then on ``fallback_solver`` when the options name
+    one; ``note`` says what was needed."""
 
     def __init__(self, problem: Any, options: CvxpyOptions) -> None:
         self.problem = problem
         self.options = options
         self.seconds = 0.0
         self.note = ""
+        self.raised = False
 
     def _run(self, solver: str, solver_options: dict[str, Any]) -> Status:
         import cvxpy as cp
 
         start = time.perf_counter()
+        self.raised = False
         try:
             with warnings.catch_warnings():
                 warnings.filterwarnings("ignore", message="Solution may be inaccurate")
                 self.problem.solve(solver=solver, warm_start=True, **solver_options)
         except cp.SolverError:
+            self.raised = True
             return Status.NUMERICAL_ERROR
         finally:
             self.seconds += time.perf_counter() - start
         return STATUS_MAP.get(self.problem.status, Status.ERROR)
 
     def solve(self) -> Status:
+        options = self.options
         self.note = ""
-        status = self._run(self.options.solver, self.options.solver_options)
-        fallback = self.options.fallback_solver
-        if status is Status.NUMERICAL_ERROR and fallback:
-            status = self._run(fallback, {})
-            self.note = f"{self.options.solver} failed numerically, {fallback} gave {status.value}"
+        status = self._run(options.solver, options.solver_options)
+        if status is Status.NUMERICAL_ERROR and options.retry:
+            status = self._run(options.solver, {**options.solver_options, **options.retry})
+            self.note = f"{options.solver} failed numerically, again with {options.retry}: {status.value}"
+        if status is Status.NUMERICAL_ERROR and options.fallback_solver:
+            status = self._run(options.fallback_solver, {})
+            self.note += f"{'; ' if self.note else ''}{options.fallback_solver}: {status.value}"
         return status
+
+    @property
+    def reported(self) -> str:
+        """What the solver reported last (cvxpy's status, or that it raised)."""
+        return "a solver error" if self.raised else self.problem.status
 
 
 class MeanProblem:
@@ -105,7 +137,7 @@ class MeanProblem:
     def solve(self, model: GameModel) -> MeanOutcome:
         start = self.problem.seconds
         status = self.problem.solve()
-        reported = f"mean QP: solver reported {self.problem.problem.status}"
+        reported = f"mean QP: solver reported {self.problem.reported}"
         if self.problem.note:
             reported += f" ({self.problem.note})"
         if self.U.value is None or not status.ok:
@@ -125,8 +157,8 @@ class CovariancePlayers:
     """Both players' best responses of Algorithm 2: the stopper's in closed form (eq. 4.59b, an
     unconstrained strictly concave QP, solved exactly by one linear solve rather than to a conic
     solver's tolerance) and the controller's SDP under eq. 4.62, built once on ``cp.Parameter``s in
-    the whitened gains ``κ = R_K⁻¹ z`` of :mod:`gamespec.lqgame.scaling`, so the solver sees a unit
-    Hessian whatever the weights' magnitudes."""
+    the whitened, normalized gains ``κ = s R_K⁻¹ ζ`` of :mod:`gamespec.lqgame.scaling`, so the solver
+    sees a unit Hessian and a unit constraint map whatever the problem's magnitudes."""
 
     def __init__(self, model: GameModel, options: CvxpyOptions) -> None:
         import cvxpy as cp
@@ -134,14 +166,14 @@ class CovariancePlayers:
         cov = model.covariance
         self.model = model
         self.w0, T_WK, self.T_WL = cov.terminal_map()
-        self.whitening = Whitening.of(cov.H_KK)
+        self.gains = ControllerScaling.of(cov.H_KK, T_WK)
         n = model.game.n
         p = self.w0.size // n
-        self.z = cp.Variable(cov.g_K.size)
+        self.zeta = cp.Variable(cov.g_K.size)
         self.c = cp.Parameter(cov.g_K.size)
         self.offset = cp.Parameter(self.w0.size)
-        W = cp.reshape(self.offset + self.whitening.map(T_WK) @ self.z, (n, p), order="F")
-        payoff = cp.sum_squares(self.z) + 2 * self.c @ self.z
+        W = cp.reshape(self.offset + self.gains.map(T_WK) @ self.zeta, (n, p), order="F")
+        payoff = cp.sum_squares(self.zeta) + 2 * self.c @ self.zeta
         self.controller = _Problem(cp.Problem(cp.Minimize(payoff), [cp.sigma_max(W) <= 1]), options)
         self.scaling = _Problem(cp.Problem(cp.Minimize(cp.sigma_max(W))), options)
         self.steps = 0
@@ -151,16 +183,16 @@ class CovariancePlayers:
         return self.model.covariance.stopper_response(kappa), StepReport(Status.OPTIMAL)
 
     def controller_step(self, ell: np.ndarray) -> tuple[np.ndarray | None, StepReport]:
-        """The controller's best response in ``𝒦(ℓ)`` (eq. 4.62), ``κ = R_K⁻¹ z``; the report names
+        """The controller's best response in ``𝒦(ℓ)`` (eq. 4.62), ``κ = s R_K⁻¹ ζ``; the report names
         the step when the solver was only inaccurate or needed the fallback."""
-        self.c.value = self.whitening.linear_term(self.model.covariance.controller_linear_term(ell))
+        self.c.value = self.gains.linear_term(self.model.covariance.controller_linear_term(ell))
         self.offset.value = self.w0 + self.T_WL @ ell
         status = self.controller.solve()
         self.steps += 1
-        notes = [f"solver reported {self.controller.problem.status}"] if status is not Status.OPTIMAL else []
+        notes = [f"solver reported {self.controller.reported}"] if status is not Status.OPTIMAL else []
         notes += [self.controller.note] if self.controller.note else []
         report = StepReport(status, f"step {self.steps}: {'; '.join(notes)}" if notes else "")
-        return (self.whitening.unscale(np.asarray(self.z.value)) if status.ok else None), report
+        return (self.gains.unscale(np.asarray(self.zeta.value)) if status.ok else None), report
 
     def smallest_scaling(self) -> float | None:
         """``min_K ‖W‖₂²`` for the current parameters: the least ``γ`` with ``Σ_N(K) ⪯ γ Σ_N``."""

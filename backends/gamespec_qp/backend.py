@@ -6,6 +6,11 @@ which gives the saddle point of Prop. 9). The covariance part is the UCSG closed
 A QP solver cannot take the controller's terminal covariance constraint (an SDP, eq. 4.62), so the
 backend does not declare the ``covariance_constraint`` feature and refuses a file that sets
 ``terminal.covariance`` (UnsupportedFeature); use the ``cvxpy`` backend for those.
+
+A solve's status is qpsolvers' own verdict (``Solution.found`` and ``Solution.is_optimal`` at a
+tolerance relative to the data's scale) through ``STATUS_MAP``; its primal and dual residuals and
+duality gap go into the Result's checks. Solver options are tried on a one-variable QP at compile
+time, so a rejected option is a one-line error and no exception is caught around a real solve.
 """
 
 from __future__ import annotations
@@ -38,6 +43,15 @@ STATUS_MAP = {
 """qpsolvers' verdicts on a Solution (``found`` and ``is_optimal``) to our statuses. The mean QP is
 feasible by Lemma 11 (checked before it is solved), so a solver that finds no point failed
 numerically."""
+
+
+_MESSAGES = {
+    "optimal": "",
+    "primal_feasible": "mean QP: {solver}'s point meets 𝒢Ū = h, but its dual residual or duality gap "
+    "exceeds {eps:.2g} (qpsolvers' is_optimal)",
+    "infeasible_point": "mean QP: {solver}'s point misses 𝒢Ū = h by more than {eps:.2g}",
+    "not_found": "mean QP: {solver} found no solution",
+}
 
 
 def data_scale(solution: qpsolvers.Solution) -> float:
@@ -120,12 +134,13 @@ class QpModel(LQCompiledModel):
         seconds = time.perf_counter() - start
         key = verdict(solution)
         status, checks = STATUS_MAP[key], residuals(solution)
+        eps = QP_TOLERANCE * checks["qp_data_scale"]
+        message = _MESSAGES[key].format(solver=self.options.solver, eps=eps)
         if not status.ok:
-            outcome = fallback_mean(self.model, status, f"{self.options.solver}: {key.replace('_', ' ')}")
+            outcome = fallback_mean(self.model, status, message)
             outcome.checks = checks
             return outcome
         U = np.asarray(solution.x)
-        message = "" if status is Status.OPTIMAL else f"{self.options.solver}: optimality not confirmed"
         return MeanOutcome(
             U, self.model.mean.stopper_response(U), status, message, solve_time_s=seconds, checks=checks
         )

@@ -130,3 +130,26 @@ def test_without_a_retry_a_numerical_failure_is_reported():
     problem = _Problem(_FailsFirst(), CvxpyOptions(retry_solver_options={}))
     assert problem.solve() is Status.NUMERICAL_ERROR
     assert problem.reported == "a solver error" and len(problem.problem.calls) == 1
+
+
+@pytest.mark.parametrize("solver", ["proxqp", "osqp", "clarabel"])
+def test_qp_status_is_qpsolvers_own_optimality_check(solver: str):
+    """An ``optimal`` mean QP has qpsolvers' primal and dual residuals and duality gap below
+    ``QP_TOLERANCE`` times the data scale (``Solution.is_optimal``), and they are in the checks."""
+    from gamespec_qp.backend import QP_TOLERANCE
+
+    result = gamespec.solve(MEAN_STEERING, "qp", options={"solver": solver})
+    assert result.status is Status.OPTIMAL, result.message
+    eps = QP_TOLERANCE * result.checks["qp_data_scale"]
+    assert max(result.checks[k] for k in ("qp_primal_residual", "qp_dual_residual", "qp_duality_gap")) < eps
+
+
+@pytest.mark.parametrize(
+    "solver_options", [{"eps_abs": 1e-2, "eps_rel": 1e-2}, {"max_iter": 10}], ids=["loose", "starved"]
+)
+def test_a_qp_solution_that_fails_the_check_is_not_optimal(solver_options: dict):
+    """OSQP stopped far from the optimum: not reported as optimal, and the message says why."""
+    options = {"solver": "osqp", "solver_options": solver_options}
+    result = gamespec.solve(MEAN_STEERING, "qp", options=options)
+    assert result.status is not Status.OPTIMAL
+    assert result.message.startswith("mean QP: osqp")

@@ -45,7 +45,7 @@ class Status(StrEnum):
     """The solver, or a game's iteration, stopped at its iteration limit before converging."""
     NOT_CONVERGED = "not_converged"
     """An iteration stopped before its limit because it cannot converge: best responses that cycle
-    or diverge (:mod:`gamespec.games.best_response`); the message says which."""
+    or diverge (:mod:`gamespec.best_response`); the message says which."""
     TIME_LIMIT = "time_limit"
     """The solver stopped at its wall-clock or CPU-time limit (never a simulation's horizon)."""
     NUMERICAL_ERROR = "numerical_error"

@@ -32,12 +32,22 @@ from gamespec.studies.compare import (
 app = typer.Typer(
     add_completion=False,
     no_args_is_help=True,
+    rich_markup_mode=None,
     help="gamespec: declarative optimal control and differential games on interchangeable backends.",
 )
 console = Console()
 err_console = Console(stderr=True)
-for _command in registry.names("gamespec.commands"):
-    app.add_typer(registry.load("gamespec.commands", _command), name=_command)
+_MOUNTED: set[str] = set()
+
+
+def mount_commands() -> None:
+    """Mount every Typer app of the ``gamespec.commands`` group (entry points, or
+    :func:`gamespec.registry.register`) as ``gamespec NAME``, once each."""
+    for name in registry.names("gamespec.commands"):
+        if name not in _MOUNTED:
+            app.add_typer(registry.load("gamespec.commands", name), name=name)
+            _MOUNTED.add(name)
+
 
 FileArg = Annotated[Path, typer.Argument(help="Problem file (.yaml, .toml or .json).")]
 SetOpt = Annotated[
@@ -46,6 +56,23 @@ SetOpt = Annotated[
 ]
 JsonOpt = Annotated[bool, typer.Option("--json", help="Print the result as JSON on stdout.")]
 OutOpt = Annotated[Path | None, typer.Option("--out", help="Folder to save results into.")]
+
+
+def _version(value: bool) -> None:
+    if value:
+        from importlib.metadata import version
+
+        console.print(f"gamespec {version('gamespec')}", highlight=False)
+        raise typer.Exit()
+
+
+@app.callback()
+def _main(
+    version: Annotated[
+        bool, typer.Option("--version", callback=_version, is_eager=True, help="Print the version and exit.")
+    ] = False,
+) -> None:
+    """gamespec: declarative optimal control and differential games on interchangeable backends."""
 
 
 def _fmt(value: object) -> str:
@@ -79,6 +106,7 @@ def solve(
     with err_console.status(f"solving {spec.name} ...", spinner="dots"):
         result = run_solve(spec, backend)
     if out is not None:
+        _remove_previous_figures(out)
         result.save(out)
     if plot:
         from gamespec.plotting import plot_result
@@ -97,6 +125,19 @@ def solve(
             file=sys.stderr,
         )
         raise typer.Exit(1)
+
+
+FIGURE_SUFFIXES = (".png", ".gif", ".mp4")
+
+
+def _remove_previous_figures(folder: Path) -> None:
+    """Before a new Result is saved over an old one, delete the old one's figures so that no figure
+    of another solve is left beside it (only in a folder that holds a saved Result)."""
+    if not (folder / "result.json").exists():
+        return
+    for path in folder.iterdir():
+        if path.is_file() and path.suffix in FIGURE_SUFFIXES:
+            path.unlink()
 
 
 def _print_summary(result: Result) -> None:
@@ -273,6 +314,7 @@ def _kinds_through_transforms(kinds: frozenset[str]) -> list[str]:
 def run(argv: list[str] | None = None) -> int:
     """Run the CLI on ``argv`` and return the exit code (user errors → 2, one line on stderr)."""
     try:
+        mount_commands()
         app(args=argv, prog_name="gamespec")
     except SystemExit as exit_:
         return exit_.code if isinstance(exit_.code, int) else (0 if exit_.code is None else 1)

@@ -25,18 +25,33 @@ GROUPS = (
 )
 
 
+_IN_PROCESS: dict[str, dict[str, Any]] = {group: {} for group in GROUPS}
+"""Objects registered with :func:`register` (scripts, notebooks, tests), ahead of entry points."""
+
+
 @cache
 def _entry_points(group: str) -> dict[str, EntryPoint]:
     return {ep.name: ep for ep in entry_points(group=group)}
 
 
+def register(group: str, name: str, obj: Any) -> None:
+    """Register ``obj`` as ``name`` in ``group`` for this process, as an entry point of an installed
+    package would (which is how a plugin ships: see the docs, "Extending gamespec")."""
+    if group not in _IN_PROCESS:
+        raise BackendError(f"unknown plugin group {group!r} (known: {', '.join(GROUPS)})")
+    _IN_PROCESS[group][name] = obj
+    load.cache_clear()
+
+
 def names(group: str) -> list[str]:
     """Names registered in ``group``, sorted."""
-    return sorted(_entry_points(group))
+    return sorted({*_entry_points(group), *_IN_PROCESS.get(group, {})})
 
 
 def distribution(group: str, name: str) -> str:
     """The distribution (and version) that registered ``name`` in ``group``."""
+    if name in _IN_PROCESS.get(group, {}):
+        return "registered in this process"
     ep = _entry_points(group)[name]
     dist = ep.dist
     return f"{dist.name} {dist.version}" if dist is not None else "?"
@@ -45,6 +60,8 @@ def distribution(group: str, name: str) -> str:
 @cache
 def load(group: str, name: str) -> Any:
     """Import and return the object registered as ``name`` in ``group``."""
+    if name in _IN_PROCESS.get(group, {}):
+        return _IN_PROCESS[group][name]
     try:
         ep = _entry_points(group)[name]
     except KeyError:

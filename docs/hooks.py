@@ -1,0 +1,146 @@
+"""MkDocs hooks: pages generated from the code, so that the documentation cannot drift from it.
+
+- ``kinds/<kind>.md``: one page per registered kind: the spec's docstring, a worked example (the
+  smallest shipped problem file of that kind) and the file format rendered from its JSON Schema
+  (``gamespec schema KIND``);
+- ``backends.md``: each backend's kinds, features and options, from its ``options_model``;
+- ``<!-- example: NAME -->`` in a page is replaced by ``docs/examples/NAME`` as a code block (the
+  files that ``tests/docs/test_extension_examples.py`` runs).
+"""
+
+from __future__ import annotations
+
+import re
+from pathlib import Path
+from typing import Any
+
+import yaml
+from mkdocs.structure.files import File
+
+from gamespec import registry
+from gamespec.specs.schema import json_schema
+
+ROOT = Path(__file__).resolve().parents[1]
+EXAMPLE = re.compile(r"<!-- example: ([\w.]+) -->")
+
+
+def _type(prop: dict[str, Any]) -> str:
+    """A short type name of a JSON Schema property."""
+    if "$ref" in prop:
+        return f"`{prop['$ref'].rsplit('/', 1)[-1]}`"
+    if "const" in prop:
+        return f"`{prop['const']!r}`"
+    if "enum" in prop:
+        return " \\| ".join(f"`{v}`" for v in prop["enum"])
+    for key in ("anyOf", "oneOf"):
+        if key in prop:
+            return " or ".join(_type(p) for p in prop[key])
+    kind = prop.get("type", "any")
+    if kind == "array":
+        if "prefixItems" in prop:
+            return "[" + ", ".join(_type(p) for p in prop["prefixItems"]) + "]"
+        return f"list of {_type(prop.get('items', {}))}"
+    if kind == "object" and isinstance(prop.get("additionalProperties"), dict):
+        return f"map of {_type(prop['additionalProperties'])}"
+    return str(kind)
+
+
+def _cell(text: object) -> str:
+    return str(text).replace("|", "\\|").replace("\n", " ")
+
+
+def _table(model: dict[str, Any]) -> str:
+    """A Markdown table of one object schema's fields: name, type, default, description."""
+    props = model.get("properties", {})
+    if not props:
+        return "No fields.\n"
+    required = set(model.get("required", []))
+    lines = ["| field | type | default | description |", "|---|---|---|---|"]
+    for name, prop in props.items():
+        default = "required" if name in required else f"`{prop['default']!r}`" if "default" in prop else ""
+        lines.append(
+            f"| `{name}` | {_cell(_type(prop))} | {_cell(default)} | {_cell(prop.get('description', ''))} |"
+        )
+    return "\n".join(lines) + "\n"
+
+
+def schema_markdown(schema: dict[str, Any]) -> str:
+    """The top-level fields, then every definition the schema refers to, as tables."""
+    parts = ["### Top level\n", _table(schema)]
+    for name, definition in schema.get("$defs", {}).items():
+        parts += [f"\n### `{name}`\n", _cell(definition.get("description", "")) + "\n\n", _table(definition)]
+    return "\n".join(parts)
+
+
+def _example_file(kind: str) -> Path | None:
+    """The smallest shipped problem file of ``kind``."""
+    files = []
+    for path in sorted((ROOT / "problems").rglob("*.yaml")):
+        data = yaml.safe_load(path.read_text())
+        if isinstance(data, dict) and data.get("kind") == kind:
+            files.append(path)
+    return min(files, key=lambda p: p.stat().st_size, default=None)
+
+
+def kind_page(kind: str) -> str:
+    """The page of one problem kind."""
+    cls = registry.spec_class(kind)
+    text = [f"# Kind `{kind}`\n", (cls.__doc__ or "").strip() + "\n"]
+    if cls.default_backend:
+        text.append(f"Default backend: `{cls.default_backend}`.\n")
+    example = _example_file(kind)
+    if example is not None:
+        relative = example.relative_to(ROOT)
+        text += [
+            "## Worked example\n",
+            f"`{relative}`:\n",
+            f"```yaml\n{example.read_text().rstrip()}\n```\n",
+            f"```bash\ngamespec solve {relative} --out runs/{example.stem} --plot\n```\n",
+        ]
+    text += [
+        "## File format\n",
+        f"Generated from the JSON Schema (`gamespec schema {kind}`).\n",
+        schema_markdown(json_schema(kind)),
+    ]
+    return "\n".join(text)
+
+
+def backends_page() -> str:
+    """Every backend: what it solves, its features and its options block."""
+    text = [
+        "# Backend options\n",
+        "Each backend reads its own block `solver.options.<backend>` of a problem file, validated when",
+        "the file is solved (a wrong key or value exits 2 naming `solver.options.<backend>.<key>`).",
+        "Generated from each backend's `options_model`.\n",
+    ]
+    for name in registry.names("gamespec.backends"):
+        cls = registry.backend_class(name)
+        summary = (cls.__doc__ or "").strip().split("\n\n")[0]
+        text += [
+            f"## `{name}`\n",
+            _cell(summary) + "\n",
+            f"Kinds: {', '.join(f'`{k}`' for k in sorted(cls.kinds))}.",
+        ]
+        if cls.features:
+            text.append(f"Features: {', '.join(f'`{f}`' for f in sorted(cls.features))}.")
+        text += ["", f"Options (`solver.options.{name}`):\n", _table(cls.options_model.model_json_schema())]
+    return "\n".join(text)
+
+
+def on_files(files, config):
+    """Add the generated pages."""
+    for kind in registry.names("gamespec.kinds"):
+        files.append(File.generated(config, f"kinds/{kind}.md", content=kind_page(kind)))
+    files.append(File.generated(config, "backends.md", content=backends_page()))
+    return files
+
+
+def on_page_markdown(markdown: str, page, config, files) -> str:
+    """Insert the example files named by ``<!-- example: NAME -->``."""
+
+    def insert(match: re.Match) -> str:
+        path = ROOT / "docs" / "examples" / match.group(1)
+        language = "python" if path.suffix == ".py" else "yaml"
+        return f"`docs/examples/{path.name}`:\n\n```{language}\n{path.read_text().rstrip()}\n```"
+
+    return EXAMPLE.sub(insert, markdown)

@@ -68,7 +68,7 @@ def test_new_plotter(projectile, tmp_path) -> None:
     assert [p.name for p in paths] == ["flight.png"] and paths[0].stat().st_size > 0
     (ax,) = opened[0][0].axes
     assert ax.get_xlabel() == "x [m]" and "ballistic, optimal" in ax.get_title()
-    assert [t.get_text() for t in ax.get_legend().get_texts()][0] == "flight"
+    assert ax.get_legend().get_texts()[0].get_text() == "flight"
 
 
 def test_new_command(projectile, cli) -> None:

@@ -20,6 +20,8 @@ from gamespec.pursuit import regions, relay
 from gamespec.result import Result
 from gamespec.specs.engagement import EngagementSpec
 
+FRAMES = 60
+"""Frames of the engagement GIF."""
 REGION_COLOURS = {"D1": "#f4cccc", "D2": "#d9e2f3", "N": "#d9ead3"}
 PLAYER_COLOURS = ["tab:blue", "tab:red", "tab:green", "tab:orange", "tab:purple", "tab:brown"]
 
@@ -92,7 +94,7 @@ def plot_regions(result: Result, spec: EngagementSpec, path: Path) -> Path | Non
         for name, point in vertices.items():
             ax.plot(*point, "k.")
             ax.annotate(name, point, textcoords="offset points", xytext=(4, 4))
-        ax.set_title(f"{result.problem}: region of non-degeneracy N (Prop. 2, green)\n{_outcome(result)}")
+        ax.set_title(f"{headline(result)}\nregion of non-degeneracy N (Prop. 2, green); {_outcome(result)}")
     elif len(spec.pursuers) == 2 and spec.pursuers[0].strategy == spec.pursuers[1].strategy != "stationary":
         strategy = spec.pursuers[0].strategy
         u1, u2 = (p.speed for p in spec.pursuers)
@@ -108,8 +110,8 @@ def plot_regions(result: Result, spec: EngagementSpec, path: Path) -> Path | Non
             ax.plot(points[:, 0], points[:, 1], "k--", linewidth=0.8)
             ax.annotate(name, points[len(points) // 4], textcoords="offset points", xytext=(4, 4))
         ax.set_title(
-            f"{result.problem}: regions D1 (red), N (green), D2 (blue) for P2 ({strategy}), "
-            f"P2 in {result.metrics.get('region') or '—'}\n{_outcome(result)}"
+            f"{headline(result)}\nregions D1 (red), N (green), D2 (blue) for P2 ({strategy}), "
+            f"P2 in {result.metrics.get('region') or '—'}; {_outcome(result)}"
         )
     else:
         plt.close(fig)
@@ -162,10 +164,12 @@ def plot_distances(result: Result, spec: EngagementSpec, path: Path) -> Path:
     return path
 
 
-def animate_paths(result: Result, spec: EngagementSpec, path: Path, frames: int = 60) -> Path:
-    """A GIF of the players moving to capture: paths grow frame by frame, with the time shown."""
+def animate_paths(result: Result, spec: EngagementSpec, path: Path) -> Path:
+    """A GIF of the players moving to capture (``FRAMES`` frames): paths grow frame by frame, with
+    the time shown."""
     from matplotlib.animation import FuncAnimation, PillowWriter
 
+    frames = FRAMES
     fig, ax = plt.subplots(figsize=(8, 4.5))
     fig.subplots_adjust(left=0.1, right=0.7)
     everything = np.concatenate(

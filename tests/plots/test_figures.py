@@ -1,0 +1,210 @@
+"""Every shipped problem's figures, drawn from a solve with fast settings and checked for what they
+show (titles with problem, backend, status and the headline number; axis labels; legends outside
+the axes; the artists each kind must draw), not for their pixels."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import pytest
+from matplotlib.patches import Circle
+
+import gamespec
+from gamespec.plotting import plot_result
+from tests.conftest import PROBLEMS
+from tests.plots.recording import legend_texts, recording, titles
+
+FAST = {
+    "pursuit_scenario": ["time_step=0.05"],
+    "lq_stochastic_game": ["method.monte_carlo.samples=20"],
+}
+FILES = sorted(p for p in PROBLEMS.rglob("*.yaml") if "study" not in p.stem)
+
+
+def _solve(path: Path) -> gamespec.Result:
+    spec = gamespec.load(path)
+    return gamespec.solve(gamespec.load(path, FAST.get(spec.kind, [])))
+
+
+def _check_common(result: gamespec.Result, saved) -> None:
+    for figure in saved:
+        text = titles(figure)
+        assert result.problem in text and result.backend in text and result.status.value in text, figure.name
+        for ax, outside in zip(figure.axes, figure.legend_outside, strict=True):
+            if outside is None:
+                continue
+            shared = ax.get_shared_x_axes().get_siblings(ax)
+            assert any(a.get_xlabel() for a in shared) and ax.get_ylabel(), (figure.name, ax.get_title())
+            assert outside, figure.name
+
+
+@pytest.mark.parametrize("path", FILES, ids=lambda p: p.stem)
+def test_shipped_problem_figures(path: Path, tmp_path: Path) -> None:
+    result = _solve(path)
+    with recording() as saved:
+        written = plot_result(result, tmp_path)
+    assert [s.name for s in saved] == [p.name for p in written]
+    _check_common(result, saved)
+    check = {
+        "engagement": _check_engagement,
+        "pursuit_scenario": _check_scenario,
+        "lq_stochastic_game": _check_lq,
+        "optimal_control": _check_ocp,
+    }[result.kind]
+    check(result, {s.name: s for s in saved})
+
+
+def _check_engagement(result, saved) -> None:
+    names = [p["name"] for p in result.metrics["engagement"]["pursuers"]]
+    paths = saved["paths.png"]
+    assert f"t_c = {result.t_final:.4f}" in titles(paths)
+    assert "P* = {" + ", ".join(result.metrics["capturing_set"]) + "}" in titles(paths)
+    (ax,) = paths.axes
+    labels = legend_texts(ax)
+    assert all(any(label.startswith(n) for label in labels) for n in names)
+    assert "capture point" in labels
+    distances = saved["distances.png"].axes
+    assert len(distances) == (2 if len(names) > 1 else 1)
+    assert len([line for line in distances[0].lines if line.get_label().startswith("r to")]) == len(names)
+    if len(names) > 1:
+        assert distances[1].lines, "the second panel is drawn for any number of pursuers"
+
+
+def _check_scenario(result, saved) -> None:
+    n = result.states["pursuers"].shape[1]
+    m = result.states["evaders"].shape[1]
+    for name in ("trajectories.png", "snapshots.png"):
+        figure = saved[name]
+        assert "captured" in titles(figure)
+        for ax in figure.axes:
+            labels = {t.get_text() for t in ax.texts}
+            assert {f"P{i + 1}" for i in range(n)} | {f"E{j + 1}" for j in range(m)} <= labels
+    first = saved["snapshots.png"].axes[0]
+    arrows = [t for t in first.texts if t.arrow_patch is not None]
+    assert len(arrows) == int(np.sum(result.arrays["allocation"][0] >= 0))
+    assert f"t = {result.time[-1]:.2f}" in titles(saved["trajectories.png"])
+
+
+def _check_lq(result, saved) -> None:
+    if "ellipses.png" not in saved:
+        return
+    ax = saved["ellipses.png"].axes[0]
+    labels = legend_texts(ax)
+    assert "initial 3σ" in labels and "terminal 3σ" in labels
+    colours = {line.get_label(): line.get_color() for line in ax.lines}
+    if "target_covariance" in result.arrays:
+        assert "target 3σ" in labels and colours["target 3σ"] != colours["initial 3σ"]
+    zoom = ax.child_axes
+    assert len(zoom) == 1 and "zoom" in zoom[0].get_title()
+
+
+def _check_ocp(result, saved) -> None:
+    pairs = result.metrics["plot"]["planar"]
+    assert (f"{result.problem}_path.png" in saved) == bool(pairs)
+    assert f"J = {result.objective:.6g}" in titles(saved[f"{result.problem}_time.png"])
+
+
+def _ocp(plot: dict | None, constraints: list[str]) -> dict:
+    data = {
+        "kind": "optimal_control",
+        "name": "around_a_disk",
+        "problem": {
+            "parameters": {"r": 0.5},
+            "states": {"x": {"initial": 0.0, "final": 2.0}, "y": {"initial": 0.0, "final": 0.0}},
+            "controls": {"th": {}},
+            "dynamics": {"x": "cos(th)", "y": "sin(th)"},
+            "objective": {"mayer": "t_f"},
+            "time": {"final": "free", "bounds": [0.5, 6.0], "guess": 2.5},
+            "path_constraints": constraints,
+        },
+        "method": {"intervals": 12, "degree": 3},
+        "guess": {"controls": {"th": "1.0 - 2.0*tau"}},
+    }
+    return data | ({"plot": plot} if plot is not None else {})
+
+
+def test_a_circular_obstacle_is_drawn_as_a_disk(tmp_path: Path) -> None:
+    """(x − 1)² + (y − 0.05)² ≥ r² over the declared pair: a keep-out disk at (1, 0.05) of radius r,
+    and the path around it stays outside (the distance from the centre ≥ r at every node)."""
+    spec = gamespec.spec_from_dict(
+        _ocp({"planar": [["x", "y"]], "units": {"x": "m", "y": "m"}}, ["(x - 1)**2 + (y - 0.05)**2 >= r**2"])
+    )
+    result = gamespec.solve(spec)
+    assert result.ok
+    with recording() as saved:
+        plot_result(result, tmp_path)
+    (ax,) = saved[-1].axes
+    (disk,) = [p for p in ax.patches if isinstance(p, Circle)]
+    assert disk.center == pytest.approx((1.0, 0.05)) and disk.radius == pytest.approx(0.5)
+    assert disk.get_fill()
+    assert ax.get_xlabel() == "x [m]" and ax.get_ylabel() == "y [m]"
+    gap = np.hypot(result.states["x"] - 1.0, result.states["y"] - 0.05)
+    assert gap.min() >= 0.5 - 1e-6
+
+
+def test_a_keep_in_circle_is_an_outline() -> None:
+    from gamespec.obstacles import circle_of
+
+    inside = circle_of("x**2 + y**2 <= 4", ("x", "y"), ["x", "y"], {})
+    assert inside.center == pytest.approx((0.0, 0.0)) and inside.radius == pytest.approx(2.0)
+    assert not inside.keep_out
+    assert circle_of("4 - (x - 1)**2 - y**2 >= 0", ("x", "y"), ["x", "y"], {}).keep_out is False
+    assert circle_of("x**2 + 2*y**2 >= 1", ("x", "y"), ["x", "y"], {}) is None
+    assert circle_of("(x - z)**2 + y**2 >= 1", ("x", "y"), ["x", "y", "z"], {}) is None
+
+
+def test_the_planar_pair_is_declared_never_guessed(tmp_path: Path) -> None:
+    """States named x, y get no path figure unless declared; a declared pair is drawn as declared,
+    the second pair of a two-pair hint too."""
+    plain = gamespec.solve(gamespec.spec_from_dict(_ocp(None, [])))
+    names = [p.name for p in plot_result(plain, tmp_path / "plain")]
+    assert names == ["around_a_disk_time.png"]
+    declared = gamespec.solve(gamespec.spec_from_dict(_ocp({"planar": [["y", "x"]]}, [])))
+    with recording() as saved:
+        plot_result(declared, tmp_path / "declared")
+    (ax,) = saved[-1].axes
+    path = next(line for line in ax.lines if line.get_label() == "(y, x)")
+    assert np.array_equal(path.get_xdata(), declared.states["y"])
+    assert np.array_equal(path.get_ydata(), declared.states["x"])
+
+
+def test_a_planar_pair_must_name_states(cli, tmp_path: Path) -> None:
+    import yaml
+
+    file = tmp_path / "bad.yaml"
+    file.write_text(yaml.safe_dump(_ocp({"planar": [["x", "xE"]]}, [])))
+    code, _, err = cli("validate", file)
+    assert code == 2 and "plot.planar.0" in err and "xE" in err and len(err.strip().splitlines()) == 1
+
+
+@pytest.mark.parametrize(
+    ("name", "overrides"),
+    [("ch2/pure_pursuit_two_on_one.yaml", []), ("ch3/mpse_five_on_one_cb.yaml", ["time_step=0.05"])],
+)
+def test_animations_show_time_legend_labels_and_growing_paths(name, overrides, tmp_path, monkeypatch) -> None:
+    import gamespec_geometric.plot as scenario_plots
+    import matplotlib
+    from matplotlib.animation import PillowWriter
+
+    from gamespec.pursuit import plotting as engagement_plots
+
+    frames = []
+    original = PillowWriter.grab_frame
+
+    def grab(self, **kwargs):
+        ax = self.fig.axes[0]
+        longest = max(len(line.get_xdata()) for line in ax.lines)
+        frames.append((ax.get_title(), ax.get_legend() is not None, ax.get_xlabel(), longest))
+        return original(self, **kwargs)
+
+    monkeypatch.setattr(PillowWriter, "grab_frame", grab)
+    monkeypatch.setitem(matplotlib.rcParams, "savefig.dpi", 20)
+    monkeypatch.setattr(engagement_plots, "FRAMES", 15)
+    monkeypatch.setattr(scenario_plots, "_FRAMES", 15)
+    result = gamespec.solve(gamespec.load(PROBLEMS / name, overrides))
+    plot_result(result, tmp_path, animate=True)
+    assert len(frames) > 10
+    assert all("t = " in title and legend and xlabel for title, legend, xlabel, _ in frames)
+    lengths = [n for *_, n in frames]
+    assert lengths == sorted(lengths) and lengths[0] < lengths[-1]

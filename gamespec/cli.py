@@ -238,6 +238,7 @@ def show(
             raise GamespecError(f"backend {target.name!r} cannot take kind {spec.kind!r}")
         for transform in chain:
             spec, _ = transform.apply(spec)
+        spec = spec.as_solved()
     data = spec.model_dump(mode="json", exclude_defaults=False)
     sys.stdout.write(yaml.safe_dump(data, sort_keys=False, allow_unicode=True))
 

@@ -69,6 +69,11 @@ class SpecBase(StrictModel):
         """Features a backend must declare to take this spec (e.g. ``free_final_time``)."""
         return frozenset()
 
+    def as_solved(self) -> SpecBase:
+        """This spec with what a backend derives from it written out (``gamespec show
+        --transformed`` prints it); a kind whose backends derive nothing keeps this default."""
+        return self
+
     @property
     def objective_sense(self) -> str:
         """``minimize`` or ``maximize``: which objective is better, for comparisons."""

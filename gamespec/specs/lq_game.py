@@ -197,6 +197,19 @@ class LQGameSpec(SpecBase):
             return frozenset({"mean_steering", "covariance_constraint"})
         return frozenset({"mean_steering"})
 
+    def as_solved(self) -> LQGameSpec:
+        """A continuous model as the discrete one the backends solve: the zero-order-hold matrices of
+        eq. 4.70 for the file's parameter values (the step is named in the description)."""
+        if self.problem.continuous is None:
+            return self
+        game = self.game()
+        discrete = {name: getattr(game, name)[0].tolist() for name in ("A", "B", "C", "D")}
+        problem = self.problem.model_dump(mode="json") | {"continuous": None, "discrete": discrete}
+        note = f"continuous model discretized by zero-order hold with step {game.dt:g} (eq. 4.70)"
+        data = self.model_dump(mode="json") | {"problem": problem}
+        data["description"] = f"{self.description.strip()} [{note}]".strip()
+        return LQGameSpec.model_validate(data)
+
     @property
     def state_names(self) -> list[str]:
         """The declared state names, or x1, x2, ..."""

@@ -31,6 +31,7 @@ The public entry is :func:`active_pursuers`.
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from dataclasses import dataclass, replace
 from typing import Literal
 
@@ -41,11 +42,14 @@ from gamespec.errors import SpecError
 from gamespec.pursuit.apollonius import ApolloniusCircles, apollonius_circles
 from gamespec_geometric.apollonius import (
     cb_reach,
+    circle_polygons,
     refined_pp_polygons,
     refined_pp_reach,
 )
 
 Strategy = Literal["cb", "pp"]
+TeamStrategy = Strategy | Sequence[Strategy] | np.ndarray
+"""One strategy for every pursuer, or one each (a mixed team)."""
 Method = Literal["fast", "reference"]
 _ROUND_OFF = 1e-12
 
@@ -273,6 +277,9 @@ def active_pursuers(
 @dataclass(frozen=True)
 class CaptureRegions:
     """The Apollonius regions of ``n`` pursuers around one evader: circles (CB) or polygons (PP).
+    ``strategy`` is ``mixed`` for a team with both, whose regions are all polygons (the circles'
+    inscribed in them, :func:`~gamespec_geometric.apollonius.circle_polygons`); ``kinds`` holds
+    each pursuer's own strategy.
 
     ``inner[i]`` is the radius of a disk around the evader inside region ``i`` and ``outer[i]`` that
     of one holding it (closed forms, :func:`~gamespec_geometric.apollonius.cb_reach` and
@@ -284,10 +291,11 @@ class CaptureRegions:
     evader: np.ndarray
     pursuer_speeds: np.ndarray
     evader_speed: float
-    strategy: Strategy
+    strategy: Strategy | Literal["mixed"]
     samples: int
     inner: np.ndarray
     outer: np.ndarray
+    kinds: np.ndarray
 
     def take(self, index: np.ndarray) -> CaptureRegions:
         """The regions of the pursuers ``index`` only."""
@@ -297,6 +305,7 @@ class CaptureRegions:
             pursuer_speeds=self.pursuer_speeds[index],
             inner=self.inner[index],
             outer=self.outer[index],
+            kinds=self.kinds[index],
         )
 
     def may_touch(self) -> np.ndarray:
@@ -312,10 +321,18 @@ class CaptureRegions:
         return apollonius_circles(self.pursuers, self.evader, self.pursuer_speeds, self.evader_speed)
 
     def polygons(self) -> np.ndarray:
-        """The polygons inscribed in the refined Apollonius curves (PP), ``(n, samples, 2)``."""
-        return refined_pp_polygons(
-            self.pursuers, self.evader, self.pursuer_speeds, self.evader_speed, self.samples
-        )
+        """The polygons inscribed in the refined Apollonius curves (PP) and, in a mixed team, in the
+        Apollonius circles (CB): ``(n, samples, 2)``."""
+        out = np.empty((len(self.pursuers), self.samples, 2))
+        pp = self.kinds == "pp"
+        if pp.any():
+            out[pp] = refined_pp_polygons(
+                self.pursuers[pp], self.evader, self.pursuer_speeds[pp], self.evader_speed, self.samples
+            )
+        if not pp.all():
+            cb = self.take(np.flatnonzero(~pp)).circles()
+            out[~pp] = circle_polygons(cb.centers, cb.radii, self.evader, self.samples)
+        return out
 
 
 def capture_regions(
@@ -323,22 +340,30 @@ def capture_regions(
     evader: np.ndarray,
     pursuer_speeds: np.ndarray,
     evader_speed: float,
-    strategy: Strategy,
+    strategy: TeamStrategy,
     samples: int = 64,
 ) -> CaptureRegions:
-    """The CB or PP regions of the pursuers around the evader, with their reach bounds.
+    """The CB or PP regions of the pursuers around the evader (one strategy each in a mixed team),
+    with their reach bounds.
 
-    A ``samples``-gon inscribed in a refined curve has its vertices on the curve at polar steps of
-    at most ``2 pi / samples`` seen from the evader, so its edges stay ``cos(pi / samples)`` times
-    the curve's nearest distance away.
+    A ``samples``-gon inscribed in a refined curve (or, in a mixed team, in a circle) has its
+    vertices on the curve at polar steps of at most ``2 pi / samples`` seen from the evader, so its
+    edges stay ``cos(pi / samples)`` times the curve's nearest distance away.
     """
     distance = np.linalg.norm(pursuers - evader, axis=1)
-    if strategy == "cb":
-        inner, outer = cb_reach(distance, pursuer_speeds, evader_speed)
-    else:
-        nearest, outer = refined_pp_reach(distance, pursuer_speeds, evader_speed)
-        inner = nearest * np.cos(np.pi / samples)
-    return CaptureRegions(pursuers, evader, pursuer_speeds, evader_speed, strategy, samples, inner, outer)
+    kinds = np.broadcast_to(np.asarray(strategy), distance.shape)
+    team = str(kinds[0]) if np.all(kinds == kinds[0]) else "mixed"
+    inner, outer = cb_reach(distance, pursuer_speeds, evader_speed)
+    pp = kinds == "pp"
+    if team != "cb":
+        inner = inner * np.cos(np.pi / samples)
+    if pp.any():
+        nearest, far = refined_pp_reach(
+            distance[pp], np.broadcast_to(pursuer_speeds, distance.shape)[pp], evader_speed
+        )
+        inner, outer = inner.copy(), outer.copy()
+        inner[pp], outer[pp] = nearest * np.cos(np.pi / samples), far
+    return CaptureRegions(pursuers, evader, pursuer_speeds, evader_speed, team, samples, inner, outer, kinds)
 
 
 def active_in(regions: CaptureRegions, method: Method = "fast") -> np.ndarray:
@@ -362,7 +387,7 @@ def active_set(
     evader: np.ndarray,
     pursuer_speeds: np.ndarray,
     evader_speed: float,
-    strategy: Strategy,
+    strategy: TeamStrategy,
     *,
     method: Method = "fast",
     samples: int = 64,

@@ -20,7 +20,7 @@ from typing import Literal
 
 import numpy as np
 
-from gamespec_geometric.active import Method, Strategy, active_in, capture_regions
+from gamespec_geometric.active import Method, TeamStrategy, active_in, capture_regions
 
 Algorithm = Literal["avaa", "a2"]
 UNASSIGNED = -1
@@ -55,7 +55,7 @@ def allocate(
     evader_speeds: np.ndarray,
     *,
     algorithm: Algorithm = "a2",
-    strategy: Strategy = "cb",
+    strategy: TeamStrategy = "cb",
     method: Method = "fast",
     samples: int = 64,
     max_rounds: int | None = None,

@@ -127,3 +127,18 @@ def refined_pp_polygons(
     radius = pp_curve_radius(distance[:, None], heading, speeds[:, None], evader_speed)
     angle = line_of_sight_angles(pursuers, evader)[:, None] + heading
     return evader + radius[..., None] * np.stack([np.cos(angle), np.sin(angle)], axis=-1)
+
+
+def circle_polygons(
+    centers: FloatArray, radii: FloatArray, evader: FloatArray, samples: int = 64
+) -> FloatArray:
+    """Polygons inscribed in circles that hold the evader, vertices at ``samples`` evenly spaced
+    polar angles seen from the evader: shape ``(n, samples, 2)``, CCW. As for the refined curves,
+    the edges stay ``cos(pi / samples)`` times the circle's nearest distance from the evader away."""
+    angle = np.linspace(0.0, 2 * np.pi, samples, endpoint=False)
+    direction = np.stack([np.cos(angle), np.sin(angle)], axis=-1)
+    offset = np.asarray(evader, dtype=float) - np.asarray(centers, dtype=float)
+    b = offset @ direction.T
+    c = np.sum(offset**2, axis=1)[:, None] - np.asarray(radii, dtype=float)[:, None] ** 2
+    reach = -b + np.sqrt(np.maximum(b**2 - c, 0.0))
+    return evader + reach[..., None] * direction[None, :, :]

@@ -57,14 +57,18 @@ def _capture_regions(ax: Axes, result: Result) -> None:
     u = np.asarray(result.metrics["pursuer_speeds"])
     allocated = result.arrays["allocation"][0]
     angles = np.linspace(-np.pi, np.pi, 361)
+    kinds = np.asarray(
+        result.metrics.get("pursuer_strategies", [result.metrics["pursuit_strategy"]] * len(u))
+    )
     evaders = zip(result.states["evaders"][0], result.metrics["evader_speeds"], strict=True)
     for j, (evader, v) in enumerate(evaders):
-        mine = allocated == j
         colour = plt.get_cmap("tab10")(j % 10)
-        if result.metrics["pursuit_strategy"] == "cb":
-            circles = apollonius_circles(pursuers[mine], evader, u[mine], v)
-            for center, radius in zip(circles.centers, circles.radii, strict=True):
-                ax.add_patch(plt.Circle(center, radius, fill=False, lw=0.7, color=colour, alpha=0.7))
+        mine = (allocated == j) & (kinds == "cb")
+        circles = apollonius_circles(pursuers[mine], evader, u[mine], v)
+        for center, radius in zip(circles.centers, circles.radii, strict=True):
+            ax.add_patch(plt.Circle(center, radius, fill=False, lw=0.7, color=colour, alpha=0.7))
+        mine = (allocated == j) & (kinds == "pp")
+        if not mine.any():
             continue
         distance = np.linalg.norm(pursuers[mine] - evader, axis=1)
         radius = refined_pp_radius(distance[:, None], angles[None, :], u[mine][:, None], v)

@@ -72,13 +72,15 @@ def pursuer_headings(
     pursuer_speeds: np.ndarray,
     target_speeds: np.ndarray,
     target_headings: np.ndarray,
-    strategy: str,
+    strategy: str | np.ndarray,
 ) -> np.ndarray:
-    """Heading of each pursuer at its target: pure pursuit, or constant bearing from eq. 3.3."""
+    """Heading of each pursuer at its target: pure pursuit, or constant bearing from eq. 3.3 (one
+    strategy for all, or one each)."""
     los = line_of_sight_angles(pursuers, targets)
-    if strategy == "pp":
+    pp = np.broadcast_to(np.asarray(strategy) == "pp", los.shape)
+    if pp.all():
         return los
-    return constant_bearing_headings(los, pursuer_speeds, target_speeds, target_headings)
+    return np.where(pp, los, constant_bearing_headings(los, pursuer_speeds, target_speeds, target_headings))
 
 
 def first_contact(relative: np.ndarray, motion: np.ndarray, radius: float) -> np.ndarray:
@@ -130,7 +132,7 @@ def plan_step(
         u,
         v[idx],
         algorithm=spec.algorithm,
-        strategy=spec.pursuers.strategy,
+        strategy=spec.pursuers.strategies(),
         method=method,
         samples=samples,
     )
@@ -146,7 +148,7 @@ def plan_step(
         u[chasing],
         v[idx][targets],
         headings[targets],
-        spec.pursuers.strategy,
+        spec.pursuers.strategies()[chasing],
     )
     pursuer_velocity = np.zeros_like(pursuers)
     pursuer_velocity[chasing] = u[chasing, None] * np.column_stack([np.cos(theta), np.sin(theta)])

@@ -117,11 +117,23 @@ class Team(StrictModel):
 
 
 class PursuerTeam(Team):
-    """Pursuer positions, speeds and pursuit strategy."""
+    """Pursuer positions, speeds and pursuit strategies: ``cb`` or ``pp`` for the whole team, or a
+    list with one per pursuer (a mixed team; its capture regions are all polygons, see
+    :class:`gamespec_geometric.active.CaptureRegions`)."""
 
     role: ClassVar[str] = "pursuer"
     speed: PositiveFloat | list[PositiveFloat] = 1.0
-    strategy: Literal["cb", "pp"] = "cb"
+    strategy: Literal["cb", "pp"] | list[Literal["cb", "pp"]] = "cb"
+
+    def strategies(self) -> np.ndarray:
+        """Strategy of each pursuer, ``(len(positions),)``."""
+        return np.broadcast_to(np.asarray(self.strategy), (len(self.positions),)).copy()
+
+    @property
+    def team_strategy(self) -> str:
+        """``cb`` or ``pp`` when every pursuer uses it, else ``mixed``."""
+        kinds = set(self.strategies().tolist())
+        return kinds.pop() if len(kinds) == 1 else "mixed"
 
 
 class EvaderTeam(Team):
@@ -162,6 +174,13 @@ class PursuitScenarioSpec(SpecBase):
                 raise SpecError(
                     f"{len(team.speed)} speeds for {len(team.positions)} positions", field=f"{field}.speed"
                 )
+        if isinstance(self.pursuers.strategy, list) and len(self.pursuers.strategy) != len(
+            self.pursuers.positions
+        ):
+            raise SpecError(
+                f"{len(self.pursuers.strategy)} strategies for {len(self.pursuers.positions)} pursuers",
+                field="pursuers.strategy",
+            )
         strategy = self.evaders.strategy
         if isinstance(strategy, list) and len(strategy) != len(self.evaders.positions):
             raise SpecError(

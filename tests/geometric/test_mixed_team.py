@@ -15,11 +15,11 @@ from tests.geometric.helpers import random_team
 from tests.geometric.test_scenario import _scenario, capture_time_bound
 
 
-@pytest.mark.parametrize("strategy", ["cb", "pp"])
 def _cross(a: np.ndarray, b: np.ndarray) -> np.ndarray:
     return a[..., 0] * b[..., 1] - a[..., 1] * b[..., 0]
 
 
+@pytest.mark.parametrize("strategy", ["cb", "pp"])
 def test_a_list_of_one_strategy_is_that_team(strategy: str) -> None:
     data = _scenario(3, 4, 2, heterogeneous=True, strategy=strategy)
     team = simulate(spec_from_dict(data))

@@ -48,15 +48,17 @@ def _target(result: Result) -> tuple[np.ndarray | None, np.ndarray | None]:
     return centre, None if covariance is None else covariance[:2, :2]
 
 
-def _ends(ax: Axes, result: Result, *, legend: bool) -> None:
-    """The terminal 3σ ellipse (blue) against the target (green): what the controller had to meet."""
+def _ends(ax: Axes, result: Result, *, legend: bool, terminal: bool = True) -> None:
+    """The terminal 3σ ellipse (blue, unless ``terminal`` is False) against the target (green):
+    what the controller had to meet."""
     means, covs = result.arrays["mean"], result.arrays["covariance"]
-    ax.plot(
-        *ellipse_points(means[-1, :2], covs[-1, :2, :2]).T,
-        color="tab:blue",
-        lw=2.0,
-        label="terminal 3σ" if legend else None,
-    )
+    if terminal:
+        ax.plot(
+            *ellipse_points(means[-1, :2], covs[-1, :2, :2]).T,
+            color="tab:blue",
+            lw=2.0,
+            label="terminal 3σ" if legend else None,
+        )
     centre, covariance = _target(result)
     if centre is not None:
         ax.plot(*centre, "+", color="tab:green", ms=10, mew=2, label="target mean" if legend else None)
@@ -103,8 +105,7 @@ def _plane(ax: Axes, result: Result, upto: int | None = None) -> None:
     for k in range(last):
         ax.plot(*ellipse_points(means[k, :2], covs[k, :2, :2]).T, color="tab:blue", lw=0.5, alpha=0.6)
     ax.plot(*ellipse_points(means[0, :2], covs[0, :2, :2]).T, color="tab:red", lw=1.6, label="initial 3σ")
-    if upto is None or upto == len(means) - 1:
-        _ends(ax, result, legend=True)
+    _ends(ax, result, legend=True, terminal=upto is None or upto == len(means) - 1)
     ax.set_xlabel(names[0])
     ax.set_ylabel(names[1])
     ax.set_title(
@@ -170,10 +171,13 @@ def plot(result: Result, output_dir: Path, *, animate: bool = False) -> list[Pat
     if animate and result.arrays["mean"].shape[1] >= 2:
         fig, ax = plt.subplots(figsize=(8.5, 5))
         fig.subplots_adjust(left=0.1, right=0.7, top=0.85)
+        _plane(ax, result)
+        limits = ax.get_xlim(), ax.get_ylim()
 
         def frame(k: int) -> None:
             ax.clear()
             _plane(ax, result, upto=k)
+            ax.set(xlim=limits[0], ylim=limits[1])
 
         anim = FuncAnimation(fig, frame, frames=len(result.arrays["mean"]))
         anim.save(output_dir / "ellipses.gif", writer=PillowWriter(fps=4))

@@ -76,5 +76,6 @@ class SpecBase(StrictModel):
 
     @property
     def objective_sense(self) -> str:
-        """``minimize`` or ``maximize``: which objective is better, for comparisons."""
+        """``minimize`` or ``maximize``: which objective is better, for comparisons; ``saddle`` for a
+        game whose objective is a saddle value (neither lower nor higher is better)."""
         return "minimize"

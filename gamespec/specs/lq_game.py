@@ -197,6 +197,12 @@ class LQGameSpec(SpecBase):
             return frozenset({"mean_steering", "covariance_constraint"})
         return frozenset({"mean_steering"})
 
+    @property
+    def objective_sense(self) -> str:
+        """``saddle``: the objective is the game's value (eq. 4.12), which the controller minimizes
+        and the stopper maximizes."""
+        return "saddle"
+
     def as_solved(self) -> LQGameSpec:
         """A continuous model as the discrete one the backends solve: the zero-order-hold matrices of
         eq. 4.70 for the file's parameter values (the step is named in the description)."""

@@ -7,6 +7,7 @@ its reason instead of stopping the study.
 from __future__ import annotations
 
 import math
+import statistics
 from collections.abc import Callable
 from pathlib import Path
 from typing import Any
@@ -63,11 +64,22 @@ def compare_backends(
         rows.append({**result.summary(), "backend": label})
     best = [r["objective"] for r in rows if _trusted(r)]
     if best:
-        ref = max(best) if spec.objective_sense == "maximize" else min(best)
+        ref = reference_objective(best, spec.objective_sense)
         for r in rows:
             if r.get("objective") is not None:
                 r["relative_gap"] = abs(r["objective"] - ref) / max(abs(ref), 1e-12)
     return rows
+
+
+def reference_objective(objectives: list[float], sense: str) -> float:
+    """J* of the gap column: the best trusted objective (lowest when minimizing, highest when
+    maximizing), or, for a saddle-point game (``sense == "saddle"``), whose value no backend can
+    beat, their median, so that the gap measures disagreement rather than ranking the rows."""
+    if sense == "maximize":
+        return max(objectives)
+    if sense == "minimize":
+        return min(objectives)
+    return float(statistics.median(objectives))
 
 
 FEASIBILITY_TOL = 1e-6
@@ -114,7 +126,7 @@ COLUMNS: list[tuple[str, str, Callable[[Any], str]]] = [
 LEGEND = (
     "build, solve: wall time in ms; viol: max constraint violation; defect: max dynamics defect, "
     "recomputed without the solver; gap: |J - J*| / |J*| to the best optimal objective J* among "
-    "rows with no constraint violation above 1e-6."
+    "rows with no constraint violation above 1e-6 (for a saddle-point game, their median)."
 )
 
 

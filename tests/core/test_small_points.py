@@ -60,3 +60,19 @@ def test_show_transformed_of_a_continuous_lq_game_gives_the_zero_order_hold(cli,
     assert B[3][0] == pytest.approx(1 - math.exp(-dt / tau_p), rel=1e-12)
     again = gamespec.spec_from_dict(data)
     assert again.kind == "lq_stochastic_game" and again.problem.discrete is not None
+
+
+def test_the_compare_gap_of_a_saddle_point_game_is_to_the_median() -> None:
+    """A minimization's reference is its lowest trusted objective; a saddle value has no better
+    side, so the rows are measured against their median (two rows: equal gaps either side)."""
+    from gamespec.studies.compare import compare_backends, reference_objective
+
+    assert reference_objective([3.0, 1.0, 2.0], "minimize") == 1.0
+    assert reference_objective([3.0, 1.0, 2.0], "maximize") == 3.0
+    assert reference_objective([3.0, 1.0, 2.0], "saddle") == 2.0
+    spec = gamespec.load(PROBLEMS / "ch4/test_example_mean_steering.yaml", ["method.monte_carlo.samples=0"])
+    assert spec.objective_sense == "saddle"
+    rows = compare_backends(spec, [("qp", "proxqp"), ("cvxpy", "clarabel")])
+    gaps = [r["relative_gap"] for r in rows]
+    assert all(r["status"] == "optimal" for r in rows)
+    assert gaps[0] == pytest.approx(gaps[1], rel=1e-9, abs=1e-15)

@@ -47,7 +47,7 @@ class CasadiOptions(StrictModel):
     warm_start: bool = Field(True, description="Re-solves start from the previous solution.")
 
 
-def _library(ca) -> Library:
+def casadi_library(ca: Any) -> Library:
     """CasADi's functions by gamespec's names; ``heaviside(x) = (1 + sign(x))/2``, which is 1/2 at 0
     as SymPy's ``Heaviside`` (CasADi's ``sign(0) = 0``)."""
     return Library.from_namespace(
@@ -67,7 +67,7 @@ class CasadiModel(CompiledModel):
         self.tr = tr = Transcription(spec)
         self.options = options
         ocp, grid = tr.ocp, tr.grid
-        lib = _library(ca)
+        lib = casadi_library(ca)
         nx, nu, npar = tr.n_x, tr.n_u, len(ocp.p)
         x, u, p, t = ca.SX.sym("x", nx), ca.SX.sym("u", nu), ca.SX.sym("p", npar), ca.SX.sym("t")
         values = dict(zip(ocp.x, ca.vertsplit(x), strict=True)) | dict(

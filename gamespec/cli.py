@@ -180,15 +180,9 @@ def show(
     """Print the (validated, optionally transformed) problem as YAML."""
     spec = load(file, set_ or [])
     if transformed:
-        from gamespec.solving import backend_name, get_backend
-        from gamespec.transforms.base import chain_to
+        from gamespec.solving import transformed as transformed_spec
 
-        target = get_backend(backend_name(spec, backend))
-        chain = chain_to(spec, target.kinds)
-        if chain is None:
-            raise GamespecError(f"backend {target.name!r} cannot take kind {spec.kind!r}")
-        for transform in chain:
-            spec, _ = transform.apply(spec)
+        spec = transformed_spec(spec, backend)
     data = spec.model_dump(mode="json", exclude_defaults=False)
     sys.stdout.write(yaml.safe_dump(data, sort_keys=False, allow_unicode=True))
 

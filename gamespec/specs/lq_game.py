@@ -24,7 +24,7 @@ from pydantic import Field, field_validator, model_validator
 
 from gamespec.errors import ExpressionError, SpecError
 from gamespec.lqgame.game import LQGame, zero_order_hold
-from gamespec.specs.base import SpecBase, StrictModel
+from gamespec.specs.base import ProblemParameters, SpecBase, StrictModel
 from gamespec.symbolic.language import RESERVED, parse, symbol
 
 Value = float | str
@@ -147,7 +147,7 @@ class LQMethodSpec(StrictModel):
     monte_carlo: MonteCarloSpec = Field(default_factory=MonteCarloSpec)
 
 
-class LQGameSpec(SpecBase):
+class LQGameSpec(ProblemParameters, SpecBase):
     """An LQ stochastic game with one-sided terminal mean/covariance constraints (chapter 4)."""
 
     kind: Literal["lq_stochastic_game"] = "lq_stochastic_game"

@@ -74,10 +74,11 @@ def sweep(
     show_progress: bool = True,
 ) -> list[dict[str, Any]]:
     """Solve ``path`` on the Cartesian product of ``ranges``; rows in grid order."""
-    from gamespec.loader import load, spec_hash
+    from gamespec.loader import load, spec_hash, with_values
     from gamespec.solving import backend_name
 
     spec = load(path, overrides)
+    with_values(spec, {name: values[0] for name, values in ranges})
     problem = f"{backend_name(spec, backend)}/{spec_hash(spec)}"
     names = [name for name, _ in ranges]
     points = {}

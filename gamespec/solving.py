@@ -188,10 +188,12 @@ class Solver:
         """Solve ``spec``, the compiled source spec with other runtime parameter values, on the
         compiled model; a SpecError (naming ``names``, the parameters that were set) when its target
         differs from the compiled one in more than those values."""
+        requested = [options for _, options in requested_steps(spec)]
         steps = []
         current = spec.model_copy(update={"transforms": []}) if spec.transforms else spec
-        for old in self.steps:
-            steps.append(_applied(old.transform, old.options, current, old.upstream))
+        for index, old in enumerate(self.steps):
+            options = requested[index] if index < len(requested) else old.options
+            steps.append(_applied(old.transform, options, current, old.upstream))
             current = steps[-1].target
         difference = _first_difference(current.structure(), self.target_spec.structure())
         if difference is not None:

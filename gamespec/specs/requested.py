@@ -48,10 +48,13 @@ def validated_options(cls: type, name: str, options: dict[str, Any], index: int)
     try:
         return cls.options_model.model_validate(options)
     except ValidationError as err:
-        first = err.errors()[0]
+        errors = err.errors()
+        first = next((e for e in errors if e["type"] == "extra_forbidden"), errors[0])
         loc = ".".join(str(p) for p in first["loc"])
         reason = first["msg"].removeprefix("Value error, ")
-        if first["type"] == "extra_forbidden":
+        if first["type"] == "missing":
+            reason = "required option is missing"
+        elif first["type"] == "extra_forbidden":
             keys = list(cls.options_model.model_fields)
             near = difflib.get_close_matches(str(first["loc"][-1]), keys, n=1)
             reason = f"unknown option {first['loc'][-1]!r}" + (

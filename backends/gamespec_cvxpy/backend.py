@@ -61,8 +61,6 @@ class _Problem:
                 self.problem.solve(solver=self.options.solver, warm_start=True, **self.options.solver_options)
         except cp.SolverError:
             return Status.NUMERICAL_ERROR
-        except (TypeError, ValueError) as err:
-            raise self.options.rejected(err) from None
         finally:
             self.seconds += time.perf_counter() - start
         return STATUS_MAP.get(self.problem.status, Status.ERROR)
@@ -247,3 +245,12 @@ class CvxpyBackend(LQBackend):
         import cvxpy as cp
 
         return list(cp.installed_solvers())
+
+    @classmethod
+    def probe(cls, options: CvxpyOptions) -> None:
+        import cvxpy as cp
+
+        x = cp.Variable()
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            cp.Problem(cp.Minimize(cp.square(x - 1))).solve(solver=options.solver, **options.solver_options)

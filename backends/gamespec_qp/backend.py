@@ -55,12 +55,9 @@ class QpModel(LQCompiledModel):
 
         initvals = self._initial_controls(guess)
         start = time.perf_counter()
-        try:
-            solution = qpsolvers.solve_problem(
-                self.problem, solver=self.options.solver, initvals=initvals, **self.options.solver_options
-            )
-        except (TypeError, ValueError, qpsolvers.ParamError) as err:
-            raise self.options.rejected(err) from None
+        solution = qpsolvers.solve_problem(
+            self.problem, solver=self.options.solver, initvals=initvals, **self.options.solver_options
+        )
         seconds = time.perf_counter() - start
         if not solution.found or solution.x is None:
             return fallback_mean(
@@ -84,3 +81,15 @@ class QpBackend(LQBackend):
         import qpsolvers
 
         return list(qpsolvers.available_solvers)
+
+    @classmethod
+    def probe(cls, options: QpOptions) -> None:
+        import qpsolvers
+
+        problem = qpsolvers.Problem(np.eye(1), -np.ones(1))
+        if options.solver not in qpsolvers.dense_solvers:
+            problem = qpsolvers.Problem(csc_matrix(problem.P), problem.q)
+        try:
+            qpsolvers.solve_problem(problem, solver=options.solver, **options.solver_options)
+        except qpsolvers.ParamError as err:
+            raise ValueError(str(err)) from None

@@ -120,6 +120,12 @@ class LQBackend(Backend):
         """The solvers ``library`` finds here (imports it; ImportError when it is missing)."""
 
     @classmethod
+    @abstractmethod
+    def probe(cls, options: LQSolverOptions) -> None:
+        """Solve a one-variable problem with the chosen solver and ``solver_options``: the
+        solver's TypeError or ValueError about an option surfaces here, before any real solve."""
+
+    @classmethod
     def available(cls) -> Availability:
         try:
             solvers = cls.installed_solvers()
@@ -139,4 +145,9 @@ class LQBackend(Backend):
                 f"solver {options.solver!r} is not installed for {self.library} "
                 f"(installed: {', '.join(solvers)})"
             )
-        return self.model_class(spec, options.model_copy(update={"solver": found[0]}))
+        options = options.model_copy(update={"solver": found[0]})
+        try:
+            self.probe(options)
+        except (TypeError, ValueError) as err:
+            raise options.rejected(err) from None
+        return self.model_class(spec, options)

@@ -113,7 +113,11 @@ def test_a_transform_that_does_not_accept_the_spec_is_refused(test_transforms, t
 @pytest.mark.parametrize(
     ("entry", "field", "reason"),
     [
-        ({"weighted_lagrang": {"term": "u", "weight": 1}}, "transforms.0", "did you mean 'weighted_lagrange'"),
+        (
+            {"weighted_lagrang": {"term": "u", "weight": 1}},
+            "transforms.0",
+            "did you mean 'weighted_lagrange'",
+        ),
         ({"weighted_lagrange": {"term": "u", "weight": -1}}, f"{WEIGHT_PATH}", "greater than or equal"),
         ({"weighted_lagrange": {"term": "u", "wieght": 1}}, "transforms.0.weighted_lagrange", "'weight'"),
         ({"engagement_to_ocp": {}}, "transforms.0", "cannot be requested"),
@@ -152,13 +156,13 @@ def test_runtime_parameters_by_short_name_and_dotted_path() -> None:
 
 def test_unknown_or_structural_runtime_parameter_is_refused() -> None:
     solver = gamespec.compile_spec(MAX_RANGE)
-    with pytest.raises(SpecError, match="unknown parameter 'rh'.*did you mean 'rho'") as err:
+    with pytest.raises(SpecError, match=r"unknown parameter 'rh'.*did you mean 'rho'") as err:
         solver.solve(parameters={"rh": 2.0})
     assert err.value.field == "rh"
-    with pytest.raises(SpecError, match="method.intervals change") as err:
+    with pytest.raises(SpecError, match=r"method\.intervals change") as err:
         solver.solve(parameters={"method.intervals": 10})
     assert err.value.field == "method.intervals"
-    with pytest.raises(SpecError, match="problem.states.x2.initial"):
+    with pytest.raises(SpecError, match=r"problem\.states\.x2\.initial"):
         solver.solve(parameters={"problem.states.x2.initial": "nope"})
 
 

@@ -80,9 +80,9 @@ def test_runtime_parameters_are_validated_as_at_load() -> None:
         solver.solve(parameters={"evader.speed": 1.2})
     with pytest.raises(SpecError, match="unknown parameter 'v'"):
         solver.solve(parameters={"v": 0.3})
-    with pytest.raises(SpecError, match="did you mean 'evader.speed'"):
+    with pytest.raises(SpecError, match=r"did you mean 'evader\.speed'"):
         solver.solve(parameters={"evader.sped": 0.3})
-    with pytest.raises(SpecError, match="pursuers.0.strategy change"):
+    with pytest.raises(SpecError, match=r"pursuers\.0\.strategy change"):
         solver.solve(parameters={"pursuers.0.strategy": "pp"})
 
 

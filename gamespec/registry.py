@@ -2,7 +2,8 @@
 
 Groups: ``gamespec.kinds`` (spec classes by ``kind``), ``gamespec.backends`` (backend classes by
 name), ``gamespec.transforms`` (spec → spec reductions), ``gamespec.plotters`` (plot functions by
-kind) and ``gamespec.commands`` (Typer apps of area commands, by sub-command name). Nothing is imported until it is asked for, so ``import gamespec`` stays light.
+kind) and ``gamespec.commands`` (Typer apps of area commands, by sub-command name). Nothing is
+imported until it is asked for, so ``import gamespec`` stays light.
 """
 
 from __future__ import annotations

@@ -26,7 +26,7 @@ from pathlib import Path
 from typing import Any
 
 from gamespec import registry
-from gamespec.backend import Backend, CompiledModel
+from gamespec.backend import Backend, CompiledModel, Inputs
 from gamespec.errors import BackendError, SpecError, UnsupportedFeature
 from gamespec.loader import load, spec_hash, with_values
 from gamespec.result import Provenance, Result, Status
@@ -169,7 +169,7 @@ class Solver:
         self,
         parameters: dict[str, Any] | None = None,
         guess: Result | None = None,
-        inputs: dict[str, Any] | None = None,
+        inputs: Inputs = None,
     ) -> Result:
         """Solve (again) with new values of the source spec's runtime parameters or dotted fields
         (validated as at load), an optional guess Result of the target spec, and grid ``inputs``
@@ -182,7 +182,7 @@ class Solver:
         self,
         spec: SpecBase,
         guess: Result | None = None,
-        inputs: dict[str, Any] | None = None,
+        inputs: Inputs = None,
         names: list[str] | None = None,
     ) -> Result:
         """Solve ``spec``, the compiled source spec with other runtime parameter values, on the
@@ -206,20 +206,17 @@ class Solver:
             )
         return self._solve(spec, steps, guess, inputs)
 
-    def _solve(
-        self, spec: SpecBase, steps: list[Step], guess: Result | None, inputs: dict[str, Any] | None
-    ) -> Result:
+    def _solve(self, spec: SpecBase, steps: list[Step], guess: Result | None, inputs: Inputs) -> Result:
         target = steps[-1].target if steps else spec
         values = target.runtime_parameters() or None
-        extra = {} if inputs is None else {"inputs": inputs}
         last = steps[-1] if steps else None
         start = guess if guess is not None or last is None else last.transform.guess(last.inverse)
-        result = self.compiled.solve(parameters=values, guess=start, **extra)
+        result = self.compiled.solve(parameters=values, guess=start, inputs=inputs)
         for index in reversed(range(len(steps))):
             step = steps[index]
             result = step.transform.invert(result, step.source, step.inverse)
             if result.ok:
-                result = self._verified(step, result, values, extra, multistart=index == len(steps) - 1)
+                result = self._verified(step, result, values, inputs, multistart=index == len(steps) - 1)
         provenance = Provenance(
             spec_hash=spec_hash(spec),
             source=self.spec.source,
@@ -238,13 +235,13 @@ class Solver:
             }
         )
 
-    def _restarted(self, step: Step, values: dict[str, float] | None, extra: dict[str, Any]) -> Result | None:
+    def _restarted(self, step: Step, values: dict[str, float] | None, inputs: Inputs) -> Result | None:
         """Multi-start: the best verified Result among re-solves of the compiled model from the
         step's restarts (None if none verifies)."""
         best = None
         guesses = step.transform.restarts(step.source, step.inverse)
         for number, start in enumerate(guesses, 1):
-            raw = self.compiled.solve(parameters=values, guess=start, **extra)
+            raw = self.compiled.solve(parameters=values, guess=start, inputs=inputs)
             candidate = step.transform.invert(raw, step.source, step.inverse)
             if not candidate.ok or step.transform.verify(candidate, step.source, step.inverse) is not None:
                 continue
@@ -258,7 +255,7 @@ class Solver:
         step: Step,
         result: Result,
         values: dict[str, float] | None,
-        extra: dict[str, Any],
+        inputs: Inputs,
         multistart: bool,
     ) -> Result:
         """``result`` if the step verifies it; else the best verified multi-start Result (only the
@@ -266,7 +263,7 @@ class Solver:
         failed = step.transform.verify(result, step.source, step.inverse)
         if failed is None:
             return result
-        better = self._restarted(step, values, extra) if multistart else None
+        better = self._restarted(step, values, inputs) if multistart else None
         if better is not None:
             return better
         status = Status.FEASIBLE if result.status is Status.OPTIMAL else result.status
@@ -297,7 +294,7 @@ def solve(
     *,
     parameters: dict[str, Any] | None = None,
     guess: Result | None = None,
-    inputs: dict[str, Any] | None = None,
+    inputs: Inputs = None,
     options: dict[str, Any] | None = None,
 ) -> Result:
     """Solve a spec (or problem file) once on ``backend`` and return its Result."""

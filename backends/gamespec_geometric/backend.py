@@ -12,7 +12,7 @@ from typing import ClassVar, Literal
 
 from pydantic import Field
 
-from gamespec.backend import Backend, CompiledModel
+from gamespec.backend import Backend, CompiledModel, Inputs, refuse_inputs
 from gamespec.loader import with_values
 from gamespec.result import Result, Status
 from gamespec.specs.base import SpecBase, StrictModel
@@ -35,8 +35,11 @@ class CompiledScenario(CompiledModel):
         self.spec = spec
         self.options = options
 
-    def solve(self, parameters: dict[str, float] | None = None, guess: Result | None = None) -> Result:
+    def solve(
+        self, parameters: dict[str, float] | None = None, guess: Result | None = None, inputs: Inputs = None
+    ) -> Result:
         """Simulate (``guess`` is not used: the simulation has no iterate to warm-start)."""
+        refuse_inputs(inputs, self.spec.kind)
         spec = with_values(self.spec, parameters) if parameters else self.spec
         start = time.perf_counter()
         run = simulate(spec, method=self.options.active_check, samples=self.options.pp_samples)

@@ -19,7 +19,7 @@ from __future__ import annotations
 import time
 from typing import ClassVar
 
-from gamespec.backend import Backend, CompiledModel
+from gamespec.backend import Backend, CompiledModel, Inputs, refuse_inputs
 from gamespec.loader import with_values
 from gamespec.pursuit import constant_bearing, pure_pursuit
 from gamespec.pursuit.reduced import observe, reduce
@@ -37,7 +37,10 @@ class AnalyticModel(CompiledModel):
     def __init__(self, spec: EngagementSpec) -> None:
         self.spec = spec
 
-    def solve(self, parameters: dict[str, float] | None = None, guess: Result | None = None) -> Result:
+    def solve(
+        self, parameters: dict[str, float] | None = None, guess: Result | None = None, inputs: Inputs = None
+    ) -> Result:
+        refuse_inputs(inputs, self.spec.kind)
         tic = time.perf_counter()
         spec = with_values(self.spec, parameters) if parameters else self.spec
         players = Players.from_spec(spec)

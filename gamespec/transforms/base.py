@@ -67,7 +67,7 @@ class Transform(ABC):
         self, spec: SpecBase, options: StrictModel, upstream: Result | None = None
     ) -> tuple[SpecBase, Any]:
         """The new spec and the data :meth:`invert` needs; ``upstream`` is the Result of
-        :meth:`stage`'s spec when it names one."""
+        :meth:`stage`'s spec when it names one, whatever its status (check ``upstream.ok``)."""
 
     def invert(self, result: Result, spec: SpecBase, inverse_data: Any) -> Result:
         """Map a Result of the transformed spec back to the original ``spec`` (default: relabel)."""

@@ -13,7 +13,7 @@ than the guess (eq. 2.28 respected), from which the solving layer re-solves the 
 
 from __future__ import annotations
 
-from typing import Any, ClassVar
+from typing import ClassVar
 
 import numpy as np
 
@@ -55,7 +55,7 @@ class EngagementToOcp(Transform):
     def verify(self, result: Result, spec: EngagementSpec, inverse_data: EngagementInverse) -> str | None:
         return verify(result, inverse_data.guess_capture_time)
 
-    def restarts(self, spec: EngagementSpec, inverse_data: Any) -> list[Result]:
+    def restarts(self, spec: EngagementSpec, inverse_data: EngagementInverse) -> list[Result]:
         if spec.guess_heading is not None:
             return []
         headings = [

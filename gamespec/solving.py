@@ -187,7 +187,8 @@ class Solver:
     ) -> Result:
         """Solve ``spec``, the compiled source spec with other runtime parameter values, on the
         compiled model; a SpecError (naming ``names``, the parameters that were set) when its target
-        differs from the compiled one in more than those values."""
+        differs from the compiled one in more than those values — or in its starting point, when
+        neither the caller nor the last transform gives the compiled model one."""
         requested = [options for _, options in requested_steps(spec)]
         steps = []
         current = spec.model_copy(update={"transforms": []}) if spec.transforms else spec
@@ -195,7 +196,11 @@ class Solver:
             options = requested[index] if index < len(requested) else old.options
             steps.append(_applied(old.transform, options, current, old.upstream))
             current = steps[-1].target
-        difference = _first_difference(current.structure(), self.target_spec.structure())
+        last = steps[-1] if steps else None
+        started = guess is not None or (last is not None and last.transform.guess(last.inverse) is not None)
+        difference = _first_difference(
+            current.structure(with_guess=not started), self.target_spec.structure(with_guess=not started)
+        )
         if difference is not None:
             what = ", ".join(names) if names else "the new values"
             raise SpecError(

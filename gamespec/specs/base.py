@@ -109,13 +109,15 @@ class SpecBase(StrictModel):
         """The dotted field a runtime parameter ``name`` stands for (the name itself by default)."""
         return name
 
-    def structure(self) -> dict[str, Any]:
-        """This spec without its runtime parameter values, its starting point, name and description:
-        two specs with the same structure compile to the same model."""
+    def structure(self, with_guess: bool = False) -> dict[str, Any]:
+        """This spec without its runtime parameter values, name and description (and without its
+        starting point unless ``with_guess``): two specs with the same structure compile to the same
+        model."""
         data = self.model_dump(mode="json")
         data.pop("name")
         data.pop("description")
-        for path in [*(self.parameter_path(n) for n in self.runtime_parameters()), *self.guess_fields]:
+        blanked = [self.parameter_path(n) for n in self.runtime_parameters()]
+        for path in blanked + ([] if with_guess else list(self.guess_fields)):
             *parents, last = path.split(".")
             node: Any = data
             for part in parents:

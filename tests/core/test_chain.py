@@ -164,6 +164,11 @@ def test_unknown_or_structural_runtime_parameter_is_refused() -> None:
     assert err.value.field == "method.intervals"
     with pytest.raises(SpecError, match=r"problem\.states\.x2\.initial"):
         solver.solve(parameters={"problem.states.x2.initial": "nope"})
+    with pytest.raises(SpecError, match=r"field guess\.controls\.u"):
+        solver.solve(parameters={"guess.controls.u": 0.5})
+    start = solver.solve()
+    moved = solver.solve(parameters={"guess.controls.u": 0.5}, guess=start)
+    assert moved.objective == pytest.approx(start.objective, rel=1e-9)
 
 
 def test_transformed_spec_of_a_spec_without_transforms_is_itself() -> None:

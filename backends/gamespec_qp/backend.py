@@ -86,9 +86,10 @@ class QpBackend(LQBackend):
     def probe(cls, options: QpOptions) -> None:
         import qpsolvers
 
-        problem = qpsolvers.Problem(np.eye(1), -np.ones(1))
+        P, G = np.eye(1), np.ones((1, 1))
         if options.solver not in qpsolvers.dense_solvers:
-            problem = qpsolvers.Problem(csc_matrix(problem.P), problem.q)
+            P, G = csc_matrix(P), csc_matrix(G)
+        problem = qpsolvers.Problem(P, -np.ones(1), G=G, h=np.full(1, 0.5))
         try:
             qpsolvers.solve_problem(problem, solver=options.solver, **options.solver_options)
         except qpsolvers.ParamError as err:

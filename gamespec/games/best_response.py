@@ -186,10 +186,6 @@ class BestResponseRun:
         }
 
 
-def _finite(x: float) -> bool:
-    return bool(np.isfinite(x))
-
-
 class _Iterator:
     """The state of one run of :func:`iterate`."""
 
@@ -273,7 +269,7 @@ class _Iterator:
         changes = {p.name: float(p.distance(following[p.name], self.current[p.name])) for p in self.players}
         payoff = float(self.payoff(following)) if self.payoff is not None else None
         self.history.append(Iteration(changes, payoff))
-        if not all(_finite(c) for c in changes.values()):
+        if not np.isfinite(list(changes.values())).all():
             return Outcome.DIVERGED
         self.current = following
         if max(changes.values()) <= self.settings.tolerance:

@@ -124,9 +124,9 @@ class LQBackend(Backend):
 
     @classmethod
     @abstractmethod
-    def probe(cls, options: LQSolverOptions) -> None:
-        """Solve a one-variable problem with the chosen solver and ``solver_options``: the
-        solver's TypeError or ValueError about an option surfaces here, before any real solve."""
+    def probe_options(cls, options: LQSolverOptions) -> None:
+        """Raise ``options.rejected(...)`` when the solver refuses ``options.solver_options`` (a
+        one-variable problem at compile time, so no real solve needs an exception handler)."""
 
     @classmethod
     def available(cls) -> Availability:
@@ -149,8 +149,5 @@ class LQBackend(Backend):
                 f"(installed: {', '.join(solvers)})"
             )
         options = options.model_copy(update={"solver": found[0]})
-        try:
-            self.probe(options)
-        except (TypeError, ValueError) as err:
-            raise options.rejected(err) from None
+        self.probe_options(options)
         return self.model_class(spec, options)

@@ -69,6 +69,19 @@ def test_requested_transform_resolves_like_fresh_solves(test_transforms, tmp_pat
     assert objectives[0] == pytest.approx(plain.objective, rel=1e-7)
 
 
+def test_weight_enters_the_compiled_model_as_the_envelope_theorem_says(test_transforms, tmp_path) -> None:
+    """J*(w) = max x1(t_f) − w∫u²: by the envelope theorem dJ*/dw = −∫u² at the optimum, which the
+    Result gives as (x1(t_f) − J*)/w. A central difference of re-solves over w must match it."""
+    file = _with_transforms(MAX_RANGE, tmp_path, [{"weighted_lagrange": {"term": "-u**2", "weight": 0.5}}])
+    solver = gamespec.compile_spec(file)
+    weight, step = 0.5, 1e-3
+    at = solver.solve()
+    above, below = (solver.solve(parameters={WEIGHT_PATH: weight + d}) for d in (step, -step))
+    slope = (above.objective - below.objective) / (2 * step)
+    assert slope == pytest.approx(-(at.states["x1"][-1] - at.objective) / weight, rel=1e-3)
+    assert slope < 0
+
+
 def test_show_transformed_prints_what_the_backend_solves(test_transforms, tmp_path, cli) -> None:
     """The printed spec is the compiled target (requested, then no lowering for this kind) and
     solving it on its own gives the chain's answer."""

@@ -100,11 +100,17 @@ def _applied(
     return Step(transform, options, spec, target, inverse, upstream)
 
 
+def _unrequested(spec: SpecBase) -> SpecBase:
+    """``spec`` with an empty ``transforms:`` section: what its first transform receives, so that
+    the spec the backend gets does not ask for them again."""
+    return spec.model_copy(update={"transforms": []}) if spec.transforms else spec
+
+
 def build_steps(spec: SpecBase, backend: Backend) -> list[Step]:
     """The requested transforms of ``spec`` in order, then the lowering ones to a kind ``backend``
     solves."""
     steps: list[Step] = []
-    current = spec.model_copy(update={"transforms": []}) if spec.transforms else spec
+    current = _unrequested(spec)
     for transform, options in requested_steps(spec):
         steps.append(_applied(transform, options, current))
         current = steps[-1].target
@@ -191,7 +197,7 @@ class Solver:
         neither the caller nor the last transform gives the compiled model one."""
         requested = [options for _, options in requested_steps(spec)]
         steps = []
-        current = spec.model_copy(update={"transforms": []}) if spec.transforms else spec
+        current = _unrequested(spec)
         for index, old in enumerate(self.steps):
             options = requested[index] if index < len(requested) else old.options
             steps.append(_applied(old.transform, options, current, old.upstream))

@@ -21,8 +21,8 @@ from typing import Any, ClassVar
 import numpy as np
 from pydantic import Field
 
+from gamespec.best_response import Settings, StepReport
 from gamespec.errors import BackendError
-from gamespec.games.best_response import Settings, StepReport
 from gamespec.lqgame.backend import LQBackend, LQCompiledModel, LQSolverOptions
 from gamespec.lqgame.covariance import CONTROLLER, STOPPER, algorithm_2, gains_to_vector
 from gamespec.lqgame.scaling import ControllerScaling

@@ -10,7 +10,7 @@ whose blocks are the structured parts of ``Σ_s ⊗ (ℬᵀQ̄ℬ + R̄)``, ``Σ
 ``Σ_s ⊗ (𝒞ᵀQ̄𝒞 − S̄)`` and of ``ℬᵀQ̄Σ_s``, ``𝒞ᵀQ̄Σ_s``. Its stationary point is eq. 4.59 (UCSG).
 The relaxed terminal constraint eq. 4.61 reads ``‖W‖₂ ≤ 1`` (eq. 4.62) with
 ``vec W = w_0 + T_WK κ + T_WL ℓ``, ``W = Σ_N^{-1/2} E_N (I + ℬK + 𝒞L) F``.
-:func:`algorithm_2` is Algorithm 2 on the best-response engine (:mod:`gamespec.games.best_response`)
+:func:`algorithm_2` is Algorithm 2 on the best-response engine (:mod:`gamespec.best_response`)
 with the players' best responses supplied by a backend.
 """
 
@@ -21,7 +21,7 @@ from collections.abc import Callable
 import numpy as np
 from scipy.linalg import sqrtm
 
-from gamespec.games.best_response import BestResponseRun, Response, Settings, VectorPlayer, iterate
+from gamespec.best_response import BestResponseRun, Response, Settings, VectorPlayer, iterate
 from gamespec.lqgame.game import LQGame
 from gamespec.lqgame.lifting import Lifted
 

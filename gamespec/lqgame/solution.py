@@ -78,7 +78,7 @@ class MeanOutcome:
 class CovarianceOutcome:
     """Vectorized gains ``κ``, ``ℓ`` (see :mod:`gamespec.lqgame.covariance`) and how they were found:
     ``history`` holds ``(ε_k, ε_ℓ)`` per iteration, ``best_response`` the engine's metrics
-    (:meth:`~gamespec.games.best_response.BestResponseRun.as_metrics`) when Algorithm 2 ran."""
+    (:meth:`~gamespec.best_response.BestResponseRun.as_metrics`) when Algorithm 2 ran."""
 
     kappa: np.ndarray
     ell: np.ndarray

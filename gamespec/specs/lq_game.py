@@ -162,7 +162,7 @@ class MonteCarloSpec(StrictModel):
 
 class LQMethodSpec(StrictModel):
     """The best-response iteration of the covariance game (Algorithm 2: scheme, stopping rule,
-    damping; :mod:`gamespec.games.best_response`) and the Monte Carlo check."""
+    damping; :mod:`gamespec.best_response`) and the Monte Carlo check."""
 
     tolerance: Number = Field(1e-5, gt=0, description="Bound on ε_k and ε_ℓ (section 4.5).")
     max_iterations: int = Field(100, ge=1)

@@ -10,7 +10,7 @@ from gamespec_cvxpy.backend import CovariancePlayers, CvxpyOptions
 from scipy.linalg import sqrtm
 
 import gamespec
-from gamespec.games.best_response import Settings
+from gamespec.best_response import Settings
 from gamespec.lqgame.covariance import lift_gains, vector_to_gains
 from gamespec.lqgame.solution import GameModel
 from gamespec.result import Status

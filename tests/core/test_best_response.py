@@ -17,7 +17,7 @@ import json
 import numpy as np
 import pytest
 
-from gamespec.games.best_response import (
+from gamespec.best_response import (
     Outcome,
     Settings,
     StepReport,

@@ -14,8 +14,9 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
+import sympy as sp
 
-from gamespec.pursuit.guess import default_heading
+from gamespec.pursuit.guess import default_heading, fit_polynomial, polynomial
 from gamespec.pursuit.reduced import Reduction, observe, reduce
 from gamespec.pursuit.simulation import Players, Trajectory, simulate_to_capture
 from gamespec.result import Result, Status
@@ -29,9 +30,8 @@ from gamespec.specs.ocp import (
     StateSpec,
     TimeSpec,
 )
-
-GUESS_DEGREE = 5
-"""Degree of the polynomials in normalized time τ that carry the simulated guess."""
+from gamespec.symbolic.language import symbol
+from gamespec.symbolic.printer import to_text
 
 
 @dataclass(frozen=True)
@@ -47,18 +47,6 @@ class EngagementInverse:
     guess: Result
 
 
-def _fit(tau: np.ndarray, values: np.ndarray) -> np.ndarray:
-    """Coefficients (lowest degree first) of the least-squares polynomial of :data:`GUESS_DEGREE`."""
-    return np.polynomial.polynomial.polyfit(tau, values, GUESS_DEGREE)
-
-
-def polynomial(tau: np.ndarray, values: np.ndarray) -> str:
-    """A least-squares polynomial in ``tau`` through ``values``, as an expression string."""
-    coeffs = _fit(tau, values)
-    terms = [f"({c:.12g})*tau**{k}" if k else f"({c:.12g})" for k, c in enumerate(coeffs) if abs(c) > 1e-10]
-    return " + ".join(terms) or "0"
-
-
 def trajectory_guess(red: Reduction, traj: Trajectory) -> Result:
     """A simulated trajectory in the reduced states and control of ``red``: a guess Result."""
     observed = observe(red, traj)
@@ -72,7 +60,7 @@ def fitted_guess(red: Reduction, traj: Trajectory) -> Result:
     trajectory itself, is what the NLP starts well from)."""
     tau = traj.time / traj.time[-1]
     fitted = {
-        name: np.polynomial.polynomial.polyval(tau, _fit(tau, values))
+        name: np.polynomial.polynomial.polyval(tau, fit_polynomial(tau, values))
         for name, values in observe(red, traj).items()
     }
     control = fitted.pop(red.control)
@@ -88,8 +76,8 @@ def _control_bounds(red: Reduction) -> ControlSpec:
     """θ ∈ [−π, π] in the line-of-sight frame; θ_E within π of pursuer 1's initial line of sight."""
     if red.frame == "line_of_sight":
         return ControlSpec(lower="-pi", upper="pi")
-    ref = red.angle[0] if red.angle[0] in red.parameters else f"{red.angle[0]}_init"
-    return ControlSpec(lower=f"{ref} - pi", upper=f"{ref} + pi")
+    ref = symbol(red.angle[0] if red.angle[0] in red.parameters else red.initial[red.angle[0]])
+    return ControlSpec(lower=to_text(ref - sp.pi), upper=to_text(ref + sp.pi))
 
 
 def to_ocp(spec: EngagementSpec) -> tuple[OptimalControlSpec, EngagementInverse]:

@@ -4,13 +4,13 @@ from __future__ import annotations
 
 from typing import Any, ClassVar
 
-import sympy as sp
 from pydantic import Field
 
 from gamespec.result import Result
 from gamespec.specs.base import StrictModel
 from gamespec.specs.ocp import OptimalControlSpec, TimeSpec
 from gamespec.symbolic.language import parse, symbol
+from gamespec.symbolic.printer import to_text
 from gamespec.transforms.base import Stage, Transform
 
 WEIGHT = "lagrange_weight"
@@ -42,7 +42,7 @@ class WeightedLagrange(Transform):
         problem = p.model_copy(
             update={
                 "parameters": {**p.parameters, WEIGHT: options.weight},
-                "objective": p.objective.model_copy(update={"lagrange": sp.sstr(lagrange)}),
+                "objective": p.objective.model_copy(update={"lagrange": to_text(lagrange)}),
             }
         )
         return OptimalControlSpec.model_validate({**spec.model_dump(), "problem": problem.model_dump()}), None

@@ -13,6 +13,7 @@ from typing import Any, ClassVar
 from gamespec import registry
 from gamespec.loader import spec_from_dict
 from gamespec.result import Result
+from gamespec.specs.base import StrictModel
 from gamespec.transforms.base import Transform
 
 
@@ -24,7 +25,7 @@ class ProjectileToOcp(Transform):
     target_kind: ClassVar[str] = "optimal_control"
     requested: ClassVar[bool] = False
 
-    def apply(self, spec, options: Any = None, upstream: Result | None = None):
+    def apply(self, spec, options: StrictModel, upstream: Result | None = None):
         a = math.radians(spec.angle)
         vx, vy = spec.speed * math.cos(a), spec.speed * math.sin(a)
         ocp = {

@@ -1,0 +1,124 @@
+"""Monte Carlo check of a desensitized solution (§6.3.1, §6.5.2): draw the uncertain parameters,
+re-simulate the solution's open-loop control (and, when asked, the LQR-tracking closed loop of
+eqs. 6.27-6.29) for every sample at once, and summarize final states, costs and path-constraint
+violations. It only re-simulates; it never solves.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Mapping
+from typing import Any
+
+import numpy as np
+
+from gamespec.desensitize.augment import initial_values
+from gamespec.desensitize.simulate import Trajectories, cost, evaluate, open_loop, path_violation, rk4
+from gamespec.desensitize.tracking import linearization, riccati_gains
+from gamespec.ocp.symbolic import SymbolicOcp
+from gamespec.result import Result
+from gamespec.specs.desensitize import MonteCarloOptions
+from gamespec.specs.uncertainty import UncertainParameter
+from gamespec.symbolic.language import symbol
+
+VIOLATION_TOL = 1e-6
+"""A sample violates the path constraints when its largest violation exceeds this."""
+
+
+def draw(
+    uncertain: Mapping[str, UncertainParameter], nominal: Mapping[str, float], n: int, seed: int
+) -> dict[str, np.ndarray]:
+    """``n`` seeded draws of each uncertain parameter about its nominal value."""
+    rng = np.random.default_rng(seed)
+    out = {}
+    for name, dist in uncertain.items():
+        if dist.normal is not None:
+            out[name] = rng.normal(nominal[name], dist.normal.std, n)
+        else:
+            out[name] = rng.uniform(*dist.uniform_bounds(nominal[name]), n)
+    return out
+
+
+def summary(values: np.ndarray) -> dict[str, float]:
+    return {
+        "mean": float(values.mean()),
+        "std": float(values.std(ddof=1)) if values.size > 1 else 0.0,
+        "min": float(values.min()),
+        "max": float(values.max()),
+    }
+
+
+def initial_state(ocp: SymbolicOcp, result: Result, params: Mapping[Any, Any], samples: int) -> np.ndarray:
+    """The initial state of each sample: the solution's, or the file's expression of the (sampled)
+    parameters when the initial value depends on them."""
+    x0 = np.empty((len(ocp.states), samples))
+    for i, (name, expr) in enumerate(zip(ocp.states, initial_values(ocp), strict=True)):
+        x0[i] = result.states[name][0] if expr is None else evaluate([expr], params, (samples,))[0]
+    return x0
+
+
+def monte_carlo(
+    ocp: SymbolicOcp, result: Result, uncertain: Mapping[str, UncertainParameter], options: MonteCarloOptions
+) -> dict[str, Any]:
+    """``metrics.monte_carlo`` for the open-loop control of ``result`` (plus ``tracking``)."""
+    nominal = {k: float(v) for k, v in result.parameters.items()}
+    n = options.samples
+    drawn = draw(uncertain, nominal, n, options.seed)
+    params = {symbol(k): drawn.get(k, v) for k, v in nominal.items()}
+    t0, tf = float(result.time[0]), float(result.t_final)
+    x0 = initial_state(ocp, result, params, n)
+    u_star = open_loop(result, ocp.controls)
+
+    def open_law(t: float, x: np.ndarray, k: int) -> np.ndarray:
+        return u_star(t)[:, None]
+
+    run = rk4(ocp, x0, open_law, params, t0, tf, options.steps)
+    metrics = {"samples": n, "seed": options.seed, "parameters": {k: summary(v) for k, v in drawn.items()}}
+    metrics.update(_outcome(ocp, run, params))
+    metrics["control_energy_mean"] = float(run.energy.mean())
+    if options.tracking:
+        metrics["tracking"] = _tracking(ocp, result, params, nominal, u_star, options, x0)
+    return metrics
+
+
+def _outcome(ocp: SymbolicOcp, run: Trajectories, params: Mapping[Any, Any]) -> dict[str, Any]:
+    final = run.x[-1]
+    costs = cost(ocp, run, params)
+    out = {
+        "final_state_mean": {s: float(final[i].mean()) for i, s in enumerate(ocp.states)},
+        "final_state_std": {s: float(final[i].std(ddof=1)) for i, s in enumerate(ocp.states)},
+        "cost_mean": float(costs.mean()),
+        "cost_std": float(costs.std(ddof=1)),
+        "cost_min": float(costs.min()),
+        "cost_max": float(costs.max()),
+    }
+    if ocp.path:
+        out["violation_probability"] = float(np.mean(path_violation(ocp, run, params) > VIOLATION_TOL))
+    return out
+
+
+def _tracking(
+    ocp: SymbolicOcp,
+    result: Result,
+    params: Mapping[Any, Any],
+    nominal: Mapping[str, float],
+    u_star: Callable[[float], np.ndarray],
+    options: MonteCarloOptions,
+    x0: np.ndarray,
+) -> dict[str, Any]:
+    """The closed loop ``u = u* - K(t)(x - x*(t))`` of eqs. 6.27-6.29 for the same samples."""
+    t0, tf = float(result.time[0]), float(result.t_final)
+    nominal_params = {symbol(k): v for k, v in nominal.items()}
+    x0_nominal = initial_state(ocp, result, nominal_params, 1)
+    reference = rk4(ocp, x0_nominal, lambda t, x, k: u_star(t)[:, None], nominal_params, t0, tf, options.steps)
+    A, B = linearization(ocp, reference, nominal_params)
+    K = riccati_gains(reference.t, A, B)
+    x_ref = reference.x[:, :, 0]
+
+    def law(t: float, x: np.ndarray, k: int) -> np.ndarray:
+        return u_star(t)[:, None] - K[k] @ (x - x_ref[k][:, None])
+
+    run = rk4(ocp, x0, law, params, t0, tf, options.steps)
+    out = _outcome(ocp, run, params)
+    out["control_energy_mean"] = float(run.energy.mean())
+    out["control_energy_std"] = float(run.energy.std(ddof=1))
+    return out

@@ -12,13 +12,16 @@ from typing import Any
 import numpy as np
 
 from gamespec.desensitize.augment import initial_values
-from gamespec.desensitize.simulate import Trajectories, cost, evaluate, open_loop, path_violation, rk4
+from gamespec.desensitize.simulate import Trajectories, cost, evaluate, open_loop, rk4
 from gamespec.desensitize.tracking import linearization, riccati_gains
 from gamespec.ocp.symbolic import SymbolicOcp
 from gamespec.result import Result
 from gamespec.specs.desensitize import MonteCarloOptions
 from gamespec.specs.uncertainty import UncertainParameter
 from gamespec.symbolic.language import symbol
+
+BUNDLE = 50
+"""How many sampled trajectories are kept for plots."""
 
 VIOLATION_TOL = 1e-6
 """A sample violates the path constraints when its largest violation exceeds this."""
@@ -58,8 +61,10 @@ def initial_state(ocp: SymbolicOcp, result: Result, params: Mapping[Any, Any], s
 
 def monte_carlo(
     ocp: SymbolicOcp, result: Result, uncertain: Mapping[str, UncertainParameter], options: MonteCarloOptions
-) -> dict[str, Any]:
-    """``metrics.monte_carlo`` for the open-loop control of ``result`` (plus ``tracking``)."""
+) -> tuple[dict[str, Any], dict[str, np.ndarray]]:
+    """``metrics.monte_carlo`` for the open-loop control of ``result`` (with ``tracking`` when asked),
+    and the trajectories of the first :data:`BUNDLE` samples (``monte_carlo_<state>``, and
+    ``tracking_<state>``, (steps+1, samples) each, on ``monte_carlo_time``) for plots."""
     nominal = {k: float(v) for k, v in result.parameters.items()}
     n = options.samples
     drawn = draw(uncertain, nominal, n, options.seed)
@@ -71,18 +76,24 @@ def monte_carlo(
     def open_law(t: float, x: np.ndarray, k: int) -> np.ndarray:
         return u_star(t)[:, None]
 
-    run = rk4(ocp, x0, open_law, params, t0, tf, options.steps)
+    run = rk4(ocp, x0, open_law, params, t0, tf, options.steps, keep=BUNDLE)
     metrics = {"samples": n, "seed": options.seed, "parameters": {k: summary(v) for k, v in drawn.items()}}
-    metrics.update(_outcome(ocp, run, params))
+    metrics.update(_outcome(ocp, x0, run, params))
     metrics["control_energy_mean"] = float(run.energy.mean())
+    arrays = {"monte_carlo_time": run.t} | _bundle("monte_carlo", ocp, run)
     if options.tracking:
-        metrics["tracking"] = _tracking(ocp, result, params, nominal, u_star, options, x0)
-    return metrics
+        metrics["tracking"], closed = _tracking(ocp, result, params, nominal, u_star, options, x0)
+        arrays |= _bundle("tracking", ocp, closed)
+    return metrics, arrays
 
 
-def _outcome(ocp: SymbolicOcp, run: Trajectories, params: Mapping[Any, Any]) -> dict[str, Any]:
-    final = run.x[-1]
-    costs = cost(ocp, run, params)
+def _bundle(prefix: str, ocp: SymbolicOcp, run: Trajectories) -> dict[str, np.ndarray]:
+    return {f"{prefix}_{s}": run.x[:, i, :] for i, s in enumerate(ocp.states)}
+
+
+def _outcome(ocp: SymbolicOcp, x0: np.ndarray, run: Trajectories, params: Mapping[Any, Any]) -> dict[str, Any]:
+    final = run.final
+    costs = cost(ocp, x0, run, params)
     out = {
         "final_state_mean": {s: float(final[i].mean()) for i, s in enumerate(ocp.states)},
         "final_state_std": {s: float(final[i].std(ddof=1)) for i, s in enumerate(ocp.states)},
@@ -92,7 +103,7 @@ def _outcome(ocp: SymbolicOcp, run: Trajectories, params: Mapping[Any, Any]) -> 
         "cost_max": float(costs.max()),
     }
     if ocp.path:
-        out["violation_probability"] = float(np.mean(path_violation(ocp, run, params) > VIOLATION_TOL))
+        out["violation_probability"] = float(np.mean(run.violation > VIOLATION_TOL))
     return out
 
 
@@ -104,7 +115,7 @@ def _tracking(
     u_star: Callable[[float], np.ndarray],
     options: MonteCarloOptions,
     x0: np.ndarray,
-) -> dict[str, Any]:
+) -> tuple[dict[str, Any], Trajectories]:
     """The closed loop ``u = u* - K(t)(x - x*(t))`` of eqs. 6.27-6.29 for the same samples."""
     t0, tf = float(result.time[0]), float(result.t_final)
     nominal_params = {symbol(k): v for k, v in nominal.items()}
@@ -117,8 +128,8 @@ def _tracking(
     def law(t: float, x: np.ndarray, k: int) -> np.ndarray:
         return u_star(t)[:, None] - K[k] @ (x - x_ref[k][:, None])
 
-    run = rk4(ocp, x0, law, params, t0, tf, options.steps)
-    out = _outcome(ocp, run, params)
+    run = rk4(ocp, x0, law, params, t0, tf, options.steps, keep=BUNDLE)
+    out = _outcome(ocp, x0, run, params)
     out["control_energy_mean"] = float(run.energy.mean())
     out["control_energy_std"] = float(run.energy.std(ddof=1))
-    return out
+    return out, run

@@ -27,14 +27,17 @@ ControlLaw = Callable[[float, np.ndarray, int], np.ndarray]
 
 @dataclass(frozen=True)
 class Trajectories:
-    """Per grid time and sample: states ``x`` (steps+1, n, samples) and controls ``u`` (steps+1, m,
-    samples); the accumulated running cost ``running`` (samples,) and control energy ∫Σu² ``energy``."""
+    """The grid ``t``; states ``x`` and controls ``u`` (steps+1, n or m, kept samples) of the first
+    ``keep`` samples; per sample the final state ``final`` (n, samples), the integrated running cost
+    ``running``, the control energy ∫Σu² ``energy`` and the largest path-constraint violation."""
 
     t: np.ndarray
     x: np.ndarray
     u: np.ndarray
+    final: np.ndarray
     running: np.ndarray
     energy: np.ndarray
+    violation: np.ndarray
 
 
 def open_loop(result: Result, controls: list[str]) -> Callable[[float], np.ndarray]:
@@ -61,80 +64,73 @@ def rk4(
     t0: float,
     tf: float,
     steps: int,
-    dynamics: list[sp.Expr] | None = None,
+    keep: int | None = None,
 ) -> Trajectories:
-    """Integrate ``dynamics`` (default: the file's) from ``x0`` (n, samples) under ``law``.
+    """Integrate the file's dynamics from ``x0`` (n, samples) under ``law``; keep the trajectories of
+    the first ``keep`` samples (all when None).
 
-    The law is evaluated at the start of each step and at the RK4 stage times it is asked for, so an
-    open-loop law is exact in time and a feedback law sees the state at the step's start (a
-    zero-order hold of the feedback over one fine step).
+    The law is evaluated at the RK4 stage times with the state at the step's start, so an open-loop
+    law is exact in time and a feedback law is held over one fine step (a zero-order hold).
     """
-    f = ocp.dynamics if dynamics is None else dynamics
     states, controls = ocp.x, ocp.u
     samples = x0.shape[1]
+    keep = samples if keep is None else min(keep, samples)
     lagrange = ocp.sign * ocp.lagrange
     h = (tf - t0) / steps
     t = t0 + h * np.arange(steps + 1)
-    X = np.empty((steps + 1, len(states), samples))
-    U = np.empty((steps + 1, len(controls), samples))
-    X[0] = x0
-    running = np.zeros(samples)
-    energy = np.zeros(samples)
+    X = np.empty((steps + 1, len(states), keep))
+    U = np.empty((steps + 1, len(controls), keep))
+    running, energy, violation = np.zeros(samples), np.zeros(samples), np.zeros(samples)
 
-    def rhs(tk: float, x: np.ndarray, u: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    def values_at(tk: float, x: np.ndarray, u: np.ndarray) -> dict:
         values = dict(params)
         values.update(zip(states, x, strict=True))
         values.update(zip(controls, u, strict=True))
         values[TIME] = tk
-        dx = evaluate(f, values, (samples,))
+        return values
+
+    def rhs(tk: float, x: np.ndarray, u: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        values = values_at(tk, x, u)
+        dx = evaluate(ocp.dynamics, values, (samples,))
         cost = evaluate([lagrange], values, (samples,))[0]
         return dx, cost, np.sum(u**2, axis=0)
 
+    def record(k: int, x: np.ndarray, u: np.ndarray) -> None:
+        X[k], U[k] = x[:, :keep], np.broadcast_to(u, (len(controls), samples))[:, :keep]
+        values = values_at(t[k], x, u)
+        for rel in ocp.path:
+            g = evaluate([rel.expr], values, (samples,))[0]
+            np.maximum(violation, np.maximum(rel.lower - g, 0.0) + np.maximum(g - rel.upper, 0.0), out=violation)
+
+    x = x0
     for k in range(steps):
-        tk, x = t[k], X[k]
-        u1 = law(tk, x, k)
-        u2 = law(tk + h / 2, x, k)
-        u4 = law(tk + h, x, k)
-        U[k] = u1
+        tk = t[k]
+        u1, u2, u4 = law(tk, x, k), law(tk + h / 2, x, k), law(tk + h, x, k)
+        record(k, x, u1)
         k1, c1, e1 = rhs(tk, x, u1)
         k2, c2, e2 = rhs(tk + h / 2, x + h / 2 * k1, u2)
         k3, c3, e3 = rhs(tk + h / 2, x + h / 2 * k2, u2)
         k4, c4, e4 = rhs(tk + h, x + h * k3, u4)
-        X[k + 1] = x + h / 6 * (k1 + 2 * k2 + 2 * k3 + k4)
+        x = x + h / 6 * (k1 + 2 * k2 + 2 * k3 + k4)
         running += h / 6 * (c1 + 2 * c2 + 2 * c3 + c4)
         energy += h / 6 * (e1 + 2 * e2 + 2 * e3 + e4)
-    U[-1] = law(t[-1], X[-1], steps)
-    return Trajectories(t, X, U, ocp.sign * running, energy)
+    record(steps, x, law(t[-1], x, steps))
+    return Trajectories(t, X, U, x, ocp.sign * running, energy, violation)
 
 
-def end_values(ocp: SymbolicOcp, x: np.ndarray, tf: float, params: Values) -> dict[sp.Symbol, np.ndarray]:
-    """The end symbols ``<state>_0``, ``<state>_f``, ``t_f`` and the parameters, from trajectories."""
+def end_values(
+    ocp: SymbolicOcp, x0: np.ndarray, xf: np.ndarray, tf: float, params: Values
+) -> dict[sp.Symbol, np.ndarray | float]:
+    """The end symbols ``<state>_0``, ``<state>_f``, ``t_f`` and the parameters."""
     values: dict[sp.Symbol, np.ndarray | float] = dict(params)
-    values.update(zip(ocp.x0, x[0], strict=True))
-    values.update(zip(ocp.xf, x[-1], strict=True))
+    values.update(zip(ocp.x0, x0, strict=True))
+    values.update(zip(ocp.xf, xf, strict=True))
     values[symbol("t_f")] = tf
     return values
 
 
-def cost(ocp: SymbolicOcp, run: Trajectories, params: Values) -> np.ndarray:
+def cost(ocp: SymbolicOcp, x0: np.ndarray, run: Trajectories, params: Values) -> np.ndarray:
     """The file's objective (its own sense) of each sample: Mayer term plus the integrated Lagrange."""
-    values = end_values(ocp, run.x, float(run.t[-1]), params)
+    values = end_values(ocp, x0, run.final, float(run.t[-1]), params)
     mayer = evaluate([ocp.sign * ocp.mayer], values, run.running.shape)[0]
     return mayer + run.running
-
-
-def path_violation(ocp: SymbolicOcp, run: Trajectories, params: Values) -> np.ndarray:
-    """Largest violation of the path constraints (eq. 6.2b) over the grid, per sample (0 if none)."""
-    steps, _, samples = run.x.shape
-    worst = np.zeros(samples)
-    if not ocp.path:
-        return worst
-    values: dict[sp.Symbol, np.ndarray | float] = dict(params)
-    values.update(zip(ocp.x, np.moveaxis(run.x, 1, 0), strict=True))
-    values.update(zip(ocp.u, np.moveaxis(run.u, 1, 0), strict=True))
-    values[TIME] = run.t[:, None]
-    for rel in ocp.path:
-        g = np.broadcast_to(translate(rel.expr, values, NUMPY), (steps, samples))
-        excess = np.maximum(rel.lower - g, 0.0) + np.maximum(g - rel.upper, 0.0)
-        worst = np.maximum(worst, excess.max(axis=0))
-    return worst

@@ -177,7 +177,7 @@ def _weighted(
 
 def report(result: Result, spec: OptimalControlSpec, inverse: InverseData) -> Result:
     """The Result with the desensitization metrics and the Monte Carlo summary (pure: re-simulates only)."""
-    metrics = dict(result.metrics)
+    metrics, arrays = dict(result.metrics), dict(result.arrays)
     metrics["desensitization"] = {
         "method": inverse.augmentation.method,
         "original_states": inverse.original_states,
@@ -190,10 +190,13 @@ def report(result: Result, spec: OptimalControlSpec, inverse: InverseData) -> Re
         sign = SymbolicOcp(spec).sign
         metrics["nominal_objective"] = None if result.objective is None else result.objective - sign * sensitivity
         if inverse.options.monte_carlo.samples > 1:
-            metrics["monte_carlo"] = monte_carlo(
+            metrics["monte_carlo"], bundle = monte_carlo(
                 SymbolicOcp(spec), result, spec.problem.uncertain, inverse.options.monte_carlo
             )
-    return result.model_copy(update={"metrics": metrics, "kind": spec.kind, "problem": spec.name})
+            arrays |= bundle
+    return result.model_copy(
+        update={"metrics": metrics, "arrays": arrays, "kind": spec.kind, "problem": spec.name}
+    )
 
 
 def _penalty_value(spec: OptimalControlSpec, result: Result, penalty: Penalty) -> float:

@@ -14,6 +14,7 @@ import numpy as np
 from gamespec.desensitize.augment import initial_values
 from gamespec.desensitize.simulate import Trajectories, cost, evaluate, open_loop, rk4
 from gamespec.desensitize.tracking import linearization, riccati_gains
+from gamespec.montecarlo import Distribution, Normal, Uniform, proportion, sample, summarize
 from gamespec.ocp.symbolic import SymbolicOcp
 from gamespec.result import Result
 from gamespec.specs.desensitize import MonteCarloOptions
@@ -27,27 +28,17 @@ VIOLATION_TOL = 1e-6
 """A sample violates the path constraints when its largest violation exceeds this."""
 
 
-def draw(
-    uncertain: Mapping[str, UncertainParameter], nominal: Mapping[str, float], n: int, seed: int
-) -> dict[str, np.ndarray]:
-    """``n`` seeded draws of each uncertain parameter about its nominal value."""
-    rng = np.random.default_rng(seed)
-    out = {}
+def distributions(
+    uncertain: Mapping[str, UncertainParameter], nominal: Mapping[str, float]
+) -> dict[str, Distribution]:
+    """The Monte Carlo engine's distribution of each uncertain parameter about its nominal value."""
+    out: dict[str, Distribution] = {}
     for name, dist in uncertain.items():
         if dist.normal is not None:
-            out[name] = rng.normal(nominal[name], dist.normal.std, n)
+            out[name] = Normal(nominal[name], dist.normal.std)
         else:
-            out[name] = rng.uniform(*dist.uniform_bounds(nominal[name]), n)
+            out[name] = Uniform(*dist.uniform_bounds(nominal[name]))
     return out
-
-
-def summary(values: np.ndarray) -> dict[str, float]:
-    return {
-        "mean": float(values.mean()),
-        "std": float(values.std(ddof=1)) if values.size > 1 else 0.0,
-        "min": float(values.min()),
-        "max": float(values.max()),
-    }
 
 
 def initial_state(ocp: SymbolicOcp, result: Result, params: Mapping[Any, Any], samples: int) -> np.ndarray:
@@ -67,7 +58,7 @@ def monte_carlo(
     ``tracking_<state>``, (steps+1, samples) each, on ``monte_carlo_time``) for plots."""
     nominal = {k: float(v) for k, v in result.parameters.items()}
     n = options.samples
-    drawn = draw(uncertain, nominal, n, options.seed)
+    drawn = sample(distributions(uncertain, nominal), n, options.seed)
     params = {symbol(k): drawn.get(k, v) for k, v in nominal.items()}
     t0, tf = float(result.time[0]), float(result.t_final)
     x0 = initial_state(ocp, result, params, n)
@@ -77,7 +68,12 @@ def monte_carlo(
         return u_star(t)[:, None]
 
     run = rk4(ocp, x0, open_law, params, t0, tf, options.steps, keep=BUNDLE)
-    metrics = {"samples": n, "seed": options.seed, "parameters": {k: summary(v) for k, v in drawn.items()}}
+    spread = summarize(drawn)
+    metrics = {
+        "samples": n,
+        "seed": options.seed,
+        "parameters": {k: {"mean": v.mean, "std": v.std, "min": v.min, "max": v.max} for k, v in spread.items()},
+    }
     metrics.update(_outcome(ocp, x0, run, params))
     metrics["control_energy_mean"] = float(run.energy.mean())
     arrays = {"monte_carlo_time": run.t} | _bundle("monte_carlo", ocp, run)
@@ -92,18 +88,21 @@ def _bundle(prefix: str, ocp: SymbolicOcp, run: Trajectories) -> dict[str, np.nd
 
 
 def _outcome(ocp: SymbolicOcp, x0: np.ndarray, run: Trajectories, params: Mapping[Any, Any]) -> dict[str, Any]:
-    final = run.final
-    costs = cost(ocp, x0, run, params)
+    final = summarize(dict(zip(ocp.states, run.final, strict=True)))
+    costs = summarize({"cost": cost(ocp, x0, run, params)})["cost"]
     out = {
-        "final_state_mean": {s: float(final[i].mean()) for i, s in enumerate(ocp.states)},
-        "final_state_std": {s: float(final[i].std(ddof=1)) for i, s in enumerate(ocp.states)},
-        "cost_mean": float(costs.mean()),
-        "cost_std": float(costs.std(ddof=1)),
-        "cost_min": float(costs.min()),
-        "cost_max": float(costs.max()),
+        "final_state_mean": {s: v.mean for s, v in final.items()},
+        "final_state_std": {s: v.std for s, v in final.items()},
+        "cost_mean": costs.mean,
+        "cost_std": costs.std,
+        "cost_min": costs.min,
+        "cost_max": costs.max,
+        "cost_mean_ci": [costs.ci_low, costs.ci_high],
     }
     if ocp.path:
-        out["violation_probability"] = float(np.mean(run.violation > VIOLATION_TOL))
+        violated = proportion(run.violation > VIOLATION_TOL)
+        out["violation_probability"] = violated.estimate
+        out["violation_probability_ci"] = [violated.low, violated.high]
     return out
 
 
@@ -130,6 +129,6 @@ def _tracking(
 
     run = rk4(ocp, x0, law, params, t0, tf, options.steps, keep=BUNDLE)
     out = _outcome(ocp, x0, run, params)
-    out["control_energy_mean"] = float(run.energy.mean())
-    out["control_energy_std"] = float(run.energy.std(ddof=1))
+    energy = summarize({"energy": run.energy})["energy"]
+    out["control_energy_mean"], out["control_energy_std"] = energy.mean, energy.std
     return out, run

@@ -14,6 +14,7 @@ from dataclasses import dataclass
 
 import numpy as np
 import sympy as sp
+from scipy.interpolate import PchipInterpolator
 
 from gamespec.ocp.symbolic import SymbolicOcp
 from gamespec.result import Result
@@ -41,14 +42,14 @@ class Trajectories:
 
 
 def open_loop(result: Result, controls: list[str]) -> Callable[[float], np.ndarray]:
-    """The Result's control as a function of time (linear between its control points)."""
+    """The Result's control as a function of time: the piecewise-cubic Hermite interpolant of its
+    control points (shape-preserving, so it does not overshoot between them), its end pieces
+    continued to the ends of the horizon (Radau collocation has no control point at t0)."""
     tc = np.asarray(result.control_time if result.control_time is not None else result.time)
     table = np.array([np.asarray(result.controls[c], dtype=float) for c in controls]).reshape(len(controls), -1)
-
-    def u(t: float) -> np.ndarray:
-        return np.array([np.interp(t, tc, row) for row in table])
-
-    return u
+    if tc.size < 2:
+        return lambda t: table[:, 0]
+    return PchipInterpolator(tc, table, axis=1, extrapolate=True)
 
 
 def evaluate(exprs: list[sp.Expr], values: Values, shape: tuple[int, ...]) -> np.ndarray:

@@ -52,8 +52,13 @@ class Penalty:
 
 @dataclass(frozen=True)
 class InverseData:
+    """What :func:`report` needs: the augmentation, the added cost, and the same terms with unit
+    weights on the entries the file weights or fixes (the *sensitivity measure*, e.g. ∫S1² or
+    S1(t_f)², defined at α = 0 too)."""
+
     augmentation: Augmentation
     penalty: Penalty
+    measure: Penalty
     options: DesensitizeOptions
     original_states: int
     augmented_states: int
@@ -92,6 +97,11 @@ def desensitize(spec: OptimalControlSpec, options: DesensitizeOptions) -> tuple[
     running = _weighted(options.trajectory, aug.running, params, spec, "trajectory")
     final = _weighted(options.final, aug.final, params, spec, "final")
     penalty = Penalty(running, final)
+    measure = Penalty(
+        _weighted(_unit(options.trajectory, aug.running), aug.running, params, spec, "trajectory"),
+        _weighted(_unit(options.final, aug.final) or _unit(options.fixed or None, aug.final), aug.final, params,
+                  spec, "final"),
+    )
     data = spec.model_dump(exclude={"transforms"} & set(type(spec).model_fields))
     problem = data["problem"]
     taken = set(problem["states"]) | set(problem["parameters"]) | set(problem["controls"])
@@ -127,7 +137,7 @@ def desensitize(spec: OptimalControlSpec, options: DesensitizeOptions) -> tuple[
     problem["objective"]["mayer"] = _text(user_mayer + sign * final)
     new = OptimalControlSpec.model_validate(data)
     new.with_source(spec.source, spec.file_hash)
-    inverse = InverseData(aug, penalty, options, len(spec.problem.states), len(new.problem.states))
+    inverse = InverseData(aug, penalty, measure, options, len(spec.problem.states), len(new.problem.states))
     return new, inverse
 
 
@@ -156,6 +166,13 @@ def _parse(raw: float | str, params: dict[str, sp.Symbol], spec: SpecBase, where
         return sp.sympify(parse(raw, params))
     except ExpressionError as err:
         raise SpecError(str(err), field=f"{FIELD}.{where}", source=spec.source) from None
+
+
+def _unit(weights: Weights | None, entries: dict[str, sp.Expr]) -> dict[str, float] | None:
+    """Weight 1 on the entries ``weights`` names (all of them for a single weight)."""
+    if weights is None:
+        return None
+    return dict.fromkeys(weights if isinstance(weights, dict) else entries, 1.0)
 
 
 def _weighted(
@@ -187,6 +204,11 @@ def report(result: Result, spec: OptimalControlSpec, inverse: InverseData) -> Re
     if result.ok and result.time is not None:
         sensitivity = _penalty_value(spec, result, inverse.penalty)
         metrics["sensitivity_cost"] = sensitivity
+        metrics["sensitivity_measure"] = _penalty_value(spec, result, inverse.measure)
+        ends = _end_values(result)
+        metrics["final_sensitivity"] = {
+            k: float(evaluate([e], ends, ())[0]) for k, e in inverse.augmentation.final.items()
+        }
         sign = SymbolicOcp(spec).sign
         metrics["nominal_objective"] = None if result.objective is None else result.objective - sign * sensitivity
         if inverse.options.monte_carlo.samples > 1:
@@ -211,9 +233,14 @@ def _penalty_value(spec: OptimalControlSpec, result: Result, penalty: Penalty) -
     values.update({symbol(k): np.asarray(v) for k, v in result.controls.items()})
     values[TIME] = t[idx]
     running = evaluate([penalty.running], values, (len(idx),))[0]
-    ends: dict[sp.Symbol, Any] = {symbol(k): v for k, v in result.parameters.items()}
+    final = float(evaluate([penalty.final], _end_values(result), ())[0])
+    return float((t[-1] - t[0]) * q @ running) + final
+
+
+def _end_values(result: Result) -> dict[sp.Symbol, float]:
+    """The end symbols (``<state>_0``, ``<state>_f``, ``t_f``) and the parameters of a Result."""
+    ends: dict[sp.Symbol, float] = {symbol(k): v for k, v in result.parameters.items()}
     for k, v in result.states.items():
         ends[symbol(f"{k}_0")], ends[symbol(f"{k}_f")] = float(v[0]), float(v[-1])
     ends[symbol("t_f")] = float(result.t_final)
-    final = float(evaluate([penalty.final], ends, ())[0])
-    return float((t[-1] - t[0]) * q @ running) + final
+    return ends

@@ -69,5 +69,7 @@ def test_one_nominal_resimulation(benchmark, boat) -> None:
     x0 = np.zeros((2, 1))
     steps = MonteCarloOptions().steps
     benchmark.pedantic(
-        rk4, args=(ocp, x0, lambda t, x, k: u(t)[:, None], params, 0.0, float(result.t_final), steps), rounds=5
+        rk4,
+        args=(ocp, x0, lambda t, x, k: u(t)[:, None], params, 0.0, float(result.t_final), steps),
+        rounds=5,
     )

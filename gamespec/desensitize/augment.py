@@ -131,7 +131,7 @@ def costate_desensitization(ocp: SymbolicOcp, uncertain: list[str]) -> Augmentat
     lam = [symbol(f"lambda_{n}") for n in ocp.states]
     H = lagrange + sum((lv * fv for lv, fv in zip(lam, ocp.dynamics, strict=True)), sp.Integer(0))
     states = []
-    for name, xi, lv, xf in zip(ocp.states, ocp.x, lam, ocp.xf, strict=True):
+    for xi, lv, xf in zip(ocp.x, lam, ocp.xf, strict=True):
         states.append(NewState(str(lv), sp.expand(-sp.diff(H, xi)), None, sp.diff(mayer, xf)))
     running = {}
     for p, r in zip(uncertain, rho, strict=True):

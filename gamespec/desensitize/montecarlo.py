@@ -72,7 +72,9 @@ def monte_carlo(
     metrics = {
         "samples": n,
         "seed": options.seed,
-        "parameters": {k: {"mean": v.mean, "std": v.std, "min": v.min, "max": v.max} for k, v in spread.items()},
+        "parameters": {
+            k: {"mean": v.mean, "std": v.std, "min": v.min, "max": v.max} for k, v in spread.items()
+        },
     }
     metrics.update(_outcome(ocp, x0, run, params))
     metrics["control_energy_mean"] = float(run.energy.mean())
@@ -87,7 +89,9 @@ def _bundle(prefix: str, ocp: SymbolicOcp, run: Trajectories) -> dict[str, np.nd
     return {f"{prefix}_{s}": run.x[:, i, :] for i, s in enumerate(ocp.states)}
 
 
-def _outcome(ocp: SymbolicOcp, x0: np.ndarray, run: Trajectories, params: Mapping[Any, Any]) -> dict[str, Any]:
+def _outcome(
+    ocp: SymbolicOcp, x0: np.ndarray, run: Trajectories, params: Mapping[Any, Any]
+) -> dict[str, Any]:
     final = summarize(dict(zip(ocp.states, run.final, strict=True)))
     costs = summarize({"cost": cost(ocp, x0, run, params)})["cost"]
     out = {
@@ -119,7 +123,9 @@ def _tracking(
     t0, tf = float(result.time[0]), float(result.t_final)
     nominal_params = {symbol(k): v for k, v in nominal.items()}
     x0_nominal = initial_state(ocp, result, nominal_params, 1)
-    reference = rk4(ocp, x0_nominal, lambda t, x, k: u_star(t)[:, None], nominal_params, t0, tf, options.steps)
+    reference = rk4(
+        ocp, x0_nominal, lambda t, x, k: u_star(t)[:, None], nominal_params, t0, tf, options.steps
+    )
     A, B = linearization(ocp, reference, nominal_params)
     K = riccati_gains(reference.t, A, B)
     x_ref = reference.x[:, :, 0]

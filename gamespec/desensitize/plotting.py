@@ -37,13 +37,22 @@ def plot_desensitized(result: Result, output_dir: Path) -> list[Path]:
     if states:
         planar = states[:2] if len(states) >= 2 else None
         fig, ax = plt.subplots(figsize=(6.5, 4.5))
-        for prefix, color, label in (("monte_carlo", "0.6", "open loop"), ("tracking", "tab:green", "LQR tracking")):
+        for prefix, color, label in (
+            ("monte_carlo", "0.6", "open loop"),
+            ("tracking", "tab:green", "LQR tracking"),
+        ):
             if f"{prefix}_{states[0]}" not in result.arrays:
                 continue
-            xs = result.arrays[f"{prefix}_{planar[0]}"] if planar else result.arrays["monte_carlo_time"][:, None]
+            xs = (
+                result.arrays[f"{prefix}_{planar[0]}"]
+                if planar
+                else result.arrays["monte_carlo_time"][:, None]
+            )
             ys = result.arrays[f"{prefix}_{planar[1] if planar else states[0]}"]
             lines = ax.plot(xs if planar else xs.repeat(ys.shape[1], 1), ys, color=color, lw=0.6, alpha=0.5)
-            lines[0].set_label(f"{label} ({result.metrics['monte_carlo']['samples']} samples, first {ys.shape[1]})")
+            lines[0].set_label(
+                f"{label} ({result.metrics['monte_carlo']['samples']} samples, first {ys.shape[1]})"
+            )
         x_nominal = result.states[planar[0]] if planar else result.time
         ax.plot(x_nominal, result.states[planar[1] if planar else states[0]], "k-", lw=2, label="nominal")
         ax.set_xlabel(planar[0] if planar else "t")
@@ -94,8 +103,13 @@ def plot_tradeoff(folder: Path, output_dir: Path) -> list[Path]:
     fig, ax = plt.subplots(figsize=(6, 4.5))
     ax.plot(measure, cost, "o-")
     for r, x, y in zip(rows, measure, cost, strict=True):
-        ax.annotate(f"{name}={r.get(name, float('nan')):g}", (x, y), textcoords="offset points", xytext=(5, 5),
-                    fontsize=8)
+        ax.annotate(
+            f"{name}={r.get(name, float('nan')):g}",
+            (x, y),
+            textcoords="offset points",
+            xytext=(5, 5),
+            fontsize=8,
+        )
     ax.set_xlabel("sensitivity measure")
     ax.set_ylabel("original cost")
     ax.grid(alpha=0.3)

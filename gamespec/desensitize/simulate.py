@@ -46,7 +46,9 @@ def open_loop(result: Result, controls: list[str]) -> Callable[[float], np.ndarr
     control points (shape-preserving, so it does not overshoot between them), its end pieces
     continued to the ends of the horizon (Radau collocation has no control point at t0)."""
     tc = np.asarray(result.control_time if result.control_time is not None else result.time)
-    table = np.array([np.asarray(result.controls[c], dtype=float) for c in controls]).reshape(len(controls), -1)
+    table = np.array([np.asarray(result.controls[c], dtype=float) for c in controls]).reshape(
+        len(controls), -1
+    )
     if tc.size < 2:
         return lambda t: table[:, 0]
     return PchipInterpolator(tc, table, axis=1, extrapolate=True)
@@ -101,7 +103,9 @@ def rk4(
         values = values_at(t[k], x, u)
         for rel in ocp.path:
             g = evaluate([rel.expr], values, (samples,))[0]
-            np.maximum(violation, np.maximum(rel.lower - g, 0.0) + np.maximum(g - rel.upper, 0.0), out=violation)
+            np.maximum(
+                violation, np.maximum(rel.lower - g, 0.0) + np.maximum(g - rel.upper, 0.0), out=violation
+            )
 
     x = x0
     for k in range(steps):

@@ -83,7 +83,9 @@ class Desensitize(Transform):
         return report(result, spec, inverse_data)
 
 
-def desensitize(spec: OptimalControlSpec, options: DesensitizeOptions) -> tuple[OptimalControlSpec, InverseData]:
+def desensitize(
+    spec: OptimalControlSpec, options: DesensitizeOptions
+) -> tuple[OptimalControlSpec, InverseData]:
     """The augmented spec and what :func:`report` needs (pure)."""
     uncertain = list(spec.problem.uncertain)
     if not uncertain:
@@ -99,16 +101,22 @@ def desensitize(spec: OptimalControlSpec, options: DesensitizeOptions) -> tuple[
     penalty = Penalty(running, final)
     measure = Penalty(
         _weighted(_unit(options.trajectory, aug.running), aug.running, params, spec, "trajectory"),
-        _weighted(_unit(options.final, aug.final) or _unit(options.fixed or None, aug.final), aug.final, params,
-                  spec, "final"),
+        _weighted(
+            _unit(options.final, aug.final) or _unit(options.fixed or None, aug.final),
+            aug.final,
+            params,
+            spec,
+            "final",
+        ),
     )
     data = spec.model_dump(exclude={"transforms"} & set(type(spec).model_fields))
     problem = data["problem"]
     taken = set(problem["states"]) | set(problem["parameters"]) | set(problem["controls"])
     clash = sorted(taken & {s.name for s in aug.states})
     if clash:
-        raise SpecError(f"names needed by the {options.method} method are taken: {clash}", field=FIELD,
-                        source=spec.source)
+        raise SpecError(
+            f"names needed by the {options.method} method are taken: {clash}", field=FIELD, source=spec.source
+        )
     for name, expr in aug.dynamics.items():
         problem["dynamics"][name] = _text(expr)
     constraints = problem["boundary_constraints"]
@@ -157,8 +165,11 @@ def _check_terms(spec: OptimalControlSpec, options: DesensitizeOptions, aug: Aug
         )
     for key in options.fixed:
         if key not in aug.final:
-            raise SpecError(f"unknown entry {key!r} (entries: {', '.join(aug.final)})",
-                            field=f"{FIELD}.fixed.{key}", source=spec.source)
+            raise SpecError(
+                f"unknown entry {key!r} (entries: {', '.join(aug.final)})",
+                field=f"{FIELD}.fixed.{key}",
+                source=spec.source,
+            )
 
 
 def _parse(raw: float | str, params: dict[str, sp.Symbol], spec: SpecBase, where: str) -> sp.Expr:
@@ -176,7 +187,11 @@ def _unit(weights: Weights | None, entries: dict[str, sp.Expr]) -> dict[str, flo
 
 
 def _weighted(
-    weights: Weights | None, entries: dict[str, sp.Expr], params: dict[str, sp.Symbol], spec: SpecBase, term: str
+    weights: Weights | None,
+    entries: dict[str, sp.Expr],
+    params: dict[str, sp.Symbol],
+    spec: SpecBase,
+    term: str,
 ) -> sp.Expr:
     """``Σ w_e · e²`` over the entries (eq. 6.16/6.17 with a diagonal Q)."""
     if weights is None:
@@ -186,8 +201,11 @@ def _weighted(
     total = sp.Integer(0)
     for key, raw in weights.items():
         if key not in entries:
-            raise SpecError(f"unknown entry {key!r} (entries: {', '.join(entries)})",
-                            field=f"{FIELD}.{term}.{key}", source=spec.source)
+            raise SpecError(
+                f"unknown entry {key!r} (entries: {', '.join(entries)})",
+                field=f"{FIELD}.{term}.{key}",
+                source=spec.source,
+            )
         total += _parse(raw, params, spec, f"{term}.{key}") * entries[key] ** 2
     return total
 
@@ -210,7 +228,9 @@ def report(result: Result, spec: OptimalControlSpec, inverse: InverseData) -> Re
             k: float(evaluate([e], ends, ())[0]) for k, e in inverse.augmentation.final.items()
         }
         sign = SymbolicOcp(spec).sign
-        metrics["nominal_objective"] = None if result.objective is None else result.objective - sign * sensitivity
+        metrics["nominal_objective"] = (
+            None if result.objective is None else result.objective - sign * sensitivity
+        )
         if inverse.options.monte_carlo.samples > 1:
             metrics["monte_carlo"], bundle = monte_carlo(
                 SymbolicOcp(spec), result, spec.problem.uncertain, inverse.options.monte_carlo

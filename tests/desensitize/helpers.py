@@ -62,8 +62,12 @@ def file_solver(
 
 
 def resimulate(
-    spec: OptimalControlSpec, result: Result, params: Mapping[str, np.ndarray | float], steps: int = 2000,
-    t0: float | None = None, x0: np.ndarray | None = None,
+    spec: OptimalControlSpec,
+    result: Result,
+    params: Mapping[str, np.ndarray | float],
+    steps: int = 2000,
+    t0: float | None = None,
+    x0: np.ndarray | None = None,
 ) -> Trajectories:
     """The file's dynamics under the Result's control from ``t0`` (default: the start) and ``x0``
     (default: the Result's state there), for each value of the parameter arrays."""

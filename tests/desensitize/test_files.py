@@ -8,7 +8,15 @@ import pytest
 
 from tests.desensitize.helpers import NEW_FILES, file_solver
 
-SUMMARY_KEYS = {"samples", "final_state_mean", "final_state_std", "cost_mean", "cost_std", "cost_min", "cost_max"}
+SUMMARY_KEYS = {
+    "samples",
+    "final_state_mean",
+    "final_state_std",
+    "cost_mean",
+    "cost_std",
+    "cost_min",
+    "cost_max",
+}
 AGREEMENT = 1e-6
 """Both backends hand IPOPT (tolerance 1e-8) the same transcription; their optima agree far closer."""
 
@@ -23,7 +31,7 @@ def test_file_solves_alike_on_casadi_and_pyomo(path) -> None:
     assert pyomo.t_final == pytest.approx(casadi.t_final, rel=AGREEMENT)
     for result in results.values():
         metrics = result.metrics
-        assert SUMMARY_KEYS <= set(metrics["monte_carlo"])
+        assert set(metrics["monte_carlo"]) >= SUMMARY_KEYS
         assert metrics["monte_carlo"]["samples"] == 200
         assert metrics["nominal_objective"] + _sign(result) * metrics["sensitivity_cost"] == pytest.approx(
             result.objective, rel=1e-9, abs=1e-12

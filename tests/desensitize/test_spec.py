@@ -42,7 +42,11 @@ def test_bad_uncertain_section(uncertain, field, reason) -> None:
     ("edit", "field", "reason"),
     [
         ({"trajectory": {"S_x3_rho": 1.0}}, "transforms.desensitize.trajectory.S_x3_rho", "unknown entry"),
-        ({"trajectory": "alpha*beta"}, "transforms.desensitize.trajectory.S_x1_rho", "undefined symbol 'beta'"),
+        (
+            {"trajectory": "alpha*beta"},
+            "transforms.desensitize.trajectory.S_x1_rho",
+            "undefined symbol 'beta'",
+        ),
         ({"fixed": {"S_x9_rho": 0.0}}, "transforms.desensitize.fixed.S_x9_rho", "unknown entry"),
         ({"method": "costate", "final": 1.0}, "transforms.desensitize", "use trajectory"),
         ({"trajectory": None}, "transforms.desensitize", "at least one"),

@@ -39,7 +39,8 @@ def nominal_gap(spec, result) -> float:
     run = resimulate(spec, result, {})
     ocp = SymbolicOcp(spec)
     gaps = [
-        np.abs(at_nodes(run, result, i, 0) - result.states[s]).max() / max(np.abs(result.states[s]).max(), 1.0)
+        np.abs(at_nodes(run, result, i, 0) - result.states[s]).max()
+        / max(np.abs(result.states[s]).max(), 1.0)
         for i, s in enumerate(ocp.states)
     ]
     return max(gaps)
@@ -154,7 +155,9 @@ def test_cdoc_without_weight_is_the_riccati_lqr(path) -> None:
 def test_theorem_7_costates_are_gradients_of_the_cost_to_go(path) -> None:
     """For the solution's (fixed) control, λ(t) = ∂C/∂x (eq. 6.55) and μ(t) = ∂C/∂ρ (eq. 6.61b),
     with C the cost-to-go (eq. 6.54) from the state at t, by central differences of re-simulations."""
-    solver = file_solver(path, edit={**NO_MC, "method": "costate", "trajectory": "alpha"} if path == TRAJECTORY else NO_MC)
+    solver = file_solver(
+        path, edit={**NO_MC, "method": "costate", "trajectory": "alpha"} if path == TRAJECTORY else NO_MC
+    )
     result = solver.solve()
     _check_theorem_7(solver.spec, result)
 
@@ -206,7 +209,10 @@ def _check_theorem_7(spec, result) -> None:
         gradients = (c[0::2] - c[1::2]) / (2 * delta)
         scale = max(np.abs(gradients).max(), 1e-3)
         for name, fd in zip(names, gradients, strict=True):
-            assert result.states[name][k] == pytest.approx(fd, abs=GAP_FACTOR * gap * scale + 1e-6), (tk, name)
+            assert result.states[name][k] == pytest.approx(fd, abs=GAP_FACTOR * gap * scale + 1e-6), (
+                tk,
+                name,
+            )
 
 
 def test_trends_in_alpha_are_monotone() -> None:

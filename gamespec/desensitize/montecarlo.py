@@ -67,7 +67,8 @@ def monte_carlo(
     def open_law(t: float, x: np.ndarray, k: int) -> np.ndarray:
         return u_star(t)[:, None]
 
-    run = rk4(ocp, x0, open_law, params, t0, tf, options.steps, keep=BUNDLE)
+    signals = open_loop(result, ocp.inputs) if ocp.inputs else None
+    run = rk4(ocp, x0, open_law, params, t0, tf, options.steps, keep=BUNDLE, inputs=signals)
     spread = summarize(drawn)
     metrics = {
         "samples": n,
@@ -80,7 +81,7 @@ def monte_carlo(
     metrics["control_energy_mean"] = float(run.energy.mean())
     arrays = {"monte_carlo_time": run.t} | _bundle("monte_carlo", ocp, run)
     if options.tracking:
-        metrics["tracking"], closed = _tracking(ocp, result, params, nominal, u_star, options, x0)
+        metrics["tracking"], closed = _tracking(ocp, result, params, nominal, (u_star, signals), options, x0)
         arrays |= _bundle("tracking", ocp, closed)
     return metrics, arrays
 
@@ -115,7 +116,7 @@ def _tracking(
     result: Result,
     params: Mapping[Any, Any],
     nominal: Mapping[str, float],
-    u_star: Callable[[float], np.ndarray],
+    signals: tuple[Callable[[float], np.ndarray], Callable[[float], np.ndarray] | None],
     options: MonteCarloOptions,
     x0: np.ndarray,
 ) -> tuple[dict[str, Any], Trajectories]:
@@ -123,17 +124,25 @@ def _tracking(
     t0, tf = float(result.time[0]), float(result.t_final)
     nominal_params = {symbol(k): v for k, v in nominal.items()}
     x0_nominal = initial_state(ocp, result, nominal_params, 1)
+    u_star, inputs = signals
     reference = rk4(
-        ocp, x0_nominal, lambda t, x, k: u_star(t)[:, None], nominal_params, t0, tf, options.steps
+        ocp,
+        x0_nominal,
+        lambda t, x, k: u_star(t)[:, None],
+        nominal_params,
+        t0,
+        tf,
+        options.steps,
+        inputs=inputs,
     )
-    A, B = linearization(ocp, reference, nominal_params)
+    A, B = linearization(ocp, reference, nominal_params, inputs)
     K = riccati_gains(reference.t, A, B)
     x_ref = reference.x[:, :, 0]
 
     def law(t: float, x: np.ndarray, k: int) -> np.ndarray:
         return u_star(t)[:, None] - K[k] @ (x - x_ref[k][:, None])
 
-    run = rk4(ocp, x0, law, params, t0, tf, options.steps, keep=BUNDLE)
+    run = rk4(ocp, x0, law, params, t0, tf, options.steps, keep=BUNDLE, inputs=inputs)
     out = _outcome(ocp, x0, run, params)
     energy = summarize({"energy": run.energy})["energy"]
     out["control_energy_mean"], out["control_energy_std"] = energy.mean, energy.std

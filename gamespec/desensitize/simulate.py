@@ -68,9 +68,11 @@ def rk4(
     tf: float,
     steps: int,
     keep: int | None = None,
+    inputs: Callable[[float], np.ndarray] | None = None,
 ) -> Trajectories:
-    """Integrate the file's dynamics from ``x0`` (n, samples) under ``law``; keep the trajectories of
-    the first ``keep`` samples (all when None).
+    """Integrate the file's dynamics from ``x0`` (n, samples) under ``law`` (and the grid ``inputs``
+    as functions of time, when the problem has some); keep the trajectories of the first ``keep``
+    samples (all when None).
 
     The law is evaluated at the RK4 stage times with the state at the step's start, so an open-loop
     law is exact in time and a feedback law is held over one fine step (a zero-order hold).
@@ -89,6 +91,8 @@ def rk4(
         values = dict(params)
         values.update(zip(states, x, strict=True))
         values.update(zip(controls, u, strict=True))
+        if inputs is not None:
+            values.update(zip(ocp.w, inputs(tk), strict=True))
         values[TIME] = tk
         return values
 

@@ -8,6 +8,8 @@ gives the gain ``K = R⁻¹ Bᵀ P`` and the feedback ``Δu = -K Δx``.
 
 from __future__ import annotations
 
+from collections.abc import Callable
+
 import numpy as np
 import sympy as sp
 
@@ -19,12 +21,17 @@ CONTROL_WEIGHT = 2.0
 """R of eq. 6.27 written as ½ Δuᵀ R Δu (the integrand is Δu² without the ½)."""
 
 
-def linearization(ocp: SymbolicOcp, nominal: Trajectories, params: Values) -> tuple[np.ndarray, np.ndarray]:
-    """``A(t)`` (steps+1, n, n) and ``B(t)`` (steps+1, n, m) along the nominal (eq. 6.29)."""
+def linearization(
+    ocp: SymbolicOcp, nominal: Trajectories, params: Values, inputs: Callable[[np.ndarray], np.ndarray] | None
+) -> tuple[np.ndarray, np.ndarray]:
+    """``A(t)`` (steps+1, n, n) and ``B(t)`` (steps+1, n, m) along the nominal (eq. 6.29), with the
+    grid inputs as functions of time when the problem has some."""
     f = sp.Matrix(ocp.dynamics)
     values: dict[sp.Symbol, np.ndarray | float] = {k: v for k, v in params.items()}
     values.update(zip(ocp.x, nominal.x[:, :, 0].T, strict=True))
     values.update(zip(ocp.u, nominal.u[:, :, 0].T, strict=True))
+    if inputs is not None:
+        values.update(zip(ocp.w, inputs(nominal.t), strict=True))
     values[TIME] = nominal.t
     shape = nominal.t.shape
     n, m = len(ocp.x), len(ocp.u)

@@ -41,14 +41,14 @@ class Trajectories:
     violation: np.ndarray
 
 
-def open_loop(result: Result, controls: list[str]) -> Callable[[float], np.ndarray]:
-    """The Result's control as a function of time: the piecewise-cubic Hermite interpolant of its
-    control points (shape-preserving, so it does not overshoot between them), its end pieces
-    continued to the ends of the horizon (Radau collocation has no control point at t0)."""
+def open_loop(result: Result, names: list[str]) -> Callable[[float], np.ndarray]:
+    """The Result's controls (or grid inputs, ``arrays["input/<name>"]``) of these names as a function
+    of time: the piecewise-cubic Hermite interpolant of the control points (shape-preserving, so it
+    does not overshoot between them), its end pieces continued to the ends of the horizon (Radau
+    collocation has no control point at t0)."""
     tc = np.asarray(result.control_time if result.control_time is not None else result.time)
-    table = np.array([np.asarray(result.controls[c], dtype=float) for c in controls]).reshape(
-        len(controls), -1
-    )
+    rows = [result.controls[n] if n in result.controls else result.arrays[f"input/{n}"] for n in names]
+    table = np.array(rows, dtype=float).reshape(len(names), -1)
     if tc.size < 2:
         return lambda t: table[:, 0]
     return PchipInterpolator(tc, table, axis=1, extrapolate=True)

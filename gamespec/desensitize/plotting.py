@@ -10,6 +10,7 @@ import json
 from pathlib import Path
 from typing import Any
 
+from gamespec.errors import GamespecError
 from gamespec.result import Result
 
 SENSITIVITY_PREFIXES = ("S_", "mu_", "Phi_")
@@ -93,7 +94,7 @@ def plot_tradeoff(folder: Path, output_dir: Path) -> list[Path]:
     """Original cost against the sensitivity measure, one point per swept value (Fig. 6.3(b))."""
     rows = sweep_rows(folder)
     if not rows:
-        return []
+        raise GamespecError(f"{folder}: the sweep holds no solved desensitized points to plot")
     plt = _pyplot()
     swept = [k for k in rows[0] if k not in ("metrics",) and isinstance(rows[0][k], float)]
     name = next((k for k in swept if k not in _SUMMARY_KEYS), swept[0] if swept else "")

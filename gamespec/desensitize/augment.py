@@ -13,6 +13,8 @@ may penalize, as expressions over the running symbols (trajectory term) and over
   eq. 6.7 says. Eq. 6.7 needs ``Λ(t_f) Λ(t)^{-1}`` inside the running cost; that is the transition
   matrix ``Φ(t_f, t)``, which obeys ``Φ̇ = -Φ ∂f̃/∂x̃`` with ``Φ(t_f, t_f) = I`` — the same number of
   states without an inverse or a final value inside the integrand, so we integrate Φ backward.
+  (§6.3.1 reports 21 states for Zermelo, n = 2, ℓ = 1: that is 2(n+ℓ)² + n + ℓ, the count of
+  §6.5.1, i.e. Λ and Λ⁻¹ both propagated; the formula below eq. 6.7 and this method give 12.)
   Its ``x``-row, ``ρ``-column block at time t is the sensitivity of the final state to the parameter
   from t on; at t0 (with the initial-state term) it equals ``S(t_f)``. The ρ rows are constant
   (0 and 1) but they are states of the method as published, and kept so the counts compare.

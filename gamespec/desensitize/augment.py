@@ -33,6 +33,7 @@ from dataclasses import dataclass, field
 import sympy as sp
 
 from gamespec.ocp.symbolic import SymbolicOcp
+from gamespec.symbolic.calculus import jacobian
 from gamespec.symbolic.language import parse, symbol
 
 
@@ -81,7 +82,7 @@ def sensitivity_functions(ocp: SymbolicOcp, uncertain: list[str]) -> Augmentatio
     x, f = ocp.x, sp.Matrix(ocp.dynamics)
     rho = [symbol(p) for p in uncertain]
     S = sp.Matrix(len(x), len(rho), lambda i, j: symbol(sensitivity_name(ocp.states[i], uncertain[j])))
-    rhs = f.jacobian(x) * S + f.jacobian(rho)
+    rhs = jacobian(f, x) * S + jacobian(f, rho)
     x0 = initial_values(ocp)
     states, running, final = [], {}, {}
     for j, p in enumerate(rho):
@@ -105,7 +106,7 @@ def seywald_matrix(ocp: SymbolicOcp, uncertain: list[str]) -> Augmentation:
     names = [*ocp.states, *carriers]
     m = len(names)
     Phi = sp.Matrix(m, m, lambda r, c: symbol(f"Phi_{names[r]}_{names[c]}"))
-    rhs = -Phi * f_tilde.jacobian(x_tilde)
+    rhs = -Phi * jacobian(f_tilde, x_tilde)
     states = [NewState(c, sp.Integer(0), p, None) for c, p in zip(carriers, rho, strict=True)]
     for c in range(m):
         for r in range(m):

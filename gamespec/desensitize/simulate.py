@@ -3,7 +3,7 @@
 Classical RK4 on a uniform grid of ``steps`` steps over ``[t0, t_f]``, every sample in one NumPy
 array (samples along the last axis), the control interpolated linearly between the Result's control
 points, and the running cost integrated as one more state. The dynamics are the file's SymPy
-expressions evaluated by :func:`gamespec.symbolic.translate.translate` on arrays (no code is
+expressions evaluated on arrays by :func:`gamespec.symbolic.calculus.numeric_function` (no code is
 generated, no Python call per sample).
 """
 
@@ -18,8 +18,8 @@ from scipy.interpolate import PchipInterpolator
 
 from gamespec.ocp.symbolic import SymbolicOcp
 from gamespec.result import Result
+from gamespec.symbolic.calculus import numeric_function
 from gamespec.symbolic.language import TIME, symbol
-from gamespec.symbolic.translate import NUMPY, translate
 
 Values = Mapping[sp.Symbol, np.ndarray | float]
 ControlLaw = Callable[[float, np.ndarray, int], np.ndarray]
@@ -30,7 +30,8 @@ ControlLaw = Callable[[float, np.ndarray, int], np.ndarray]
 class Trajectories:
     """The grid ``t``; states ``x`` and controls ``u`` (steps+1, n or m, kept samples) of the first
     ``keep`` samples; per sample the final state ``final`` (n, samples), the integrated running cost
-    ``running``, the control energy ∫Σu² ``energy`` and the largest path-constraint violation."""
+    ``running`` (the file's Lagrange term, in its own sense), the control energy ∫Σu² ``energy``
+    and the largest path-constraint violation ``violation``."""
 
     t: np.ndarray
     x: np.ndarray
@@ -55,8 +56,9 @@ def open_loop(result: Result, names: list[str]) -> Callable[[float], np.ndarray]
 
 
 def evaluate(exprs: list[sp.Expr], values: Values, shape: tuple[int, ...]) -> np.ndarray:
-    """The expressions on arrays, stacked (len(exprs), *shape)."""
-    return np.array([np.broadcast_to(translate(e, values, NUMPY), shape) for e in exprs], dtype=float)
+    """The expressions with each symbol of ``values`` given its value, stacked (len(exprs), *shape)."""
+    function = numeric_function(exprs, list(values))
+    return np.broadcast_to(function(*values.values()), (len(exprs), *shape))
 
 
 def rk4(
@@ -77,39 +79,37 @@ def rk4(
     The law is evaluated at the RK4 stage times with the state at the step's start, so an open-loop
     law is exact in time and a feedback law is held over one fine step (a zero-order hold).
     """
-    states, controls = ocp.x, ocp.u
     samples = x0.shape[1]
     keep = samples if keep is None else min(keep, samples)
-    lagrange = ocp.sign * ocp.lagrange
+    n, m = len(ocp.x), len(ocp.u)
     h = (tf - t0) / steps
     t = t0 + h * np.arange(steps + 1)
-    X = np.empty((steps + 1, len(states), keep))
-    U = np.empty((steps + 1, len(controls), keep))
+    X = np.empty((steps + 1, n, keep))
+    U = np.empty((steps + 1, m, keep))
     running, energy, violation = np.zeros(samples), np.zeros(samples), np.zeros(samples)
+    args = [*ocp.p, *ocp.w, *ocp.x, *ocp.u, TIME]
+    flow = numeric_function([*ocp.dynamics, ocp.sign * ocp.lagrange], args)
+    path = numeric_function([rel.expr for rel in ocp.path], args)
+    lower = np.array([[rel.lower] for rel in ocp.path])
+    upper = np.array([[rel.upper] for rel in ocp.path])
+    fixed = [params[p] for p in ocp.p]
 
-    def values_at(tk: float, x: np.ndarray, u: np.ndarray) -> dict:
-        values = dict(params)
-        values.update(zip(states, x, strict=True))
-        values.update(zip(controls, u, strict=True))
-        if inputs is not None:
-            values.update(zip(ocp.w, inputs(tk), strict=True))
-        values[TIME] = tk
-        return values
+    def at(
+        function: Callable[..., np.ndarray], rows: int, tk: float, x: np.ndarray, u: np.ndarray
+    ) -> np.ndarray:
+        signals = [] if inputs is None else list(inputs(tk))
+        return np.broadcast_to(function(*fixed, *signals, *x, *u, tk), (rows, samples))
 
     def rhs(tk: float, x: np.ndarray, u: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        values = values_at(tk, x, u)
-        dx = evaluate(ocp.dynamics, values, (samples,))
-        cost = evaluate([lagrange], values, (samples,))[0]
-        return dx, cost, np.sum(u**2, axis=0)
+        values = at(flow, n + 1, tk, x, u)
+        return values[:n], values[n], np.sum(u**2, axis=0)
 
     def record(k: int, x: np.ndarray, u: np.ndarray) -> None:
-        X[k], U[k] = x[:, :keep], np.broadcast_to(u, (len(controls), samples))[:, :keep]
-        values = values_at(t[k], x, u)
-        for rel in ocp.path:
-            g = evaluate([rel.expr], values, (samples,))[0]
-            np.maximum(
-                violation, np.maximum(rel.lower - g, 0.0) + np.maximum(g - rel.upper, 0.0), out=violation
-            )
+        X[k], U[k] = x[:, :keep], np.broadcast_to(u, (m, samples))[:, :keep]
+        if ocp.path:
+            g = at(path, len(ocp.path), t[k], x, u)
+            excess = np.maximum(lower - g, 0.0) + np.maximum(g - upper, 0.0)
+            np.maximum(violation, excess.max(axis=0), out=violation)
 
     x = x0
     for k in range(steps):
@@ -124,7 +124,7 @@ def rk4(
         running += h / 6 * (c1 + 2 * c2 + 2 * c3 + c4)
         energy += h / 6 * (e1 + 2 * e2 + 2 * e3 + e4)
     record(steps, x, law(t[-1], x, steps))
-    return Trajectories(t, X, U, x, ocp.sign * running, energy, violation)
+    return Trajectories(t, X, U, x, running, energy, violation)
 
 
 def end_values(

@@ -11,10 +11,10 @@ from __future__ import annotations
 from collections.abc import Callable
 
 import numpy as np
-import sympy as sp
 
-from gamespec.desensitize.simulate import Trajectories, Values, evaluate
+from gamespec.desensitize.simulate import Trajectories, Values
 from gamespec.ocp.symbolic import SymbolicOcp
+from gamespec.symbolic.calculus import linearize
 from gamespec.symbolic.language import TIME
 
 CONTROL_WEIGHT = 2.0
@@ -24,20 +24,16 @@ CONTROL_WEIGHT = 2.0
 def linearization(
     ocp: SymbolicOcp, nominal: Trajectories, params: Values, inputs: Callable[[np.ndarray], np.ndarray] | None
 ) -> tuple[np.ndarray, np.ndarray]:
-    """``A(t)`` (steps+1, n, n) and ``B(t)`` (steps+1, n, m) along the nominal (eq. 6.29), with the
-    grid inputs as functions of time when the problem has some."""
-    f = sp.Matrix(ocp.dynamics)
-    values: dict[sp.Symbol, np.ndarray | float] = {k: v for k, v in params.items()}
-    values.update(zip(ocp.x, nominal.x[:, :, 0].T, strict=True))
-    values.update(zip(ocp.u, nominal.u[:, :, 0].T, strict=True))
+    """``A(t)`` (steps+1, n, n) and ``B(t)`` (steps+1, n, m) along the nominal (eq. 6.29); grid
+    inputs enter as further columns of the input matrix, dropped from ``B``."""
+    m = len(ocp.u)
+    controls = nominal.u[:, :, 0]
     if inputs is not None:
-        values.update(zip(ocp.w, inputs(nominal.t), strict=True))
-    values[TIME] = nominal.t
-    shape = nominal.t.shape
-    n, m = len(ocp.x), len(ocp.u)
-    A = evaluate(list(f.jacobian(ocp.x)), values, shape).reshape(n, n, -1)
-    B = evaluate(list(f.jacobian(ocp.u)), values, shape).reshape(n, m, -1)
-    return np.moveaxis(A, -1, 0), np.moveaxis(B, -1, 0)
+        controls = np.hstack([controls, np.asarray(inputs(nominal.t)).T])
+    A, B = linearize(
+        ocp.dynamics, ocp.x, [*ocp.u, *ocp.w], nominal.x[:, :, 0], controls, dict(params), (TIME, nominal.t)
+    )
+    return A, B[:, :, :m]
 
 
 def riccati_gains(t: np.ndarray, A: np.ndarray, B: np.ndarray) -> np.ndarray:

@@ -21,8 +21,7 @@ from typing import Literal
 
 from pydantic import Field
 
-from gamespec.specs.base import StrictModel
-from gamespec.specs.ocp import Value
+from gamespec.specs.base import StrictModel, Value
 
 Weights = Value | dict[str, Value]
 """One weight for every entry, or weights by entry name (a diagonal Q)."""

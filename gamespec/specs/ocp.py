@@ -13,16 +13,13 @@ from collections.abc import Callable, Mapping
 from dataclasses import dataclass
 from typing import Literal
 
-from pydantic import Field, FiniteFloat, field_validator, model_validator
+from pydantic import Field, field_validator, model_validator
 
 from gamespec.errors import ExpressionError, SpecError
-from gamespec.specs.base import SpecBase, StrictModel
+from gamespec.specs.base import Number, SpecBase, StrictModel, Value
 from gamespec.specs.uncertainty import UncertainParameter
 from gamespec.symbolic.language import RESERVED, parse, parse_relation, symbol
 from gamespec.symbolic.translate import numeric
-
-Value = FiniteFloat | str
-"""A finite number, or an expression over the problem's parameters."""
 
 INF = math.inf
 NORMALIZED_TIME = "tau"
@@ -65,10 +62,10 @@ class ObjectiveSpec(StrictModel):
 class TimeSpec(StrictModel):
     """Initial time, and the final time: a value, or ``free`` within ``bounds`` from ``guess``."""
 
-    initial: FiniteFloat = 0.0
+    initial: Number = 0.0
     final: Value | Literal["free"] = 1.0
-    bounds: tuple[FiniteFloat, FiniteFloat] | None = None
-    guess: FiniteFloat | None = None
+    bounds: tuple[Number, Number] | None = None
+    guess: Number | None = None
 
     @model_validator(mode="after")
     def _free_needs_bounds(self) -> TimeSpec:
@@ -90,7 +87,7 @@ class TimeSpec(StrictModel):
 class OcpProblem(StrictModel):
     """The mathematics of an optimal-control problem."""
 
-    parameters: dict[str, FiniteFloat] = Field(default_factory=dict)
+    parameters: dict[str, Number] = Field(default_factory=dict)
     states: dict[str, StateSpec]
     controls: dict[str, ControlSpec] = Field(default_factory=dict)
     inputs: dict[str, InputSpec] = Field(default_factory=dict)
@@ -265,7 +262,7 @@ class MethodSpec(StrictModel):
     scheme: Literal["radau", "trapezoidal"] = "radau"
     intervals: int = Field(40, ge=1, le=100_000)
     degree: int = Field(3, ge=1, le=12)
-    grading: FiniteFloat = Field(1.0, gt=0, le=1e4)
+    grading: Number = Field(1.0, gt=0, le=1e4)
 
 
 class GuessSpec(StrictModel):
@@ -275,7 +272,7 @@ class GuessSpec(StrictModel):
 
     states: dict[str, Value] = Field(default_factory=dict)
     controls: dict[str, Value] = Field(default_factory=dict)
-    t_final: FiniteFloat | None = None
+    t_final: Number | None = None
     result: str | None = None
 
 

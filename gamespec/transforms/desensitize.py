@@ -32,14 +32,10 @@ from gamespec.specs.base import SpecBase
 from gamespec.specs.desensitize import DesensitizeOptions, Weights
 from gamespec.specs.ocp import OptimalControlSpec
 from gamespec.symbolic.language import TIME, parse, symbol
+from gamespec.symbolic.printer import to_text
 from gamespec.transforms.base import Transform
 
 FIELD = "transforms.desensitize"
-
-
-def _text(expr: sp.Expr) -> str:
-    """The one place generated expressions are printed back to the file language."""
-    return sp.sstr(expr)
 
 
 @dataclass(frozen=True)
@@ -118,31 +114,31 @@ def desensitize(
             f"names needed by the {options.method} method are taken: {clash}", field=FIELD, source=spec.source
         )
     for name, expr in aug.dynamics.items():
-        problem["dynamics"][name] = _text(expr)
+        problem["dynamics"][name] = to_text(expr)
     constraints = problem["boundary_constraints"]
     for state in aug.states:
         entry: dict[str, Any] = {}
         if state.initial is not None:
-            entry["initial"] = _text(state.initial)
+            entry["initial"] = to_text(state.initial)
         if state.final is not None:
             if state.final.free_symbols <= set(params.values()):
-                entry["final"] = _text(state.final)
+                entry["final"] = to_text(state.final)
             else:
                 constraints.append(_equation(symbol(f"{state.name}_f") - state.final))
         problem["states"][state.name] = entry
-        problem["dynamics"][state.name] = _text(state.rhs)
+        problem["dynamics"][state.name] = to_text(state.rhs)
     for key, raw in options.fixed.items():
         value = _parse(raw, params, spec, f"fixed.{key}")
         end = aug.final[key]
         owner = str(end)[:-2]
         if end.is_Symbol and owner in problem["states"]:
-            problem["states"][owner]["final" if str(end).endswith("_f") else "initial"] = _text(value)
+            problem["states"][owner]["final" if str(end).endswith("_f") else "initial"] = to_text(value)
         else:
             constraints.append(_equation(end - value))
     sign = ocp.sign
     user_lagrange, user_mayer = sign * ocp.lagrange, sign * ocp.mayer
-    problem["objective"]["lagrange"] = _text(user_lagrange + sign * running)
-    problem["objective"]["mayer"] = _text(user_mayer + sign * final)
+    problem["objective"]["lagrange"] = to_text(user_lagrange + sign * running)
+    problem["objective"]["mayer"] = to_text(user_mayer + sign * final)
     new = OptimalControlSpec.model_validate(data)
     new.with_source(spec.source, spec.file_hash)
     inverse = InverseData(aug, penalty, measure, options, len(spec.problem.states), len(new.problem.states))
@@ -151,7 +147,7 @@ def desensitize(
 
 def _equation(residual: sp.Expr) -> str:
     """A boundary constraint ``residual == 0`` in the file language."""
-    return _text(sp.Eq(residual, 0, evaluate=False)).replace("Eq(", "(").replace(", 0)", ") == 0")
+    return to_text(sp.Eq(residual, 0, evaluate=False))
 
 
 def _check_terms(spec: OptimalControlSpec, options: DesensitizeOptions, aug: Augmentation) -> None:

@@ -70,6 +70,6 @@ def test_one_nominal_resimulation(benchmark, boat) -> None:
     steps = MonteCarloOptions().steps
     benchmark.pedantic(
         rk4,
-        args=(ocp, x0, lambda t, x, k: u(t)[:, None], params, 0.0, float(result.t_final), steps),
+        args=(ocp, x0, u, params, 0.0, float(result.t_final), steps),
         rounds=5,
     )

@@ -6,13 +6,13 @@ violations. It only re-simulates; it never solves.
 
 from __future__ import annotations
 
-from collections.abc import Callable, Mapping
+from collections.abc import Mapping
 from typing import Any
 
 import numpy as np
 
 from gamespec.desensitize.augment import initial_values
-from gamespec.desensitize.simulate import Trajectories, cost, evaluate, open_loop, rk4
+from gamespec.desensitize.simulate import Signal, Trajectories, cost, evaluate, open_loop, rk4
 from gamespec.desensitize.tracking import linearization, riccati_gains
 from gamespec.montecarlo import Distribution, Normal, Uniform, proportion, sample, summarize
 from gamespec.ocp.symbolic import SymbolicOcp
@@ -63,12 +63,8 @@ def monte_carlo(
     t0, tf = float(result.time[0]), float(result.t_final)
     x0 = initial_state(ocp, result, params, n)
     u_star = open_loop(result, ocp.controls)
-
-    def open_law(t: float, x: np.ndarray, k: int) -> np.ndarray:
-        return u_star(t)[:, None]
-
     signals = open_loop(result, ocp.inputs) if ocp.inputs else None
-    run = rk4(ocp, x0, open_law, params, t0, tf, options.steps, keep=BUNDLE, inputs=signals)
+    run = rk4(ocp, x0, u_star, params, t0, tf, options.steps, keep=BUNDLE, inputs=signals)
     spread = summarize(drawn)
     metrics = {
         "samples": n,
@@ -116,7 +112,7 @@ def _tracking(
     result: Result,
     params: Mapping[Any, Any],
     nominal: Mapping[str, float],
-    signals: tuple[Callable[[float], np.ndarray], Callable[[float], np.ndarray] | None],
+    signals: tuple[Signal, Signal | None],
     options: MonteCarloOptions,
     x0: np.ndarray,
 ) -> tuple[dict[str, Any], Trajectories]:
@@ -125,24 +121,15 @@ def _tracking(
     nominal_params = {symbol(k): v for k, v in nominal.items()}
     x0_nominal = initial_state(ocp, result, nominal_params, 1)
     u_star, inputs = signals
-    reference = rk4(
-        ocp,
-        x0_nominal,
-        lambda t, x, k: u_star(t)[:, None],
-        nominal_params,
-        t0,
-        tf,
-        options.steps,
-        inputs=inputs,
-    )
+    reference = rk4(ocp, x0_nominal, u_star, nominal_params, t0, tf, options.steps, inputs=inputs)
     A, B = linearization(ocp, reference, nominal_params, inputs)
     K = riccati_gains(reference.t, A, B)
     x_ref = reference.x[:, :, 0]
 
-    def law(t: float, x: np.ndarray, k: int) -> np.ndarray:
-        return u_star(t)[:, None] - K[k] @ (x - x_ref[k][:, None])
+    def law(k: int, x: np.ndarray) -> np.ndarray:
+        return -K[k] @ (x - x_ref[k][:, None])
 
-    run = rk4(ocp, x0, law, params, t0, tf, options.steps, keep=BUNDLE, inputs=inputs)
+    run = rk4(ocp, x0, u_star, params, t0, tf, options.steps, keep=BUNDLE, inputs=inputs, feedback=law)
     out = _outcome(ocp, x0, run, params)
     energy = summarize({"energy": run.energy})["energy"]
     out["control_energy_mean"], out["control_energy_std"] = energy.mean, energy.std

@@ -22,8 +22,10 @@ from gamespec.symbolic.calculus import numeric_function
 from gamespec.symbolic.language import TIME, symbol
 
 Values = Mapping[sp.Symbol, np.ndarray | float]
-ControlLaw = Callable[[float, np.ndarray, int], np.ndarray]
-"""``(t, x (n, samples), step) -> u (m, samples)``: the control applied at time t."""
+Signal = Callable[[np.ndarray], np.ndarray]
+"""Times ``(k,)`` → values ``(rows, k)``: an open-loop control or a grid input."""
+Feedback = Callable[[int, np.ndarray], np.ndarray]
+"""``(step, x (n, samples)) -> Δu (m, samples)``: a correction added to the open-loop control."""
 
 
 @dataclass(frozen=True)
@@ -42,7 +44,7 @@ class Trajectories:
     violation: np.ndarray
 
 
-def open_loop(result: Result, names: list[str]) -> Callable[[float], np.ndarray]:
+def open_loop(result: Result, names: list[str]) -> Signal:
     """The Result's controls (or grid inputs, ``arrays["input/<name>"]``) of these names as a function
     of time: the piecewise-cubic Hermite interpolant of the control points (shape-preserving, so it
     does not overshoot between them), its end pieces continued to the ends of the horizon (Radau
@@ -51,7 +53,7 @@ def open_loop(result: Result, names: list[str]) -> Callable[[float], np.ndarray]
     rows = [result.controls[n] if n in result.controls else result.arrays[f"input/{n}"] for n in names]
     table = np.array(rows, dtype=float).reshape(len(names), -1)
     if tc.size < 2:
-        return lambda t: table[:, 0]
+        return lambda t: np.repeat(table, np.size(t), axis=1)
     return PchipInterpolator(tc, table, axis=1, extrapolate=True)
 
 
@@ -64,26 +66,30 @@ def evaluate(exprs: list[sp.Expr], values: Values, shape: tuple[int, ...]) -> np
 def rk4(
     ocp: SymbolicOcp,
     x0: np.ndarray,
-    law: ControlLaw,
+    controls: Signal,
     params: Values,
     t0: float,
     tf: float,
     steps: int,
     keep: int | None = None,
-    inputs: Callable[[float], np.ndarray] | None = None,
+    inputs: Signal | None = None,
+    feedback: Feedback | None = None,
 ) -> Trajectories:
-    """Integrate the file's dynamics from ``x0`` (n, samples) under ``law`` (and the grid ``inputs``
-    as functions of time, when the problem has some); keep the trajectories of the first ``keep``
-    samples (all when None).
+    """Integrate the file's dynamics from ``x0`` (n, samples) under the open-loop ``controls`` (plus
+    ``feedback``, when given) and the grid ``inputs`` (when the problem has some); keep the
+    trajectories of the first ``keep`` samples (all when None).
 
-    The law is evaluated at the RK4 stage times with the state at the step's start, so an open-loop
-    law is exact in time and a feedback law is held over one fine step (a zero-order hold).
+    The open-loop signals are tabulated once at the RK4 stage times (every half step); the feedback
+    sees the state at the start of each step and is held over it (a zero-order hold).
     """
     samples = x0.shape[1]
     keep = samples if keep is None else min(keep, samples)
     n, m = len(ocp.x), len(ocp.u)
     h = (tf - t0) / steps
     t = t0 + h * np.arange(steps + 1)
+    stages = t0 + h / 2 * np.arange(2 * steps + 1)
+    u_open = np.asarray(controls(stages), dtype=float).reshape(m, -1)
+    w_open = np.asarray(inputs(stages), dtype=float).reshape(len(ocp.w), -1) if inputs else np.empty((0, 0))
     X = np.empty((steps + 1, n, keep))
     U = np.empty((steps + 1, m, keep))
     running, energy, violation = np.zeros(samples), np.zeros(samples), np.zeros(samples)
@@ -95,35 +101,42 @@ def rk4(
     fixed = [params[p] for p in ocp.p]
 
     def at(
-        function: Callable[..., np.ndarray], rows: int, tk: float, x: np.ndarray, u: np.ndarray
+        function: Callable[..., np.ndarray], rows: int, j: int, x: np.ndarray, u: np.ndarray
     ) -> np.ndarray:
-        signals = [] if inputs is None else list(inputs(tk))
-        return np.broadcast_to(function(*fixed, *signals, *x, *u, tk), (rows, samples))
+        signals = list(w_open[:, j]) if inputs else []
+        return np.broadcast_to(function(*fixed, *signals, *x, *u, stages[j]), (rows, samples))
 
-    def rhs(tk: float, x: np.ndarray, u: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        values = at(flow, n + 1, tk, x, u)
+    def rhs(j: int, x: np.ndarray, u: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        values = at(flow, n + 1, j, x, u)
         return values[:n], values[n], np.sum(u**2, axis=0)
+
+    def control(j: int, correction: np.ndarray) -> np.ndarray:
+        return u_open[:, j, None] + correction
 
     def record(k: int, x: np.ndarray, u: np.ndarray) -> None:
         X[k], U[k] = x[:, :keep], np.broadcast_to(u, (m, samples))[:, :keep]
         if ocp.path:
-            g = at(path, len(ocp.path), t[k], x, u)
+            g = at(path, len(ocp.path), 2 * k, x, u)
             excess = np.maximum(lower - g, 0.0) + np.maximum(g - upper, 0.0)
             np.maximum(violation, excess.max(axis=0), out=violation)
 
     x = x0
     for k in range(steps):
-        tk = t[k]
-        u1, u2, u4 = law(tk, x, k), law(tk + h / 2, x, k), law(tk + h, x, k)
+        correction = np.zeros((m, 1)) if feedback is None else feedback(k, x)
+        u1, u2, u4 = (
+            control(2 * k, correction),
+            control(2 * k + 1, correction),
+            control(2 * k + 2, correction),
+        )
         record(k, x, u1)
-        k1, c1, e1 = rhs(tk, x, u1)
-        k2, c2, e2 = rhs(tk + h / 2, x + h / 2 * k1, u2)
-        k3, c3, e3 = rhs(tk + h / 2, x + h / 2 * k2, u2)
-        k4, c4, e4 = rhs(tk + h, x + h * k3, u4)
+        k1, c1, e1 = rhs(2 * k, x, u1)
+        k2, c2, e2 = rhs(2 * k + 1, x + h / 2 * k1, u2)
+        k3, c3, e3 = rhs(2 * k + 1, x + h / 2 * k2, u2)
+        k4, c4, e4 = rhs(2 * k + 2, x + h * k3, u4)
         x = x + h / 6 * (k1 + 2 * k2 + 2 * k3 + k4)
         running += h / 6 * (c1 + 2 * c2 + 2 * c3 + c4)
         energy += h / 6 * (e1 + 2 * e2 + 2 * e3 + e4)
-    record(steps, x, law(t[-1], x, steps))
+    record(steps, x, control(2 * steps, np.zeros((m, 1)) if feedback is None else feedback(steps, x)))
     return Trajectories(t, X, U, x, running, energy, violation)
 
 

@@ -78,4 +78,4 @@ def resimulate(
     if x0 is None:
         x0 = np.array([[np.interp(start, result.time, result.states[s])] * samples for s in ocp.states])
     u = open_loop(result, ocp.controls)
-    return rk4(ocp, x0, lambda t, x, k: u(t)[:, None], values, start, float(result.t_final), steps)
+    return rk4(ocp, x0, u, values, start, float(result.t_final), steps)

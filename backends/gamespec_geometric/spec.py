@@ -155,6 +155,11 @@ class PursuitScenarioSpec(SpecBase):
 
     default_backend: ClassVar[str] = "geometric"
 
+    def runtime_parameters(self) -> dict[str, float]:
+        """The simulation's capture radius, time step and horizon (what a compiled scenario re-runs
+        with)."""
+        return {"capture_radius": self.capture_radius, "time_step": self.time_step, "horizon": self.horizon}
+
     @model_validator(mode="after")
     def _consistent(self) -> PursuitScenarioSpec:
         for team, field in ((self.pursuers, "pursuers"), (self.evaders, "evaders")):

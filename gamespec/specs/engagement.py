@@ -64,6 +64,16 @@ class EngagementSpec(SpecBase):
     )
 
     default_backend = "casadi"
+    guess_fields = ("guess_heading",)
+
+    def runtime_parameters(self) -> dict[str, float]:
+        """Positions, speeds and the capture radius, by dotted path (``pursuers.1.speed``)."""
+        values = {"capture_radius": self.capture_radius, "evader.speed": self.evader.speed}
+        players = [("evader", self.evader), *((f"pursuers.{i}", p) for i, p in enumerate(self.pursuers))]
+        for path, player in players:
+            values |= {f"{path}.position.{k}": float(x) for k, x in enumerate(player.position)}
+            values[f"{path}.speed"] = player.speed
+        return values
 
     @property
     def objective_sense(self) -> str:

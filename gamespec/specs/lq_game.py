@@ -24,7 +24,7 @@ from pydantic import Discriminator, Field, Tag, field_validator, model_validator
 
 from gamespec.errors import ExpressionError, SpecError
 from gamespec.lqgame.game import LQGame, zero_order_hold
-from gamespec.specs.base import Number, SpecBase, StrictModel, Value
+from gamespec.specs.base import Number, ProblemParameters, SpecBase, StrictModel, Value
 from gamespec.symbolic.language import RESERVED, parse, symbol
 
 
@@ -175,7 +175,7 @@ class LQMethodSpec(StrictModel):
     monte_carlo: MonteCarloSpec = Field(default_factory=MonteCarloSpec)
 
 
-class LQGameSpec(SpecBase):
+class LQGameSpec(ProblemParameters, SpecBase):
     """An LQ stochastic game with one-sided terminal mean/covariance constraints (chapter 4)."""
 
     kind: Literal["lq_stochastic_game"] = "lq_stochastic_game"

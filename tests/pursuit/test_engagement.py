@@ -8,9 +8,9 @@ import pytest
 import sympy as sp
 
 import gamespec
+from gamespec.pursuit.ocp_generation import to_ocp
 from gamespec.specs.ocp import OptimalControlSpec
 from gamespec.symbolic.language import parse, parse_relation, symbol
-from gamespec.transforms.engagement import to_ocp
 from tests.conftest import PROBLEMS
 
 FILES = [

@@ -9,13 +9,12 @@ import numpy as np
 import yaml
 
 from gamespec.desensitize.simulate import Trajectories, open_loop, rk4
+from gamespec.loader import spec_from_dict
 from gamespec.ocp.symbolic import SymbolicOcp
 from gamespec.result import Result
 from gamespec.solving import compile_spec
-from gamespec.specs.desensitize import DesensitizeOptions
 from gamespec.specs.ocp import OptimalControlSpec
 from gamespec.symbolic.language import symbol
-from gamespec.transforms.desensitize import Desensitize
 from tests.conftest import PROBLEMS
 
 CH6 = PROBLEMS / "ch6"
@@ -28,21 +27,18 @@ NEW_FILES = [TRAJECTORY, FINAL, FIXED, SEYWALD, *LQR_FILES]
 
 
 class FileSolver:
-    """A desensitized problem (``data`` without its ``transforms``, and the ``desensitize`` request)
-    compiled once on one backend, re-solved for new parameter values."""
+    """A desensitized problem (``data`` without its ``transforms`` section, plus the ``desensitize``
+    request) compiled once through the solving chain on one backend, re-solved for new parameters."""
 
     def __init__(self, data: Mapping, request: Mapping, backend: str = "casadi") -> None:
         self.request = dict(request)
-        self.spec = OptimalControlSpec.model_validate(data)
-        self.transform = Desensitize()
-        self.target, self.inverse = self.transform.apply(
-            self.spec, DesensitizeOptions.model_validate(self.request)
-        )
-        self.compiled = compile_spec(self.target, backend)
+        full = {**data, "transforms": [{"desensitize": self.request}]}
+        self.solver = compile_spec(spec_from_dict(full), backend)
+        self.spec = OptimalControlSpec.model_validate({**data, "transforms": []})
+        self.target = self.solver.target_spec
 
     def solve(self, parameters: Mapping[str, float] | None = None) -> Result:
-        result = self.compiled.solve(parameters=dict(parameters or {}))
-        return self.transform.invert(result, self.spec, self.inverse)
+        return self.solver.solve(parameters=dict(parameters or {}))
 
 
 def file_solver(

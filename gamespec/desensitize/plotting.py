@@ -96,8 +96,7 @@ def plot_tradeoff(folder: Path, output_dir: Path) -> list[Path]:
     if not rows:
         raise GamespecError(f"{folder}: the sweep holds no solved desensitized points to plot")
     plt = _pyplot()
-    swept = [k for k in rows[0] if k not in ("metrics",) and isinstance(rows[0][k], float)]
-    name = next((k for k in swept if k not in _SUMMARY_KEYS), swept[0] if swept else "")
+    name = next(iter(rows[0]))  # a sweep row starts with its parameter values
     rows.sort(key=lambda r: r.get(name, 0.0))
     cost = [r["metrics"]["nominal_objective"] for r in rows]
     measure = [r["metrics"]["sensitivity_measure"] for r in rows]
@@ -121,6 +120,3 @@ def plot_tradeoff(folder: Path, output_dir: Path) -> list[Path]:
     fig.savefig(path, dpi=120)
     plt.close(fig)
     return [path]
-
-
-_SUMMARY_KEYS = frozenset({"objective", "t_final", "solve_time_s", "build_time_s"})

@@ -19,7 +19,7 @@ from __future__ import annotations
 
 from typing import Literal
 
-from pydantic import Field
+from pydantic import Field, field_validator
 
 from gamespec.specs.base import StrictModel, Value
 
@@ -30,10 +30,17 @@ Weights = Value | dict[str, Value]
 class MonteCarloOptions(StrictModel):
     """Re-simulation of the solution's open-loop control under sampled uncertain parameters."""
 
-    samples: int = Field(1000, ge=0, le=1_000_000, description="Number of samples; 0 switches it off.")
+    samples: int = Field(1000, ge=0, le=1_000_000, description="Number of samples (0: off; else at least 2).")
     seed: int = Field(0, ge=0, description="Seed of the sampler: the same seed gives the same samples.")
     steps: int = Field(500, ge=10, le=100_000, description="RK4 steps over the horizon.")
     tracking: bool = Field(False, description="Also run the LQR-tracking closed loop (eqs. 6.27-6.29).")
+
+    @field_validator("samples")
+    @classmethod
+    def _not_one(cls, v: int) -> int:
+        if v == 1:
+            raise ValueError("one sample has no spread: use 0 (off) or at least 2")
+        return v
 
 
 class DesensitizeOptions(StrictModel):

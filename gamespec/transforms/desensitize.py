@@ -25,8 +25,8 @@ from gamespec.desensitize.augment import METHODS, Augmentation
 from gamespec.desensitize.montecarlo import monte_carlo
 from gamespec.desensitize.simulate import evaluate
 from gamespec.errors import ExpressionError, SpecError
-from gamespec.ocp.collocation import Grid
 from gamespec.ocp.symbolic import SymbolicOcp
+from gamespec.ocp.transcription import Transcription
 from gamespec.result import Result
 from gamespec.specs.base import SpecBase
 from gamespec.specs.desensitize import DesensitizeOptions, Weights
@@ -127,12 +127,17 @@ def desensitize(
                 constraints.append(_equation(symbol(f"{state.name}_f") - state.final))
         problem["states"][state.name] = entry
         problem["dynamics"][state.name] = to_text(state.rhs)
+    end_of = {
+        symbol(f"{s}_{e}"): (s, key)
+        for s in problem["states"]
+        for e, key in (("0", "initial"), ("f", "final"))
+    }
     for key, raw in options.fixed.items():
         value = _parse(raw, params, spec, f"fixed.{key}")
         end = aug.final[key]
-        owner = str(end)[:-2]
-        if end.is_Symbol and owner in problem["states"]:
-            problem["states"][owner]["final" if str(end).endswith("_f") else "initial"] = to_text(value)
+        if end in end_of:
+            state, which = end_of[end]
+            problem["states"][state][which] = to_text(value)
         else:
             constraints.append(_equation(end - value))
     sign = ocp.sign
@@ -216,6 +221,7 @@ def report(result: Result, spec: OptimalControlSpec, inverse: InverseData) -> Re
         "formula_states": inverse.augmentation.formula_states,
     }
     if result.ok and result.time is not None:
+        ocp = SymbolicOcp(spec)
         sensitivity = _penalty_value(spec, result, inverse.penalty)
         metrics["sensitivity_cost"] = sensitivity
         metrics["sensitivity_measure"] = _penalty_value(spec, result, inverse.measure)
@@ -223,13 +229,12 @@ def report(result: Result, spec: OptimalControlSpec, inverse: InverseData) -> Re
         metrics["final_sensitivity"] = {
             k: float(evaluate([e], ends, ())[0]) for k, e in inverse.augmentation.final.items()
         }
-        sign = SymbolicOcp(spec).sign
         metrics["nominal_objective"] = (
-            None if result.objective is None else result.objective - sign * sensitivity
+            None if result.objective is None else result.objective - ocp.sign * sensitivity
         )
-        if inverse.options.monte_carlo.samples > 1:
+        if inverse.options.monte_carlo.samples:
             metrics["monte_carlo"], bundle = monte_carlo(
-                SymbolicOcp(spec), result, spec.problem.uncertain, inverse.options.monte_carlo
+                ocp, result, spec.problem.uncertain, inverse.options.monte_carlo
             )
             arrays |= bundle
     return result.model_copy(
@@ -239,8 +244,7 @@ def report(result: Result, spec: OptimalControlSpec, inverse: InverseData) -> Re
 
 def _penalty_value(spec: OptimalControlSpec, result: Result, penalty: Penalty) -> float:
     """The added cost on the solution, with the transcription's own quadrature (``T q·L``)."""
-    m = spec.method
-    grid = Grid(m.scheme, m.intervals, m.degree if m.scheme == "radau" else 1, m.grading)
+    grid = Transcription(spec).grid
     _, _, q = grid.matrices
     idx = grid.eval_index
     t = np.asarray(result.time)

@@ -71,6 +71,10 @@ def plot_trajectories(result: Result, output_dir: Path, *, animate: bool = False
     pairs = [tuple(p) for p in hint.get("planar", [])]
     if pairs:
         paths.append(plot_plane(result, pairs, output_dir / f"{result.problem}_path.png"))
+    if "desensitization" in result.metrics:
+        from gamespec.desensitize.plotting import plot_desensitized
+
+        paths += plot_desensitized(result, output_dir)
     return paths
 
 

@@ -8,9 +8,11 @@ from __future__ import annotations
 
 import json
 import sys
+import warnings
 from pathlib import Path
 from typing import Annotated
 
+import numpy as np
 import typer
 import yaml
 from rich.console import Console
@@ -243,16 +245,37 @@ def backends() -> None:
     console.print(table)
 
 
+_ClickException = next(c for c in typer.BadParameter.__mro__ if c.__name__ == "ClickException")
+"""Click's root exception (vendored by recent typer, a separate package before): usage errors."""
+
+
 def run(argv: list[str] | None = None) -> int:
-    """Run the CLI on ``argv`` and return the exit code (user errors → 2, one line on stderr)."""
+    """Run the CLI on ``argv`` and return the exit code: user errors and usage errors → 2 with one
+    line on stderr. Warnings (numpy's, a solver's) are not printed: what a solve found is in its
+    Result's status, message and checks."""
+    command = typer.main.get_command(app)
     try:
-        app(args=argv, prog_name="gamespec")
+        with warnings.catch_warnings(), np.errstate(all="ignore"):
+            warnings.simplefilter("ignore")
+            code = command.main(args=argv, prog_name="gamespec", standalone_mode=False)
     except SystemExit as exit_:
         return exit_.code if isinstance(exit_.code, int) else (0 if exit_.code is None else 1)
     except GamespecError as err:
-        print(f"error: {err}", file=sys.stderr)
+        print(f"error: {_one_line(str(err))}", file=sys.stderr)
         return 2
-    return 0
+    except _ClickException as err:
+        message = _one_line(err.format_message())
+        if message:
+            print(f"error: {message} (see 'gamespec --help')", file=sys.stderr)
+        return err.exit_code
+    except typer.Abort:
+        print("error: aborted", file=sys.stderr)
+        return 1
+    return code if isinstance(code, int) else 0
+
+
+def _one_line(text: str) -> str:
+    return " ".join(text.split())
 
 
 def main() -> None:

@@ -1,7 +1,7 @@
 """Problem files (YAML, TOML, JSON) → validated spec, with ``--set`` overrides (DESIGN.md, stage 1).
 
-YAML is read with ``yaml.safe_load`` only. Validation errors become one
-:class:`~gamespec.errors.SpecError` that names the file, the dotted field and the reason, and for a
+Files are read by :func:`gamespec.reading.read_file` (within :mod:`gamespec.limits`). Validation errors
+become one :class:`~gamespec.errors.SpecError` that names the file, the dotted field and the reason, and for a
 misspelled key the nearest valid one.
 """
 
@@ -10,7 +10,6 @@ from __future__ import annotations
 import difflib
 import hashlib
 import json
-import tomllib
 from collections.abc import Iterable, Mapping
 from pathlib import Path
 from typing import Any
@@ -20,36 +19,8 @@ from pydantic import BaseModel, ValidationError
 
 from gamespec import registry
 from gamespec.errors import SpecError
+from gamespec.reading import read_file
 from gamespec.specs.base import SpecBase
-
-SUFFIXES = {".yaml": "yaml", ".yml": "yaml", ".toml": "toml", ".json": "json"}
-
-
-def read_file(path: str | Path) -> dict[str, Any]:
-    """The raw mapping in a problem file; a SpecError for a missing, unreadable or malformed file."""
-    path = Path(path)
-    fmt = SUFFIXES.get(path.suffix.lower())
-    if fmt is None:
-        raise SpecError(f"unknown file type {path.suffix!r} (use .yaml, .toml or .json)", source=str(path))
-    try:
-        text = path.read_text(encoding="utf-8")
-    except FileNotFoundError:
-        raise SpecError("file not found", source=str(path)) from None
-    except OSError as err:
-        raise SpecError(f"cannot read file: {err.strerror}", source=str(path)) from None
-    try:
-        if fmt == "yaml":
-            data = yaml.safe_load(text)
-        elif fmt == "toml":
-            data = tomllib.loads(text)
-        else:
-            data = json.loads(text)
-    except (yaml.YAMLError, tomllib.TOMLDecodeError, json.JSONDecodeError) as err:
-        reason = " ".join(str(err).split())
-        raise SpecError(f"malformed {fmt.upper()}: {reason}", source=str(path)) from None
-    if not isinstance(data, dict):
-        raise SpecError("the file must hold a mapping at the top level", source=str(path))
-    return data
 
 
 def parse_override(assignment: str) -> tuple[list[str], Any]:
@@ -92,7 +63,7 @@ def _valid_keys(model: type[BaseModel] | None, loc: tuple[Any, ...]) -> list[str
         if field is None:
             return []
         annotation = field.annotation
-        if getattr(annotation, "__origin__", None) is dict and parts:
+        if getattr(annotation, "__origin__", None) in (dict, list, tuple) and parts:
             parts.pop(0)
         model = _model_in(annotation)
     return list(model.model_fields) if model is not None and not parts else []
@@ -117,13 +88,34 @@ def _is_type_tag(part: object) -> bool:
     return isinstance(part, str) and ("[" in part or "-" in part or part in _TYPE_TAGS)
 
 
-def format_validation_error(err: ValidationError, model: type[BaseModel], source: str) -> SpecError:
-    """The first pydantic error as a SpecError with dotted location and a nearest-key hint."""
+def _user_location(loc: tuple[Any, ...], data: Any) -> tuple[Any, ...]:
+    """``loc`` without pydantic's union tags: a part the file holds at that point (a key such as
+    ``x-notes`` or ``pursuers[1]``, a list index) is always kept; only a part the file does not hold
+    and that looks like a tag is dropped."""
+    kept: list[Any] = []
+    node = data
+    for part in loc:
+        in_list = isinstance(node, list) and isinstance(part, int) and -len(node) <= part < len(node)
+        if in_list or (isinstance(node, Mapping) and part in node):
+            node = node[part]
+        elif _is_type_tag(part):
+            continue
+        else:
+            node = None
+        kept.append(part)
+    return tuple(kept)
+
+
+def format_validation_error(
+    err: ValidationError, model: type[BaseModel], source: str, data: Any = None
+) -> SpecError:
+    """The first pydantic error as a SpecError with dotted location and a nearest-key hint
+    (``data``, the validated input, tells the file's own keys from pydantic's union tags)."""
     first = err.errors()[0]
-    loc = tuple(p for p in first["loc"] if not _is_type_tag(p))
+    loc = _user_location(tuple(first["loc"]), data)
     field = ".".join(str(p) for p in loc)
     reason = first["msg"]
-    if first["type"] == "extra_forbidden":
+    if first["type"] == "extra_forbidden" and loc:
         keys = _valid_keys(model, loc[:-1])
         near = difflib.get_close_matches(str(loc[-1]), keys, n=1)
         reason = f"unknown key {loc[-1]!r}" + (f"; did you mean {near[0]!r}?" if near else "")
@@ -151,7 +143,7 @@ def spec_from_dict(data: Mapping[str, Any], source: str = "<spec>") -> SpecBase:
     try:
         return cls.model_validate(dict(data))
     except ValidationError as err:
-        raise format_validation_error(err, cls, source) from None
+        raise format_validation_error(err, cls, source, data) from None
     except SpecError as err:
         raise SpecError(err.reason, field=err.field, source=source) from None
 

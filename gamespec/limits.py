@@ -1,0 +1,40 @@
+"""Limits on what a problem file may ask for, each checked where the input is read (README, "Limits").
+
+A file beyond one of these is bad input: exit 2 with one line naming the limit, never a hang, a
+traceback or an exhausted memory. The values are far beyond every problem of the thesis and small
+enough that the work or memory they allow takes seconds, not hours.
+"""
+
+from __future__ import annotations
+
+MAX_FILE_BYTES = 1_000_000
+"""Largest problem file read (bytes)."""
+
+MAX_DEPTH = 64
+"""Deepest nesting of mappings and lists in a problem file."""
+
+MAX_VALUES = 100_000
+"""Most values (mappings, lists and scalars) in a problem file after its YAML aliases are expanded:
+a "billion laughs" file of nested aliases is refused at this count instead of being expanded."""
+
+MAX_INT_DIGITS = 4300
+"""Longest integer literal (decimal digits); Python's own limit on converting text to an integer."""
+
+MAX_EXPRESSION_CHARS = 10_000
+"""Longest expression string."""
+
+MAX_EXPRESSION_NODES = 2_000
+"""Most syntax-tree nodes in one expression."""
+
+MAX_MAGNITUDE = 1e300
+"""Largest absolute value of a number an expression evaluates to (numeric evaluation in floating
+point; a larger intermediate value is refused as out of range instead of being computed exactly)."""
+
+MAX_INTERVALS = 20_000
+"""Most intervals of a transcription grid (collocation intervals, discrete horizon steps)."""
+
+MAX_STEPS = 1_000_000
+"""Most time steps of a simulation (horizon divided by time step)."""
+
+MAX_SAMPLES = 1_000_000
+"""Most Monte Carlo samples of one study."""

@@ -23,9 +23,10 @@ import sympy as sp
 from pydantic import Field, field_validator, model_validator
 
 from gamespec.errors import ExpressionError, SpecError
+from gamespec.limits import MAX_MAGNITUDE
 from gamespec.lqgame.game import LQGame, zero_order_hold
 from gamespec.specs.base import SpecBase, StrictModel
-from gamespec.symbolic.language import RESERVED, parse, symbol
+from gamespec.symbolic.language import RESERVED, float_value, parse, symbol
 
 Value = float | str
 """A number, or an expression over the problem's parameters."""
@@ -196,15 +197,15 @@ class _Evaluator:
         if not isinstance(value, str):
             return float(value)
         try:
-            number = parse(value, self.symbols).xreplace(self.substitution)
-            result = complex(number)
+            return float_value(parse(value, self.symbols).xreplace(self.substitution))
         except ExpressionError as err:
             raise SpecError(str(err), field=f"problem.{field}") from None
-        except (TypeError, ValueError):
-            raise SpecError(f"{value!r} does not evaluate to a number", field=f"problem.{field}") from None
-        if result.imag != 0 or not np.isfinite(result.real):
-            raise SpecError(f"{value!r} evaluates to {result}", field=f"problem.{field}")
-        return result.real
+        except OverflowError:
+            reason = f"{value!r} is out of range (beyond {MAX_MAGNITUDE:g})"
+            raise SpecError(reason, field=f"problem.{field}") from None
+        except (TypeError, ValueError, RecursionError):
+            reason = f"{value!r} does not evaluate to a real number"
+            raise SpecError(reason, field=f"problem.{field}") from None
 
     def vector(self, values: list[Value], field: str) -> np.ndarray:
         return np.array([self.scalar(v, f"{field}.{i}") for i, v in enumerate(values)])

@@ -30,11 +30,28 @@ MAX_MAGNITUDE = 1e300
 """Largest absolute value of a number an expression evaluates to (numeric evaluation in floating
 point; a larger intermediate value is refused as out of range instead of being computed exactly)."""
 
-MAX_INTERVALS = 20_000
-"""Most intervals of a transcription grid (collocation intervals, discrete horizon steps)."""
+MAX_INTERVALS = 10_000
+"""Most intervals of a grid: collocation intervals of an ``optimal_control`` transcription (and of the
+OCP an ``engagement`` becomes), steps of an ``lq_stochastic_game`` horizon."""
 
-MAX_STEPS = 1_000_000
-"""Most time steps of a simulation (horizon divided by time step)."""
+MAX_SIMULATION_VALUES = 2_000_000
+"""Most positions a ``pursuit_scenario`` simulation records: time steps (``horizon / time_step``)
+times players."""
 
 MAX_SAMPLES = 1_000_000
-"""Most Monte Carlo samples of one study."""
+"""Most Monte Carlo samples of an ``lq_stochastic_game``."""
+
+MAX_SAMPLE_VALUES = 20_000_000
+"""Most numbers the Monte Carlo samples of an ``lq_stochastic_game`` hold: samples times
+(horizon + 1) times states (160 MB of doubles)."""
+
+MAX_STUDY_POINTS = 10_000
+"""Most points of a ``pursuit_suboptimal_study`` grid (angles times fractions times speeds), each an
+OCP solve."""
+
+MAX_COORDINATE = 1e9
+"""Largest absolute value of a position coordinate (``engagement``, ``pursuit_scenario``): beyond it
+squared distances lose the precision a capture radius needs, and far beyond it they overflow."""
+
+MAX_SPEED = 1e9
+"""Largest speed of a player (``engagement``, ``pursuit_scenario``)."""

@@ -6,9 +6,17 @@ dotted location and the nearest valid key (see :func:`gamespec.loader.format_val
 
 from __future__ import annotations
 
-from typing import Any, ClassVar
+from typing import Annotated, Any, ClassVar
 
 from pydantic import BaseModel, ConfigDict, Field, PrivateAttr
+
+from gamespec.limits import MAX_COORDINATE, MAX_SPEED
+
+Coordinate = Annotated[float, Field(allow_inf_nan=False, ge=-MAX_COORDINATE, le=MAX_COORDINATE)]
+"""A position coordinate, finite and within :data:`~gamespec.limits.MAX_COORDINATE`."""
+
+Speed = Annotated[float, Field(allow_inf_nan=False, ge=0, le=MAX_SPEED)]
+"""A player's speed, finite, non-negative and within :data:`~gamespec.limits.MAX_SPEED`."""
 
 
 class StrictModel(BaseModel):

@@ -23,7 +23,7 @@ import sympy as sp
 from pydantic import Field, field_validator, model_validator
 
 from gamespec.errors import ExpressionError, SpecError
-from gamespec.limits import MAX_MAGNITUDE
+from gamespec.limits import MAX_INTERVALS, MAX_MAGNITUDE, MAX_SAMPLE_VALUES, MAX_SAMPLES
 from gamespec.lqgame.game import LQGame, zero_order_hold
 from gamespec.specs.base import SpecBase, StrictModel
 from gamespec.symbolic.language import RESERVED, float_value, parse, symbol
@@ -101,7 +101,7 @@ class LQGameProblem(StrictModel):
     """The mathematics of the game."""
 
     parameters: dict[str, float] = Field(default_factory=dict)
-    horizon: int = Field(ge=1, le=10_000, description="Number of steps N.")
+    horizon: int = Field(ge=1, le=MAX_INTERVALS, description="Number of steps N.")
     states: list[str] | None = Field(None, description="State names (default x1, x2, ...).")
     discrete: DiscreteModel | None = None
     continuous: ContinuousModel | None = None
@@ -136,7 +136,7 @@ class LQGameProblem(StrictModel):
 class MonteCarloSpec(StrictModel):
     """Closed-loop samples drawn after the solve (0 to skip)."""
 
-    samples: int = Field(100, ge=0, le=1_000_000)
+    samples: int = Field(100, ge=0, le=MAX_SAMPLES)
     seed: int = 0
 
 
@@ -160,6 +160,19 @@ class LQGameSpec(SpecBase):
     @model_validator(mode="after")
     def _evaluates(self) -> LQGameSpec:
         self.game()
+        return self
+
+    @model_validator(mode="after")
+    def _samples_fit(self) -> LQGameSpec:
+        """Monte Carlo samples times (horizon + 1) times states within
+        :data:`~gamespec.limits.MAX_SAMPLE_VALUES` (the memory the sampled trajectories take)."""
+        values = self.method.monte_carlo.samples * (self.problem.horizon + 1) * len(self.problem.initial.mean)
+        if values > MAX_SAMPLE_VALUES:
+            raise SpecError(
+                f"{values} sampled values exceed the limit of {MAX_SAMPLE_VALUES} (samples × (horizon + 1)"
+                " × states): draw fewer samples",
+                field="method.monte_carlo.samples",
+            )
         return self
 
     def required_features(self) -> frozenset[str]:

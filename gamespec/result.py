@@ -218,7 +218,7 @@ def _read_arrays(npz: Path) -> dict[str, Any]:
                 else:
                     fields[field] = packed[key]
     except (OSError, EOFError, ValueError, KeyError, zipfile.BadZipFile, zlib.error) as err:
-        raise SpecError(f"not a readable array file: {_first_line(err)}", source=str(npz)) from None
+        raise SpecError(f"not a readable Result: {_first_line(err)}", source=str(npz)) from None
     return fields
 
 

@@ -141,11 +141,25 @@ def spec_from_dict(data: Mapping[str, Any], source: str = "<spec>") -> SpecBase:
     except SpecError as err:
         raise SpecError(err.reason, field="kind", source=source) from None
     try:
-        return cls.model_validate(dict(data))
+        spec = cls.model_validate(dict(data))
     except ValidationError as err:
         raise format_validation_error(err, cls, source, data) from None
     except SpecError as err:
         raise SpecError(err.reason, field=err.field, source=source) from None
+    check_backend_options(spec, source)
+    return spec
+
+
+def check_backend_options(spec: SpecBase, source: str) -> None:
+    """Validate every block of ``solver.options`` with its backend's options model (imported only
+    when the file has a block for it), so a misspelled backend or option fails at load, not at solve."""
+    for name, block in spec.solver.options.items():
+        known = registry.names("gamespec.backends")
+        if name not in known:
+            near = difflib.get_close_matches(name, known, n=1)
+            hint = f"; did you mean {near[0]!r}?" if near else f" (known: {', '.join(known)})"
+            raise SpecError(f"unknown backend {name!r}{hint}", field=f"solver.options.{name}", source=source)
+        registry.backend_class(name).validate_options(block, source)
 
 
 def spec_hash(spec: SpecBase) -> str:

@@ -12,7 +12,7 @@ import time
 from typing import Any, ClassVar
 
 import numpy as np
-from pydantic import Field
+from pydantic import Field, ValidationInfo, field_validator
 
 from gamespec.backend import Availability, CompiledModel
 from gamespec.errors import BackendError
@@ -45,6 +45,16 @@ class CasadiOptions(StrictModel):
     max_iter: int = Field(3000, ge=1)
     ipopt: dict[str, Any] = Field(default_factory=dict, description="Further IPOPT options.")
     warm_start: bool = Field(True, description="Re-solves start from the previous solution.")
+
+    @field_validator("ipopt")
+    @classmethod
+    def _known_to_ipopt(cls, ipopt: dict[str, Any], info: ValidationInfo) -> dict[str, Any]:
+        """``ipopt`` holds options IPOPT itself knows and accepts (checked against its own list)."""
+        if ipopt and info.data.get("solver") == "ipopt":
+            from gamespec_casadi.ipopt_options import check_ipopt_options
+
+            check_ipopt_options(ipopt)
+        return ipopt
 
 
 def _library(ca) -> Library:

@@ -29,6 +29,11 @@ class Status(StrEnum):
     OPTIMAL = "optimal"
     FEASIBLE = "feasible"
     INFEASIBLE = "infeasible"
+    """No solution exists: the solver proved it (a convex solver's certificate of infeasibility)."""
+    LOCALLY_INFEASIBLE = "locally_infeasible"
+    """A local NLP solver (IPOPT, ripopt) converged to a point that minimizes the constraint
+    violation without reaching zero: no feasible point *near where it looked*. A solution may still
+    exist; try another initial guess, finer grid or bounds before concluding there is none."""
     UNBOUNDED = "unbounded"
     ITERATION_LIMIT = "iteration_limit"
     TIME_LIMIT = "time_limit"

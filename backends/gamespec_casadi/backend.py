@@ -26,7 +26,7 @@ STATUS_MAP = {
     "Solve_Succeeded": Status.OPTIMAL,
     "Solved_To_Acceptable_Level": Status.FEASIBLE,
     "Feasible_Point_Found": Status.FEASIBLE,
-    "Infeasible_Problem_Detected": Status.INFEASIBLE,
+    "Infeasible_Problem_Detected": Status.LOCALLY_INFEASIBLE,
     "Diverging_Iterates": Status.UNBOUNDED,
     "Maximum_Iterations_Exceeded": Status.ITERATION_LIMIT,
     "Maximum_CpuTime_Exceeded": Status.TIME_LIMIT,
@@ -35,6 +35,8 @@ STATUS_MAP = {
     "Error_In_Step_Computation": Status.NUMERICAL_ERROR,
     "Invalid_Number_Detected": Status.NUMERICAL_ERROR,
 }
+"""IPOPT's return status → gamespec's Status. IPOPT is a local solver: ``Infeasible_Problem_Detected``
+means it converged to a point of local infeasibility, hence ``locally_infeasible``."""
 
 
 class CasadiOptions(StrictModel):

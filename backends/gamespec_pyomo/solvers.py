@@ -29,8 +29,8 @@ STATUS_MAP: dict[str, Status] = {
     "locallyOptimal": Status.OPTIMAL,
     "globallyOptimal": Status.OPTIMAL,
     "feasible": Status.FEASIBLE,
-    "infeasible": Status.INFEASIBLE,
-    "locallyInfeasible": Status.INFEASIBLE,
+    "infeasible": Status.LOCALLY_INFEASIBLE,
+    "locallyInfeasible": Status.LOCALLY_INFEASIBLE,
     "unbounded": Status.UNBOUNDED,
     "maxIterations": Status.ITERATION_LIMIT,
     "maxEvaluations": Status.ITERATION_LIMIT,
@@ -39,7 +39,9 @@ STATUS_MAP: dict[str, Status] = {
     "solverFailure": Status.ERROR,
     "error": Status.ERROR,
 }
-"""Pyomo's ``TerminationCondition`` (read from the SOL file's solve code) → gamespec's Status."""
+"""Pyomo's ``TerminationCondition`` (read from the SOL file's solve code) → gamespec's Status. Both
+executables are local interior-point solvers: what the SOL file calls infeasible is a converged point
+of local infeasibility, so it is ``locally_infeasible``, never a proof that no solution exists."""
 
 PRINT_LEVEL = {"ripopt": 1, "ipopt": 3}
 """The lowest print level at which each executable still reports its iteration count."""

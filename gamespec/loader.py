@@ -168,8 +168,26 @@ def spec_hash(spec: SpecBase) -> str:
     return hashlib.sha256(text.encode()).hexdigest()[:16]
 
 
+def refuse_undeclared_parameters(data: Mapping[str, Any], assignments: Iterable[str]) -> None:
+    """A SpecError (with the nearest declared name) for a ``--set problem.parameters.NAME=...`` whose
+    NAME the file does not declare: a misspelled parameter would otherwise be added unused and change
+    nothing."""
+    problem = data.get("problem")
+    declared = problem.get("parameters") if isinstance(problem, Mapping) else None
+    if not isinstance(declared, Mapping):
+        return
+    for assignment in assignments:
+        path, _ = parse_override(assignment)
+        if len(path) == 3 and path[:2] == ["problem", "parameters"] and path[2] not in declared:
+            near = difflib.get_close_matches(path[2], [str(k) for k in declared], n=1)
+            hint = f"; did you mean {near[0]!r}?" if near else f" (declared: {', '.join(map(str, declared))})"
+            raise SpecError(f"unknown parameter {path[2]!r}{hint}", field=".".join(path), source="--set")
+
+
 def load(path: str | Path, overrides: Iterable[str] = ()) -> SpecBase:
     """Read, override and validate a problem file into its spec."""
-    data = apply_overrides(read_file(path), overrides)
+    raw = read_file(path)
+    refuse_undeclared_parameters(raw, overrides)
+    data = apply_overrides(raw, overrides)
     spec = spec_from_dict(data, source=str(path))
     return spec.with_source(str(path), hashlib.sha256(Path(path).read_bytes()).hexdigest()[:16])

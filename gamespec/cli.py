@@ -86,7 +86,8 @@ def solve(
         from gamespec.plotting import plot_result
 
         for path in plot_result(result, out or Path(".")):
-            err_console.print(f"wrote {path}")
+            if not json_:
+                console.print(f"wrote {path}", markup=False, highlight=False)
     if json_:
         sys.stdout.write(result.to_json() + "\n")
     else:

@@ -2,20 +2,21 @@
 against it (``solver.options.casadi.ipopt``), so that a misspelled option is refused at load with the
 nearest valid name instead of failing in the solve.
 
-The list comes from IPOPT's ``print_options_documentation`` (printed on the C standard output, which
-is redirected to a file while a one-variable NLP is solved); the values are checked by building that
-NLP with the options, which is where IPOPT rejects an unknown option or a value of the wrong type.
+The list comes from IPOPT's ``print_options_documentation`` (captured while a one-variable NLP is
+solved); the values are checked by building that NLP with the options, which is where IPOPT rejects
+an unknown option or a value of the wrong type.
 """
 
 from __future__ import annotations
 
 import difflib
+import io
 import os
 import re
 import sys
 import tempfile
 from collections.abc import Iterator, Mapping
-from contextlib import contextmanager, suppress
+from contextlib import contextmanager, redirect_stdout, suppress
 from functools import cache
 from typing import Any
 
@@ -32,27 +33,29 @@ def _tiny_nlp(ipopt: Mapping[str, Any]) -> Any:
 
 
 @contextmanager
-def _c_stdout() -> Iterator[list[str]]:
-    """Capture what C code prints on file descriptor 1 (IPOPT writes there); the text is appended to
-    the yielded list on exit."""
+def _solver_output() -> Iterator[list[str]]:
+    """Capture what IPOPT prints, whether casadi routes it through Python's ``sys.stdout`` or it
+    reaches file descriptor 1 directly; the text is appended to the yielded list on exit."""
     sys.stdout.flush()
     saved = os.dup(1)
     out: list[str] = []
+    python_level = io.StringIO()
     with tempfile.TemporaryFile() as captured:
         os.dup2(captured.fileno(), 1)
         try:
-            yield out
+            with redirect_stdout(python_level):
+                yield out
         finally:
             os.dup2(saved, 1)
             os.close(saved)
             captured.seek(0)
-            out.append(captured.read().decode("utf-8", "replace"))
+            out.append(python_level.getvalue() + captured.read().decode("utf-8", "replace"))
 
 
 @cache
 def ipopt_option_names() -> frozenset[str]:
     """The names of every IPOPT option (empty when this IPOPT prints no documentation)."""
-    with _c_stdout() as text, suppress(RuntimeError):
+    with _solver_output() as text, suppress(RuntimeError):
         _tiny_nlp({"print_options_documentation": "yes", "max_iter": 0})(x0=1.0)
     return frozenset(_OPTION_LINE.findall(text[0]))
 
@@ -67,7 +70,7 @@ def check_ipopt_options(options: Mapping[str, Any]) -> None:
             hint = f"; did you mean {near[0]!r}?" if near else ""
             raise ValueError(f"IPOPT has no option {key!r}{hint}")
     for key, value in options.items():
-        with _c_stdout() as text:
+        with _solver_output() as text:
             try:
                 _tiny_nlp({"print_level": 0, key: value})
                 refused = ""

@@ -57,12 +57,43 @@ EXPRESSIONS = [
 """Expression texts a user might write, and texts an attacker or a typo might: valid, undefined,
 infinite, not real, enormous, nested, outside the whitelist."""
 
-NASTY_NUMBERS = [0, 1, -1, 0.5, 2, 10, 1e-300, -1e-12, 1e12, 1e308, -1e308, 2**63, -(2**63), 10**400,
-                 math.nan, math.inf, -math.inf]
+NASTY_NUMBERS = [
+    0,
+    1,
+    -1,
+    0.5,
+    2,
+    10,
+    1e-300,
+    -1e-12,
+    1e12,
+    1e308,
+    -1e308,
+    2**63,
+    -(2**63),
+    10**400,
+    math.nan,
+    math.inf,
+    -math.inf,
+]
 """Numbers at the edges: zero, tiny, huge, beyond float range, not finite."""
 
-NASTY = [None, True, False, "", " ", "x-notes", [], {}, [[]], {"a": None}, *NASTY_NUMBERS,
-         *EXPRESSIONS[:6], "é" * 3, "\x00"]
+NASTY = [
+    None,
+    True,
+    False,
+    "",
+    " ",
+    "x-notes",
+    [],
+    {},
+    [[]],
+    {"a": None},
+    *NASTY_NUMBERS,
+    *EXPRESSIONS[:6],
+    "é" * 3,
+    "\x00",
+]
 
 numbers = st.one_of(
     st.sampled_from(NASTY_NUMBERS),
@@ -216,8 +247,23 @@ def mutated_bytes(draw: st.DrawFn) -> bytes:
     return bytes(raw)
 
 
-_SNIPPETS = [b"&a ", b"*a", b"<<: ", b"\xff\xfe", b"\t", b": ", b"- ", b"[", b"{", b"!!python/object ",
-             b"!!binary ", b"!!set ", b"2001-12-14", b"9" * 4400, b"\n" + b"  " * 40 + b"x: 1\n"]
+_SNIPPETS = [
+    b"&a ",
+    b"*a",
+    b"<<: ",
+    b"\xff\xfe",
+    b"\t",
+    b": ",
+    b"- ",
+    b"[",
+    b"{",
+    b"!!python/object ",
+    b"!!binary ",
+    b"!!set ",
+    b"2001-12-14",
+    b"9" * 4400,
+    b"\n" + b"  " * 40 + b"x: 1\n",
+]
 
 
 def dumped(data: Any, fmt: str) -> str:

@@ -61,10 +61,24 @@ def test_raw_bytes_and_text(raw: bytes | str, suffix: str) -> None:
 @given(
     target=st.sampled_from(SHIPPED),
     key=st.one_of(
-        st.sampled_from(["problem.parameters.rho", "problem.parameters.rhoo", "method.intervals", "pursuers",
-                         "pursuers.0.speed", "pursuers[1].speed", "solver.options.casadi.max_iter",
-                         "solver.options.casadi.ipopt", "solver.options.nosuch.x", "horizon", "kind", "",
-                         "a..b", "."]),
+        st.sampled_from(
+            [
+                "problem.parameters.rho",
+                "problem.parameters.rhoo",
+                "method.intervals",
+                "pursuers",
+                "pursuers.0.speed",
+                "pursuers[1].speed",
+                "solver.options.casadi.max_iter",
+                "solver.options.casadi.ipopt",
+                "solver.options.nosuch.x",
+                "horizon",
+                "kind",
+                "",
+                "a..b",
+                ".",
+            ]
+        ),
         st.text(max_size=20),
     ),
     value=values,

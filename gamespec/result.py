@@ -36,6 +36,9 @@ class Status(StrEnum):
     exist; try another initial guess, finer grid or bounds before concluding there is none."""
     UNBOUNDED = "unbounded"
     ITERATION_LIMIT = "iteration_limit"
+    NOT_CONVERGED = "not_converged"
+    """An iteration stopped before its limit because it cannot converge: best responses that cycle
+    or diverge (:mod:`gamespec.games.best_response`); the message says which."""
     TIME_LIMIT = "time_limit"
     NUMERICAL_ERROR = "numerical_error"
     ERROR = "error"

@@ -4,7 +4,8 @@ solve the identical discretization.
 
 Variables ``X[i, node]``, ``U[j, point]`` and the horizon ``T``, a Var when the final time is free
 (time scaling ``t = t0 + tau * T``) and a mutable Param otherwise. The problem's parameters are
-mutable Params indexed by name, so a re-solve changes values, not the model. Constraints: the
+mutable Params indexed by name, and the grid inputs mutable Params ``w[input, point]`` indexed by
+evaluation point, so a re-solve changes values, not the model. Constraints: the
 defects ``D X - T W F(X, U, t) = 0``, path constraints at every evaluation point and boundary
 constraints over the end values; objective ``Phi + T q^T L`` in minimization form.
 """
@@ -67,6 +68,7 @@ def build_model(tr: Transcription, params: Mapping[str, float]) -> Any:
     k = len(grid.eval_index)
     m = pyo.ConcreteModel(name=tr.spec.name)
     m.p = pyo.Param(ocp.parameters, mutable=True, initialize=dict(params))
+    m.w = pyo.Param(range(tr.n_w), range(k), mutable=True, initialize=0.0)
     m.X = pyo.Var(range(tr.n_x), range(grid.n_nodes), initialize=0.0)
     m.U = pyo.Var(range(tr.n_u), range(k), initialize=0.0)
     if tr.free_time:
@@ -82,6 +84,7 @@ def build_model(tr: Transcription, params: Mapping[str, float]) -> Any:
         values = symbols | {ocp.t: tr.t0 + tau * m.T}
         values |= {s: m.X[i, int(node)] for i, s in enumerate(ocp.x)}
         values |= {s: m.U[j, col] for j, s in enumerate(ocp.u)}
+        values |= {s: m.w[i, col] for i, s in enumerate(ocp.w)}
         F[:, col] = [translate(f, values, lib) for f in ocp.dynamics]
         L.append(translate(ocp.lagrange, values, lib))
         path.append([_relation(r, translate(r.expr, values, lib)) for r in ocp.path])

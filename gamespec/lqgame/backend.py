@@ -17,7 +17,7 @@ from typing import Any, ClassVar
 
 from pydantic import Field
 
-from gamespec.backend import Availability, Backend, CompiledModel
+from gamespec.backend import Availability, Backend, CompiledModel, Inputs, refuse_inputs
 from gamespec.errors import BackendError
 from gamespec.lqgame.solution import (
     CovarianceOutcome,
@@ -85,8 +85,11 @@ class LQCompiledModel(CompiledModel):
             return fallback_mean(self.model, Status.INFEASIBLE, unreachable)
         return self._solve_mean_qp(guess)
 
-    def solve(self, parameters: dict[str, float] | None = None, guess: Result | None = None) -> Result:
+    def solve(
+        self, parameters: dict[str, float] | None = None, guess: Result | None = None, inputs: Inputs = None
+    ) -> Result:
         """Rebuild if the effective parameter values changed, then the mean and covariance games."""
+        refuse_inputs(inputs, self.spec.kind)
         values = {**self.spec.problem.parameters, **(parameters or {})}
         if values != self.values:
             self._build(values)

@@ -9,7 +9,7 @@ symbols it may use, so a typo stops at load time with the field that holds it.
 from __future__ import annotations
 
 import math
-from collections.abc import Mapping
+from collections.abc import Callable, Mapping
 from dataclasses import dataclass
 from typing import Literal
 
@@ -25,6 +25,8 @@ Value = FiniteFloat | str
 """A finite number, or an expression over the problem's parameters."""
 
 INF = math.inf
+NORMALIZED_TIME = "tau"
+"""The name of normalized time ``(t - t0) / (t_f - t0)`` in guess and input-default expressions."""
 
 
 class StateSpec(StrictModel):
@@ -41,6 +43,15 @@ class ControlSpec(StrictModel):
 
     lower: Value | None = None
     upper: Value | None = None
+
+
+class InputSpec(StrictModel):
+    """One grid input: a signal tabulated at the transcription's evaluation points (the Result's
+    ``control_time``), used in the dynamics, the Lagrange integrand and path constraints like a
+    parameter that varies along the horizon. ``default`` is a number or an expression of normalized
+    time ``tau`` (in [0, 1]) and the parameters; ``CompiledModel.solve(inputs=...)`` replaces it."""
+
+    default: Value = 0.0
 
 
 class ObjectiveSpec(StrictModel):
@@ -82,6 +93,7 @@ class OcpProblem(StrictModel):
     parameters: dict[str, FiniteFloat] = Field(default_factory=dict)
     states: dict[str, StateSpec]
     controls: dict[str, ControlSpec] = Field(default_factory=dict)
+    inputs: dict[str, InputSpec] = Field(default_factory=dict)
     dynamics: dict[str, Value]
     objective: ObjectiveSpec = Field(default_factory=ObjectiveSpec)
     time: TimeSpec = Field(default_factory=TimeSpec)
@@ -97,10 +109,10 @@ class OcpProblem(StrictModel):
 
     @model_validator(mode="after")
     def _consistent(self) -> OcpProblem:
-        names = [*self.parameters, *self.states, *self.controls]
+        names = [*self.parameters, *self.states, *self.controls, *self.inputs]
         boundary = [f"{s}_0" for s in self.states] + [f"{s}_f" for s in self.states] + ["t_f"]
         for name in names:
-            if not name.isidentifier() or name in RESERVED:
+            if not name.isidentifier() or name in RESERVED or name == NORMALIZED_TIME:
                 raise ValueError(f"{name!r} cannot be a symbol name (reserved or not an identifier)")
         clashes = {n for n in names if names.count(n) > 1} | (set(names) & set(boundary))
         if clashes:
@@ -163,8 +175,11 @@ class OcpProblem(StrictModel):
         return EvaluatedValues(states, controls, t_final)
 
     def _check_expressions(self) -> None:
+        """Parse every expression over the symbols its field may use; an input where it may not
+        appear (bounds, end values, Mayer and boundary terms, the final time) is named as such."""
         params = {n: symbol(n) for n in self.parameters}
-        running = {**params, **{n: symbol(n) for n in [*self.states, *self.controls, "t"]}}
+        inputs = {n: symbol(n) for n in self.inputs}
+        running = {**params, **inputs, **{n: symbol(n) for n in [*self.states, *self.controls, "t"]}}
         ends = {
             **params,
             **{f"{s}_{e}": symbol(f"{s}_{e}") for s in self.states for e in "0f"},
@@ -176,6 +191,11 @@ class OcpProblem(StrictModel):
                 for key, value in spec.model_dump().items():
                     if isinstance(value, str):
                         checks.append((f"{group}.{name}.{key}", value, params, False))
+        checks += [
+            (f"inputs.{n}.default", i.default, params | {NORMALIZED_TIME: symbol(NORMALIZED_TIME)}, False)
+            for n, i in self.inputs.items()
+            if isinstance(i.default, str)
+        ]
         checks += [(f"dynamics.{k}", v, running, False) for k, v in self.dynamics.items()]
         checks += [
             ("objective.mayer", self.objective.mayer, ends, False),
@@ -188,10 +208,30 @@ class OcpProblem(StrictModel):
             (f"boundary_constraints.{i}", c, ends, True) for i, c in enumerate(self.boundary_constraints)
         ]
         for field, text, symbols, relation in checks:
+            read = parse_relation if relation else parse
             try:
-                (parse_relation if relation else parse)(text, symbols)
+                read(text, symbols)
             except ExpressionError as err:
-                raise SpecError(str(err), field=f"problem.{field}") from None
+                used = _inputs_in(read, text, symbols, inputs)
+                reason = (
+                    f"uses grid input(s) {', '.join(used)}: inputs are signals along the horizon and "
+                    "may appear only in dynamics, the Lagrange integrand and path constraints"
+                    if used
+                    else str(err)
+                )
+                raise SpecError(reason, field=f"problem.{field}") from None
+
+
+def _inputs_in(read: Callable, text: str, symbols: dict, inputs: dict) -> list[str]:
+    """The grid inputs that ``text`` uses, when it parses once they are allowed (else none)."""
+    if not inputs or set(inputs) <= set(symbols):
+        return []
+    try:
+        parsed = read(text, symbols | inputs)
+    except ExpressionError:
+        return []
+    expr = getattr(parsed, "expr", parsed)
+    return sorted(n for n, s in inputs.items() if s in expr.free_symbols)
 
 
 @dataclass(frozen=True)
@@ -264,4 +304,6 @@ class OptimalControlSpec(SpecBase):
             needed.add("path_constraints")
         if p.boundary_constraints:
             needed.add("boundary_constraints")
+        if p.inputs:
+            needed.add("grid_inputs")
         return frozenset(needed)

@@ -19,7 +19,7 @@ from pydantic import BaseModel, ValidationError
 
 from gamespec import registry
 from gamespec.errors import SpecError
-from gamespec.reading import read_file
+from gamespec.reading import read_file, read_value
 from gamespec.specs.base import SpecBase
 
 
@@ -184,10 +184,21 @@ def refuse_undeclared_parameters(data: Mapping[str, Any], assignments: Iterable[
             raise SpecError(f"unknown parameter {path[2]!r}{hint}", field=".".join(path), source="--set")
 
 
+def check_overrides(data: Mapping[str, Any], assignments: Iterable[str]) -> None:
+    """Each ``--set`` value read within the limits of a file (:func:`gamespec.reading.read_value`),
+    and no undeclared parameter set; a SpecError from ``--set`` otherwise."""
+    assignments = list(assignments)
+    for assignment in assignments:
+        _, sep, value = assignment.partition("=")
+        if sep and value.strip():
+            read_value(value)
+    refuse_undeclared_parameters(data, assignments)
+
+
 def load(path: str | Path, overrides: Iterable[str] = ()) -> SpecBase:
     """Read, override and validate a problem file into its spec."""
     raw = read_file(path)
-    refuse_undeclared_parameters(raw, overrides)
+    check_overrides(raw, overrides)
     data = apply_overrides(raw, overrides)
     spec = spec_from_dict(data, source=str(path))
     return spec.with_source(str(path), hashlib.sha256(Path(path).read_bytes()).hexdigest()[:16])

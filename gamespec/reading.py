@@ -22,9 +22,8 @@ from typing import Any, ClassVar
 
 import yaml
 from yaml.composer import ComposerError
-from yaml.constructor import ConstructorError
 
-from gamespec.errors import SpecError
+from gamespec.errors import RefusedInput, SpecError
 from gamespec.limits import MAX_DEPTH, MAX_FILE_BYTES, MAX_INT_DIGITS, MAX_VALUES
 
 SUFFIXES = {".yaml": "yaml", ".yml": "yaml", ".toml": "toml", ".json": "json"}
@@ -33,6 +32,11 @@ _MAX_INT_BITS = int(MAX_INT_DIGITS * math.log2(10))
 _LONG_INTEGER = re.compile(rf"[0-9][0-9_]{{{MAX_INT_DIGITS},}}")
 _TIMESTAMP = "tag:yaml.org,2002:timestamp"
 _MERGE = "tag:yaml.org,2002:merge"
+
+
+class RefusedYAML(ComposerError):
+    """Well-formed YAML that gamespec refuses: a recursive alias, nesting or alias expansion beyond
+    the limits, a duplicate key."""
 
 
 class SafeProblemLoader(yaml.SafeLoader):
@@ -57,10 +61,10 @@ class SafeProblemLoader(yaml.SafeLoader):
         event = self.peek_event()
         if isinstance(event, yaml.AliasEvent):
             if event.anchor in self._open_anchors:
-                raise ComposerError(None, None, f"recursive alias *{event.anchor}", event.start_mark)
+                raise RefusedYAML(None, None, f"recursive alias *{event.anchor}", event.start_mark)
             return super().compose_node(parent, index)
         if len(self._open_anchors) >= MAX_DEPTH:
-            raise ComposerError(None, None, f"nested deeper than {MAX_DEPTH} levels", event.start_mark)
+            raise RefusedYAML(None, None, f"nested deeper than {MAX_DEPTH} levels", event.start_mark)
         self._open_anchors.append(getattr(event, "anchor", None))
         try:
             node = super().compose_node(parent, index)
@@ -78,7 +82,7 @@ class SafeProblemLoader(yaml.SafeLoader):
             children = []
         size = 1 + sum(self._expanded.get(id(child), 1) for child in children)
         if size > MAX_VALUES:
-            raise ComposerError(
+            raise RefusedYAML(
                 None, None, f"more than {MAX_VALUES} values once aliases are expanded", node.start_mark
             )
         self._expanded[id(node)] = size
@@ -91,7 +95,7 @@ class SafeProblemLoader(yaml.SafeLoader):
                     continue
                 key = self.construct_object(key_node)
                 if key in seen:
-                    raise ConstructorError(
+                    raise RefusedYAML(
                         "while constructing a mapping",
                         node.start_mark,
                         f"found duplicate key {key!r}",
@@ -115,6 +119,19 @@ def read_file(path: str | Path) -> dict[str, Any]:
     if not isinstance(data, dict):
         raise SpecError("the file must hold a mapping at the top level", source=source)
     return data
+
+
+def read_value(text: str, source: str = "--set") -> Any:
+    """A ``--set`` value read as YAML within the same limits as a file (the text itself when it is
+    not YAML, as :func:`gamespec.loader.parse_override` reads it); a SpecError for a refused one."""
+    try:
+        value = _parse(text, "yaml", source)
+    except RefusedInput:
+        raise
+    except SpecError:
+        return text
+    _check_values(value, source)
+    return value
 
 
 def _read_bytes(path: Path) -> bytes:
@@ -162,20 +179,23 @@ def _parse(text: str, fmt: str, source: str) -> Any:
         if fmt == "toml":
             return tomllib.loads(text)
         return json.loads(text, object_pairs_hook=_unique_pairs)
+    except RefusedYAML as err:
+        refused, reason = True, _yaml_reason(err)
     except yaml.MarkedYAMLError as err:
-        reason = _yaml_reason(err)
+        refused, reason = False, _yaml_reason(err)
     except (yaml.YAMLError, tomllib.TOMLDecodeError, json.JSONDecodeError) as err:
-        reason = " ".join(str(err).split())
+        refused, reason = False, " ".join(str(err).split())
     except RecursionError:
-        reason = f"nested deeper than {MAX_DEPTH} levels"
+        refused, reason = True, f"nested deeper than {MAX_DEPTH} levels"
     except ValueError as err:
         long_literal = _LONG_INTEGER.search(text)
-        if "digits" in str(err) and long_literal is not None:
+        refused = "digits" in str(err) and long_literal is not None
+        if refused:
             where = _line_column(text, long_literal.start())
             reason = f"integer literal longer than {MAX_INT_DIGITS} digits at {where}"
         else:
             reason = " ".join(str(err).split())
-    raise SpecError(f"malformed {fmt.upper()}: {reason}", source=source)
+    raise (RefusedInput if refused else SpecError)(f"malformed {fmt.upper()}: {reason}", source=source)
 
 
 def _yaml_reason(err: yaml.MarkedYAMLError) -> str:

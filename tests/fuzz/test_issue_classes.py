@@ -386,3 +386,15 @@ def test_local_solvers_never_claim_infeasibility_is_proven() -> None:
     assert Status.INFEASIBLE not in set(CASADI.values()) | set(PYOMO.values())
     assert CASADI["Infeasible_Problem_Detected"] is PYOMO["infeasible"] is Status.LOCALLY_INFEASIBLE
     assert not Status.LOCALLY_INFEASIBLE.ok
+
+
+@pytest.mark.parametrize(
+    ("value", "needle"),
+    [
+        ("&a [*a]", "recursive alias"),
+        ("9" * (MAX_INT_DIGITS + 1), "digits"),
+        ("{a: 1, a: 2}", "duplicate key"),
+    ],
+)
+def test_set_values_are_read_within_the_limits_of_a_file(value, needle) -> None:
+    _refused(["validate", ZERMELO, "--set", f"name={value}"], needle, source="--set")

@@ -49,6 +49,9 @@ MAX_STUDY_POINTS = 10_000
 """Most points of a ``pursuit_suboptimal_study`` grid (angles times fractions times speeds), each an
 OCP solve."""
 
+MAX_SWEEP_POINTS = 10_000
+"""Most points of a ``gamespec sweep`` grid (the product of the ``--param`` counts), each a solve."""
+
 MAX_COORDINATE = 1e9
 """Largest absolute value of a position coordinate (``engagement``, ``pursuit_scenario``): beyond it
 squared distances lose the precision a capture radius needs, and far beyond it they overflow."""

@@ -17,6 +17,7 @@ import json
 import math
 import re
 import tomllib
+from collections.abc import Hashable
 from pathlib import Path
 from typing import Any, ClassVar
 
@@ -94,6 +95,8 @@ class SafeProblemLoader(yaml.SafeLoader):
                 if key_node.tag == _MERGE or not isinstance(key_node, yaml.ScalarNode):
                     continue
                 key = self.construct_object(key_node)
+                if not isinstance(key, Hashable):
+                    continue
                 if key in seen:
                     raise RefusedYAML(
                         "while constructing a mapping",

@@ -9,6 +9,7 @@ folder shared by different sweeps never mixes them up; failed points are solved 
 from __future__ import annotations
 
 import itertools
+import math
 from dataclasses import dataclass
 from functools import cache
 from pathlib import Path
@@ -17,6 +18,7 @@ from typing import Any
 import numpy as np
 
 from gamespec.errors import SpecError
+from gamespec.limits import MAX_SWEEP_POINTS
 from gamespec.studies.executors import executor
 from gamespec.studies.runner import run_study
 from gamespec.studies.store import ResultStore
@@ -33,6 +35,11 @@ def parse_range(text: str) -> tuple[str, list[float]]:
             count = int(n)
             if count < 1:
                 raise ValueError
+            if count > MAX_SWEEP_POINTS:
+                raise SpecError(
+                    f"{count} values in {text!r} exceed the limit of {MAX_SWEEP_POINTS} points",
+                    source="--param",
+                )
             return name.strip(), [float(v) for v in np.linspace(float(a), float(b), count)]
         return name.strip(), [float(v) for v in spec.split(",")]
     except ValueError:
@@ -77,6 +84,9 @@ def sweep(
     from gamespec.loader import load, spec_hash
     from gamespec.solving import backend_name
 
+    total = math.prod(len(values) for _, values in ranges)
+    if total > MAX_SWEEP_POINTS:
+        raise SpecError(f"{total} grid points exceed the limit of {MAX_SWEEP_POINTS}", source="--param")
     spec = load(path, overrides)
     problem = f"{backend_name(spec, backend)}/{spec_hash(spec)}"
     names = [name for name, _ in ranges]

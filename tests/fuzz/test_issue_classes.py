@@ -398,3 +398,40 @@ def test_local_solvers_never_claim_infeasibility_is_proven() -> None:
 )
 def test_set_values_are_read_within_the_limits_of_a_file(value, needle) -> None:
     _refused(["validate", ZERMELO, "--set", f"name={value}"], needle, source="--set")
+
+
+def test_sweep_grid_limit() -> None:
+    _refused(
+        ["sweep", ZERMELO, "--param", "rho=1:2:1000", "--param", "xf=1:2:1000", "--out", "unused"],
+        "grid points exceed the limit",
+        source="--param",
+    )
+
+
+FILE = "{file}"
+COMMANDS = [
+    ["validate", FILE],
+    ["solve", FILE],
+    ["solve", FILE, "--json"],
+    ["compare", FILE, "--backends", "casadi,pyomo"],
+    ["sweep", FILE, "--param", "rho=1:2:2", "--out", "unused"],
+    ["show", FILE],
+    ["show", FILE, "--transformed"],
+    ["pursuit", "study", FILE],
+]
+
+
+@pytest.mark.parametrize("command", COMMANDS, ids=lambda c: " ".join(c[:2]))
+@pytest.mark.parametrize(
+    ("name", "content"),
+    [
+        ("latin.yaml", b"kind: optimal_control\nname: \xff\n"),
+        ("loop.yaml", b"kind: optimal_control\nx: &a [*a]\n"),
+        ("dash.json", b'{"kind": "engagement", "capture-radius": 1}'),
+    ],
+)
+def test_every_command_refuses_a_bad_file_in_one_line(tmp_path, command, name, content) -> None:
+    path = _text(tmp_path, content, name)
+    outcome = run_cli([str(path) if part == FILE else part for part in command])
+    assert_promise(outcome, str(path))
+    assert outcome.code == 2

@@ -155,13 +155,15 @@ class _Translator:
 
     def finite(self, node: ast.AST, value: sp.Expr) -> sp.Expr:
         """Refuse results SymPy already knows to be infinite, undefined or complex (``1/0``), and
-        numbers that are out of range or not real when computed in floating point
-        (:func:`float_value`; ``exp(exp(exp(100)))``, ``asin(2)``)."""
+        numbers (the value, or the numeric terms and factors SymPy folded into it) that are out of
+        range or not real when computed in floating point (:func:`float_value`;
+        ``exp(exp(exp(100)))``, ``asin(2)``, ``x*1e300*1e300``)."""
         if value.has(sp.zoo, sp.oo, -sp.oo, sp.nan, sp.I):
             raise self.fail(node, "is infinite, undefined or not real")
-        if value.is_number:
+        numbers = [value] if value.is_number else [a for a in value.args if a.is_number]
+        for number in numbers:
             try:
-                float_value(value)
+                float_value(number)
             except OverflowError:
                 raise self.fail(node, f"number out of range (beyond {MAX_MAGNITUDE:g})") from None
             except ValueError:

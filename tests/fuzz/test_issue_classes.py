@@ -435,3 +435,31 @@ def test_every_command_refuses_a_bad_file_in_one_line(tmp_path, command, name, c
     outcome = run_cli([str(path) if part == FILE else part for part in command])
     assert_promise(outcome, str(path))
     assert outcome.code == 2
+
+
+@pytest.mark.parametrize(
+    ("expression", "needle"),
+    [
+        ("exp(exp(exp(100)))", "out of range"),
+        ("x1*1e300*1e300", "out of range"),
+        ("asin(2)*u", "not a real"),
+        ("max(exp(exp(exp(9))), u)", "out of range"),
+        ("sin(10**400)", "out of range"),
+    ],
+)
+def test_expressions_are_evaluated_in_floating_point(expression, needle) -> None:
+    _refused(
+        ["validate", ZERMELO, "--set", f"problem.dynamics.x1={expression}"], "problem.dynamics.x1", needle
+    )
+
+
+def test_float_value_agrees_with_sympy_where_sympy_is_quick() -> None:
+    import sympy as sp
+
+    from gamespec.symbolic.language import float_value
+
+    x = sp.Integer(3)
+    for expr in (sp.sqrt(x) * sp.pi, sp.exp(x) - sp.log(x), sp.atan2(x, -x), sp.Max(sp.sin(x), sp.cos(x))):
+        assert float_value(expr) == pytest.approx(float(expr), rel=1e-14)
+    with pytest.raises(OverflowError):
+        float_value(sp.exp(sp.exp(sp.exp(sp.Integer(100)))))

@@ -152,14 +152,19 @@ def spec_from_dict(data: Mapping[str, Any], source: str = "<spec>") -> SpecBase:
 
 def check_backend_options(spec: SpecBase, source: str) -> None:
     """Validate every block of ``solver.options`` with its backend's options model (imported only
-    when the file has a block for it), so a misspelled backend or option fails at load, not at solve."""
+    when the file has a block for it), so a misspelled backend or option fails at load, not at solve.
+    A backend whose module cannot be imported here is left to the solve, which says why."""
     for name, block in spec.solver.options.items():
         known = registry.names("gamespec.backends")
         if name not in known:
             near = difflib.get_close_matches(name, known, n=1)
             hint = f"; did you mean {near[0]!r}?" if near else f" (known: {', '.join(known)})"
             raise SpecError(f"unknown backend {name!r}{hint}", field=f"solver.options.{name}", source=source)
-        registry.backend_class(name).validate_options(block, source)
+        try:
+            backend = registry.backend_class(name)
+        except ImportError:
+            continue
+        backend.validate_options(block, source)
 
 
 def spec_hash(spec: SpecBase) -> str:

@@ -7,6 +7,8 @@ enough that the work or memory they allow takes seconds, not hours.
 
 from __future__ import annotations
 
+import sys
+
 MAX_FILE_BYTES = 1_000_000
 """Largest problem file read (bytes)."""
 
@@ -26,9 +28,10 @@ MAX_EXPRESSION_CHARS = 10_000
 MAX_EXPRESSION_NODES = 2_000
 """Most syntax-tree nodes in one expression."""
 
-MAX_MAGNITUDE = 1e300
-"""Largest absolute value of a number an expression evaluates to (numeric evaluation in floating
-point; a larger intermediate value is refused as out of range instead of being computed exactly)."""
+MAX_MAGNITUDE = sys.float_info.max
+"""Largest absolute value of a constant (sub-)expression, the largest finite double: expressions are
+evaluated in floating point, and one whose value or an intermediate value overflows is refused as out
+of range instead of being computed exactly."""
 
 MAX_INTERVALS = 10_000
 """Most intervals of a grid: collocation intervals of an ``optimal_control`` transcription (and of the

@@ -61,7 +61,11 @@ class CasadiOptions(StrictModel):
 
 
 def _library(ca) -> Library:
-    return Library.from_namespace(ca, abs=ca.fabs, min=ca.fmin, max=ca.fmax)
+    """CasADi's functions by gamespec's names; ``heaviside(x) = (1 + sign(x))/2``, which is 1/2 at 0
+    as SymPy's ``Heaviside`` (CasADi's ``sign(0) = 0``)."""
+    return Library.from_namespace(
+        ca, abs=ca.fabs, min=ca.fmin, max=ca.fmax, heaviside=lambda x: 0.5 * (1 + ca.sign(x))
+    )
 
 
 class CasadiModel(CollocationModel):

@@ -23,11 +23,11 @@ from pydantic import (
 
 from gamespec.errors import ExpressionError, SpecError
 from gamespec.limits import MAX_SIMULATION_VALUES
-from gamespec.specs.base import Coordinate, SpecBase, Speed, StrictModel
+from gamespec.specs.base import Coordinate, Number, SpecBase, Speed, StrictModel
 from gamespec.symbolic.language import parse
 
 Position = tuple[Coordinate, Coordinate]
-PositiveFloat = Annotated[float, Field(gt=0, allow_inf_nan=False)]
+PositiveFloat = Annotated[Number, Field(gt=0)]
 PositiveSpeed = Annotated[Speed, Field(gt=0)]
 
 
@@ -156,6 +156,11 @@ class PursuitScenarioSpec(SpecBase):
     allocation: Literal["auto", "avaa", "a2"] = "auto"
 
     default_backend: ClassVar[str] = "geometric"
+
+    def runtime_parameters(self) -> dict[str, float]:
+        """The simulation's capture radius, time step and horizon (what a compiled scenario re-runs
+        with)."""
+        return {"capture_radius": self.capture_radius, "time_step": self.time_step, "horizon": self.horizon}
 
     @model_validator(mode="after")
     def _consistent(self) -> PursuitScenarioSpec:

@@ -123,6 +123,12 @@ class LQBackend(Backend):
         """The solvers ``library`` finds here (imports it; ImportError when it is missing)."""
 
     @classmethod
+    @abstractmethod
+    def probe_options(cls, options: LQSolverOptions) -> None:
+        """Raise ``options.rejected(...)`` when the solver refuses ``options.solver_options`` (a
+        one-variable problem at compile time, so no real solve needs an exception handler)."""
+
+    @classmethod
     def available(cls) -> Availability:
         try:
             solvers = cls.installed_solvers()
@@ -142,4 +148,6 @@ class LQBackend(Backend):
                 f"solver {options.solver!r} is not installed for {self.library} "
                 f"(installed: {', '.join(solvers)})"
             )
-        return self.model_class(spec, options.model_copy(update={"solver": found[0]}))
+        options = options.model_copy(update={"solver": found[0]})
+        self.probe_options(options)
+        return self.model_class(spec, options)

@@ -168,7 +168,7 @@ class SymbolicOcp:
         """``(lower, upper, guess)`` of the final time (lower == upper when it is fixed)."""
         time = self.spec.problem.time
         if time.free:
-            lo, hi = time.bounds
+            lo, hi = self._evaluated(params).t_bounds
             guess = self.spec.guess.t_final or time.guess or 0.5 * (lo + hi)
             return lo, hi, guess
         tf = self._evaluated(params).t_final

@@ -442,7 +442,6 @@ def test_every_command_refuses_a_bad_file_in_one_line(tmp_path, command, name, c
     [
         ("exp(exp(exp(100)))", "out of range"),
         ("x1*1e300*1e300", "out of range"),
-        ("asin(2)*u", "not a real"),
         ("max(exp(exp(exp(9))), u)", "out of range"),
         ("sin(10**400)", "out of range"),
     ],

@@ -9,13 +9,13 @@ from __future__ import annotations
 
 import sys
 
-MAX_FILE_BYTES = 1_000_000
-"""Largest problem file read (bytes)."""
+MAX_FILE_BYTES = 4_000_000
+"""Largest problem file read (bytes): room for per-step matrices over a long horizon."""
 
 MAX_DEPTH = 64
 """Deepest nesting of mappings and lists in a problem file."""
 
-MAX_VALUES = 100_000
+MAX_VALUES = 1_000_000
 """Most values (mappings, lists and scalars) in a problem file after its YAML aliases are expanded:
 a "billion laughs" file of nested aliases is refused at this count instead of being expanded."""
 

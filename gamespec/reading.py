@@ -214,27 +214,42 @@ _SCALARS = (str, bool, int, float, type(None))
 
 
 def _check_values(data: Any, source: str) -> None:
-    """Walk the parsed data (without recursion) against the depth, size and type limits."""
-    stack: list[tuple[Any, tuple[Any, ...]]] = [(data, ())]
-    count = 0
+    """Walk the parsed data (without recursion) against the depth, size and type limits; only
+    containers are stacked, so a long list of numbers is one pass."""
+    _check_scalar(data, (), source)
+    stack: list[tuple[Any, tuple[Any, ...]]] = [(data, ())] if isinstance(data, dict | list) else []
+    count = 1
     while stack:
         value, path = stack.pop()
-        count += 1
-        field = ".".join(str(p) for p in path)
-        if count > MAX_VALUES:
-            raise SpecError(f"more than {MAX_VALUES} values in the file", source=source)
-        if len(path) > MAX_DEPTH:
-            raise SpecError(f"nested deeper than {MAX_DEPTH} levels", field=field, source=source)
+        if len(path) >= MAX_DEPTH:
+            raise RefusedInput(f"nested deeper than {MAX_DEPTH} levels", field=_dotted(path), source=source)
         if isinstance(value, dict):
-            for key, child in value.items():
+            for key in value:
                 if not isinstance(key, str):
-                    reason = f"key {key!r} is not text (quote it)"
-                    raise SpecError(reason, field=field, source=source)
+                    raise SpecError(f"key {key!r} is not text (quote it)", field=_dotted(path), source=source)
+            children = value.items()
+        else:
+            children = enumerate(value)
+        count += len(value)
+        if count > MAX_VALUES:
+            raise RefusedInput(f"more than {MAX_VALUES} values in the file", source=source)
+        for key, child in children:
+            if isinstance(child, dict | list):
                 stack.append((child, (*path, key)))
-        elif isinstance(value, list):
-            stack.extend((child, (*path, i)) for i, child in enumerate(value))
-        elif isinstance(value, int) and value.bit_length() > _MAX_INT_BITS:
-            raise SpecError(f"integer longer than {MAX_INT_DIGITS} digits", field=field, source=source)
-        elif not isinstance(value, _SCALARS):
-            reason = f"a {type(value).__name__} is not a value gamespec reads (quote it to make it text)"
-            raise SpecError(reason, field=field, source=source)
+            elif not isinstance(child, _PLAIN):
+                _check_scalar(child, (*path, key), source)
+
+
+_PLAIN = (str, bool, float, type(None))
+
+
+def _dotted(path: tuple[Any, ...]) -> str:
+    return ".".join(str(p) for p in path)
+
+
+def _check_scalar(value: Any, path: tuple[Any, ...], source: str) -> None:
+    if isinstance(value, int) and value.bit_length() > _MAX_INT_BITS:
+        raise RefusedInput(f"integer longer than {MAX_INT_DIGITS} digits", field=_dotted(path), source=source)
+    if not isinstance(value, (*_SCALARS, dict, list)):
+        reason = f"a {type(value).__name__} is not a value gamespec reads (quote it to make it text)"
+        raise SpecError(reason, field=_dotted(path), source=source)

@@ -14,7 +14,7 @@ from hypothesis import HealthCheck, assume, given, settings
 from hypothesis import strategies as st
 
 from gamespec.errors import ExpressionError
-from gamespec.symbolic.language import parse, parse_relation, symbol
+from gamespec.symbolic.language import float_value, parse, parse_relation, symbol
 from gamespec.symbolic.printer import to_text
 from gamespec.symbolic.translate import NUMPY, translate
 
@@ -95,8 +95,9 @@ def trees(unary: list[Unary], binary: list[Binary]) -> st.SearchStrategy[sp.Expr
 
 
 def representable(expr: sp.Expr) -> bool:
-    """Finite, real, every float within double precision and every power of two numbers real:
-    what the language can hold (it refuses the rest when parsing)."""
+    """Finite, real, every float within double precision, every power of two numbers real and every
+    number-valued part within double range (:func:`float_value`): what the language can hold (it
+    refuses the rest when parsing)."""
     if expr.has(sp.zoo, sp.oo, -sp.oo, sp.nan, sp.I):
         return False
     if not all(math.isfinite(float(f)) and (float(f) != 0.0 or f.is_zero) for f in expr.atoms(sp.Float)):
@@ -111,6 +112,14 @@ def representable(expr: sp.Expr) -> bool:
                 return False
             if isinstance(value, complex):
                 return False
+    for part in sp.preorder_traversal(expr):
+        if part.is_number:
+            try:
+                float_value(part)
+            except OverflowError:
+                return False
+            except (ValueError, TypeError, RecursionError):
+                pass
     return True
 
 

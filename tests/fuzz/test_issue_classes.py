@@ -462,3 +462,15 @@ def test_float_value_agrees_with_sympy_where_sympy_is_quick() -> None:
         assert float_value(expr) == pytest.approx(float(expr), rel=1e-14)
     with pytest.raises(OverflowError):
         float_value(sp.exp(sp.exp(sp.exp(sp.Integer(100)))))
+
+
+def test_file_size_limit(tmp_path) -> None:
+    from gamespec.limits import MAX_FILE_BYTES
+
+    path = _text(tmp_path, "kind: optimal_control\n" + "#" * MAX_FILE_BYTES + "\n", "big.yaml")
+    _refused(["validate", path], f"larger than the limit of {MAX_FILE_BYTES} bytes")
+
+
+def test_many_values_without_aliases(tmp_path) -> None:
+    path = _text(tmp_path, json.dumps({"kind": "optimal_control", "x": [0] * MAX_VALUES}), "many.json")
+    _refused(["validate", path], f"more than {MAX_VALUES} values")

@@ -187,9 +187,8 @@ def sweep(
     else:
         names = [name for name, _ in ranges]
         console.print(_rows_table(rows, [*names, *SWEEP_COLUMNS], f"sweep of {file.name}"))
-        err_console.print(
-            f"{len(rows)} points in {out} ({run.computed} computed now, {run.reused} reused)", highlight=False
-        )
+        tally = f"{run.computed} computed now, {run.reused} reused"
+        print(f"{len(rows)} points in {out} ({tally})", file=sys.stderr)
     failed = [r for r in rows if r["status"] not in ("optimal", "feasible")]
     if failed:
         print(f"error: {len(failed)} of {len(rows)} points did not solve", file=sys.stderr)
@@ -231,7 +230,7 @@ def results(
     store = find_store(folder)
     rows = study_rows(store)
     for line in store.damaged:
-        err_console.print(line, markup=False, highlight=False)
+        print(line, file=sys.stderr)
     if json_:
         sys.stdout.write(json.dumps(rows, indent=2) + "\n")
     else:
@@ -242,7 +241,7 @@ def results(
         console.print(_rows_table(rows, shown or ["key"], title))
     for path in (write_csv(rows, csv) if csv else None, write_parquet(rows, parquet) if parquet else None):
         if path is not None:
-            err_console.print(f"wrote {path}", highlight=False)
+            print(f"wrote {path}", file=sys.stderr)
 
 
 @app.command()

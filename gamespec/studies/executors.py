@@ -69,15 +69,17 @@ PR_SET_PDEATHSIG = 1
 """``prctl`` option (linux/prctl.h): the signal a process gets when its parent dies."""
 
 
-def _die_with_parent() -> None:
-    """Pool-worker initializer: end this worker when the process that forked it dies, even by
-    SIGKILL (which runs no cleanup there): ``PR_SET_PDEATHSIG`` on Linux, a watchdog thread that
-    polls ``os.getppid()`` elsewhere. The parent is the fork server, which exits as soon as the
-    study's process is gone."""
+def _die_with_parent(parent: int) -> None:
+    """Pool-worker initializer: end this worker when the study's process ``parent`` that started
+    it dies, even by SIGKILL (which runs no cleanup there): ``PR_SET_PDEATHSIG`` on Linux, a
+    watchdog thread that polls ``os.getppid()`` elsewhere; a parent already gone ends it at once."""
+    if os.getppid() != parent:
+        os._exit(1)
     if sys.platform.startswith("linux"):
         ctypes.CDLL(None, use_errno=True).prctl(PR_SET_PDEATHSIG, signal.SIGKILL)
+        if os.getppid() != parent:  # it died before prctl took effect
+            os._exit(1)
         return
-    parent = os.getppid()
 
     def watch() -> None:
         while os.getppid() == parent:
@@ -88,10 +90,11 @@ def _die_with_parent() -> None:
 
 
 class ProcessExecutor:
-    """Runs in ``workers`` local processes (started by a fork server, so the caller's threads are
-    never forked), keeping ``2 * workers`` runs in flight. The workers die with this process; a
-    worker that dies mid-run (the pool breaks) is replaced and the runs in flight are submitted
-    again, up to ``restarts`` times per ``imap``."""
+    """Runs in ``workers`` local processes, keeping ``2 * workers`` runs in flight. Workers are
+    spawned (a fresh interpreter: the caller's threads are never forked; a fork server would keep
+    them alive past the caller, as each holds the server's liveness pipe). The workers die with
+    this process; a worker that dies mid-run (the pool breaks) is replaced and the runs in flight
+    are submitted again, up to ``restarts`` times per ``imap``."""
 
     def __init__(self, workers: int, restarts: int = 3) -> None:
         if workers < 1:
@@ -105,8 +108,10 @@ class ProcessExecutor:
         return cls(workers)
 
     def _start(self) -> ProcessPoolExecutor:
-        context = multiprocessing.get_context("forkserver" if sys.platform != "win32" else "spawn")
-        return ProcessPoolExecutor(self.workers, mp_context=context, initializer=_die_with_parent)
+        context = multiprocessing.get_context("spawn")
+        return ProcessPoolExecutor(
+            self.workers, mp_context=context, initializer=_die_with_parent, initargs=(os.getpid(),)
+        )
 
     def __enter__(self) -> Self:
         if self._pool is None:

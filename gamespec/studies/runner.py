@@ -12,6 +12,7 @@ from __future__ import annotations
 import math
 import platform
 import socket
+import sys
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
 from functools import cache
@@ -89,8 +90,7 @@ def run_study(
     record and, on a resumed run, the number of points reused (default: stderr). The progress bar
     goes to stderr too, so stdout stays clean for ``--json``.
     """
-    err = Console(stderr=True)
-    say = report or (lambda line: err.print(line, markup=False, highlight=False))
+    say = report or (lambda line: print(line, file=sys.stderr))
     saved = store.items()
     damaged = list(store.damaged)
     for line in damaged:
@@ -102,7 +102,7 @@ def run_study(
         say(f"resuming: {reused} of {len(points)} points reused from {store.path}")
     runner = executor or SerialExecutor()
     columns = (TextColumn("{task.description}"), BarColumn(), MofNCompleteColumn(), TimeRemainingColumn())
-    progress_bar = Progress(*columns, disable=not show_progress, console=err)
+    progress_bar = Progress(*columns, disable=not show_progress, console=Console(stderr=True))
     with runner, progress_bar as progress:
         size = chunk_size(len(todo), runner.workers)
         jobs = [(fn, todo[i : i + size]) for i in range(0, len(todo), size)]

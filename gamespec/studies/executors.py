@@ -90,11 +90,16 @@ def _die_with_parent(parent: int) -> None:
 
 
 class ProcessExecutor:
-    """Runs in ``workers`` local processes, keeping ``2 * workers`` runs in flight. Workers are
-    spawned (a fresh interpreter: the caller's threads are never forked; a fork server would keep
-    them alive past the caller, as each holds the server's liveness pipe). The workers die with
-    this process; a worker that dies mid-run (the pool breaks) is replaced and the runs in flight
-    are submitted again, up to ``restarts`` times per ``imap``."""
+    """Runs in ``workers`` local processes, keeping ``2 * workers`` runs in flight.
+
+    On Linux, while this process has a single thread, the workers are forked when the executor is
+    entered (before a progress bar starts its thread): they inherit the imported modules, so no
+    worker pays for importing gamespec and the solvers again. Otherwise they are spawned (a fresh
+    interpreter; the main module must then be guarded by ``if __name__ == "__main__"``). A fork
+    server is not used: each of its workers holds the server's liveness pipe, so the server and
+    the workers would outlive this process. The workers die with this process; a worker that dies
+    mid-run (the pool breaks) is replaced and the runs in flight are submitted again, up to
+    ``restarts`` times per ``imap``."""
 
     def __init__(self, workers: int, restarts: int = 3) -> None:
         if workers < 1:
@@ -108,10 +113,13 @@ class ProcessExecutor:
         return cls(workers)
 
     def _start(self) -> ProcessPoolExecutor:
-        context = multiprocessing.get_context("spawn")
-        return ProcessPoolExecutor(
+        forkable = sys.platform.startswith("linux") and threading.active_count() == 1
+        context = multiprocessing.get_context("fork" if forkable else "spawn")
+        pool = ProcessPoolExecutor(
             self.workers, mp_context=context, initializer=_die_with_parent, initargs=(os.getpid(),)
         )
+        pool.submit(os.getpid).result()  # start the workers now, from this thread
+        return pool
 
     def __enter__(self) -> Self:
         if self._pool is None:

@@ -1,6 +1,9 @@
 """The command line (DESIGN.md, "CLI"): validate, solve, compare, sweep, results, show, plot, schema,
 backends.
 
+Area commands (``gamespec pursuit ...``) are Typer apps registered in the ``gamespec.commands``
+entry-point group, mounted under their entry-point name; the core imports none of them by name.
+
 Bad input is exit code 2 with one line on stderr; a solve that fails is exit code 1 with one line
 saying why; tracebacks are for bugs only.
 """
@@ -21,7 +24,6 @@ from rich.table import Table
 from gamespec import registry
 from gamespec.errors import GamespecError
 from gamespec.loader import load
-from gamespec.pursuit.cli import pursuit_app
 from gamespec.result import Result, writable_folder
 from gamespec.studies.compare import (
     LEGEND,
@@ -38,7 +40,8 @@ app = typer.Typer(
 )
 console = Console()
 err_console = Console(stderr=True)
-app.add_typer(pursuit_app, name="pursuit")
+for _area in registry.names("gamespec.commands"):
+    app.add_typer(registry.load("gamespec.commands", _area), name=_area)
 
 FileArg = Annotated[Path, typer.Argument(help="Problem file (.yaml, .toml or .json).")]
 SetOpt = Annotated[
@@ -254,15 +257,9 @@ def show(
     """Print the (validated, optionally transformed) problem as YAML."""
     spec = load(file, set_ or [])
     if transformed:
-        from gamespec.solving import backend_name, get_backend
-        from gamespec.transforms.base import chain_to
+        from gamespec.solving import transformed as transformed_spec
 
-        target = get_backend(backend_name(spec, backend))
-        chain = chain_to(spec, target.kinds)
-        if chain is None:
-            raise GamespecError(f"backend {target.name!r} cannot take kind {spec.kind!r}")
-        for transform in chain:
-            spec, _ = transform.apply(spec)
+        spec = transformed_spec(spec, backend)
     data = spec.model_dump(mode="json", exclude_defaults=False)
     sys.stdout.write(yaml.safe_dump(data, sort_keys=False, allow_unicode=True))
 

@@ -10,6 +10,7 @@ from __future__ import annotations
 import difflib
 import hashlib
 import json
+import re
 import tomllib
 from collections.abc import Iterable, Mapping
 from pathlib import Path
@@ -52,6 +53,14 @@ def read_file(path: str | Path) -> dict[str, Any]:
     return data
 
 
+def override_path(key: str, source: str = "--set") -> list[str]:
+    """``a.b.1.c`` or ``a.b[1].c`` → ``["a", "b", "1", "c"]`` (list entries by their index)."""
+    parts = re.sub(r"\[(\d+)\]", r".\1", key.strip()).split(".")
+    if not all(parts):
+        raise SpecError(f"cannot read the dotted path {key!r}", source=source)
+    return parts
+
+
 def parse_override(assignment: str) -> tuple[list[str], Any]:
     """``a.b.c=value`` → (["a", "b", "c"], value), the value read as a YAML scalar or list."""
     key, sep, value = assignment.partition("=")
@@ -61,7 +70,35 @@ def parse_override(assignment: str) -> tuple[list[str], Any]:
         parsed = yaml.safe_load(value) if value.strip() else ""
     except yaml.YAMLError:
         parsed = value
-    return key.strip().split("."), parsed
+    return override_path(key), parsed
+
+
+def set_path(data: dict[str, Any], path: list[str], value: Any, *, create: bool, source: str) -> None:
+    """Set ``data`` at ``path`` in place: mapping keys by name (missing ones made when ``create``),
+    list entries by an index they already have; a SpecError naming the path otherwise."""
+    node: Any = data
+    for i, part in enumerate(path):
+        last = i == len(path) - 1
+        if isinstance(node, list):
+            if not part.isdigit() or int(part) >= len(node):
+                raise SpecError(
+                    f"cannot set {'.'.join(path)}: {'.'.join(path[:i])} has entries 0 to {len(node) - 1}, "
+                    f"not {part!r}",
+                    source=source,
+                )
+            part = int(part)
+        elif not isinstance(node, dict):
+            raise SpecError(
+                f"cannot set {'.'.join(path)}: {'.'.join(path[:i])} is not a mapping or a list", source=source
+            )
+        elif not create and part not in node:
+            raise SpecError(f"cannot set {'.'.join(path)}: no field {'.'.join(path[: i + 1])}", source=source)
+        if last:
+            node[part] = value
+            return
+        if isinstance(node, dict) and node.get(part) is None:
+            node[part] = {}
+        node = node[part]
 
 
 def apply_overrides(data: dict[str, Any], assignments: Iterable[str]) -> dict[str, Any]:
@@ -69,19 +106,26 @@ def apply_overrides(data: dict[str, Any], assignments: Iterable[str]) -> dict[st
     data = json.loads(json.dumps(data))
     for assignment in assignments:
         path, value = parse_override(assignment)
-        node = data
-        for i, part in enumerate(path[:-1]):
-            child = node.get(part) if isinstance(node, dict) else None
-            if child is None:
-                child = node.setdefault(part, {}) if isinstance(node, dict) else None
-            if not isinstance(child, dict):
-                raise SpecError(
-                    f"cannot set {'.'.join(path)}: {'.'.join(path[: i + 1])} is not a mapping",
-                    source="--set",
-                )
-            node = child
-        node[path[-1]] = value
+        set_path(data, path, value, create=True, source="--set")
     return data
+
+
+def with_values(spec: SpecBase, values: Mapping[str, Any]) -> SpecBase:
+    """``spec`` with each runtime parameter or dotted field in ``values`` set, validated as at load
+    (the code path of ``--set``); an unknown name is a SpecError naming it and the nearest one."""
+    data = spec.model_dump(mode="json")
+    for name, value in values.items():
+        path = override_path(spec.parameter_path(name), source=spec.source)
+        try:
+            set_path(data, path, value, create=False, source=spec.source)
+        except SpecError:
+            known = list(spec.runtime_parameters())
+            near = difflib.get_close_matches(name, known, n=1)
+            hint = f"; did you mean {near[0]!r}?" if near else f" (runtime parameters: {', '.join(known)})"
+            raise SpecError(
+                f"unknown parameter {name!r}: no such field{hint}", field=name, source=spec.source
+            ) from None
+    return spec_from_dict(data, source=spec.source).with_source(spec.source, spec.file_hash)
 
 
 def _valid_keys(model: type[BaseModel] | None, loc: tuple[Any, ...]) -> list[str]:

@@ -12,9 +12,8 @@ from typing import ClassVar, Literal
 
 from pydantic import Field
 
-from gamespec.backend import Backend, CompiledModel
-from gamespec.errors import SpecError
-from gamespec.loader import spec_from_dict
+from gamespec.backend import Backend, CompiledModel, Inputs, refuse_inputs
+from gamespec.loader import with_values
 from gamespec.result import Result, Status
 from gamespec.specs.base import SpecBase, StrictModel
 from gamespec_geometric.simulation import Trajectories, simulate
@@ -29,26 +28,19 @@ class GeometricOptions(StrictModel):
 
 
 class CompiledScenario(CompiledModel):
-    """A scenario ready to simulate; ``parameters`` may override ``capture_radius``, ``time_step``
-    and ``horizon``."""
-
-    TUNABLE: ClassVar[tuple[str, ...]] = ("capture_radius", "time_step", "horizon")
+    """A scenario ready to simulate; ``parameters`` set fields by dotted path (the runtime parameters
+    of :class:`PursuitScenarioSpec`: ``capture_radius``, ``time_step`` and ``horizon``)."""
 
     def __init__(self, spec: PursuitScenarioSpec, options: GeometricOptions) -> None:
         self.spec = spec
         self.options = options
 
-    def solve(self, parameters: dict[str, float] | None = None, guess: Result | None = None) -> Result:
+    def solve(
+        self, parameters: dict[str, float] | None = None, guess: Result | None = None, inputs: Inputs = None
+    ) -> Result:
         """Simulate (``guess`` is not used: the simulation has no iterate to warm-start)."""
-        unknown = set(parameters or {}) - set(self.TUNABLE)
-        if unknown:
-            raise SpecError(
-                f"unknown parameter(s) {', '.join(sorted(unknown))} (tunable: {', '.join(self.TUNABLE)})",
-                field="parameters",
-            )
-        spec = self.spec
-        if parameters:
-            spec = spec_from_dict({**spec.model_dump(), **parameters}, source=spec.source)
+        refuse_inputs(inputs, self.spec.kind)
+        spec = with_values(self.spec, parameters) if parameters else self.spec
         start = time.perf_counter()
         run = simulate(spec, method=self.options.active_check, samples=self.options.pp_samples)
         return scenario_result(spec, run, time.perf_counter() - start)

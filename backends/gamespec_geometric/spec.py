@@ -15,7 +15,6 @@ from typing import Annotated, ClassVar, Literal
 import numpy as np
 from pydantic import (
     Field,
-    FiniteFloat,
     ValidationError,
     ValidatorFunctionWrapHandler,
     field_validator,
@@ -23,11 +22,11 @@ from pydantic import (
 )
 
 from gamespec.errors import ExpressionError, SpecError
-from gamespec.specs.base import SpecBase, StrictModel
+from gamespec.specs.base import Number, SpecBase, StrictModel
 from gamespec.symbolic.language import parse
 
-Position = tuple[FiniteFloat, FiniteFloat]
-PositiveFloat = Annotated[float, Field(gt=0, allow_inf_nan=False)]
+Position = tuple[Number, Number]
+PositiveFloat = Annotated[Number, Field(gt=0)]
 
 
 def _constant(value: object) -> object:
@@ -155,6 +154,11 @@ class PursuitScenarioSpec(SpecBase):
     allocation: Literal["auto", "avaa", "a2"] = "auto"
 
     default_backend: ClassVar[str] = "geometric"
+
+    def runtime_parameters(self) -> dict[str, float]:
+        """The simulation's capture radius, time step and horizon (what a compiled scenario re-runs
+        with)."""
+        return {"capture_radius": self.capture_radius, "time_step": self.time_step, "horizon": self.horizon}
 
     @model_validator(mode="after")
     def _consistent(self) -> PursuitScenarioSpec:

@@ -1,4 +1,5 @@
-"""``gamespec pursuit ...``: commands of the pursuit-evasion area (mounted in :mod:`gamespec.cli`)."""
+"""``gamespec pursuit ...``: commands of the pursuit-evasion area (registered in the
+``gamespec.commands`` entry-point group, mounted by :mod:`gamespec.cli`)."""
 
 from __future__ import annotations
 

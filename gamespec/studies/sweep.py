@@ -2,7 +2,9 @@
 
 A job carries the validated spec as JSON and the point's parameter values (no file path, so a
 cluster without a shared filesystem works); each worker compiles a spec once, cached by its hash,
-and re-solves it for every point it gets. Every finished point goes into a :class:`ResultStore`, so
+and re-solves it for every point it gets, with the values named as the file names them
+(``evader.speed``, ``pursuers.1.speed``, an OCP parameter ``rho``) and validated as at load (see
+:meth:`gamespec.solving.Solver.solve`). Every finished point goes into a :class:`ResultStore`, so
 a sweep resumes. Points are keyed by the backend, the hash of the (overridden) spec and the
 parameter values, so a folder shared by different sweeps never mixes them up; failed points are
 solved again on a rerun.
@@ -85,10 +87,11 @@ def sweep(
     show_progress: bool = True,
 ) -> StudyRun:
     """Solve ``path`` on the Cartesian product of ``ranges``; the run's values in grid order."""
-    from gamespec.loader import load, spec_hash
+    from gamespec.loader import load, spec_hash, with_values
     from gamespec.solving import backend_name
 
     spec = load(path, overrides)
+    with_values(spec, {name: values[0] for name, values in ranges})
     digest = spec_hash(spec)
     spec_json = json.dumps(spec.model_dump(mode="json"))
     problem = f"{backend_name(spec, backend)}/{digest}"

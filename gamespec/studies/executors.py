@@ -17,6 +17,7 @@ import signal
 import sys
 import threading
 import time
+from collections import deque
 from collections.abc import Callable, Iterable, Iterator, Sequence
 from concurrent.futures import FIRST_COMPLETED, Future, ProcessPoolExecutor, wait
 from concurrent.futures.process import BrokenProcessPool
@@ -142,30 +143,33 @@ class ProcessExecutor:
 
     def _run(self, fn: Callable[[T], R], pending: Iterator[T]) -> Iterator[tuple[T, R]]:
         running: dict[Future[R], T] = {}
+        lost: deque[T] = deque()
         restarts = 0
         while True:
-            while len(running) < 2 * self.workers:
-                item = next(pending, _END)
-                if item is _END:
-                    break
-                running[self._pool.submit(fn, item)] = item
-            if not running:
-                return
-            done, _ = wait(running, return_when=FIRST_COMPLETED)
             try:
+                while len(running) < 2 * self.workers:
+                    item = lost.popleft() if lost else next(pending, _END)
+                    if item is _END:
+                        break
+                    try:
+                        running[self._pool.submit(fn, item)] = item
+                    except BrokenProcessPool:
+                        lost.appendleft(item)
+                        raise
+                if not running:
+                    return
+                done, _ = wait(running, return_when=FIRST_COMPLETED)
                 for future in done:
                     value = future.result()
                     yield running.pop(future), value
             except BrokenProcessPool:
                 restarts += 1
                 if restarts > self.restarts:
-                    raise GamespecError(
-                        f"local workers died {restarts} times in one run; giving up"
-                    ) from None
-                lost = list(running.values())
+                    raise GamespecError(f"local workers died {restarts} times in one run") from None
+                lost.extend(running.values())
+                running = {}
                 self._pool.shutdown(wait=False, cancel_futures=True)
                 self._pool = self._start()
-                running = {self._pool.submit(fn, item): item for item in lost}
 
 
 _END: Any = object()

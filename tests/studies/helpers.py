@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import os
 import signal
+import sys
 import time
 from pathlib import Path
 
@@ -19,7 +20,8 @@ def slow_square(x: int) -> int:
 
 def announce_and_sleep(seconds: float) -> int:
     """Print this worker's PID on stdout (the worker is past its initializer), then sleep."""
-    print(os.getpid(), flush=True)
+    sys.stdout.write(f"{os.getpid()}\n")  # one write: two workers share the pipe
+    sys.stdout.flush()
     time.sleep(seconds)
     return os.getpid()
 

@@ -14,7 +14,7 @@ import platform
 import socket
 import sys
 from collections.abc import Callable, Mapping
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from functools import cache
 from importlib.metadata import PackageNotFoundError, version
 from typing import Any
@@ -61,7 +61,6 @@ class StudyRun:
     values: dict[str, Any]
     computed: int
     reused: int
-    damaged: list[str] = field(default_factory=list)
 
 
 def _evaluate_chunk(job: tuple[Callable[[Any], Any], list[tuple[str, Any]]]) -> list[tuple[str, Any, dict]]:
@@ -92,8 +91,7 @@ def run_study(
     """
     say = report or (lambda line: print(line, file=sys.stderr))
     saved = store.items()
-    damaged = list(store.damaged)
-    for line in damaged:
+    for line in store.damaged:
         say(line)
     done = {key for key, value in saved.items() if accept is None or accept(value)}
     todo = [(key, point) for key, point in points.items() if key not in done]
@@ -112,4 +110,4 @@ def run_study(
             progress.advance(task, len(records))
     saved = store.items()
     values = {key: saved[key] for key in points if key in saved}
-    return StudyRun(values, computed=len(todo), reused=reused, damaged=damaged)
+    return StudyRun(values, computed=len(todo), reused=reused)

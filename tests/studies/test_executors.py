@@ -92,3 +92,23 @@ def test_chunks_cover_every_point_once(workers) -> None:
         size = chunk_size(points, workers)
         assert 1 <= size <= MAX_CHUNK
         assert workers > 1 or size == 1
+
+
+def test_a_worker_compiles_a_spec_once_and_resolves_per_point(tmp_path, monkeypatch) -> None:
+    import gamespec.solving
+    from gamespec.studies import sweep
+
+    compiled: list[str] = []
+    real = gamespec.solving.compile_spec
+
+    def counted(spec, backend=None, options=None):
+        compiled.append(spec.name)
+        return real(spec, backend, options)
+
+    monkeypatch.setattr(gamespec.solving, "compile_spec", counted)
+    monkeypatch.setattr(sweep, "_COMPILED", {})
+    path = PROBLEMS / "ch2" / "one_on_one_pure_evasion.yaml"
+    run = sweep.sweep(path, [("v", [0.3, 0.4, 0.5, 0.6])], out=tmp_path, show_progress=False)
+    assert len(run.values) == 4 and len(compiled) == 1
+    for row in run.values.values():
+        assert row["t_final"] == pytest.approx((1.0 - 0.001) / (1.0 - row["v"]), abs=1e-6)

@@ -271,7 +271,8 @@ def plot(
     animate: Annotated[bool, typer.Option(help="Also write an animation where the kind has one.")] = False,
 ) -> None:
     """Draw a saved Result (states, controls, paths; kind-specific figures), or a study folder
-    (a sweep: outputs against each parameter; a compare: bars per backend)."""
+    (a sweep: outputs against each parameter, and the cost/sensitivity trade-off when its points are
+    desensitized Results; a compare: bars per backend)."""
     from gamespec.plotting import plot_result
     from gamespec.studies.store import ResultStore, is_store
 

@@ -2,6 +2,7 @@
 
 - a sweep: ``sweep_<parameter>.png`` per swept parameter, each output (objective, t_f, and the
   capture times of a Table 2.1 study) against it, one line per combination of the other parameters;
+  and ``tradeoff.png`` (Fig. 6.3(b)) when its points are desensitized Results;
 - a compare: ``compare.png``, bars per backend of the objective and the solve time.
 
 Read from the store only (:mod:`gamespec.studies.export`), never from solver objects.
@@ -19,6 +20,7 @@ import matplotlib
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt
 
+from gamespec.desensitize.plotting import desensitized_rows, plot_tradeoff
 from gamespec.errors import GamespecError
 from gamespec.studies.export import study_rows
 from gamespec.studies.store import ResultStore
@@ -94,5 +96,9 @@ def plot_study(store: ResultStore, output_dir: str | Path) -> list[Path]:
     if study.get("type") == "compare":
         return _compare(rows, folder)
     if study.get("type") == "sweep":
-        return _sweep(rows, list(study.get("parameters", [])), folder)
+        paths = _sweep(rows, list(study.get("parameters", [])), folder)
+        values = [v for v in store.items().values() if isinstance(v, dict)]
+        if desensitized_rows(values):
+            paths += plot_tradeoff(values, folder)
+        return paths
     raise GamespecError(f"{store.folder}: not a sweep or a compare study")

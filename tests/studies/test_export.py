@@ -83,3 +83,12 @@ def test_compare_is_stored_tabled_and_plotted(cli, tmp_path) -> None:
 def test_results_of_a_folder_without_a_study_is_exit_2(cli, tmp_path) -> None:
     code, _, err = cli("results", tmp_path)
     assert code == 2 and "no study results here" in err and err.count("\n") == 1
+
+
+def test_plot_of_a_desensitized_sweep_adds_the_tradeoff(cli, tmp_path) -> None:
+    path = PROBLEMS / "ch6" / "zermelo_final_state_desensitized.yaml"
+    code, _, err = cli("sweep", path, "--param", "alpha=0,75", "--out", tmp_path)
+    assert code == 0, err
+    code, _, err = cli("plot", tmp_path)
+    assert code == 0, err
+    assert (tmp_path / "sweep_alpha.png").exists() and (tmp_path / "tradeoff.png").exists()

@@ -30,7 +30,14 @@ def study(
         Path | None,
         typer.Option(help="Save the Result and table_2_1.png here, and the points in OUT/points."),
     ] = None,
-    workers: Annotated[int | None, typer.Option(min=1, help="Local processes (default: the file's).")] = None,
+    workers: Annotated[int | None, typer.Option(min=1, help="Processes (default: the file's).")] = None,
+    executor: Annotated[
+        str | None, typer.Option(help="serial, process or dask (default: the file's, else by --workers).")
+    ] = None,
+    scheduler: Annotated[
+        str | None,
+        typer.Option(envvar="GAMESPEC_SCHEDULER", help="Address of a running Dask scheduler."),
+    ] = None,
     set_: Annotated[
         list[str] | None, typer.Option("--set", help="Override a value: dotted.path=value (repeatable).")
     ] = None,
@@ -50,7 +57,8 @@ def study(
     if spec.kind != "pursuit_suboptimal_study":
         reason = f"expected kind 'pursuit_suboptimal_study', got {spec.kind!r}"
         raise SpecError(reason, field="kind", source=str(file))
-    options = {"progress": True} | ({"workers": workers} if workers is not None else {})
+    chosen = {"workers": workers, "executor": executor, "scheduler": scheduler}
+    options = {"progress": True} | {name: value for name, value in chosen.items() if value is not None}
     result = solve(spec, options=options)
     if out is not None:
         result.save(out)

@@ -1,10 +1,10 @@
 """Lazy plugin registries read from entry points (after pluggy's ``_importlib_metadata``).
 
 Groups: ``gamespec.kinds`` (spec classes by ``kind``), ``gamespec.backends`` (backend classes by
-name), ``gamespec.transforms`` (spec → spec reductions), ``gamespec.plotters`` (plot functions by kind),
-``gamespec.summaries`` (the rows that lead a kind's solve summary) and ``gamespec.commands`` (Typer
-apps mounted as ``gamespec NAME``). Nothing is imported until it is asked for, so ``import gamespec``
-stays light.
+name), ``gamespec.transforms`` (spec → spec reductions), ``gamespec.plotters`` (plot functions by
+kind), ``gamespec.summaries`` (the rows that lead a kind's solve summary), ``gamespec.executors``
+(how a study runs its points) and ``gamespec.commands`` (Typer apps mounted as ``gamespec NAME``).
+Nothing is imported until it is asked for, so ``import gamespec`` stays light.
 """
 
 from __future__ import annotations
@@ -21,6 +21,7 @@ GROUPS = (
     "gamespec.transforms",
     "gamespec.plotters",
     "gamespec.summaries",
+    "gamespec.executors",
     "gamespec.commands",
 )
 

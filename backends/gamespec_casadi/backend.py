@@ -13,7 +13,7 @@ import time
 from typing import Any, ClassVar
 
 import numpy as np
-from pydantic import Field
+from pydantic import Field, ValidationInfo, field_validator
 
 from gamespec.backend import Availability, Inputs
 from gamespec.errors import BackendError
@@ -27,7 +27,7 @@ STATUS_MAP = {
     "Solve_Succeeded": Status.OPTIMAL,
     "Solved_To_Acceptable_Level": Status.FEASIBLE,
     "Feasible_Point_Found": Status.FEASIBLE,
-    "Infeasible_Problem_Detected": Status.INFEASIBLE,
+    "Infeasible_Problem_Detected": Status.LOCALLY_INFEASIBLE,
     "Diverging_Iterates": Status.UNBOUNDED,
     "Maximum_Iterations_Exceeded": Status.ITERATION_LIMIT,
     "Maximum_CpuTime_Exceeded": Status.TIME_LIMIT,
@@ -36,6 +36,8 @@ STATUS_MAP = {
     "Error_In_Step_Computation": Status.NUMERICAL_ERROR,
     "Invalid_Number_Detected": Status.NUMERICAL_ERROR,
 }
+"""IPOPT's return status → gamespec's Status. IPOPT is a local solver: ``Infeasible_Problem_Detected``
+means it converged to a point of local infeasibility, hence ``locally_infeasible``."""
 
 
 class CasadiOptions(StrictModel):
@@ -46,6 +48,16 @@ class CasadiOptions(StrictModel):
     max_iter: int = Field(3000, ge=1)
     ipopt: dict[str, Any] = Field(default_factory=dict, description="Further IPOPT options.")
     warm_start: bool = Field(True, description="Re-solves start from the previous solution.")
+
+    @field_validator("ipopt")
+    @classmethod
+    def _known_to_ipopt(cls, ipopt: dict[str, Any], info: ValidationInfo) -> dict[str, Any]:
+        """``ipopt`` holds options IPOPT itself knows and accepts (checked against its own list)."""
+        if ipopt and info.data.get("solver") == "ipopt":
+            from gamespec_casadi.ipopt_options import check_ipopt_options
+
+            check_ipopt_options(ipopt)
+        return ipopt
 
 
 def casadi_library(ca: Any) -> Library:

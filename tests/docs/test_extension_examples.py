@@ -42,9 +42,8 @@ def test_new_kind_and_backend(projectile) -> None:
 
 
 def test_bad_backend_option_names_the_field(projectile) -> None:
-    spec = gamespec.load(EXAMPLES / "projectile.yaml", ["solver.options.ballistic.samples=1"])
     with pytest.raises(gamespec.SpecError, match=r"solver\.options\.ballistic\.samples"):
-        gamespec.solve(spec)
+        gamespec.solve(gamespec.load(EXAMPLES / "projectile.yaml", ["solver.options.ballistic.samples=1"]))
 
 
 def test_new_transform_lowers_to_an_ocp_that_casadi_integrates(projectile) -> None:

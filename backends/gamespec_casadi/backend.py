@@ -16,8 +16,9 @@ import numpy as np
 from pydantic import Field, ValidationInfo, field_validator
 
 from gamespec.backend import Availability, Inputs
+from gamespec.backend.collocation import CollocationBackend, CollocationModel
 from gamespec.errors import BackendError
-from gamespec.ocp.transcription import CollocationBackend, CollocationModel, Guess, Transcription
+from gamespec.ocp.transcription import Guess, Transcription
 from gamespec.result import Result, Status
 from gamespec.specs.base import StrictModel
 from gamespec.specs.ocp import OptimalControlSpec

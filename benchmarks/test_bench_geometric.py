@@ -16,10 +16,12 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-from gamespec_geometric import active_pursuers
+import yaml
+from gamespec_geometric import active_pursuers, allocation, simulation
 from gamespec_geometric.simulation import simulate
 
 from gamespec.loader import spec_from_dict
+from tests.conftest import PROBLEMS
 
 SIZES = [10, 100, 1_000, 10_000]
 
@@ -71,3 +73,35 @@ def test_mpme_step_100_on_50(benchmark, strategy: str) -> None:
     )
     run = benchmark(simulate, spec)
     assert len(run.time) == 2
+
+
+def _ten_on_five_copy(pursuers: int, evaders: int, steps: int) -> dict:
+    """``problems/ch3/mpme_ten_on_five.yaml`` (AVAA, CB, blind evaders) with random teams of a given size."""
+    data = yaml.safe_load((PROBLEMS / "ch3" / "mpme_ten_on_five.yaml").read_text())
+    if pursuers != len(data["pursuers"]["positions"]):
+        rng = np.random.default_rng(5)
+        data["pursuers"]["positions"] = rng.uniform(-50, 50, (pursuers, 2)).tolist()
+        data["evaders"]["positions"] = rng.uniform(-50, 50, (evaders, 2)).tolist()
+    data["horizon"] = steps * data["time_step"]
+    return data
+
+
+def _one_evader_at_a_time(pursuers, evaders, u, v, *, algorithm, strategy, method, samples):
+    """The allocation with the active sets checked evader by evader (the path before issue 16)."""
+    cost = allocation.tie_break_cost(pursuers, evaders, u, v, algorithm)
+    check = allocation._one_by_one(pursuers, evaders, u, v, strategy, method, samples)
+    return allocation._iterate(cost, check, len(pursuers) + 1)
+
+
+@pytest.mark.parametrize("case", ["10 x 5", "100 x 50", "100 x 50, one evader at a time"])
+def test_mpme_copy_steps(benchmark, monkeypatch, case: str) -> None:
+    """Issue 16: the 100 × 50 copy of the ten-on-five file at ≤ 20 ms per step (20 steps here), with
+    the file itself and the evader-by-evader allocation as baselines; allocations agree."""
+    benchmark.group = "MPME ten-on-five copies, 20 steps"
+    size = (10, 5) if case == "10 x 5" else (100, 50)
+    spec = spec_from_dict(_ten_on_five_copy(*size, steps=20))
+    expected = simulate(spec).allocation
+    if "one evader" in case:
+        monkeypatch.setattr(simulation, "allocate", _one_evader_at_a_time)
+    run = benchmark.pedantic(simulate, (spec,), rounds=3, warmup_rounds=1)
+    np.testing.assert_array_equal(run.allocation, expected)

@@ -49,7 +49,7 @@ from gamespec_geometric.apollonius import (
 
 Strategy = Literal["cb", "pp"]
 Method = Literal["fast", "reference"]
-_ROUND_OFF = 1e-12
+ROUND_OFF = 1e-12
 _FLAT = 1e-12
 
 
@@ -147,7 +147,7 @@ def _circle_crosses_edge(
     s = np.clip(-slope / np.maximum(curvature, np.finfo(float).tiny), 0.0, end)
     lowest = power0 + 2 * s * slope + s**2 * curvature
     power1 = np.where(np.isfinite(end), power0 + 2 * slope + curvature, np.inf)
-    return (lowest <= _ROUND_OFF) & (np.maximum(power0, power1) >= -_ROUND_OFF)
+    return (lowest <= ROUND_OFF) & (np.maximum(power0, power1) >= -ROUND_OFF)
 
 
 _Edges = tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray]
@@ -249,7 +249,7 @@ def _farthest_power_edges(
     listed once per lower facet that holds it.
     """
     normals = hull.equations[:, :3]
-    lower = normals[:, 2] < -_ROUND_OFF
+    lower = normals[:, 2] < -ROUND_OFF
     vertex = np.zeros((len(normals), 2))
     vertex[lower] = normals[lower, :2] / normals[lower, 2:3]
     facets = np.flatnonzero(lower)

@@ -1,5 +1,8 @@
 """The command line (DESIGN.md, "CLI"): validate, solve, compare, show, plot, schema, backends.
 
+Area commands (``gamespec pursuit ...``) are Typer apps registered in the ``gamespec.commands``
+entry-point group, mounted under their entry-point name; the core imports none of them by name.
+
 Bad input is exit code 2 with one line on stderr; a solve that fails is exit code 1 with one line
 saying why; tracebacks are for bugs only.
 """
@@ -8,9 +11,11 @@ from __future__ import annotations
 
 import json
 import sys
+import warnings
 from pathlib import Path
 from typing import Annotated
 
+import numpy as np
 import typer
 import yaml
 from rich.console import Console
@@ -20,7 +25,6 @@ from rich.table import Table
 from gamespec import registry
 from gamespec.errors import GamespecError
 from gamespec.loader import load
-from gamespec.pursuit.cli import pursuit_app
 from gamespec.result import Result, writable_folder
 from gamespec.studies.compare import (
     LEGEND,
@@ -37,7 +41,8 @@ app = typer.Typer(
 )
 console = Console()
 err_console = Console(stderr=True)
-app.add_typer(pursuit_app, name="pursuit")
+for _area in registry.names("gamespec.commands"):
+    app.add_typer(registry.load("gamespec.commands", _area), name=_area)
 
 FileArg = Annotated[Path, typer.Argument(help="Problem file (.yaml, .toml or .json).")]
 SetOpt = Annotated[
@@ -84,7 +89,8 @@ def solve(
         from gamespec.plotting import plot_result
 
         for path in plot_result(result, out or Path(".")):
-            err_console.print(f"wrote {path}")
+            if not json_:
+                console.print(f"wrote {path}", markup=False, highlight=False)
     if json_:
         sys.stdout.write(result.to_json() + "\n")
     else:
@@ -180,15 +186,9 @@ def show(
     """Print the (validated, optionally transformed) problem as YAML."""
     spec = load(file, set_ or [])
     if transformed:
-        from gamespec.solving import backend_name, get_backend
-        from gamespec.transforms.base import chain_to
+        from gamespec.solving import transformed as transformed_spec
 
-        target = get_backend(backend_name(spec, backend))
-        chain = chain_to(spec, target.kinds)
-        if chain is None:
-            raise GamespecError(f"backend {target.name!r} cannot take kind {spec.kind!r}")
-        for transform in chain:
-            spec, _ = transform.apply(spec)
+        spec = transformed_spec(spec, backend)
     data = spec.model_dump(mode="json", exclude_defaults=False)
     sys.stdout.write(yaml.safe_dump(data, sort_keys=False, allow_unicode=True))
 
@@ -199,9 +199,16 @@ def plot(
     out: OutOpt = None,
     animate: Annotated[bool, typer.Option(help="Also write an animation where the kind has one.")] = False,
 ) -> None:
-    """Draw a saved Result (states, controls, paths; kind-specific figures)."""
+    """Draw a saved Result (states, controls, paths; kind-specific figures), or a sweep folder's
+    cost/sensitivity trade-off when its points are desensitized Results."""
     from gamespec.plotting import plot_result
 
+    if (result / "points").is_dir():
+        from gamespec.desensitize.plotting import plot_tradeoff
+
+        for path in plot_tradeoff(result, writable_folder(out or result)):
+            console.print(f"wrote {path}")
+        return
     loaded = Result.load(result)
     folder = writable_folder(out or (result if result.is_dir() else result.parent))
     for path in plot_result(loaded, folder, animate=animate):
@@ -243,16 +250,37 @@ def backends() -> None:
     console.print(table)
 
 
+_ClickException = next(c for c in typer.BadParameter.__mro__ if c.__name__ == "ClickException")
+"""Click's root exception (vendored by recent typer, a separate package before): usage errors."""
+
+
 def run(argv: list[str] | None = None) -> int:
-    """Run the CLI on ``argv`` and return the exit code (user errors → 2, one line on stderr)."""
+    """Run the CLI on ``argv`` and return the exit code: user errors and usage errors → 2 with one
+    line on stderr. Warnings (numpy's, a solver's) are not printed: what a solve found is in its
+    Result's status, message and checks."""
+    command = typer.main.get_command(app)
     try:
-        app(args=argv, prog_name="gamespec")
+        with warnings.catch_warnings(), np.errstate(all="ignore"):
+            warnings.simplefilter("ignore")
+            code = command.main(args=argv, prog_name="gamespec", standalone_mode=False)
     except SystemExit as exit_:
         return exit_.code if isinstance(exit_.code, int) else (0 if exit_.code is None else 1)
     except GamespecError as err:
-        print(f"error: {err}", file=sys.stderr)
+        print(f"error: {_one_line(str(err))}", file=sys.stderr)
         return 2
-    return 0
+    except _ClickException as err:
+        message = _one_line(err.format_message())
+        if message:
+            print(f"error: {message} (see 'gamespec --help')", file=sys.stderr)
+        return err.exit_code
+    except typer.Abort:
+        print("error: aborted", file=sys.stderr)
+        return 1
+    return code if isinstance(code, int) else 0
+
+
+def _one_line(text: str) -> str:
+    return " ".join(text.split())
 
 
 def main() -> None:

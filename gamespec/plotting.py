@@ -40,7 +40,8 @@ def plot_trajectories(result: Result, output_dir: Path, *, animate: bool = False
         axes[1, 0].set_ylabel("controls")
         axes[1, 0].legend(loc="best")
     axes[-1, 0].set_xlabel("t")
-    fig.suptitle(f"{result.problem} — {result.backend}, {result.status.value}, J = {result.objective:.6g}")
+    objective = "" if result.objective is None else f", J = {result.objective:.6g}"
+    fig.suptitle(f"{result.problem} — {result.backend}, {result.status.value}{objective}")
     fig.tight_layout()
     paths = [output_dir / f"{result.problem}_time.png"]
     fig.savefig(paths[0], dpi=120)
@@ -61,6 +62,10 @@ def plot_trajectories(result: Result, output_dir: Path, *, animate: bool = False
             plt.close(fig)
             paths.append(path)
             break
+    if "desensitization" in result.metrics:
+        from gamespec.desensitize.plotting import plot_desensitized
+
+        paths += plot_desensitized(result, output_dir)
     return paths
 
 

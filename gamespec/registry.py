@@ -1,8 +1,9 @@
 """Lazy plugin registries read from entry points (after pluggy's ``_importlib_metadata``).
 
 Groups: ``gamespec.kinds`` (spec classes by ``kind``), ``gamespec.backends`` (backend classes by
-name), ``gamespec.transforms`` (spec → spec reductions) and ``gamespec.plotters`` (plot functions by
-kind). Nothing is imported until it is asked for, so ``import gamespec`` stays light.
+name), ``gamespec.transforms`` (spec → spec reductions), ``gamespec.plotters`` (plot functions by
+kind) and ``gamespec.commands`` (Typer apps of area commands, by sub-command name). Nothing is
+imported until it is asked for, so ``import gamespec`` stays light.
 """
 
 from __future__ import annotations
@@ -13,7 +14,13 @@ from typing import Any
 
 from gamespec.errors import BackendError, SpecError
 
-GROUPS = ("gamespec.kinds", "gamespec.backends", "gamespec.transforms", "gamespec.plotters")
+GROUPS = (
+    "gamespec.kinds",
+    "gamespec.backends",
+    "gamespec.transforms",
+    "gamespec.plotters",
+    "gamespec.commands",
+)
 
 
 @cache

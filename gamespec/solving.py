@@ -1,8 +1,18 @@
-"""The solving chain: spec → (transforms) → backend model → Result (DESIGN.md, stages 2–4).
+"""The solving chain: spec → requested → lowering transforms → backend model → Result (DESIGN.md,
+stages 2–4).
 
-:func:`compile_spec` picks the backend, finds the transforms that take the spec to a kind the
-backend solves, compiles once, and returns a :class:`Solver` that re-solves with new parameter
-values and warm starts. :func:`solve` is the one-shot form.
+:func:`compile_spec` picks the backend, applies the transforms the file requests (in its order) and
+then the lowering transforms that take the spec to a kind the backend solves, solving first the
+upstream stage of any staged transform; it compiles the target once and returns a :class:`Solver`.
+
+:meth:`Solver.solve` takes runtime parameters by the **source** spec's names (every field a user
+can see, by dotted path, and a kind's short names such as an ``optimal_control`` parameter): it sets
+them as ``--set`` would and re-validates the source spec, re-applies the (pure) transforms, checks
+that the target changed in runtime parameter values only (else a SpecError naming the parameters),
+and re-solves the compiled model with the target's values — cvxpy's ``update_parameters``. When the
+last transform's :meth:`~gamespec.transforms.base.Transform.verify` rejects the mapped-back Result,
+the same compiled model is re-solved from that transform's ``restarts`` (multi-start) with the
+caller's parameters and inputs, and the best verified Result is kept.
 """
 
 from __future__ import annotations
@@ -17,11 +27,11 @@ from typing import Any
 
 from gamespec import registry
 from gamespec.backend import Backend, CompiledModel, Inputs
-from gamespec.errors import BackendError, UnsupportedFeature
-from gamespec.loader import load, spec_hash
-from gamespec.result import Provenance, Result
-from gamespec.specs.base import SpecBase
-from gamespec.transforms.base import Transform, chain_to
+from gamespec.errors import BackendError, SpecError, UnsupportedFeature
+from gamespec.loader import load, spec_hash, with_values
+from gamespec.result import Provenance, Result, Status
+from gamespec.specs.base import SpecBase, StrictModel
+from gamespec.transforms.base import Transform, lowering_path, requested_steps
 
 
 def get_backend(name: str) -> Backend:
@@ -58,32 +68,168 @@ def _versions(backend: Backend) -> dict[str, str]:
     }
 
 
+@dataclass(frozen=True)
+class Step:
+    """One applied transform: ``source`` → ``target`` with ``options``; ``inverse`` is its inverse
+    data and ``upstream`` the compiled upstream stage it took a Result from (None if not staged)."""
+
+    transform: Transform
+    options: StrictModel
+    source: SpecBase
+    target: SpecBase
+    inverse: Any
+    upstream: Solver | None = None
+
+
+def _applied(
+    transform: Transform, options: StrictModel, spec: SpecBase, upstream: Solver | None = None
+) -> Step:
+    """Apply one transform to ``spec`` (solving its upstream stage on ``upstream``, or compiling
+    that stage first when ``upstream`` is None and the transform is staged)."""
+    if not transform.accepts(spec):
+        raise UnsupportedFeature(f"transform {transform.name!r} does not accept problem {spec.name!r}")
+    stage = transform.stage(spec, options)
+    stage_result = None
+    if stage is not None:
+        if upstream is None:
+            upstream = compile_spec(stage.spec, stage.backend)
+            stage_result = upstream.solve()
+        else:
+            stage_result = upstream.solve_spec(stage.spec)
+    target, inverse = transform.apply(spec, options, stage_result)
+    return Step(transform, options, spec, target, inverse, upstream)
+
+
+def _unrequested(spec: SpecBase) -> SpecBase:
+    """``spec`` with an empty ``transforms:`` section: what its first transform receives, so that
+    the spec the backend gets does not ask for them again."""
+    return spec.model_copy(update={"transforms": []}) if spec.transforms else spec
+
+
+def build_steps(spec: SpecBase, backend: Backend) -> list[Step]:
+    """The requested transforms of ``spec`` in order, then the lowering ones to a kind ``backend``
+    solves."""
+    steps: list[Step] = []
+    current = _unrequested(spec)
+    for transform, options in requested_steps(spec):
+        steps.append(_applied(transform, options, current))
+        current = steps[-1].target
+    lowering = lowering_path(current, backend.kinds)
+    if lowering is None:
+        raise UnsupportedFeature(f"backend {backend.name!r} does not solve kind {spec.kind!r}")
+    for transform in lowering:
+        steps.append(_applied(transform, transform.options_model(), current))
+        current = steps[-1].target
+    return steps
+
+
+def transformed(spec: SpecBase, backend: str | None = None) -> SpecBase:
+    """The spec the backend receives: ``spec`` after its requested and lowering transforms."""
+    steps = build_steps(spec, get_backend(backend_name(spec, backend)))
+    return steps[-1].target if steps else spec
+
+
+def _first_difference(a: Any, b: Any, path: tuple[str, ...] = ()) -> str | None:
+    """The dotted path of the first place two JSON-like values differ, None if they are equal."""
+    if isinstance(a, dict) and isinstance(b, dict):
+        for key in sorted(a.keys() | b.keys()):
+            found = _first_difference(a.get(key), b.get(key), (*path, str(key)))
+            if found is not None:
+                return found
+        return None
+    if isinstance(a, list) and isinstance(b, list) and len(a) == len(b):
+        for i, (x, y) in enumerate(zip(a, b, strict=True)):
+            found = _first_difference(x, y, (*path, str(i)))
+            if found is not None:
+                return found
+        return None
+    return None if a == b else ".".join(path) or "<root>"
+
+
+def _better(candidate: Result, best: Result | None, sense: str) -> bool:
+    if best is None or best.objective is None:
+        return True
+    if candidate.objective is None:
+        return False
+    if sense == "maximize":
+        return candidate.objective > best.objective
+    return candidate.objective < best.objective
+
+
 @dataclass
 class Solver:
-    """A spec compiled for one backend; call :meth:`solve` as often as needed."""
+    """A spec compiled for one backend; call :meth:`solve` as often as needed (see module doc)."""
 
     spec: SpecBase
     backend: Backend
-    transforms: list[tuple[Transform, SpecBase, Any]]
+    steps: list[Step]
     compiled: CompiledModel
     build_time_s: float
 
     @property
     def target_spec(self) -> SpecBase:
         """The spec the backend actually solves (after transforms)."""
-        return self.transforms[-1][1] if self.transforms else self.spec
+        return self.steps[-1].target if self.steps else self.spec
 
     def solve(
-        self, parameters: dict[str, float] | None = None, guess: Result | None = None, inputs: Inputs = None
+        self,
+        parameters: dict[str, Any] | None = None,
+        guess: Result | None = None,
+        inputs: Inputs = None,
     ) -> Result:
-        """Solve (again) with optional new parameter values, an optional guess Result and new grid
-        input values (see :meth:`CompiledModel.solve`)."""
-        result = self.compiled.solve(parameters=parameters, guess=guess, inputs=inputs)
-        for transform, _new, inverse in reversed(self.transforms):
-            original = self._source_spec_of(transform)
-            result = transform.invert(result, original, inverse)
+        """Solve (again) with new values of the source spec's runtime parameters or dotted fields
+        (validated as at load), an optional guess Result of the target spec, and grid ``inputs``
+        passed to the compiled model unchanged."""
+        if not parameters:
+            return self._solve(self.spec, self.steps, guess, inputs)
+        return self.solve_spec(with_values(self.spec, parameters), guess, inputs, names=list(parameters))
+
+    def solve_spec(
+        self,
+        spec: SpecBase,
+        guess: Result | None = None,
+        inputs: Inputs = None,
+        names: list[str] | None = None,
+    ) -> Result:
+        """Solve ``spec``, the compiled source spec with other runtime parameter values, on the
+        compiled model; a SpecError (naming ``names``, the parameters that were set) when its target
+        differs from the compiled one in more than those values — or in its starting point, when
+        neither the caller nor the last transform gives the compiled model one."""
+        requested = [options for _, options in requested_steps(spec)]
+        steps = []
+        current = _unrequested(spec)
+        for index, old in enumerate(self.steps):
+            options = requested[index] if index < len(requested) else old.options
+            steps.append(_applied(old.transform, options, current, old.upstream))
+            current = steps[-1].target
+        last = steps[-1] if steps else None
+        started = guess is not None or (last is not None and last.transform.guess(last.inverse) is not None)
+        difference = _first_difference(
+            current.structure(with_guess=not started), self.target_spec.structure(with_guess=not started)
+        )
+        if difference is not None:
+            what = ", ".join(names) if names else "the new values"
+            raise SpecError(
+                f"{what} change(s) the compiled problem beyond its runtime parameters (field "
+                f"{difference} of the spec the backend solves); compile it again instead",
+                field=", ".join(names or []),
+                source=self.spec.source,
+            )
+        return self._solve(spec, steps, guess, inputs)
+
+    def _solve(self, spec: SpecBase, steps: list[Step], guess: Result | None, inputs: Inputs) -> Result:
+        target = steps[-1].target if steps else spec
+        values = target.runtime_parameters() or None
+        last = steps[-1] if steps else None
+        start = guess if guess is not None or last is None else last.transform.guess(last.inverse)
+        result = self.compiled.solve(parameters=values, guess=start, inputs=inputs)
+        for index in reversed(range(len(steps))):
+            step = steps[index]
+            result = step.transform.invert(result, step.source, step.inverse)
+            if result.ok:
+                result = self._verified(step, result, values, inputs, multistart=index == len(steps) - 1)
         provenance = Provenance(
-            spec_hash=spec_hash(self.spec),
+            spec_hash=spec_hash(spec),
             source=self.spec.source,
             file_hash=self.spec.file_hash,
             versions=_versions(self.backend),
@@ -92,17 +238,47 @@ class Solver:
         return result.model_copy(
             update={
                 "backend": self.backend.name,
-                "problem": self.spec.name,
-                "kind": self.spec.kind,
+                "problem": spec.name,
+                "kind": spec.kind,
                 "build_time_s": self.build_time_s,
+                "parameters": spec.runtime_parameters() or result.parameters,
                 "provenance": provenance,
             }
         )
 
-    def _source_spec_of(self, transform: Transform) -> SpecBase:
-        specs = [self.spec, *(s for _, s, _ in self.transforms)]
-        index = [t for t, _, _ in self.transforms].index(transform)
-        return specs[index]
+    def _restarted(self, step: Step, values: dict[str, float] | None, inputs: Inputs) -> Result | None:
+        """Multi-start: the best verified Result among re-solves of the compiled model from the
+        step's restarts (None if none verifies)."""
+        best = None
+        guesses = step.transform.restarts(step.source, step.inverse)
+        for number, start in enumerate(guesses, 1):
+            raw = self.compiled.solve(parameters=values, guess=start, inputs=inputs)
+            candidate = step.transform.invert(raw, step.source, step.inverse)
+            if not candidate.ok or step.transform.verify(candidate, step.source, step.inverse) is not None:
+                continue
+            if _better(candidate, best, step.source.objective_sense):
+                note = f"verified after a re-solve from starting point {number} of {len(guesses)}"
+                best = candidate.model_copy(update={"message": f"{candidate.message}; {note}"})
+        return best
+
+    def _verified(
+        self,
+        step: Step,
+        result: Result,
+        values: dict[str, float] | None,
+        inputs: Inputs,
+        multistart: bool,
+    ) -> Result:
+        """``result`` if the step verifies it; else the best verified multi-start Result (only the
+        last step's restarts start the compiled model), else ``result`` marked not verified."""
+        failed = step.transform.verify(result, step.source, step.inverse)
+        if failed is None:
+            return result
+        better = self._restarted(step, values, inputs) if multistart else None
+        if better is not None:
+            return better
+        status = Status.FEASIBLE if result.status is Status.OPTIMAL else result.status
+        return result.model_copy(update={"status": status, "message": f"not verified optimal: {failed}"})
 
 
 def compile_spec(
@@ -110,33 +286,27 @@ def compile_spec(
     backend: str | None = None,
     options: dict[str, Any] | None = None,
 ) -> Solver:
-    """Load (if a path), pick the backend, apply the transforms it needs, and build its model once."""
+    """Load (if a path), pick the backend, apply the transforms, and build its model once."""
     if not isinstance(spec, SpecBase):
         spec = load(spec)
     name = backend_name(spec, backend)
     instance = get_backend(name)
-    chain = chain_to(spec, instance.kinds)
-    if chain is None:
-        raise UnsupportedFeature(f"backend {name!r} does not solve kind {spec.kind!r}")
     start = time.perf_counter()
-    applied: list[tuple[Transform, SpecBase, Any]] = []
-    current = spec
-    for transform in chain:
-        new, inverse = transform.apply(current)
-        applied.append((transform, new, inverse))
-        current = new
-    compiled = instance.compile(current, instance.options(current, options))
+    steps = build_steps(spec, instance)
+    target = steps[-1].target if steps else spec
+    compiled = instance.compile(target, instance.options(target, options))
     build = time.perf_counter() - start
-    return Solver(spec, instance, applied, compiled, build)
+    return Solver(spec, instance, steps, compiled, build)
 
 
 def solve(
     spec: SpecBase | str | Path,
     backend: str | None = None,
     *,
-    parameters: dict[str, float] | None = None,
+    parameters: dict[str, Any] | None = None,
     guess: Result | None = None,
+    inputs: Inputs = None,
     options: dict[str, Any] | None = None,
 ) -> Result:
     """Solve a spec (or problem file) once on ``backend`` and return its Result."""
-    return compile_spec(spec, backend, options).solve(parameters=parameters, guess=guess)
+    return compile_spec(spec, backend, options).solve(parameters=parameters, guess=guess, inputs=inputs)

@@ -14,7 +14,7 @@ import time
 from typing import Any, ClassVar, Literal
 
 import numpy as np
-from pydantic import Field
+from pydantic import Field, ValidationInfo, field_validator
 
 from gamespec.backend import Availability, Inputs
 from gamespec.errors import BackendError
@@ -28,7 +28,7 @@ STATUS_MAP = {
     "Solve_Succeeded": Status.OPTIMAL,
     "Solved_To_Acceptable_Level": Status.FEASIBLE,
     "Feasible_Point_Found": Status.FEASIBLE,
-    "Infeasible_Problem_Detected": Status.INFEASIBLE,
+    "Infeasible_Problem_Detected": Status.LOCALLY_INFEASIBLE,
     "Diverging_Iterates": Status.UNBOUNDED,
     "Maximum_Iterations_Exceeded": Status.ITERATION_LIMIT,
     "Maximum_CpuTime_Exceeded": Status.TIME_LIMIT,
@@ -37,6 +37,8 @@ STATUS_MAP = {
     "Error_In_Step_Computation": Status.NUMERICAL_ERROR,
     "Invalid_Number_Detected": Status.NUMERICAL_ERROR,
 }
+"""IPOPT's return status → gamespec's Status. IPOPT is a local solver: ``Infeasible_Problem_Detected``
+means it converged to a point of local infeasibility, hence ``locally_infeasible``."""
 
 
 class CasadiOptions(StrictModel):
@@ -55,9 +57,23 @@ class CasadiOptions(StrictModel):
         " of large grids.",
     )
 
+    @field_validator("ipopt")
+    @classmethod
+    def _known_to_ipopt(cls, ipopt: dict[str, Any], info: ValidationInfo) -> dict[str, Any]:
+        """``ipopt`` holds options IPOPT itself knows and accepts (checked against its own list)."""
+        if ipopt and info.data.get("solver") == "ipopt":
+            from gamespec_casadi.ipopt_options import check_ipopt_options
 
-def _library(ca) -> Library:
-    return Library.from_namespace(ca, abs=ca.fabs, min=ca.fmin, max=ca.fmax)
+            check_ipopt_options(ipopt)
+        return ipopt
+
+
+def casadi_library(ca: Any) -> Library:
+    """CasADi's functions by gamespec's names; ``heaviside(x) = (1 + sign(x))/2``, which is 1/2 at 0
+    as SymPy's ``Heaviside`` (CasADi's ``sign(0) = 0``)."""
+    return Library.from_namespace(
+        ca, abs=ca.fabs, min=ca.fmin, max=ca.fmax, heaviside=lambda x: 0.5 * (1 + ca.sign(x))
+    )
 
 
 class CasadiModel(CollocationModel):
@@ -72,7 +88,7 @@ class CasadiModel(CollocationModel):
         self.tr = tr = Transcription(spec)
         self.options = options
         ocp, grid = tr.ocp, tr.grid
-        lib = _library(ca)
+        lib = casadi_library(ca)
         nx, nu, nw, npar = tr.n_x, tr.n_u, tr.n_w, len(ocp.p)
         x, u, w = ca.SX.sym("x", nx), ca.SX.sym("u", nu), ca.SX.sym("w", nw)
         p, t = ca.SX.sym("p", npar), ca.SX.sym("t")

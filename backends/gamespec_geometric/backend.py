@@ -13,8 +13,7 @@ from typing import ClassVar, Literal
 from pydantic import Field
 
 from gamespec.backend import Backend, CompiledModel, Inputs, refuse_inputs
-from gamespec.errors import SpecError
-from gamespec.loader import spec_from_dict
+from gamespec.loader import with_values
 from gamespec.result import Result, Status
 from gamespec.specs.base import SpecBase, StrictModel
 from gamespec_geometric.simulation import Trajectories, simulate
@@ -29,10 +28,8 @@ class GeometricOptions(StrictModel):
 
 
 class CompiledScenario(CompiledModel):
-    """A scenario ready to simulate; ``parameters`` may override ``capture_radius``, ``time_step``
-    and ``horizon``."""
-
-    TUNABLE: ClassVar[tuple[str, ...]] = ("capture_radius", "time_step", "horizon")
+    """A scenario ready to simulate; ``parameters`` set fields by dotted path (the runtime parameters
+    of :class:`PursuitScenarioSpec`: ``capture_radius``, ``time_step`` and ``horizon``)."""
 
     def __init__(self, spec: PursuitScenarioSpec, options: GeometricOptions) -> None:
         self.spec = spec
@@ -43,15 +40,7 @@ class CompiledScenario(CompiledModel):
     ) -> Result:
         """Simulate (``guess`` is not used: the simulation has no iterate to warm-start)."""
         refuse_inputs(inputs, self.spec.kind)
-        unknown = set(parameters or {}) - set(self.TUNABLE)
-        if unknown:
-            raise SpecError(
-                f"unknown parameter(s) {', '.join(sorted(unknown))} (tunable: {', '.join(self.TUNABLE)})",
-                field="parameters",
-            )
-        spec = self.spec
-        if parameters:
-            spec = spec_from_dict({**spec.model_dump(), **parameters}, source=spec.source)
+        spec = with_values(self.spec, parameters) if parameters else self.spec
         start = time.perf_counter()
         run = simulate(spec, method=self.options.active_check, samples=self.options.pp_samples)
         return scenario_result(spec, run, time.perf_counter() - start)

@@ -13,7 +13,7 @@ constraints over the end values; objective ``Phi + T q^T L`` in minimization for
 from __future__ import annotations
 
 import math
-from collections.abc import Mapping
+from collections.abc import Callable, Mapping
 from typing import Any
 
 import numpy as np
@@ -32,19 +32,33 @@ def _maximum(a: Any, b: Any) -> Any:
     return 0.5 * (a + b + abs(a - b))
 
 
-def _no_atan2(y: Any, x: Any) -> Any:
-    raise UnsupportedFeature(
-        "backend 'pyomo' cannot take atan2: Pyomo's expressions have no atan2, and ripopt "
-        "differentiates the conditional (Expr_if) form wrongly; use the casadi backend"
-    )
+def _refused(name: str) -> Callable[..., Any]:
+    """A library entry that refuses ``name``: Pyomo's expressions have no such function, and ripopt
+    differentiates the conditional (Expr_if) form that would emulate it wrongly."""
+
+    def refuse(*args: Any) -> Any:
+        raise UnsupportedFeature(
+            f"backend 'pyomo' cannot take {name}: Pyomo's expressions have no {name}, and ripopt "
+            "differentiates the conditional (Expr_if) form wrongly; use the casadi backend"
+        )
+
+    return refuse
 
 
 def pyomo_library() -> Library:
     """Pyomo's intrinsic functions by gamespec's names (min/max through ``abs``, which the NL
-    format has; no atan2)."""
+    format has; no atan2, sign or heaviside: they are refused when a problem uses them)."""
     import pyomo.environ as pyo
 
-    return Library.from_namespace(pyo, atan2=_no_atan2, abs=abs, min=_minimum, max=_maximum)
+    return Library.from_namespace(
+        pyo,
+        atan2=_refused("atan2"),
+        sign=_refused("sign"),
+        heaviside=_refused("heaviside"),
+        abs=abs,
+        min=_minimum,
+        max=_maximum,
+    )
 
 
 def _finite(value: float) -> float | None:

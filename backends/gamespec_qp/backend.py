@@ -163,10 +163,14 @@ class QpBackend(LQBackend):
 
     @classmethod
     def probe_options(cls, options: LQSolverOptions) -> None:
-        """Solve ``min ½x² − x`` with the user's solver options."""
+        """Solve ``min ½x² − x s.t. x ≤ ½`` with the user's solver options (constrained, so that
+        qpsolvers hands it to the solver rather than to SciPy's least squares)."""
         import qpsolvers
 
-        probe = qpsolvers.Problem(np.eye(1), -np.ones(1))
+        P, G = np.eye(1), np.ones((1, 1))
+        if options.solver not in qpsolvers.dense_solvers:
+            P, G = csc_matrix(P), csc_matrix(G)
+        probe = qpsolvers.Problem(P, -np.ones(1), G=G, h=np.full(1, 0.5))
         try:
             qpsolvers.solve_problem(probe, solver=options.solver, **options.solver_options)
         except (TypeError, ValueError, qpsolvers.ParamError) as err:

@@ -7,14 +7,16 @@ Everything is stated for minimization: ``J = sign * (Mayer + integral of Lagrang
 from __future__ import annotations
 
 import math
-from collections.abc import Mapping
+from collections.abc import Callable, Mapping
 from dataclasses import dataclass
 from functools import cached_property
 
+import numpy as np
 import sympy as sp
 
 from gamespec.errors import SpecError
 from gamespec.specs.ocp import EvaluatedValues, OptimalControlSpec
+from gamespec.symbolic.calculus import numeric_function
 from gamespec.symbolic.language import TIME, Relation, parse, parse_relation, symbol
 
 
@@ -128,6 +130,17 @@ class SymbolicOcp:
         return not any(TIME in e.free_symbols for e in exprs)
 
     @cached_property
+    def running_arguments(self) -> list[sp.Symbol]:
+        """The symbols a running expression may use, in the order of :attr:`running_function`."""
+        return [*self.x, *self.u, *self.w, *self.p, self.t]
+
+    @cached_property
+    def running_function(self) -> Callable[..., np.ndarray]:
+        """The dynamics and the Lagrange integrand, translated once: called with one array per
+        :attr:`running_arguments` it returns ``(n_x + 1, *shape)`` (the checks evaluate them often)."""
+        return numeric_function([*self.dynamics, self.lagrange], self.running_arguments)
+
+    @cached_property
     def inputs_in_hamiltonian(self) -> list[int]:
         """Indices of the grid inputs that enter the dynamics or the running cost: a time-varying
         one makes H time-varying (``dH/dt = dH/dw * dw/dt`` on an optimal arc)."""
@@ -168,7 +181,7 @@ class SymbolicOcp:
         """``(lower, upper, guess)`` of the final time (lower == upper when it is fixed)."""
         time = self.spec.problem.time
         if time.free:
-            lo, hi = time.bounds
+            lo, hi = self._evaluated(params).t_bounds
             guess = self.spec.guess.t_final or time.guess or 0.5 * (lo + hi)
             return lo, hi, guess
         tf = self._evaluated(params).t_final

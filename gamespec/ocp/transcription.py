@@ -152,7 +152,8 @@ class Transcription:
             try:
                 previous = Result.load(self.spec.guess.result)
             except SpecError as err:
-                raise SpecError(err.reason, field="guess.result", source=self.spec.source) from None
+                reason = f"{err.source}: {err.reason}"
+                raise SpecError(reason, field="guess.result", source=self.spec.source) from None
         if previous is not None and previous.time is not None and previous.states:
             return self._guess_from_result(previous)
         *_, tf_guess = self.ocp.final_time(params)

@@ -20,6 +20,7 @@ import time
 from typing import ClassVar
 
 from gamespec.backend import Backend, CompiledModel, Inputs, refuse_inputs
+from gamespec.loader import with_values
 from gamespec.pursuit import constant_bearing, pure_pursuit
 from gamespec.pursuit.reduced import observe, reduce
 from gamespec.pursuit.report import engagement_report
@@ -30,18 +31,19 @@ from gamespec.specs.engagement import EngagementSpec
 
 
 class AnalyticModel(CompiledModel):
-    """An engagement ready to be answered by its closed form or suboptimal heading."""
+    """An engagement ready to be answered by its closed form or suboptimal heading; ``parameters``
+    set the engagement's runtime parameters (positions, speeds, capture radius) by dotted path."""
 
     def __init__(self, spec: EngagementSpec) -> None:
         self.spec = spec
-        self.players = Players.from_spec(spec)
 
     def solve(
         self, parameters: dict[str, float] | None = None, guess: Result | None = None, inputs: Inputs = None
     ) -> Result:
         refuse_inputs(inputs, self.spec.kind)
         tic = time.perf_counter()
-        players = self.players
+        spec = with_values(self.spec, parameters) if parameters else self.spec
+        players = Players.from_spec(spec)
         if set(players.strategies) == {"cb"}:
             plan = constant_bearing.optimal_evasion(players)
             constant = constant_bearing.best_constant_heading(players)
@@ -60,11 +62,11 @@ class AnalyticModel(CompiledModel):
             extra = {"headings": [choice.heading]}
         traj = simulate_to_capture(players, law)
         check = simulate_to_capture(players, law, method="DOP853")
-        red = reduce(self.spec)
+        red = reduce(spec)
         observed = observe(red, traj)
         control = observed.pop(red.control)
         terminal = traj.distances()[-1]
-        metrics, checks, arrays = engagement_report(self.spec, players, terminal, traj.capture_time, check)
+        metrics, checks, arrays = engagement_report(spec, players, terminal, traj.capture_time, check)
         metrics |= extra | {"predicted_capture_time": predicted}
         if status == Status.OPTIMAL:
             checks["predicted_capture_time_error"] = abs(predicted - traj.capture_time)

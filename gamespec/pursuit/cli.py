@@ -1,4 +1,5 @@
-"""``gamespec pursuit ...``: commands of the pursuit-evasion area (mounted in :mod:`gamespec.cli`)."""
+"""``gamespec pursuit ...``: commands of the pursuit-evasion area (registered in the
+``gamespec.commands`` entry-point group, mounted by :mod:`gamespec.cli`)."""
 
 from __future__ import annotations
 
@@ -47,13 +48,15 @@ def study(
     overrides = [*(set_ or []), *([f"store={out / 'points'}"] if out is not None else [])]
     spec = load(file, overrides)
     if spec.kind != "pursuit_suboptimal_study":
-        raise SpecError(f"expected kind 'pursuit_suboptimal_study', got {spec.kind!r}", field="kind")
+        reason = f"expected kind 'pursuit_suboptimal_study', got {spec.kind!r}"
+        raise SpecError(reason, field="kind", source=str(file))
     options = {"progress": True} | ({"workers": workers} if workers is not None else {})
     result = solve(spec, options=options)
     if out is not None:
         result.save(out)
         for path in plot_result(result, out):
-            Console(stderr=True).print(f"wrote {out / 'result.json'} and {path}", highlight=False)
+            if not json_:
+                Console().print(f"wrote {out / 'result.json'} and {path}", highlight=False)
     table = result.metrics.get("table", [])
     if json_:
         sys.stdout.write(json.dumps(table, indent=2) + "\n")
@@ -64,6 +67,11 @@ def study(
         for row in table:
             view.add_row(*(_cell(row[c]) for c in TABLE_COLUMNS))
         Console().print(view)
-    Console(stderr=True).print(f"{result.status.value}: {result.message}", highlight=False)
     if not result.ok:
+        print(
+            f"error: {spec.name}: study ended with status {result.status.value}: {result.message}",
+            file=sys.stderr,
+        )
         raise typer.Exit(1)
+    if not json_:
+        Console().print(f"{result.status.value}: {result.message}", highlight=False)

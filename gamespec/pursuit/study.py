@@ -28,15 +28,16 @@ from typing import Any
 import numpy as np
 
 from gamespec.pursuit import pure_pursuit
+from gamespec.pursuit.ocp_generation import to_ocp, trajectory_guess
+from gamespec.pursuit.ocp_report import heading_law
 from gamespec.pursuit.pursuit_curve import constant_heading_pursuit
-from gamespec.pursuit.reduced import observe, reduce
+from gamespec.pursuit.reduced import reduce
 from gamespec.pursuit.regions import classify
 from gamespec.pursuit.report import capture_gap
 from gamespec.pursuit.simulation import Players, simulate_to_capture
-from gamespec.result import Result, Status
+from gamespec.result import Result
 from gamespec.specs.engagement import EngagementSpec
 from gamespec.specs.suboptimal_study import SuboptimalStudySpec
-from gamespec.transforms.engagement import heading_law, to_ocp
 
 DEFECT_TOL = 1e-3
 """Largest re-integrated defect (``checks.max_defect``) of an accepted optimal solution."""
@@ -141,9 +142,7 @@ def evaluate(point: StudyPoint) -> dict[str, Any]:
     red = reduce(spec)
     choice = pure_pursuit.suboptimal_heading(players)
     traj = constant_heading_pursuit(players, choice.heading)
-    observed = observe(red, traj)
-    control = observed.pop(red.control)
-    guess = Result(status=Status.FEASIBLE, time=traj.time, states=observed, controls={red.control: control})
+    guess = trajectory_guess(red, traj)
     parameters = {k: red.parameters[k] for k in ("r2_init", "psi_init")}
     attempt, result = _first_accepted(point, parameters, guess)
     row: dict[str, Any] = {

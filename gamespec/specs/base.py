@@ -6,9 +6,11 @@ dotted location and the nearest valid key (see :func:`gamespec.loader.format_val
 
 from __future__ import annotations
 
-from typing import Any, ClassVar
+from typing import Annotated, Any, ClassVar
 
-from pydantic import BaseModel, ConfigDict, Field, FiniteFloat, PrivateAttr
+from pydantic import BaseModel, ConfigDict, Field, FiniteFloat, PrivateAttr, model_validator
+
+from gamespec.limits import MAX_COORDINATE, MAX_SPEED
 
 Number = FiniteFloat
 """A finite number: NaN and ±inf are refused at load, with the field named."""
@@ -16,6 +18,12 @@ Number = FiniteFloat
 Value = Number | str
 """A finite number, or an expression over the problem's parameters (each kind checks that the
 expression evaluates to a finite number)."""
+
+Coordinate = Annotated[Number, Field(ge=-MAX_COORDINATE, le=MAX_COORDINATE)]
+"""A position coordinate, finite and within :data:`~gamespec.limits.MAX_COORDINATE`."""
+
+Speed = Annotated[Number, Field(ge=0, le=MAX_SPEED)]
+"""A player's speed, finite, non-negative and within :data:`~gamespec.limits.MAX_SPEED`."""
 
 
 class StrictModel(BaseModel):
@@ -37,15 +45,41 @@ class SolverSection(StrictModel):
     )
 
 
+class ProblemParameters:
+    """Mixin of the kinds whose runtime parameters are ``problem.parameters``, addressed by their
+    short names (``rho`` for ``problem.parameters.rho``) as well as by the dotted path."""
+
+    def runtime_parameters(self) -> dict[str, float]:
+        return dict(self.problem.parameters)
+
+    def parameter_path(self, name: str) -> str:
+        return f"problem.parameters.{name}" if name in self.problem.parameters else name
+
+
+RequestedTransforms = list[dict[str, dict[str, Any]]]
+"""The ``transforms:`` section: ``[{<transform name>: {<options>}}, ...]``, applied in order."""
+
+
 class SpecBase(StrictModel):
-    """Fields shared by every problem kind; subclasses fix ``kind`` to a literal."""
+    """Fields shared by every problem kind; subclasses fix ``kind`` to a literal.
+
+    A kind says which of its values a compiled model takes at solve time
+    (:meth:`runtime_parameters`, addressed by :meth:`parameter_path`) and which fields only give a
+    starting point (``guess_fields``); :meth:`structure` is everything else, what a compiled model
+    was built from.
+    """
 
     kind: str
     name: str = Field("unnamed", description="A short name used in reports and output folders.")
     description: str = ""
     solver: SolverSection = Field(default_factory=SolverSection)
+    transforms: RequestedTransforms = Field(
+        default_factory=list,
+        description="Requested transforms, [{name: {options}}], applied in order before the solve.",
+    )
 
     default_backend: ClassVar[str] = ""
+    guess_fields: ClassVar[tuple[str, ...]] = ()
     _source: str = PrivateAttr("<spec>")
     _file_hash: str = PrivateAttr("")
 
@@ -73,3 +107,35 @@ class SpecBase(StrictModel):
     def objective_sense(self) -> str:
         """``minimize`` or ``maximize``: which objective is better, for comparisons."""
         return "minimize"
+
+    @model_validator(mode="after")
+    def _requested_transforms(self) -> SpecBase:
+        if self.transforms:
+            from gamespec.specs.requested import check_requested
+
+            check_requested(self)
+        return self
+
+    def runtime_parameters(self) -> dict[str, float]:
+        """The values a compiled model of this spec takes as ``parameters=`` (none by default)."""
+        return {}
+
+    def parameter_path(self, name: str) -> str:
+        """The dotted field a runtime parameter ``name`` stands for (the name itself by default)."""
+        return name
+
+    def structure(self, with_guess: bool = False) -> dict[str, Any]:
+        """This spec without its runtime parameter values, name and description (and without its
+        starting point unless ``with_guess``): two specs with the same structure compile to the same
+        model."""
+        data = self.model_dump(mode="json")
+        data.pop("name")
+        data.pop("description")
+        blanked = [self.parameter_path(n) for n in self.runtime_parameters()]
+        for path in blanked + ([] if with_guess else list(self.guess_fields)):
+            *parents, last = path.split(".")
+            node: Any = data
+            for part in parents:
+                node = node[int(part)] if isinstance(node, list) else node[part]
+            node[int(last) if isinstance(node, list) else last] = None
+        return data

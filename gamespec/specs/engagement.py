@@ -16,7 +16,7 @@ from typing import Literal
 import numpy as np
 from pydantic import Field, model_validator
 
-from gamespec.specs.base import Number, SpecBase, StrictModel
+from gamespec.specs.base import Coordinate, Number, SpecBase, Speed, StrictModel
 from gamespec.specs.ocp import MethodSpec
 
 Strategy = Literal["cb", "pp", "stationary"]
@@ -30,16 +30,16 @@ class PursuerSpec(StrictModel):
     """
 
     name: str = Field(description="Label used in reports and plots (P1, P2, ...).")
-    position: tuple[Number, Number]
-    speed: Number = Field(1.0, ge=0, description="Speed u_i; unused while the pursuer is stationary.")
+    position: tuple[Coordinate, Coordinate]
+    speed: Speed = Field(1.0, description="Speed u_i; unused while the pursuer is stationary.")
     strategy: Strategy = Field(description="cb (constant bearing), pp (pure pursuit) or stationary.")
 
 
 class EvaderSpec(StrictModel):
     """The evader: its initial position and speed v."""
 
-    position: tuple[Number, Number]
-    speed: Number = Field(gt=0)
+    position: tuple[Coordinate, Coordinate]
+    speed: Speed = Field(gt=0)
 
 
 class EngagementSpec(SpecBase):
@@ -64,6 +64,16 @@ class EngagementSpec(SpecBase):
     )
 
     default_backend = "casadi"
+    guess_fields = ("guess_heading",)
+
+    def runtime_parameters(self) -> dict[str, float]:
+        """Positions, speeds and the capture radius, by dotted path (``pursuers.1.speed``)."""
+        values = {"capture_radius": self.capture_radius, "evader.speed": self.evader.speed}
+        players = [("evader", self.evader), *((f"pursuers.{i}", p) for i, p in enumerate(self.pursuers))]
+        for path, player in players:
+            values |= {f"{path}.position.{k}": float(x) for k, x in enumerate(player.position)}
+            values[f"{path}.speed"] = player.speed
+        return values
 
     @property
     def objective_sense(self) -> str:

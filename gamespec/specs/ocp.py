@@ -16,7 +16,9 @@ from typing import Literal
 from pydantic import Field, field_validator, model_validator
 
 from gamespec.errors import ExpressionError, SpecError
-from gamespec.specs.base import Number, SpecBase, StrictModel, Value
+from gamespec.limits import MAX_INTERVALS
+from gamespec.specs.base import Number, ProblemParameters, SpecBase, StrictModel, Value
+from gamespec.specs.uncertainty import UncertainParameter
 from gamespec.symbolic.language import RESERVED, parse, parse_relation, symbol
 from gamespec.symbolic.translate import numeric
 
@@ -59,11 +61,12 @@ class ObjectiveSpec(StrictModel):
 
 
 class TimeSpec(StrictModel):
-    """Initial time, and the final time: a value, or ``free`` within ``bounds`` from ``guess``."""
+    """Initial time, and the final time: a value, or ``free`` within ``bounds`` (numbers or
+    expressions of the parameters) from ``guess``."""
 
     initial: Number = 0.0
     final: Value | Literal["free"] = 1.0
-    bounds: tuple[Number, Number] | None = None
+    bounds: tuple[Value, Value] | None = None
     guess: Number | None = None
 
     @model_validator(mode="after")
@@ -71,9 +74,6 @@ class TimeSpec(StrictModel):
         if self.final == "free":
             if self.bounds is None:
                 raise ValueError("a free final time needs bounds: [lower, upper]")
-            lo, hi = self.bounds
-            if not self.initial <= lo < hi:
-                raise ValueError("bounds must satisfy initial <= lower < upper")
         elif self.bounds is not None:
             raise ValueError("bounds are only for a free final time (final: free)")
         return self
@@ -95,6 +95,9 @@ class OcpProblem(StrictModel):
     time: TimeSpec = Field(default_factory=TimeSpec)
     path_constraints: list[str] = Field(default_factory=list)
     boundary_constraints: list[str] = Field(default_factory=list)
+    uncertain: dict[str, UncertainParameter] = Field(
+        default_factory=dict, description="Uncertain parameters (chapter 6) and their distributions."
+    )
 
     @field_validator("states")
     @classmethod
@@ -120,6 +123,9 @@ class OcpProblem(StrictModel):
                 f" dynamics for undeclared states {sorted(extra)}" if extra else ""
             )
             raise ValueError(f"dynamics must give one equation per state: {what.strip()}")
+        unknown = set(self.uncertain) - set(self.parameters)
+        if unknown:
+            raise ValueError(f"uncertain names undeclared parameters: {sorted(unknown)}")
         self._check_expressions()
         self.evaluate(self.parameters)
         return self
@@ -163,12 +169,17 @@ class OcpProblem(StrictModel):
             )
             _ordered(lo, hi, f"controls.{name}")
             controls.append((lo, hi))
-        t_final = None
-        if not self.time.free:
+        t_final = t_bounds = None
+        if self.time.free:
+            lo, hi = (number(b, 0.0, f"time.bounds.{i}") for i, b in enumerate(self.time.bounds))
+            if not self.time.initial <= lo < hi:
+                raise SpecError("bounds must satisfy initial <= lower < upper", field="problem.time.bounds")
+            t_bounds = (lo, hi)
+        else:
             t_final = number(self.time.final, 1.0, "time.final")
             if t_final <= self.time.initial:
                 raise SpecError("final time must be after the initial time", field="problem.time.final")
-        return EvaluatedValues(states, controls, t_final)
+        return EvaluatedValues(states, controls, t_final, t_bounds)
 
     def _check_expressions(self) -> None:
         """Parse every expression over the symbols its field may use; an input where it may not
@@ -199,6 +210,9 @@ class OcpProblem(StrictModel):
         ]
         if isinstance(self.time.final, str) and self.time.final != "free":
             checks.append(("time.final", self.time.final, params, False))
+        for i, bound in enumerate(self.time.bounds or ()):
+            if isinstance(bound, str):
+                checks.append((f"time.bounds.{i}", bound, params, False))
         checks += [(f"path_constraints.{i}", c, running, True) for i, c in enumerate(self.path_constraints)]
         checks += [
             (f"boundary_constraints.{i}", c, ends, True) for i, c in enumerate(self.boundary_constraints)
@@ -233,11 +247,12 @@ def _inputs_in(read: Callable, text: str, symbols: dict, inputs: dict) -> list[s
 @dataclass(frozen=True)
 class EvaluatedValues:
     """Per state ``(lower, upper, initial, final)`` (initial/final None when free), per control
-    ``(lower, upper)``, and the fixed final time (None when free)."""
+    ``(lower, upper)``, the fixed final time (None when free) and the bounds of a free one."""
 
     states: list[tuple[float, float, float | None, float | None]]
     controls: list[tuple[float, float]]
     t_final: float | None
+    t_bounds: tuple[float, float] | None = None
 
 
 def _ordered(lower: float, upper: float, field: str) -> None:
@@ -253,7 +268,7 @@ class MethodSpec(StrictModel):
     """
 
     scheme: Literal["radau", "trapezoidal"] = "radau"
-    intervals: int = Field(40, ge=1, le=100_000)
+    intervals: int = Field(40, ge=1, le=MAX_INTERVALS)
     degree: int = Field(3, ge=1, le=12)
     grading: Number = Field(1.0, gt=0, le=1e4)
 
@@ -269,8 +284,9 @@ class GuessSpec(StrictModel):
     result: str | None = None
 
 
-class OptimalControlSpec(SpecBase):
-    """An optimal-control problem (kind ``optimal_control``)."""
+class OptimalControlSpec(ProblemParameters, SpecBase):
+    """An optimal-control problem (kind ``optimal_control``); its runtime parameters are
+    ``problem.parameters``, its starting point ``guess`` and ``problem.time.guess``."""
 
     kind: Literal["optimal_control"] = "optimal_control"
     problem: OcpProblem
@@ -278,6 +294,7 @@ class OptimalControlSpec(SpecBase):
     guess: GuessSpec = Field(default_factory=GuessSpec)
 
     default_backend = "casadi"
+    guess_fields = ("guess", "problem.time.guess")
 
     @model_validator(mode="after")
     def _guess_names(self) -> OptimalControlSpec:

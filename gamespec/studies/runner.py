@@ -24,7 +24,8 @@ def run_study(
     accept: Callable[[Any], bool] | None = None,
 ) -> dict[str, Any]:
     """Evaluate ``fn(point)`` for every ``key → point`` not yet in ``store``; return all values.
-    The progress bar goes to stderr, so stdout stays clean for ``--json``.
+    The progress bar goes to stderr, so stdout stays clean for ``--json``, and only to a terminal,
+    so that an error is the one line a script reads there.
 
     ``fn`` must return JSON-able data. Values already stored are reused (those ``accept`` takes,
     when given; the others are computed again), so an interrupted study resumes where it stopped.
@@ -34,7 +35,8 @@ def run_study(
     todo = [(key, point) for key, point in points.items() if key not in done]
     runner = executor or SerialExecutor()
     columns = (TextColumn("{task.description}"), BarColumn(), MofNCompleteColumn(), TimeRemainingColumn())
-    progress_bar = Progress(*columns, disable=not show_progress, console=Console(stderr=True))
+    console = Console(stderr=True)
+    progress_bar = Progress(*columns, disable=not (show_progress and console.is_terminal), console=console)
     with progress_bar as progress:
         task = progress.add_task(description, total=len(points), completed=len(points) - len(todo))
         for (_fn, (key, _point)), value in runner.imap(_call, [(fn, item) for item in todo]):

@@ -1,7 +1,9 @@
 """Parameter sweeps: one problem file, a grid of parameter values, one re-solve per point.
 
-Each process compiles the spec once and re-solves it with new parameter values (warm-started from
-the previous point); every finished point goes into a :class:`ResultStore`, so a sweep resumes.
+Each process compiles the spec once and re-solves it with new parameter values, named as the file
+names them (``evader.speed``, ``pursuers.1.speed``, an OCP parameter ``rho``) and validated as at
+load (see :meth:`gamespec.solving.Solver.solve`); every finished point goes into a
+:class:`ResultStore`, so a sweep resumes.
 Points are keyed by the backend, the hash of the (overridden) spec and the parameter values, so a
 folder shared by different sweeps never mixes them up; failed points are solved again on a rerun.
 """
@@ -9,6 +11,7 @@ folder shared by different sweeps never mixes them up; failed points are solved 
 from __future__ import annotations
 
 import itertools
+import math
 from dataclasses import dataclass
 from functools import cache
 from pathlib import Path
@@ -17,6 +20,7 @@ from typing import Any
 import numpy as np
 
 from gamespec.errors import SpecError
+from gamespec.limits import MAX_SWEEP_POINTS
 from gamespec.studies.executors import executor
 from gamespec.studies.runner import run_study
 from gamespec.studies.store import ResultStore
@@ -33,6 +37,11 @@ def parse_range(text: str) -> tuple[str, list[float]]:
             count = int(n)
             if count < 1:
                 raise ValueError
+            if count > MAX_SWEEP_POINTS:
+                raise SpecError(
+                    f"{count} values in {text!r} exceed the limit of {MAX_SWEEP_POINTS} points",
+                    source="--param",
+                )
             return name.strip(), [float(v) for v in np.linspace(float(a), float(b), count)]
         return name.strip(), [float(v) for v in spec.split(",")]
     except ValueError:
@@ -74,10 +83,14 @@ def sweep(
     show_progress: bool = True,
 ) -> list[dict[str, Any]]:
     """Solve ``path`` on the Cartesian product of ``ranges``; rows in grid order."""
-    from gamespec.loader import load, spec_hash
+    from gamespec.loader import load, spec_hash, with_values
     from gamespec.solving import backend_name
 
+    total = math.prod(len(values) for _, values in ranges)
+    if total > MAX_SWEEP_POINTS:
+        raise SpecError(f"{total} grid points exceed the limit of {MAX_SWEEP_POINTS}", source="--param")
     spec = load(path, overrides)
+    with_values(spec, {name: values[0] for name, values in ranges})
     problem = f"{backend_name(spec, backend)}/{spec_hash(spec)}"
     names = [name for name, _ in ranges]
     points = {}

@@ -1,58 +1,128 @@
-"""Spec → spec reductions after cvxpy's ``Reduction``: ``accepts``, ``apply``, ``invert``.
+"""Spec → spec transforms after cvxpy's ``Reduction``: ``accepts``, ``apply``, ``invert``.
 
-A transform maps a spec of ``source_kind`` to one of ``target_kind`` and remembers what it needs
-to map a Result of the new spec back to the names the user wrote. Transforms are registered in the
-``gamespec.transforms`` entry-point group; :func:`chain_to` finds the chain that turns a spec into a
-kind a backend takes.
+A transform maps a spec of ``source_kind`` to one of ``target_kind`` and remembers (its inverse
+data) what it needs to map a Result of the new spec back to the names the user wrote. It is pure:
+:meth:`Transform.apply` and :meth:`Transform.invert` never solve and never pick a backend. What
+needs solving is asked of the solving layer (:mod:`gamespec.solving`):
+
+- a **staged** transform names, in :meth:`Transform.stage`, a spec to solve first; the solving layer
+  solves it and passes its Result to ``apply(..., upstream=result)``;
+- a transform whose mapped-back Result can fail a check of the source problem says so in
+  :meth:`Transform.verify` and offers other starting points in :meth:`Transform.restarts`; the
+  solving layer re-solves the same compiled model from them (multi-start) and keeps the best
+  verified Result.
+
+Runtime parameters go through the chain as in cvxpy's ``update_parameters``: the solving layer
+re-applies the (pure) transforms to the source spec with new values and hands the compiled model
+the target's new parameter values, after checking the target's :meth:`~SpecBase.structure` did not
+change.
+
+*Requested* transforms (``requested = True``: same kind to same kind, applied when a file lists them
+under ``transforms:``, with options validated by ``options_model``) come first, in the file's
+order; then *lowering* transforms, found by kind (:func:`lowering_path`). Transforms register in
+the ``gamespec.transforms`` entry-point group under their ``name``.
 """
 
 from __future__ import annotations
 
 from abc import ABC, abstractmethod
 from collections import deque
+from dataclasses import dataclass
 from typing import Any, ClassVar
 
 from gamespec import registry
+from gamespec.backend import NoOptions
 from gamespec.result import Result
-from gamespec.specs.base import SpecBase
+from gamespec.specs.base import SpecBase, StrictModel
+from gamespec.specs.requested import entry, transform_class, validated_options
+
+
+@dataclass(frozen=True)
+class Stage:
+    """An upstream solve a staged transform needs: ``spec`` on ``backend`` (None: its default)."""
+
+    spec: SpecBase
+    backend: str | None = None
 
 
 class Transform(ABC):
-    """One reduction step."""
+    """One reduction step (see module doc)."""
 
+    name: ClassVar[str]
     source_kind: ClassVar[str]
     target_kind: ClassVar[str]
+    requested: ClassVar[bool] = False
+    options_model: ClassVar[type[StrictModel]] = NoOptions
 
     def accepts(self, spec: SpecBase) -> bool:
-        """Whether this transform applies to ``spec``."""
+        """Whether this transform applies to ``spec`` (by default: any spec of ``source_kind``)."""
         return spec.kind == self.source_kind
 
+    def stage(self, spec: SpecBase, options: StrictModel) -> Stage | None:
+        """The upstream solve :meth:`apply` needs the Result of, or None (the default)."""
+        return None
+
     @abstractmethod
-    def apply(self, spec: SpecBase) -> tuple[SpecBase, Any]:
-        """Return the new spec and the data :meth:`invert` needs."""
+    def apply(
+        self, spec: SpecBase, options: StrictModel, upstream: Result | None = None
+    ) -> tuple[SpecBase, Any]:
+        """The new spec and the data :meth:`invert` needs; ``upstream`` is the Result of
+        :meth:`stage`'s spec when it names one, whatever its status (check ``upstream.ok``)."""
 
     def invert(self, result: Result, spec: SpecBase, inverse_data: Any) -> Result:
         """Map a Result of the transformed spec back to the original ``spec`` (default: relabel)."""
         return result.model_copy(update={"kind": spec.kind, "problem": spec.name})
 
+    def guess(self, inverse_data: Any) -> Result | None:
+        """A starting point of the target spec (a Result in its names) the solving layer passes to
+        the compiled model when the caller gives none; None (the default) leaves it to the model."""
+        return None
 
-def _transforms() -> list[Transform]:
-    return [registry.load("gamespec.transforms", n)() for n in registry.names("gamespec.transforms")]
+    def verify(self, result: Result, spec: SpecBase, inverse_data: Any) -> str | None:
+        """The first check of the source problem a mapped-back ``result`` fails, or None when it
+        passes (the default: nothing to check)."""
+        return None
+
+    def restarts(self, spec: SpecBase, inverse_data: Any) -> list[Result]:
+        """Other starting points of the target spec, best first, to re-solve from when
+        :meth:`verify` fails (the default: none)."""
+        return []
 
 
-def chain_to(spec: SpecBase, kinds: frozenset[str]) -> list[Transform] | None:
-    """The shortest chain of transforms taking ``spec`` to one of ``kinds`` (``[]`` if it is one)."""
+def _lowering() -> list[Transform]:
+    found = []
+    for name in registry.names("gamespec.transforms"):
+        cls = registry.load("gamespec.transforms", name)
+        if not cls.requested:
+            found.append(cls())
+    return found
+
+
+def requested_steps(spec: SpecBase) -> list[tuple[Transform, StrictModel]]:
+    """The transforms ``spec``'s ``transforms:`` section asks for, with their validated options."""
+    steps = []
+    for index, item in enumerate(spec.transforms):
+        name, options = entry(item, index)
+        cls = transform_class(name, field=f"transforms.{index}")
+        steps.append((cls(), validated_options(cls, name, options, index)))
+    return steps
+
+
+def lowering_path(spec: SpecBase, kinds: frozenset[str]) -> list[Transform] | None:
+    """The shortest chain of lowering transforms taking ``spec`` to one of ``kinds`` (``[]`` if it
+    is one already), its first step one that :meth:`~Transform.accepts` ``spec``; None if none."""
     if spec.kind in kinds:
         return []
-    available = _transforms()
+    available = _lowering()
     queue: deque[tuple[str, list[Transform]]] = deque([(spec.kind, [])])
     seen = {spec.kind}
     while queue:
         kind, path = queue.popleft()
         for t in available:
-            if t.source_kind == kind and t.target_kind not in seen:
-                if t.target_kind in kinds:
-                    return [*path, t]
-                seen.add(t.target_kind)
-                queue.append((t.target_kind, [*path, t]))
+            if t.source_kind != kind or t.target_kind in seen or (not path and not t.accepts(spec)):
+                continue
+            if t.target_kind in kinds:
+                return [*path, t]
+            seen.add(t.target_kind)
+            queue.append((t.target_kind, [*path, t]))
     return None

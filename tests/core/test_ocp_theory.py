@@ -79,7 +79,7 @@ def test_two_on_one_capture_is_simultaneous_with_zero_hamiltonian() -> None:
     -t_f), whose Hamiltonian λᵀf equals -dΦ/dt_f = 1 on the arc: the same condition, which
     ``hamiltonian_end_error`` measures."""
     result = gamespec.solve(TWO_ON_ONE)
-    eps = result.parameters["eps"]
+    eps = result.parameters["capture_radius"]
     assert result.status == gamespec.Status.OPTIMAL
     assert result.states["r1"][-1] == pytest.approx(eps, abs=1e-7)
     assert result.states["r2"][-1] == pytest.approx(eps, abs=1e-6)

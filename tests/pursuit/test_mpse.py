@@ -6,7 +6,7 @@ import pytest
 
 import gamespec
 from gamespec.pursuit.mpse import check_capturing_set, keep_pursuers
-from gamespec.transforms.engagement import RESIM_RTOL
+from gamespec.pursuit.verification import RESIM_RTOL
 from tests.conftest import PROBLEMS
 
 MPSE_CB = PROBLEMS / "ch3" / "mpse_optimal_evasion_cb.yaml"

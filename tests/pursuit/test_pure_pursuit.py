@@ -9,12 +9,12 @@ from hypothesis import strategies as st
 
 import gamespec
 from gamespec.pursuit import pure_pursuit as pp
-from gamespec.pursuit import regions
+from gamespec.pursuit import regions, verification
 from gamespec.pursuit.mpse import path_difference
+from gamespec.pursuit.ocp_generation import to_ocp
 from gamespec.pursuit.simulation import Players, simulate_to_capture
 from gamespec.symbolic.language import parse, symbol
-from gamespec.transforms import engagement
-from gamespec.transforms.engagement import to_ocp
+from gamespec.transforms import engagement as transforms_engagement
 from tests.conftest import PROBLEMS
 from tests.pursuit.helpers import two_pursuers
 
@@ -109,7 +109,7 @@ def test_a_wrong_nlp_optimum_is_not_reported_optimal(monkeypatch) -> None:
     """On a uniform grid the collinear engagement's NLP stops at a point whose Hamiltonian is not
     constant (eq. 2.23) and whose capture is earlier than the guess heading's: with no re-solve
     allowed it is reported feasible, with the failed check in the message."""
-    monkeypatch.setattr(engagement, "RETRIES", 0)
+    monkeypatch.setattr(transforms_engagement, "RETRIES", 0)
     result = gamespec.solve(gamespec.load(COLLINEAR, ["method.grading=1"]))
     assert result.status == gamespec.Status.FEASIBLE
     assert "not verified optimal" in result.message
@@ -124,7 +124,7 @@ def test_collinear_pursuers_resolved_to_the_verified_optimum() -> None:
         result = gamespec.solve(gamespec.load(COLLINEAR, overrides))
         assert result.status == gamespec.Status.OPTIMAL
         assert result.t_final == pytest.approx(analytic.t_final, rel=1e-4)
-        assert result.checks["hamiltonian_variation"] < engagement.HAMILTONIAN_TOL
+        assert result.checks["hamiltonian_variation"] < verification.HAMILTONIAN_TOL
         assert abs(result.metrics["initial_heading"]) == pytest.approx(np.pi / 2, abs=0.05)
 
 

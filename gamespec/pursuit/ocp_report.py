@@ -1,0 +1,71 @@
+"""An OCP solution of an engagement's reduced problem, reported as the engagement's Result.
+
+The OCP's heading is turned into a law (:func:`heading_law`), the true dynamics are re-simulated
+under it and :func:`gamespec.pursuit.report.engagement_report` adds the engagement metrics: capture
+time, capturing set, simultaneous-capture gap, region of P2, and for relay pursuit the three arcs
+and the switching condition (eqs. 2.41, 2.46).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from gamespec.pursuit.reduced import Reduction
+from gamespec.pursuit.relay import detect_arcs
+from gamespec.pursuit.report import engagement_report
+from gamespec.pursuit.simulation import HeadingLaw, Players, simulate_to_capture
+from gamespec.result import Result
+from gamespec.specs.engagement import EngagementSpec
+
+ARC_TOL = 1e-5
+"""|S| below this counts as on the Voronoi boundary when splitting a relay path into arcs."""
+
+
+def heading_law(red: Reduction, result: Result) -> HeadingLaw:
+    """The OCP's evader heading as a law for re-simulation: θ_E(t) interpolated in the fixed frame;
+    θ(t) + φ_1 in the line-of-sight frame, φ_1 read from the simulated positions."""
+    tc = np.asarray(result.control_time if result.control_time is not None else result.time)
+    control = np.asarray(result.controls[red.control])
+    if red.frame == "fixed":
+        return lambda t, P, E: float(np.interp(t, tc, control))
+    return lambda t, P, E: float(np.interp(t, tc, control) + np.arctan2(*(E - P[0])[::-1]))
+
+
+def relay_arcs(red: Reduction, players: Players, result: Result) -> dict[str, float]:
+    """Arcs and switching condition (eq. 2.41 fixed frame / R-CB, eq. 2.46 line of sight / R-PP)."""
+    active = int(np.flatnonzero(players.active)[0])
+    guard = int(np.flatnonzero(~players.active)[0])
+    s = result.states
+    r_a, r_s = s[red.distance[active]], s[red.distance[guard]]
+    u, v = players.speeds[active], players.v
+    t = np.asarray(result.time)
+    tc = np.asarray(result.control_time if result.control_time is not None else t)
+    control = np.interp(t, tc, result.controls[red.control])
+    if red.frame == "fixed":
+        name = red.angle[active]
+        phi_a = s[name] if name in s else np.full_like(t, red.parameters[name])
+        switching = (v - u) * r_a - v * r_s * np.cos(phi_a - s[red.angle[guard]])
+        off_los = control - phi_a
+    else:
+        switching = (v - u) * r_a + v * r_s * np.cos(s[red.angle[guard]])
+        off_los = control
+    arcs = detect_arcs(t, 0.5 * (r_a**2 - r_s**2), switching, off_los, ARC_TOL)
+    return arcs.as_metrics()
+
+
+def ocp_report(result: Result, spec: EngagementSpec, red: Reduction, players: Players) -> Result:
+    """``result`` (of the reduced OCP) with the engagement metrics, checks and paths of its
+    re-simulation."""
+    terminal = np.array([result.states[red.distance[i]][-1] for i in range(len(players.names))])
+    traj = simulate_to_capture(players, heading_law(red, result))
+    metrics, checks, arrays = engagement_report(spec, players, terminal, result.t_final, traj)
+    if spec.is_relay and int(np.sum(~players.active)) == 1:
+        metrics["arcs"] = relay_arcs(red, players, result)
+    metrics["frame"] = red.frame
+    return result.model_copy(
+        update={
+            "metrics": {**result.metrics, **metrics},
+            "checks": {**result.checks, **checks},
+            "arrays": {**result.arrays, **arrays},
+        }
+    )

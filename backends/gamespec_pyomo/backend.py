@@ -21,8 +21,9 @@ import numpy as np
 from pydantic import Field, ValidationInfo, field_validator
 
 from gamespec.backend import Availability, Inputs
+from gamespec.backend.collocation import CollocationBackend, CollocationModel
 from gamespec.errors import BackendError
-from gamespec.ocp.transcription import Bounds, CollocationBackend, CollocationModel, Transcription
+from gamespec.ocp.transcription import Bounds, Transcription
 from gamespec.result import Result
 from gamespec.specs.base import StrictModel
 from gamespec.specs.ocp import OptimalControlSpec

@@ -9,7 +9,7 @@ terminal mean leaves that component free. A terminal covariance makes the file r
 that solve that SDP declare. Every matrix entry is a number or an expression over
 ``parameters``; a matrix is a list of rows, ``{diag: [...]}`` or ``{identity: scale}`` (square:
 n × n for ``A, B, C, D``, ``Q`` and the covariances, m × m for ``R``, ℓ × ℓ for ``S``).
-:meth:`LQGameSpec.game` evaluates all of it into an :class:`~gamespec.lqgame.game.LQGame`.
+:meth:`LQGameSpec.game` evaluates all of it into an :class:`~gamespec.specs.lq_model.LQGame`.
 """
 
 from __future__ import annotations
@@ -24,8 +24,8 @@ from pydantic import Discriminator, Field, Tag, field_validator, model_validator
 
 from gamespec.errors import ExpressionError, SpecError
 from gamespec.limits import MAX_INTERVALS, MAX_MAGNITUDE, MAX_SAMPLE_VALUES, MAX_SAMPLES
-from gamespec.lqgame.game import LQGame, zero_order_hold
 from gamespec.specs.base import Number, ProblemParameters, SpecBase, StrictModel, Value
+from gamespec.specs.lq_model import LQGame, zero_order_hold
 from gamespec.symbolic.language import RESERVED, float_value, parse, symbol
 
 

@@ -30,6 +30,9 @@ class Status(StrEnum):
     INFEASIBLE = "infeasible"
     UNBOUNDED = "unbounded"
     ITERATION_LIMIT = "iteration_limit"
+    NOT_CONVERGED = "not_converged"
+    """An iteration stopped before its limit because it cannot converge: best responses that cycle
+    or diverge (:mod:`gamespec.games.best_response`); the message says which."""
     TIME_LIMIT = "time_limit"
     NUMERICAL_ERROR = "numerical_error"
     ERROR = "error"

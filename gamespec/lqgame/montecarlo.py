@@ -2,7 +2,8 @@
 sample mean and covariance with the propagated ones (eq. 4.18 and 4.54).
 
 The players use ``u_k = ū_k + K_k y_k``, ``v_k = v̄_k + L_k y_k`` with ``y`` the noise-only state of
-eq. 4.52, simulated alongside ``x`` with the same draws.
+eq. 4.52, simulated alongside ``x`` with the same draws. The draws come from the Monte Carlo engine
+(:mod:`gamespec.montecarlo`): ``x_0 ~ N(μ_0, Σ_0)`` and standard normal noise per step.
 """
 
 from __future__ import annotations
@@ -12,19 +13,24 @@ from dataclasses import dataclass
 import numpy as np
 
 from gamespec.lqgame.game import LQGame, Strategies
+from gamespec.montecarlo import MultivariateNormal, Normal, sample
 
 
 def simulate(game: LQGame, strategies: Strategies, samples: int, seed: int = 0) -> np.ndarray:
     """Closed-loop trajectories of eq. 4.1 for ``samples`` draws, as an array (samples, N+1, n)."""
-    rng = np.random.default_rng(seed)
-    x = rng.multivariate_normal(game.mu0, game.Sigma0, size=samples, method="eigh")
+    draws = sample(
+        {"x0": MultivariateNormal(game.mu0, game.Sigma0), "noise": Normal(0.0, 1.0, shape=(game.N, game.r))},
+        samples,
+        seed,
+    )
+    x = draws["x0"]
     y = x - game.mu0
     out = np.empty((samples, game.N + 1, game.n))
     out[:, 0] = x
     for k in range(game.N):
         u = strategies.U[k] + y @ strategies.K[k].T
         v = strategies.V[k] + y @ strategies.L[k].T
-        noise = rng.standard_normal((samples, game.r)) @ game.D[k].T
+        noise = draws["noise"][:, k] @ game.D[k].T
         x = x @ game.A[k].T + u @ game.B[k].T + v @ game.C[k].T + noise
         y = y @ game.A[k].T + noise
         out[:, k + 1] = x

@@ -1,0 +1,348 @@
+"""One best-response engine for n players (Algorithm 2 of section 4.4 and its Gauss–Seidel form).
+
+Each player answers the others' current strategies with a best response; the engine iterates until
+no player's strategy moves by more than ``tolerance``:
+
+- **Jacobi** (Algorithm 2): every player answers the strategies of the previous iterate,
+  ``s_p^{i+1} = BR_p(s_{-p}^i)``;
+- **Gauss–Seidel**: players answer in order, each seeing the strategies already updated in this
+  sweep, ``s_p^{i+1} = BR_p(s_{<p}^{i+1}, s_{>p}^i)``.
+
+With ``damping`` ``w < 1`` a player that supports it keeps ``(1 − w) s_p^i + w BR_p`` (relaxation, which
+turns a Jacobi map whose eigenvalues lie outside the unit disc into a contraction when their real
+parts are below 1); a player without ``blend`` takes its plain response.
+
+The engine knows nothing of a strategy beyond the player's ``distance``. It stops with an honest
+outcome: ``converged``; ``iteration_limit``; ``cycling`` (the joint strategy returns to an earlier
+iterate, much closer to it than to the previous one, or the largest change over the last ``window``
+iterations is no smaller than over the ``window`` before); ``diverged`` (a non-finite change, or
+that largest change at least ``growth`` times the one before); or ``player_failed`` (a response
+whose status carries no solution). :class:`BestResponseRun` maps the outcome to a
+:class:`~gamespec.result.Status` and packs the history for ``Result.metrics["best_response"]``.
+
+This module imports nothing but NumPy and :mod:`gamespec.result`, so the numerics of a problem
+family (``lqgame``) can drive it as well as the game drivers of :mod:`gamespec.games` that compile
+their players through :mod:`gamespec.solving`.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Mapping, Sequence
+from dataclasses import dataclass, field
+from enum import StrEnum
+from typing import Any, Literal, Protocol, runtime_checkable
+
+import numpy as np
+
+from gamespec.result import Status
+
+Strategies = dict[str, Any]
+
+
+class Outcome(StrEnum):
+    """Why a best-response iteration stopped."""
+
+    CONVERGED = "converged"
+    ITERATION_LIMIT = "iteration_limit"
+    CYCLING = "cycling"
+    DIVERGED = "diverged"
+    PLAYER_FAILED = "player_failed"
+
+
+class Response(Protocol):
+    """What a player reports with its strategy: a :class:`~gamespec.result.Result` satisfies it."""
+
+    @property
+    def status(self) -> Status: ...
+
+    @property
+    def message(self) -> str: ...
+
+
+@dataclass(frozen=True)
+class StepReport:
+    """A :class:`Response` for players that solve something smaller than a whole Result."""
+
+    status: Status
+    message: str = ""
+
+
+@runtime_checkable
+class Player(Protocol):
+    """A player: ``respond`` to the others' strategies (keyed by player name) with a strategy (None
+    when the response failed) and a :class:`Response`; ``distance`` between two of its strategies."""
+
+    name: str
+
+    def respond(self, others: Mapping[str, Any]) -> tuple[Any, Response]: ...
+
+    def distance(self, a: Any, b: Any) -> float: ...
+
+
+@runtime_checkable
+class BlendingPlayer(Player, Protocol):
+    """A player whose strategies can be relaxed: ``blend(old, new, w) = (1 − w) old + w new``."""
+
+    def blend(self, old: Any, new: Any, weight: float) -> Any: ...
+
+
+@dataclass(frozen=True)
+class VectorPlayer:
+    """A player whose strategy is a NumPy array (Euclidean distance, convex blend); ``response``
+    maps the others' strategies to ``(strategy or None, Response)``."""
+
+    name: str
+    response: Callable[[Mapping[str, Any]], tuple[np.ndarray | None, Response]]
+
+    def respond(self, others: Mapping[str, Any]) -> tuple[np.ndarray | None, Response]:
+        return self.response(others)
+
+    def distance(self, a: np.ndarray, b: np.ndarray) -> float:
+        return float(np.linalg.norm(np.asarray(a) - np.asarray(b)))
+
+    def blend(self, old: np.ndarray, new: np.ndarray, weight: float) -> np.ndarray:
+        return (1 - weight) * np.asarray(old) + weight * np.asarray(new)
+
+
+@dataclass(frozen=True)
+class Settings:
+    """Scheme and stopping rule of the iteration (see the module docstring)."""
+
+    scheme: Literal["jacobi", "gauss_seidel"] = "jacobi"
+    tolerance: float = 1e-6
+    max_iterations: int = 100
+    damping: float = 1.0
+    window: int = 10
+    growth: float = 2.0
+
+    def __post_init__(self) -> None:
+        if not 0 < self.damping <= 1:
+            raise ValueError(f"damping must lie in (0, 1], got {self.damping}")
+        if self.tolerance <= 0 or self.max_iterations < 1 or self.window < 1 or self.growth <= 1:
+            raise ValueError("tolerance > 0, max_iterations ≥ 1, window ≥ 1 and growth > 1 are required")
+
+
+@dataclass
+class PlayerRecord:
+    """One player's last response: its status and message, and how many responses it gave."""
+
+    status: Status = Status.OPTIMAL
+    message: str = ""
+    responses: int = 0
+
+
+@dataclass
+class Iteration:
+    """One sweep: each player's change ``distance(s_p^{i+1}, s_p^i)`` and the payoff after it."""
+
+    changes: dict[str, float]
+    payoff: float | None = None
+
+    @property
+    def largest(self) -> float:
+        return max(self.changes.values())
+
+
+@dataclass
+class BestResponseRun:
+    """The last strategies, why the iteration stopped, its history and each player's record."""
+
+    strategies: Strategies
+    outcome: Outcome
+    status: Status
+    message: str
+    settings: Settings
+    history: list[Iteration] = field(default_factory=list)
+    players: dict[str, PlayerRecord] = field(default_factory=dict)
+    failed_player: str = ""
+
+    @property
+    def converged(self) -> bool:
+        return self.outcome is Outcome.CONVERGED
+
+    @property
+    def iterations(self) -> int:
+        return len(self.history)
+
+    def changes(self, name: str) -> list[float]:
+        """``name``'s change per iteration."""
+        return [it.changes[name] for it in self.history]
+
+    def as_metrics(self) -> dict[str, Any]:
+        """The JSON-able ``Result.metrics["best_response"]``."""
+        return {
+            "converged": self.converged,
+            "outcome": self.outcome.value,
+            "iterations": self.iterations,
+            "scheme": self.settings.scheme,
+            "tolerance": self.settings.tolerance,
+            "damping": self.settings.damping,
+            "failed_player": self.failed_player or None,
+            "players": {
+                name: {"status": r.status.value, "message": r.message, "responses": r.responses}
+                for name, r in self.players.items()
+            },
+            "history": [{"changes": it.changes, "payoff": it.payoff} for it in self.history],
+        }
+
+
+def _finite(x: float) -> bool:
+    return bool(np.isfinite(x))
+
+
+class _Iterator:
+    """The state of one run of :func:`iterate`."""
+
+    def __init__(
+        self,
+        players: Sequence[Player],
+        start: Mapping[str, Any],
+        settings: Settings,
+        payoff: Callable[[Strategies], float] | None,
+    ) -> None:
+        names = [p.name for p in players]
+        if len(set(names)) != len(names):
+            raise ValueError(f"player names must be distinct: {names}")
+        missing = set(names) - set(start)
+        if missing:
+            raise ValueError(f"no starting strategy for {sorted(missing)}")
+        self.players = list(players)
+        self.settings = settings
+        self.payoff = payoff
+        self.current: Strategies = {name: start[name] for name in names}
+        self.records = {name: PlayerRecord() for name in names}
+        self.history: list[Iteration] = []
+        self.recent: list[Strategies] = [dict(self.current)]
+        self.failed = ""
+
+    def _respond(self, player: Player, view: Strategies) -> Any:
+        """``player``'s (damped) response to ``view``, or None when it failed."""
+        others = {k: v for k, v in view.items() if k != player.name}
+        strategy, report = player.respond(others)
+        record = self.records[player.name]
+        record.status, record.message = report.status, report.message
+        record.responses += 1
+        if strategy is None or not report.status.ok:
+            return None
+        w = self.settings.damping
+        if w < 1 and isinstance(player, BlendingPlayer):
+            return player.blend(view[player.name], strategy, w)
+        return strategy
+
+    def sweep(self) -> tuple[Strategies, str]:
+        """One Jacobi or Gauss–Seidel sweep; the failed player's name ('' when none failed)."""
+        gauss_seidel = self.settings.scheme == "gauss_seidel"
+        previous = dict(self.current)
+        following = dict(self.current)
+        for player in self.players:
+            strategy = self._respond(player, following if gauss_seidel else previous)
+            if strategy is None:
+                return following, player.name
+            following[player.name] = strategy
+        return following, ""
+
+    def _returned_to_earlier(self, strategies: Strategies, change: float) -> bool:
+        """The joint strategy is back at an iterate before the previous one: within tolerance of it
+        and a thousand times closer to it than to the previous iterate (a converging sequence is
+        about as far from its earlier iterates as from its previous one)."""
+        bound = min(self.settings.tolerance, 1e-3 * change)
+        return any(
+            all(p.distance(strategies[p.name], old[p.name]) <= bound for p in self.players)
+            for old in self.recent[:-1]
+        )
+
+    def _trend(self) -> Outcome | None:
+        """Cycling or divergence from the largest changes of the last two windows."""
+        w = self.settings.window
+        if len(self.history) < 2 * w:
+            return None
+        largest = [it.largest for it in self.history[-2 * w :]]
+        before, last = max(largest[:w]), max(largest[w:])
+        if last >= self.settings.growth * before:
+            return Outcome.DIVERGED
+        if last >= before:
+            return Outcome.CYCLING
+        return None
+
+    def step(self) -> Outcome | None:
+        """One iteration; the outcome when the iteration stops here."""
+        following, failed = self.sweep()
+        if failed:
+            self.failed = failed
+            return Outcome.PLAYER_FAILED
+        changes = {p.name: float(p.distance(following[p.name], self.current[p.name])) for p in self.players}
+        payoff = float(self.payoff(following)) if self.payoff is not None else None
+        self.history.append(Iteration(changes, payoff))
+        if not all(_finite(c) for c in changes.values()):
+            return Outcome.DIVERGED
+        self.current = following
+        if max(changes.values()) <= self.settings.tolerance:
+            return Outcome.CONVERGED
+        if self._returned_to_earlier(following, max(changes.values())):
+            return Outcome.CYCLING
+        self.recent = [*self.recent[-2 * self.settings.window :], dict(following)]
+        return self._trend()
+
+
+_STATUS = {
+    Outcome.ITERATION_LIMIT: Status.ITERATION_LIMIT,
+    Outcome.CYCLING: Status.NOT_CONVERGED,
+    Outcome.DIVERGED: Status.NOT_CONVERGED,
+}
+
+
+def _message(outcome: Outcome, it: _Iterator, failed: str) -> str:
+    n = len(it.history)
+    last = it.history[-1].largest if it.history else float("nan")
+    if outcome is Outcome.CONVERGED:
+        inexact = [f"{k}: {r.message}" for k, r in it.records.items() if r.status is not Status.OPTIMAL]
+        return "; ".join(inexact)
+    if outcome is Outcome.PLAYER_FAILED:
+        record = it.records[failed]
+        reason = f": {record.message}" if record.message else ""
+        return f"best responses stopped at iteration {n + 1}: {failed} failed ({record.status.value}){reason}"
+    if outcome is Outcome.ITERATION_LIMIT:
+        return f"best responses did not converge in {n} iterations (last change {last:.3g})"
+    if outcome is Outcome.CYCLING:
+        return f"best responses cycle: no progress after {n} iterations (last change {last:.3g})"
+    return f"best responses diverge: the change grew to {last:.3g} after {n} iterations"
+
+
+def iterate(
+    players: Sequence[Player],
+    start: Mapping[str, Any],
+    settings: Settings | None = None,
+    payoff: Callable[[Strategies], float] | None = None,
+) -> BestResponseRun:
+    """Iterate best responses from ``start`` (strategies by player name) until an outcome.
+
+    A converged run is ``optimal`` when every player's last response was, else ``feasible``; a run
+    stopped by a player's failure has that player's status; the others map as in ``_STATUS``. The
+    strategies returned are the last iterate every player accepted.
+    """
+    settings = settings or Settings()
+    it = _Iterator(players, start, settings, payoff)
+    outcome = Outcome.ITERATION_LIMIT
+    for _ in range(settings.max_iterations):
+        stopped = it.step()
+        if stopped is not None:
+            outcome = stopped
+            break
+    if outcome is Outcome.CONVERGED:
+        exact = all(r.status is Status.OPTIMAL for r in it.records.values())
+        status = Status.OPTIMAL if exact else Status.FEASIBLE
+    elif outcome is Outcome.PLAYER_FAILED:
+        status = it.records[it.failed].status
+        status = status if not status.ok else Status.ERROR
+    else:
+        status = _STATUS[outcome]
+    return BestResponseRun(
+        strategies=it.current,
+        outcome=outcome,
+        status=status,
+        message=_message(outcome, it, it.failed),
+        settings=settings,
+        history=it.history,
+        players=it.records,
+        failed_player=it.failed,
+    )

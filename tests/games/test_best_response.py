@@ -1,0 +1,198 @@
+"""The best-response engine on zero-sum quadratic games whose saddle point and iteration maps are
+known in closed form.
+
+``J(u, v) = ½uᵀAu + uᵀCv − ½vᵀBv + aᵀu + bᵀv`` with ``A, B ≻ 0``, u minimizing and v maximizing:
+the best responses are ``u = −A⁻¹(Cv + a)``, ``v = B⁻¹(Cᵀu + b)`` and the saddle point solves
+``[[A, C], [Cᵀ, −B]] [u; v] = −[a; b]``. The Jacobi map ``[[0, −A⁻¹C], [B⁻¹Cᵀ, 0]]`` has the purely
+imaginary eigenvalues ``±iσ`` (``σ²`` the eigenvalues of ``A⁻¹CB⁻¹Cᵀ``), so Jacobi converges iff
+``σ_max < 1``, cycles at ``σ = 1`` and spirals outwards beyond; Gauss–Seidel's map on v is
+``−B⁻¹CᵀA⁻¹C`` (eigenvalues ``−σ²``), twice the rate per sweep. Damping ``w`` moves the Jacobi
+eigenvalues to ``1 − w ± iwσ``, inside the unit disc iff ``w < 2/(1 + σ²)``.
+"""
+
+from __future__ import annotations
+
+import json
+
+import numpy as np
+import pytest
+
+from gamespec.games.best_response import (
+    Outcome,
+    Settings,
+    StepReport,
+    VectorPlayer,
+    iterate,
+)
+from gamespec.lqgame.solution import GameModel
+from gamespec.result import Result, Status
+from tests.lqgame.conftest import random_game
+
+
+class QuadraticGame:
+    """The game of the module docstring with coupling ``C`` scaled so that ``σ_max = sigma``."""
+
+    def __init__(self, sigma: float, seed: int = 0, n: int = 3, m: int = 2) -> None:
+        rng = np.random.default_rng(seed)
+        X, Y = rng.standard_normal((n, n)), rng.standard_normal((m, m))
+        self.A, self.B = X @ X.T + n * np.eye(n), Y @ Y.T + m * np.eye(m)
+        C = rng.standard_normal((n, m))
+        coupling = np.linalg.solve(self.A, C) @ np.linalg.solve(self.B, C.T)
+        current = np.sqrt(np.linalg.eigvals(coupling).real.max())
+        self.C = C * sigma / current
+        self.a, self.b = rng.standard_normal(n), rng.standard_normal(m)
+
+    def saddle(self) -> tuple[np.ndarray, np.ndarray]:
+        K = np.block([[self.A, self.C], [self.C.T, -self.B]])
+        z = -np.linalg.solve(K, np.concatenate([self.a, self.b]))
+        return z[: self.a.size], z[self.a.size :]
+
+    def payoff(self, s: dict[str, np.ndarray]) -> float:
+        u, v = s["u"], s["v"]
+        return float(0.5 * u @ self.A @ u + u @ self.C @ v - 0.5 * v @ self.B @ v + self.a @ u + self.b @ v)
+
+    def players(self) -> list[VectorPlayer]:
+        ok = StepReport(Status.OPTIMAL)
+        return [
+            VectorPlayer("u", lambda o: (-np.linalg.solve(self.A, self.C @ o["v"] + self.a), ok)),
+            VectorPlayer("v", lambda o: (np.linalg.solve(self.B, self.C.T @ o["u"] + self.b), ok)),
+        ]
+
+    def start(self) -> dict[str, np.ndarray]:
+        return {"u": np.zeros(self.a.size), "v": np.zeros(self.b.size)}
+
+
+@pytest.mark.parametrize("scheme", ["jacobi", "gauss_seidel"])
+def test_converges_to_the_closed_form_saddle(scheme: str):
+    game = QuadraticGame(sigma=0.6)
+    run = iterate(game.players(), game.start(), Settings(scheme=scheme, tolerance=1e-12), game.payoff)
+    assert run.outcome is Outcome.CONVERGED and run.status is Status.OPTIMAL and run.message == ""
+    u, v = game.saddle()
+    # the error left after a change ≤ tol is at most tol · σ/(1 − σ) per player
+    np.testing.assert_allclose(run.strategies["u"], u, atol=1e-10)
+    np.testing.assert_allclose(run.strategies["v"], v, atol=1e-10)
+    assert run.history[-1].payoff == pytest.approx(game.payoff({"u": u, "v": v}), abs=1e-10)
+    assert all(r.status is Status.OPTIMAL and r.responses == run.iterations for r in run.players.values())
+
+
+def test_gauss_seidel_needs_about_half_the_sweeps():
+    """Spectral radius σ per Jacobi sweep against σ² per Gauss–Seidel sweep."""
+    game = QuadraticGame(sigma=0.8)
+    runs = {
+        scheme: iterate(game.players(), game.start(), Settings(scheme=scheme, tolerance=1e-10))
+        for scheme in ("jacobi", "gauss_seidel")
+    }
+    assert all(r.converged for r in runs.values())
+    ratio = runs["gauss_seidel"].iterations / runs["jacobi"].iterations
+    assert 0.35 < ratio < 0.65
+
+
+def test_jacobi_at_unit_spectral_radius_cycles():
+    """σ = 1 in one dimension: the Jacobi map is a rotation by 90°, the iterates return after four sweeps."""
+    ok = StepReport(Status.OPTIMAL)
+    players = [
+        VectorPlayer("u", lambda o: (-o["v"] - 1.0, ok)),
+        VectorPlayer("v", lambda o: (o["u"] + 0.5, ok)),
+    ]
+    run = iterate(players, {"u": np.array([3.0]), "v": np.array([0.0])}, Settings(max_iterations=100))
+    assert run.outcome is Outcome.CYCLING and run.status is Status.NOT_CONVERGED
+    assert run.iterations == 4
+    assert "cycle" in run.message
+
+
+def test_jacobi_beyond_unit_spectral_radius_diverges_and_damping_fixes_it():
+    """σ = 2: plain Jacobi and Gauss–Seidel grow; damping w = 1/(1 + σ²) = 0.2 (the best w) converges
+    to the saddle, and w = 0.5 > 2/(1 + σ²) = 0.4 still diverges."""
+    game = QuadraticGame(sigma=2.0, seed=1)
+    for scheme in ("jacobi", "gauss_seidel"):
+        run = iterate(game.players(), game.start(), Settings(scheme=scheme, max_iterations=200))
+        assert run.outcome is Outcome.DIVERGED and run.status is Status.NOT_CONVERGED, scheme
+        assert run.iterations < 200
+        assert run.changes("u")[-1] > run.changes("u")[0]
+    damped = iterate(game.players(), game.start(), Settings(damping=0.2, tolerance=1e-11, max_iterations=500))
+    assert damped.converged
+    u, v = game.saddle()
+    np.testing.assert_allclose(damped.strategies["u"], u, atol=1e-9)
+    np.testing.assert_allclose(damped.strategies["v"], v, atol=1e-9)
+    too_little = iterate(game.players(), game.start(), Settings(damping=0.5, max_iterations=500))
+    assert too_little.outcome is Outcome.DIVERGED
+
+
+def test_slow_convergence_reaches_the_iteration_limit():
+    """σ = 0.95: the change shrinks by 0.95 per sweep, far from 1e-12 after 30 sweeps."""
+    game = QuadraticGame(sigma=0.95)
+    run = iterate(game.players(), game.start(), Settings(tolerance=1e-12, max_iterations=30))
+    assert run.outcome is Outcome.ITERATION_LIMIT and run.status is Status.ITERATION_LIMIT
+    assert run.iterations == 30 and not run.converged
+
+
+def test_a_failed_player_stops_the_run_with_its_status():
+    game = QuadraticGame(sigma=0.6)
+    u_player, v_player = game.players()
+    calls = []
+
+    def failing(others):
+        calls.append(1)
+        if len(calls) == 3:
+            return None, StepReport(Status.INFEASIBLE, "empty set")
+        return v_player.respond(others)
+
+    run = iterate([u_player, VectorPlayer("v", failing)], game.start(), Settings(scheme="gauss_seidel"))
+    assert run.outcome is Outcome.PLAYER_FAILED and run.status is Status.INFEASIBLE
+    assert run.failed_player == "v" and "empty set" in run.message
+    assert run.iterations == 2
+    assert run.players["v"].status is Status.INFEASIBLE
+
+
+def test_a_non_finite_response_is_divergence():
+    ok = StepReport(Status.OPTIMAL)
+    players = [
+        VectorPlayer("u", lambda o: (np.array([np.nan]), ok)),
+        VectorPlayer("v", lambda o: (o["u"], ok)),
+    ]
+    run = iterate(players, {"u": np.zeros(1), "v": np.zeros(1)})
+    assert run.outcome is Outcome.DIVERGED
+    np.testing.assert_array_equal(run.strategies["u"], 0.0)
+
+
+def test_an_inexact_response_makes_a_converged_run_feasible():
+    game = QuadraticGame(sigma=0.5)
+    u_player, v_player = game.players()
+    inexact = VectorPlayer("v", lambda o: (v_player.respond(o)[0], StepReport(Status.FEASIBLE, "inaccurate")))
+    run = iterate([u_player, inexact], game.start())
+    assert run.converged and run.status is Status.FEASIBLE and "inaccurate" in run.message
+
+
+def test_metrics_go_into_a_result():
+    game = QuadraticGame(sigma=0.6)
+    run = iterate(game.players(), game.start(), payoff=game.payoff)
+    result = Result(status=run.status, message=run.message, metrics={"best_response": run.as_metrics()})
+    metrics = json.loads(result.to_json(arrays=False))["metrics"]["best_response"]
+    assert metrics["converged"] is True and metrics["iterations"] == run.iterations
+    assert [h["changes"]["u"] for h in metrics["history"]] == run.changes("u")
+    assert metrics["players"]["v"]["status"] == "optimal"
+
+
+def test_the_lq_mean_game_saddle_of_prop_9():
+    """The dynamic game of eq. 4.23 (no terminal target): best responses ``Ū = −H_uu⁻¹(H_uv V̄ + f_u)``
+    and eq. 4.39b converge to Prop. 9's saddle point when the Jacobi map's spectral radius
+    (√ρ(H_uu⁻¹H_uv H_vv⁻¹H_uvᵀ)) is below one, as it is for these games."""
+    game = random_game(0)
+    model = GameModel.build(type(game)(**{**game.__dict__, "muN": None}))
+    mean = model.mean
+    coupling = np.linalg.solve(mean.H_uu, mean.H_uv) @ np.linalg.solve(mean.H_vv, mean.H_uv.T)
+    radius = np.sqrt(np.abs(np.linalg.eigvals(coupling)).max())
+    assert radius < 1
+    ok = StepReport(Status.OPTIMAL)
+    players = [
+        VectorPlayer("u", lambda o: (-np.linalg.solve(mean.H_uu, mean.H_uv @ o["v"] + mean.free_u), ok)),
+        VectorPlayer("v", lambda o: (mean.stopper_response(o["u"]), ok)),
+    ]
+    start = {"u": np.zeros(mean.free_u.size), "v": np.zeros(mean.free_v.size)}
+    U, V = mean.saddle_point()
+    for scheme in ("jacobi", "gauss_seidel"):
+        run = iterate(players, start, Settings(scheme=scheme, tolerance=1e-11, max_iterations=2000))
+        assert run.converged, run.message
+        bound = 1e-11 * radius / (1 - radius) * 10
+        np.testing.assert_allclose(run.strategies["u"], U, atol=max(bound, 1e-9))
+        np.testing.assert_allclose(run.strategies["v"], V, atol=max(bound, 1e-9))

@@ -41,11 +41,17 @@ class NominalPaths:
         return CubicSpline(self.times, self.positions, axis=1)(np.asarray(t, dtype=float))
 
     def sampled(self, steps: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """``τ_k`` (N+1,), ``x̂_k`` (2, N+1, 2) and ``û_k = v̂ n_k`` (2, N, 2) on ``k T̂/N``."""
+        """``τ_k`` (N+1,), ``x̂_k`` (2, N+1, 2) and the held nominal controls ``û_k`` (2, N, 2) on
+        ``τ_k = k T̂/N``: ``û_k`` is the mean of ``v̂ n(t)`` over ``[τ_k, τ_{k+1}]`` (4-point
+        Gauss–Legendre), the zero-order hold of eq. 5.24/5.26 (the value at ``τ_0`` alone would be
+        the direction at the cone's apex, where ∇φ is undefined)."""
         tau = np.linspace(0.0, self.final_time, steps + 1)
-        direction = CubicSpline(self.times, self.directions, axis=1)(tau[:-1])
-        direction /= np.linalg.norm(direction, axis=-1, keepdims=True)
-        return tau, self.position(tau), self.speeds[:, None, None] * direction
+        nodes, weights = np.polynomial.legendre.leggauss(4)
+        h = tau[1] - tau[0]
+        inner = tau[:-1, None] + h * (nodes + 1) / 2
+        direction = _unit(CubicSpline(self.times, self.directions, axis=1)(inner.ravel()))
+        mean = np.einsum("asqi,q->asi", direction.reshape(2, steps, 4, 2), weights / 2)
+        return tau, self.position(tau), self.speeds[:, None, None] * mean
 
 
 def _unit(v: np.ndarray) -> np.ndarray:
@@ -84,6 +90,7 @@ def from_level_sets(
         positions.append(x)
     positions = np.stack(positions[::-1], axis=1)
     directions = np.stack([normal(positions[:, j], t) for j, t in enumerate(nodes)], axis=1)
+    directions[:, 0] = directions[:, 1]  # ∇φ is undefined at the apex x̂(0) = x₀
     closure = np.linalg.norm(positions[:, 0] - np.asarray(origins), axis=-1)
     return NominalPaths(nodes, positions, directions, speeds, closure)
 

@@ -63,7 +63,7 @@ class Reachability:
     metrics: dict[str, Any]
 
 
-def _level_set_reach(spec: FlowGameSpec, data: FlowGameData) -> Reachability:
+def _level_set_reach(spec: FlowGameSpec, data: FlowGameData, nominal: bool = True) -> Reachability:
     m = spec.method
     speeds = data.nominal_speeds
     solver = LevelSetSolver(
@@ -79,7 +79,7 @@ def _level_set_reach(spec: FlowGameSpec, data: FlowGameData) -> Reachability:
     arrays = {"reach_margin_time": reach.times, "reach_margin": reach.margins}
     if reach.capture_time is None:
         return Reachability(None, None, None, reach.message, arrays, metrics)
-    paths = from_level_sets(reach, data.field, speeds, data.origins)
+    paths = from_level_sets(reach, data.field, speeds, data.origins) if nominal else None
     metrics |= {
         "levels": reach.levels.tolist(),
         "level_capture_times": reach.level_times.tolist(),
@@ -93,7 +93,7 @@ def _level_set_reach(spec: FlowGameSpec, data: FlowGameData) -> Reachability:
     return Reachability(reach.capture_time, reach.capture_point, paths, "", arrays, metrics)
 
 
-def _extremal_reach(spec: FlowGameSpec, data: FlowGameData) -> Reachability:
+def _extremal_reach(spec: FlowGameSpec, data: FlowGameData, nominal: bool = True) -> Reachability:
     e = spec.method.extremals
     speeds = data.nominal_speeds
     reach = capture_by_extremals(
@@ -104,8 +104,10 @@ def _extremal_reach(spec: FlowGameSpec, data: FlowGameData) -> Reachability:
         return Reachability(
             None, None, None, f"no capture before t_max = {spec.method.max_time:g}", {}, metrics
         )
-    paths = from_extremals(
-        data.field, data.origins, speeds, reach.capture_time, reach.capture_point, dt=e.step
+    paths = (
+        from_extremals(data.field, data.origins, speeds, reach.capture_time, reach.capture_point)
+        if nominal
+        else None
     )
     arrays = {"front_final": reach.fronts[-1]}
     return Reachability(reach.capture_time, reach.capture_point, paths, "", arrays, metrics)
@@ -135,7 +137,10 @@ class FlowGameModel(CompiledModel):
     def cross_check(self, data: FlowGameData, reach: Reachability) -> dict[str, float]:
         if not self.options.cross_check or reach.capture_time is None:
             return {}
-        other = REACHABILITY["extremals" if self.method == "levelset" else "levelset"](self.spec, data)
+        if self.method == "levelset":
+            other = _extremal_reach(self.spec, data, nominal=False)
+        else:
+            other = _level_set_reach(self.spec, data, nominal=False)
         if other.capture_time is None:
             return {"capture_time_other_method": None}
         return {

@@ -109,21 +109,24 @@ class PursuerStep(_PlayerProblem):
 
         super().__init__(game, 0, solver, solver_options)
         self.scale = scale
-        self.offset = cp.Parameter(game.g0.size)
-        g = self.offset + (self.gains_map() @ self.kappa if self.kappa is not None else 0)
+        T = self.gains_map()
         if game.payoff == "trace":
-            objective = cp.sum_squares(g) / scale
+            # ‖c + Tκ‖² = ‖Rκ‖² + 2 (Tᵀc)ᵀκ + ‖c‖², R = (TᵀT)^{1/2}: the small form of the same QP
+            self.offset = cp.Parameter(T.shape[1])
+            objective = (cp.sum_squares(_root(T.T @ T) @ self.kappa) + 2 * self.offset @ self.kappa) / scale
             constraints = self.constraints
         else:
             N = game.N
-            G = cp.reshape(g, (2 * N, 4 * N), order="C") / np.sqrt(np.sqrt(scale))
+            self.offset = cp.Parameter(game.g0.size)
+            G = cp.reshape(self.offset + T @ self.kappa, (2 * N, 4 * N), order="C") / np.sqrt(np.sqrt(scale))
             S = cp.Variable((2 * N, 2 * N), symmetric=True)
             objective = cp.sum_squares(S)
             constraints = [*self.constraints, cp.bmat([[S, G], [G.T, np.eye(4 * N)]]) >> 0]
         self.problem = cp.Problem(cp.Minimize(objective + self.proximal), constraints)
 
     def respond(self, evader: Strategy) -> tuple[Strategy | None, StepReport]:
-        self.offset.value = self.game.g0 + self.game.gain_maps[1] @ evader.kappa.reshape(-1)
+        offset = self.game.g0 + self.game.gain_maps[1] @ evader.kappa.reshape(-1)
+        self.offset.value = self.gains_map().T @ offset if self.game.payoff == "trace" else offset
         status = self.run(self.problem)
         if not status.ok:
             return None, StepReport(status, f"pursuer step: solver reported {self.problem.status}")

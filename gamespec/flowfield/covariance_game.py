@@ -94,7 +94,7 @@ class CovarianceGame:
         N = self.N
         DB = (self.delta @ self.model.B).reshape(2 * N, N, 2, 2)[:, :, player, :]
         T = np.einsum("rka,kbc->rckab", DB, self.noise_rows)
-        return T.reshape(2 * N * 4 * N, N * 8)
+        return np.ascontiguousarray(T.reshape(2 * N * 4 * N, N * 8))
 
     @cached_property
     def gain_maps(self) -> tuple[np.ndarray, np.ndarray]:

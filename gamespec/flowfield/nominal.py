@@ -14,7 +14,6 @@ from dataclasses import dataclass
 
 import numpy as np
 from scipy.interpolate import CubicSpline
-from scipy.optimize import minimize_scalar
 
 from gamespec.flowfield.extremals import ExtremalMarch
 from gamespec.flowfield.field import FlowField
@@ -101,40 +100,39 @@ def from_extremals(
     speeds: np.ndarray,
     capture_time: float,
     capture_point: np.ndarray,
-    dt: float = 2e-3,
+    dt: float = 5e-3,
+    fan: int = 65,
+    rounds: int = 4,
 ) -> NominalPaths:
-    """The extremal of each agent ending nearest ``x_f`` at ``T̂`` (direction by bounded search
-    about the best of 720 angles)."""
+    """The extremal of each agent ending nearest ``x_f`` at ``T̂``: a fan of ``fan`` initial
+    directions about the best one so far, narrowed ``fan/2``-fold for ``rounds`` rounds."""
     count = int(np.ceil(capture_time / dt))
     h = capture_time / count
+    target = np.asarray(capture_point, dtype=float)
+    origins = np.asarray(origins, dtype=float)
+    speeds = np.asarray(speeds, dtype=float)
 
-    def shoot(origin: np.ndarray, speed: float, theta: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        march = ExtremalMarch(field, origin[None], np.array([speed]), len(theta), theta)
-        path, lam = [march.front[0]], [march.state[0, :, 2:]]
+    def shoot(theta: np.ndarray, keep: bool) -> tuple[np.ndarray, list[np.ndarray]]:
+        """Both agents' extremals from the angles ``theta`` (2, M): the ends, and the states."""
+        march = ExtremalMarch(field, origins, speeds, theta.shape[1], theta)
+        states = [march.state.copy()] if keep else []
         for _ in range(count):
             march.step(h)
-            path.append(march.front[0])
-            lam.append(march.state[0, :, 2:])
-        return np.stack(path, axis=1), _unit(np.stack(lam, axis=1))
+            if keep:
+                states.append(march.state.copy())
+        return march.front, states
 
-    positions, directions, closure = [], [], []
-    target = np.asarray(capture_point, dtype=float)
-    for origin, speed in zip(np.asarray(origins, dtype=float), np.asarray(speeds, dtype=float)):
-        grid = np.linspace(0, 2 * np.pi, 720, endpoint=False)
-        ends = shoot(origin, speed, grid)[0][:, -1]
-        best = grid[int(np.argmin(np.linalg.norm(ends - target, axis=-1)))]
-        step = grid[1]
-        miss = minimize_scalar(
-            lambda th: float(np.linalg.norm(shoot(origin, speed, np.array([th]))[0][0, -1] - target)),
-            bounds=(best - step, best + step),
-            method="bounded",
-            options={"xatol": 1e-10},
-        )
-        path, lam = shoot(origin, speed, np.array([miss.x]))
-        positions.append(path[0])
-        directions.append(lam[0])
-        closure.append(miss.fun)
+    theta = np.tile(np.linspace(0.0, 2 * np.pi, fan, endpoint=False), (2, 1))
+    width = 2 * np.pi
+    for _ in range(rounds):
+        ends, _ = shoot(theta, keep=False)
+        best = theta[np.arange(2), np.argmin(np.linalg.norm(ends - target, axis=-1), axis=1)]
+        width *= 4 / fan
+        theta = best[:, None] + np.linspace(-width / 2, width / 2, fan)
+    ends, _ = shoot(theta, keep=False)
+    best = theta[np.arange(2), np.argmin(np.linalg.norm(ends - target, axis=-1), axis=1)]
+    end, states = shoot(best[:, None], keep=True)
+    path = np.stack(states, axis=2)[:, 0]  # (2, S, 4)
+    closure = np.linalg.norm(end[:, 0] - target, axis=-1)
     times = np.linspace(0.0, capture_time, count + 1)
-    return NominalPaths(
-        times, np.stack(positions), np.stack(directions), np.asarray(speeds, float), np.array(closure)
-    )
+    return NominalPaths(times, path[..., :2], _unit(path[..., 2:]), speeds, closure)

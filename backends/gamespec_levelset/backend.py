@@ -165,7 +165,9 @@ class FlowGameModel(CompiledModel):
             )
         checks = self.cross_check(data, reach)
         result = _game(self.spec, self.options, data, reach)
-        checks |= {f"closure_error_{n}": float(e) for n, e in zip(PLAYERS, reach.paths.closure_error)}
+        checks |= {
+            f"closure_error_{n}": float(e) for n, e in zip(PLAYERS, reach.paths.closure_error, strict=True)
+        }
         return result.model_copy(
             update={
                 "parameters": values,
@@ -204,7 +206,7 @@ def _game(spec: FlowGameSpec, options: FlowGameOptions, data: FlowGameData, reac
     def payoff(strategies: dict[str, Strategy]) -> float:
         return game.value((strategies["pursuer"], strategies["evader"]))
 
-    run = iterate(players, dict(zip(PLAYERS, open_loop)), settings, payoff)
+    run = iterate(players, dict(zip(PLAYERS, open_loop, strict=True)), settings, payoff)
     closed = (run.strategies["pursuer"], run.strategies["evader"])
     eps = data.capture_radius
     prob = {

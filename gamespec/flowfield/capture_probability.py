@@ -41,4 +41,4 @@ def disk_probability(mean: np.ndarray, covariance: np.ndarray, radius: float) ->
 
 def capture_probabilities(means: np.ndarray, covariances: np.ndarray, radius: float) -> np.ndarray:
     """Eq. 5.39 at every step: ``means`` (N, 2), ``covariances`` (N, 2, 2) → (N,)."""
-    return np.array([disk_probability(m, S, radius) for m, S in zip(means, covariances)])
+    return np.array([disk_probability(m, S, radius) for m, S in zip(means, covariances, strict=True)])

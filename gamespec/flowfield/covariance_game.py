@@ -102,7 +102,7 @@ class CovarianceGame:
 
     def factor(self, strategies: tuple[Strategy, Strategy]) -> np.ndarray:
         """``G`` (2N × 4N) with ``Σʳ = G Gᵀ``."""
-        g = self.g0 + sum(T @ s.kappa.reshape(-1) for T, s in zip(self.gain_maps, strategies))
+        g = self.g0 + sum(T @ s.kappa.reshape(-1) for T, s in zip(self.gain_maps, strategies, strict=True))
         return g.reshape(2 * self.N, -1)
 
     def value(self, strategies: tuple[Strategy, Strategy]) -> float:
@@ -153,7 +153,7 @@ class CovarianceGame:
         """The largest excess over each bound of eqs. 5.35–5.36, per player (≤ 0 when feasible)."""
         X = self.mean(strategies)
         out: dict[str, float] = {}
-        for i, (name, s, b) in enumerate(zip(PLAYERS, strategies, self.bounds)):
+        for i, (name, s, b) in enumerate(zip(PLAYERS, strategies, self.bounds, strict=True)):
             spread = np.linalg.norm(np.einsum("kab,kbc->kac", s.kappa, self.noise_rows), axis=(1, 2))
             out[f"{name}_mean_deviation"] = float(
                 np.max(np.linalg.norm(X[:, 2 * i : 2 * i + 2] - self.X_hat[:, 2 * i : 2 * i + 2], axis=1))

@@ -24,7 +24,9 @@ class Grid:
     @cached_property
     def axes(self) -> tuple[np.ndarray, np.ndarray]:
         """The node coordinates along each axis."""
-        return tuple(np.linspace(lo, hi, n) for lo, hi, n in zip(self.lower, self.upper, self.shape))
+        return tuple(
+            np.linspace(lo, hi, n) for lo, hi, n in zip(self.lower, self.upper, self.shape, strict=True)
+        )
 
     @cached_property
     def points(self) -> np.ndarray:

@@ -79,10 +79,12 @@ def zero_order_hold(field: FlowField, paths: NominalPaths, steps: int, substeps:
     for j in range(substeps):
         t = tau + j * dt
         k1 = rate(t, state)
-        k2 = rate(t + dt / 2, tuple(s + dt / 2 * k for s, k in zip(state, k1)))
-        k3 = rate(t + dt / 2, tuple(s + dt / 2 * k for s, k in zip(state, k2)))
-        k4 = rate(t + dt, tuple(s + dt * k for s, k in zip(state, k3)))
-        state = tuple(s + dt / 6 * (a + 2 * b + 2 * c + d) for s, a, b, c, d in zip(state, k1, k2, k3, k4))
+        k2 = rate(t + dt / 2, tuple(s + dt / 2 * k for s, k in zip(state, k1, strict=True)))
+        k3 = rate(t + dt / 2, tuple(s + dt / 2 * k for s, k in zip(state, k2, strict=True)))
+        k4 = rate(t + dt, tuple(s + dt * k for s, k in zip(state, k3, strict=True)))
+        state = tuple(
+            s + dt / 6 * (a + 2 * b + 2 * c + d) for s, a, b, c, d in zip(state, k1, k2, k3, k4, strict=True)
+        )
     Phi, Z, z, P = state
 
     def augmented(blocks: np.ndarray) -> np.ndarray:

@@ -73,13 +73,11 @@ def from_level_sets(
     def rate(x: np.ndarray, t: float) -> np.ndarray:
         return speeds[:, None] * normal(x, t) + field.drift(x)
 
-    nodes = np.concatenate(
-        [[t0 + (t1 - t0) * s / substeps for s in range(substeps)] for t0, t1 in zip(snap_t[:-1], snap_t[1:])]
-        + [[snap_t[-1]]]
-    )
+    fractions = np.arange(substeps) / substeps
+    nodes = np.append((snap_t[:-1, None] + np.diff(snap_t)[:, None] * fractions).ravel(), snap_t[-1])
     x = np.tile(np.asarray(reach.capture_point, dtype=float), (2, 1))
     positions = [x]
-    for t1, t0 in zip(nodes[::-1][:-1], nodes[::-1][1:]):
+    for t1, t0 in zip(nodes[::-1][:-1], nodes[::-1][1:], strict=True):
         h = t0 - t1
         k1 = rate(x, t1)
         k2 = rate(x + h / 2 * k1, t1 + h / 2)

@@ -27,21 +27,26 @@ from gamespec.result import Result
 COLORS = ("tab:red", "tab:blue")
 
 
+def _level(result: Result) -> str:
+    levels = result.metrics["reachability"].get("levels")
+    return f"{levels[0]:.3g}" if levels else "0"
+
+
 def _sets(ax: Axes, result: Result) -> None:
     arrays = result.arrays
     if "phi_final" in arrays:
         level = result.metrics["reachability"]["levels"][0]
-        for phi, color in zip(arrays["phi_final"], COLORS):
+        for phi, color in zip(arrays["phi_final"], COLORS, strict=True):
             ax.contour(arrays["grid_x"], arrays["grid_y"], phi.T, levels=[level], colors=color, linewidths=1)
     elif "front_final" in arrays:
-        for front, color in zip(arrays["front_final"], COLORS):
+        for front, color in zip(arrays["front_final"], COLORS, strict=True):
             closed = np.vstack([front, front[:1]])
             ax.plot(closed[:, 0], closed[:, 1], color=color, lw=1)
-    for path, color, name in zip(arrays["nominal_positions"], COLORS, ("pursuer", "evader")):
+    for path, color, name in zip(arrays["nominal_positions"], COLORS, ("pursuer", "evader"), strict=True):
         ax.plot(path[:, 0], path[:, 1], "--", color=color, label=f"{name} (nominal)")
         ax.plot(*path[0], "o", color=color)
     ax.plot(*result.metrics["capture_point"], "k*", ms=10, label="capture point")
-    ax.set_title(f"reachable sets at T̂ = {result.metrics['capture_time']:.3f}")
+    ax.set_title(f"reachable sets at T̂ = {result.metrics['capture_time']:.3f} (level {_level(result)})")
 
 
 def _dispersion(ax: Axes, result: Result) -> None:
@@ -49,7 +54,7 @@ def _dispersion(ax: Axes, result: Result) -> None:
     for i, color in enumerate(COLORS):
         for sample in paths:
             ax.plot(sample[:, 2 * i], sample[:, 2 * i + 1], color=color, lw=0.3, alpha=0.3)
-    for path, color in zip(result.arrays["nominal_positions"], COLORS):
+    for path in result.arrays["nominal_positions"]:
         ax.plot(path[:, 0], path[:, 1], "k--", lw=0.8)
     ax.set_title("closed-loop trajectory dispersion")
 

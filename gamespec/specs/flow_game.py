@@ -89,7 +89,7 @@ class GridSpec(StrictModel):
 
     @model_validator(mode="after")
     def _box(self) -> GridSpec:
-        if any(lo >= hi for lo, hi in zip(self.lower, self.upper)):
+        if any(lo >= hi for lo, hi in zip(self.lower, self.upper, strict=True)):
             raise ValueError("each lower bound must be below its upper bound")
         if any(n < 11 or n > 2001 for n in self.nodes):
             raise ValueError("nodes must lie in [11, 2001] per axis")
@@ -181,7 +181,7 @@ class _Evaluator:
 
     def expression(self, value: Value, field: str, position: bool) -> sp.Expr:
         symbols = (
-            {**self.symbols, **dict(zip(self.spec.problem.position, self.position))}
+            {**self.symbols, **dict(zip(self.spec.problem.position, self.position, strict=True))}
             if position
             else self.symbols
         )

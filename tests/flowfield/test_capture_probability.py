@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-from scipy.stats import ncx2
+from scipy.stats import ncx2, norm
 
 from gamespec.flowfield.capture_probability import disk_probability
 
@@ -14,7 +14,8 @@ from gamespec.flowfield.capture_probability import disk_probability
 def test_isotropic_is_the_noncentral_chi_square(sigma: float, offset: float) -> None:
     """``‖z‖²/σ² ~ χ'²(2, ‖μ‖²/σ²)`` for ``Σ = σ²I``."""
     mean = offset * np.array([0.6, 0.8])
-    expected = ncx2.cdf(0.09**2 / sigma**2, 2, offset**2 / sigma**2) if offset else 1 - np.exp(-(0.09**2) / (2 * sigma**2))
+    centred = 1 - np.exp(-(0.09**2) / (2 * sigma**2))
+    expected = ncx2.cdf(0.09**2 / sigma**2, 2, offset**2 / sigma**2) if offset else centred
     assert disk_probability(mean, sigma**2 * np.eye(2), 0.09) == pytest.approx(expected, abs=1e-10)
 
 
@@ -23,8 +24,6 @@ def test_degenerate_covariances_are_limits() -> None:
     assert disk_probability([0.1, 0.0], np.zeros((2, 2)), 0.09) == 0.0
     line = disk_probability([0.0, 0.03], np.diag([0.04**2, 0.0]), 0.09)
     chord = np.sqrt(0.09**2 - 0.03**2)
-    from scipy.stats import norm
-
     assert line == pytest.approx(norm.cdf(chord / 0.04) - norm.cdf(-chord / 0.04), abs=1e-9)
 
 

@@ -5,12 +5,12 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+from gamespec_levelset.players import EvaderStep, PursuerStep
 
 from gamespec.flowfield.covariance_game import CovarianceGame, PlayerBounds, Strategy
 from gamespec.flowfield.linearize import lifted, zero_order_hold
-from gamespec_levelset.players import EvaderStep, PursuerStep
-from tests.flowfield.conftest import vortex_field
 from gamespec.flowfield.nominal import NominalPaths
+from tests.flowfield.conftest import vortex_field
 
 N = 6
 

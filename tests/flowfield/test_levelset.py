@@ -70,6 +70,7 @@ def test_two_methods_agree_in_the_linear_flow() -> None:
 def test_a_set_leaving_the_grid_is_reported() -> None:
     field = uniform_field()
     grid = Grid((-1.0, -1.0), (1.0, 1.0), (21, 21))
-    reach = capture_by_level_sets(_solver(grid, [1.6, 0.6], field.drift(grid.points)), np.array([[0, 0], [0.5, 0]]), 5.0)
+    solver = _solver(grid, [1.6, 0.6], field.drift(grid.points))
+    reach = capture_by_level_sets(solver, np.array([[0.0, 0.0], [0.5, 0.0]]), 5.0)
     assert reach.capture_time is None
     assert "edge" in reach.message

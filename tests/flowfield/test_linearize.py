@@ -33,7 +33,7 @@ def test_zoh_matches_direct_integration_of_the_linearized_system() -> None:
         x, u = rng.normal(size=4), rng.normal(size=4)
         t0, t1 = k * model.step, (k + 1) * model.step
 
-        def rate(t: float, z: np.ndarray) -> np.ndarray:
+        def rate(t: float, z: np.ndarray, u: np.ndarray = u) -> np.ndarray:
             xh = paths.position(np.array([t]))[:, 0]
             A, g = field.jacobian(xh), field.diffusion(xh)
             r = field.drift(xh) - np.einsum("aij,aj->ai", A, xh)

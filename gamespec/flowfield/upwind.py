@@ -44,30 +44,63 @@ def _eno2(d: np.ndarray, n: int) -> tuple[np.ndarray, np.ndarray]:
     return left, right
 
 
-def _weno5_combination(
-    v1: np.ndarray, v2: np.ndarray, v3: np.ndarray, v4: np.ndarray, v5: np.ndarray
-) -> np.ndarray:
-    """Jiang–Peng WENO5 weights on the three ENO3 candidates (Osher & Fedkiw eq. 3.28–3.39)."""
-    p1 = v1 / 3 - 7 * v2 / 6 + 11 * v3 / 6
-    p2 = -v2 / 6 + 5 * v3 / 6 + v4 / 3
-    p3 = v3 / 3 + 5 * v4 / 6 - v5 / 6
-    s1 = 13 / 12 * (v1 - 2 * v2 + v3) ** 2 + 0.25 * (v1 - 4 * v2 + 3 * v3) ** 2
-    s2 = 13 / 12 * (v2 - 2 * v3 + v4) ** 2 + 0.25 * (v2 - v4) ** 2
-    s3 = 13 / 12 * (v3 - 2 * v4 + v5) ** 2 + 0.25 * (3 * v3 - 4 * v4 + v5) ** 2
-    eps = 1e-6 * np.maximum.reduce([v1**2, v2**2, v3**2, v4**2, v5**2]) + 1e-99
-    a1, a2, a3 = 0.1 / (s1 + eps) ** 2, 0.6 / (s2 + eps) ** 2, 0.3 / (s3 + eps) ** 2
-    return (a1 * p1 + a2 * p2 + a3 * p3) / (a1 + a2 + a3)
-
-
 def _weno5(d: np.ndarray, n: int) -> tuple[np.ndarray, np.ndarray]:
+    """Jiang–Peng WENO5 (Osher & Fedkiw eq. 3.28–3.39) for both sides at once.
+
+    Every quantity of a stencil of three consecutive differences ``(d_j, d_{j+1}, d_{j+2})`` is
+    computed once per ``j`` and shared: the right-biased derivative at node i uses the left-biased
+    stencils of nodes i+1 … i+3 read backwards, whose smoothness indicators are the same numbers.
+    """
     g = GHOSTS
+    a, b, c = d[:-2], d[1:-1], d[2:]
+    curvature = 13 / 12 * (a - 2 * b + c) ** 2
+    rising = curvature + 0.25 * (a - 4 * b + 3 * c) ** 2
+    falling = curvature + 0.25 * (3 * a - 4 * b + c) ** 2
+    middle = curvature + 0.25 * (a - c) ** 2
+    forward = a / 3 - 7 * b / 6 + 11 * c / 6
+    backward = 11 * a / 6 - 7 * b / 6 + c / 3
+    centre_left = -a / 6 + 5 * b / 6 + c / 3
+    centre_right = a / 3 + 5 * b / 6 - c / 6
+    square = d * d
+    widest = np.maximum(
+        np.maximum(np.maximum(square[:-4], square[1:-3]), np.maximum(square[2:-2], square[3:-1])), square[4:]
+    )
+    eps = 1e-6 * widest + 1e-99
 
-    def shifted(k: int) -> np.ndarray:
-        """``d`` at ``i + k − 1/2`` for every node i (k = 0: the difference left of the node)."""
-        return d[g - 1 + k : g - 1 + k + n]
+    def combine(
+        s1: np.ndarray,
+        s2: np.ndarray,
+        s3: np.ndarray,
+        p1: np.ndarray,
+        p2: np.ndarray,
+        p3: np.ndarray,
+        e: np.ndarray,
+    ) -> np.ndarray:
+        w1, w2, w3 = 0.1 / (s1 + e) ** 2, 0.6 / (s2 + e) ** 2, 0.3 / (s3 + e) ** 2
+        return (w1 * p1 + w2 * p2 + w3 * p3) / (w1 + w2 + w3)
 
-    left = _weno5_combination(shifted(-2), shifted(-1), shifted(0), shifted(1), shifted(2))
-    right = _weno5_combination(shifted(3), shifted(2), shifted(1), shifted(0), shifted(-1))
+    def at(q: np.ndarray, j: int) -> np.ndarray:
+        """``q`` of the stencil starting at padded difference ``j + i`` for every node i."""
+        return q[j : j + n]
+
+    left = combine(
+        at(rising, g - 3),
+        at(middle, g - 2),
+        at(falling, g - 1),
+        at(forward, g - 3),
+        at(centre_left, g - 2),
+        at(centre_right, g - 1),
+        at(eps, g - 3),
+    )
+    right = combine(
+        at(falling, g),
+        at(middle, g - 1),
+        at(rising, g - 2),
+        at(backward, g),
+        at(centre_right, g - 1),
+        at(centre_left, g - 2),
+        at(eps, g - 2),
+    )
     return left, right
 
 

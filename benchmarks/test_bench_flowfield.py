@@ -19,7 +19,6 @@ import gamespec
 from gamespec.flowfield.grid import Grid
 from gamespec.flowfield.hamiltonian import FlowHamiltonian
 from gamespec.flowfield.levelset import LevelSetSolver, capture_by_level_sets, initial_cones
-from gamespec.symbolic.translate import Library, translate
 from tests.conftest import PROBLEMS
 
 HUGO = PROBLEMS / "ch5" / "hurricane_hugo.yaml"
@@ -50,56 +49,19 @@ def test_levelset_hugo(benchmark, n: int) -> None:
 
 
 def _hj_solver(n: int):
-    hj = pytest.importorskip("hj_reachability")
+    pytest.importorskip("hj_reachability")
+    import hj_reachability as hj
     import jax.numpy as jnp
+    from gamespec_levelset.hj_solver import drift_dynamics, hj_grid
 
     data, grid = _hugo(n)
-    library = Library.from_namespace(
-        jnp,
-        asin=jnp.arcsin,
-        acos=jnp.arccos,
-        atan=jnp.arctan,
-        atan2=jnp.arctan2,
-        min=jnp.minimum,
-        max=jnp.maximum,
-        power=jnp.power,
-    )
-    field, speed = data.field, float(data.nominal_speeds[0])
-
-    class Drift(hj.ControlAndDisturbanceAffineDynamics):
-        """``ẋ = f(x) + u``, ``|u| ≤ v̂``: the Hamiltonian ``max_u p·(f + u) = p·f + v̂|p|`` of eq. 5.22."""
-
-        def __init__(self) -> None:
-            super().__init__(
-                "max", "min", hj.sets.Ball(jnp.zeros(2), speed), hj.sets.Box(jnp.zeros(1), jnp.zeros(1))
-            )
-
-        def open_loop_dynamics(self, state, time):
-            values = dict(zip(field.position, (state[0], state[1]), strict=True))
-            return jnp.stack(
-                [
-                    jnp.asarray(translate(e, values, library), dtype=state.dtype) * jnp.ones(())
-                    for e in field.drift_exprs
-                ]
-            )
-
-        def control_jacobian(self, state, time):
-            return jnp.eye(2)
-
-        def disturbance_jacobian(self, state, time):
-            return jnp.zeros((2, 1))
-
-    hj_grid = hj.Grid.from_lattice_parameters_and_boundary_conditions(
-        hj.sets.Box(jnp.array(grid.lower), jnp.array(grid.upper)), (n, n)
-    )
-    initial = jnp.linalg.norm(hj_grid.states - jnp.array(data.origins[0]), axis=-1)
+    dynamics = drift_dynamics(data.field, float(data.nominal_speeds[0]))
+    nodes = hj_grid(grid)
+    initial = jnp.linalg.norm(nodes.states - jnp.array(data.origins[0]), axis=-1)
     settings = hj.SolverSettings.with_accuracy("very_high", CFL_number=0.5)
-    dynamics = Drift()
 
     def run() -> np.ndarray:
-        values = hj.solve(
-            settings, dynamics, hj_grid, jnp.array([0.0, DURATION]), initial, progress_bar=False
-        )
+        values = hj.solve(settings, dynamics, nodes, jnp.array([0.0, DURATION]), initial, progress_bar=False)
         return np.asarray(values[-1].block_until_ready())
 
     return run

@@ -20,7 +20,7 @@ from typing import Any, ClassVar
 import numpy as np
 from pydantic import Field
 
-from gamespec.backend import Backend, CompiledModel
+from gamespec.backend import Availability, Backend, CompiledModel
 from gamespec.flowfield.capture_probability import capture_probabilities
 from gamespec.flowfield.covariance_game import PLAYERS, CovarianceGame, Strategy
 from gamespec.flowfield.extremals import capture_by_extremals
@@ -63,16 +63,24 @@ class Reachability:
     metrics: dict[str, Any]
 
 
-def _level_set_reach(spec: FlowGameSpec, data: FlowGameData, nominal: bool = True) -> Reachability:
+def _level_set_reach(
+    spec: FlowGameSpec, data: FlowGameData, nominal: bool = True, engine: str = "numpy"
+) -> Reachability:
     m = spec.method
     speeds = data.nominal_speeds
-    solver = LevelSetSolver(
-        data.grid, FlowHamiltonian(speeds, data.field.drift(data.grid.points)), m.scheme, m.cfl
-    )
+    if engine == "jax":
+        from gamespec_levelset.hj_solver import HJSolver
+
+        solver = HJSolver(data.grid, data.field, speeds, m.cfl)
+    else:
+        solver = LevelSetSolver(
+            data.grid, FlowHamiltonian(speeds, data.field.drift(data.grid.points)), m.scheme, m.cfl
+        )
     reach = capture_by_level_sets(solver, data.origins, m.max_time, level_cells=m.level_cells)
     metrics = {
         "method": "levelset",
-        "scheme": m.scheme,
+        "engine": "hj_reachability (jax)" if engine == "jax" else "numpy",
+        "scheme": "weno5" if engine == "jax" else m.scheme,
         "nodes": list(data.grid.shape),
         "time_steps": reach.steps,
     }
@@ -113,7 +121,11 @@ def _extremal_reach(spec: FlowGameSpec, data: FlowGameData, nominal: bool = True
     return Reachability(reach.capture_time, reach.capture_point, paths, "", arrays, metrics)
 
 
-REACHABILITY = {"levelset": _level_set_reach, "extremals": _extremal_reach}
+REACHABILITY = {
+    "levelset": _level_set_reach,
+    "extremals": _extremal_reach,
+    "hj_reachability": lambda spec, data: _level_set_reach(spec, data, engine="jax"),
+}
 
 
 def _stack(per_agent: np.ndarray) -> np.ndarray:
@@ -137,7 +149,7 @@ class FlowGameModel(CompiledModel):
     def cross_check(self, data: FlowGameData, reach: Reachability) -> dict[str, float]:
         if not self.options.cross_check or reach.capture_time is None:
             return {}
-        if self.method == "levelset":
+        if self.method != "extremals":
             other = _extremal_reach(self.spec, data, nominal=False)
         else:
             other = _level_set_reach(self.spec, data, nominal=False)
@@ -291,3 +303,22 @@ class ExtremalBackend(_FlowGameBackend):
 
     name = "extremals"
     method = "extremals"
+
+
+class HJReachabilityBackend(_FlowGameBackend):
+    """Reachability by hj_reachability (JAX) on the file's grid (WENO5, TVD-RK3; the scheme of
+    ``method.scheme`` is not used). Optional: needs ``pip install hj-reachability jax``."""
+
+    name = "hj_reachability"
+    method = "hj_reachability"
+
+    @classmethod
+    def available(cls) -> Availability:
+        try:
+            import hj_reachability
+            import jax
+        except ImportError as err:
+            return Availability(False, f"optional; pip install hj-reachability jax ({err})")
+        return Availability(
+            True, f"hj_reachability {hj_reachability.__version__}, jax {jax.__version__} (CPU)"
+        )

@@ -111,3 +111,12 @@ def test_set_parameter_on_the_command_line(tmp_path: Path, cli) -> None:
     code, out, err = cli("validate", path, "--set", "problem.flow.drift=[1]")
     assert code == 2 and "problem.flow.drift" in out + err
     assert cli("validate", path, "--set", "problem.parameters.noise=0.1")[0] == 0
+
+
+def test_hj_reachability_backend_agrees(result) -> None:
+    """The optional JAX engine (same scheme, global Lax–Friedrichs) finds the same capture."""
+    pytest.importorskip("hj_reachability")
+    other = solve(spec_from_dict(SPEC), backend="hj_reachability", options={"cross_check": False})
+    assert other.metrics["reachability"]["engine"].startswith("hj_reachability")
+    cell_time = 6.5 / 52 / 1.6
+    assert other.metrics["capture_time"] == pytest.approx(result.metrics["capture_time"], abs=0.1 * cell_time)

@@ -2,12 +2,13 @@
 
 A backend declares the kinds and features it supports, says whether it can run here and why not,
 validates its own options block, compiles a spec once into a :class:`CompiledModel` and re-solves
-that model with new parameter values and warm starts.
+that model with new parameter values, grid inputs and warm starts.
 """
 
 from __future__ import annotations
 
 from abc import ABC, abstractmethod
+from collections.abc import Mapping
 from dataclasses import dataclass
 from typing import Any, ClassVar
 
@@ -30,14 +31,30 @@ class NoOptions(StrictModel):
     """Options block of a backend that takes none."""
 
 
+Inputs = Mapping[str, Any] | None
+"""Grid input values by name (see :mod:`gamespec.ocp.inputs`), or None for the spec's defaults."""
+
+
 class CompiledModel(ABC):
     """A spec compiled into a backend's own modelling objects, re-solvable without a rebuild."""
 
     build_time_s: float = 0.0
 
     @abstractmethod
-    def solve(self, parameters: dict[str, float] | None = None, guess: Result | None = None) -> Result:
-        """Solve with optional new parameter values and an optional previous Result as a guess."""
+    def solve(
+        self, parameters: dict[str, float] | None = None, guess: Result | None = None, inputs: Inputs = None
+    ) -> Result:
+        """Solve with optional new parameter values, an optional previous Result as a guess, and new
+        values of grid inputs (``{name: values}``, one value per evaluation point, for kinds that
+        declare inputs; see :mod:`gamespec.ocp.inputs`)."""
+
+
+def refuse_inputs(inputs: Inputs, kind: str) -> None:
+    """A SpecError naming the inputs when a model of ``kind``, which declares none, is given some."""
+    if inputs:
+        raise SpecError(
+            f"kind {kind!r} takes no grid inputs, got {', '.join(sorted(inputs))}", field="inputs"
+        )
 
 
 class Backend(ABC):

@@ -32,7 +32,7 @@ class Status(StrEnum):
     ITERATION_LIMIT = "iteration_limit"
     NOT_CONVERGED = "not_converged"
     """An iteration stopped before its limit because it cannot converge: best responses that cycle
-    or diverge (:mod:`gamespec.games.best_response`); the message says which."""
+    or diverge (:mod:`gamespec.best_response`); the message says which."""
     TIME_LIMIT = "time_limit"
     NUMERICAL_ERROR = "numerical_error"
     ERROR = "error"

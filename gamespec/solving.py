@@ -16,7 +16,7 @@ from pathlib import Path
 from typing import Any
 
 from gamespec import registry
-from gamespec.backend import Backend, CompiledModel
+from gamespec.backend import Backend, CompiledModel, Inputs
 from gamespec.errors import BackendError, UnsupportedFeature
 from gamespec.loader import load, spec_hash
 from gamespec.result import Provenance, Result
@@ -73,9 +73,12 @@ class Solver:
         """The spec the backend actually solves (after transforms)."""
         return self.transforms[-1][1] if self.transforms else self.spec
 
-    def solve(self, parameters: dict[str, float] | None = None, guess: Result | None = None) -> Result:
-        """Solve (again) with optional new parameter values and an optional guess Result."""
-        result = self.compiled.solve(parameters=parameters, guess=guess)
+    def solve(
+        self, parameters: dict[str, float] | None = None, guess: Result | None = None, inputs: Inputs = None
+    ) -> Result:
+        """Solve (again) with optional new parameter values, an optional guess Result and new grid
+        input values (see :meth:`CompiledModel.solve`)."""
+        result = self.compiled.solve(parameters=parameters, guess=guess, inputs=inputs)
         for transform, _new, inverse in reversed(self.transforms):
             original = self._source_spec_of(transform)
             result = transform.invert(result, original, inverse)

@@ -2,8 +2,9 @@
 
 The NLP is built once from the backend-neutral :class:`~gamespec.ocp.transcription.Transcription`:
 decision variables ``[vec(X); vec(U); T]``, defects ``D X - T W F`` with ``F`` a mapped CasADi
-function over the evaluation points, and the problem's parameters (and a fixed horizon) as NLP
-parameters, so a re-solve with new values reuses the solver and warm-starts from the last solution.
+function over the evaluation points, and the problem's parameters, the grid inputs (one block of
+n_w × n_eval values) and a fixed horizon as NLP parameters ``p = [params; vec(Win); T]``, so a re-solve
+with new values reuses the solver and warm-starts from the last solution.
 """
 
 from __future__ import annotations
@@ -14,9 +15,9 @@ from typing import Any, ClassVar
 import numpy as np
 from pydantic import Field
 
-from gamespec.backend import Availability, CompiledModel
+from gamespec.backend import Availability, Inputs
 from gamespec.errors import BackendError
-from gamespec.ocp.transcription import CollocationBackend, Guess, Transcription
+from gamespec.ocp.transcription import CollocationBackend, CollocationModel, Guess, Transcription
 from gamespec.result import Result, Status
 from gamespec.specs.base import StrictModel
 from gamespec.specs.ocp import OptimalControlSpec
@@ -48,10 +49,14 @@ class CasadiOptions(StrictModel):
 
 
 def _library(ca) -> Library:
-    return Library.from_namespace(ca, abs=ca.fabs, min=ca.fmin, max=ca.fmax)
+    """CasADi's functions by gamespec's names; ``heaviside(x) = (1 + sign(x))/2``, which is 1/2 at 0
+    as SymPy's ``Heaviside`` (CasADi's ``sign(0) = 0``)."""
+    return Library.from_namespace(
+        ca, abs=ca.fabs, min=ca.fmin, max=ca.fmax, heaviside=lambda x: 0.5 * (1 + ca.sign(x))
+    )
 
 
-class CasadiModel(CompiledModel):
+class CasadiModel(CollocationModel):
     """The NLP and its solver, built once."""
 
     def __init__(self, spec: OptimalControlSpec, options: CasadiOptions) -> None:
@@ -64,26 +69,27 @@ class CasadiModel(CompiledModel):
         self.options = options
         ocp, grid = tr.ocp, tr.grid
         lib = _library(ca)
-        nx, nu, npar = tr.n_x, tr.n_u, len(ocp.p)
-        x, u, p, t = ca.SX.sym("x", nx), ca.SX.sym("u", nu), ca.SX.sym("p", npar), ca.SX.sym("t")
-        values = dict(zip(ocp.x, ca.vertsplit(x), strict=True)) | dict(
-            zip(ocp.u, ca.vertsplit(u), strict=True)
-        )
-        values |= dict(zip(ocp.p, ca.vertsplit(p), strict=True)) | {ocp.t: t}
+        nx, nu, nw, npar = tr.n_x, tr.n_u, tr.n_w, len(ocp.p)
+        x, u, w = ca.SX.sym("x", nx), ca.SX.sym("u", nu), ca.SX.sym("w", nw)
+        p, t = ca.SX.sym("p", npar), ca.SX.sym("t")
+        values = {ocp.t: t}
+        for symbols, var in ((ocp.x, x), (ocp.u, u), (ocp.w, w), (ocp.p, p)):
+            values |= dict(zip(symbols, ca.vertsplit(var), strict=True))
         f = ca.vertcat(*(translate(e, values, lib) for e in ocp.dynamics))
         L = translate(ocp.lagrange, values, lib)
         path = ca.vertcat(*(translate(r.expr, values, lib) for r in ocp.path))
         k = len(grid.eval_index)
-        point = ca.Function("point", [x, u, t, p], [f, L, path]).map(k)
+        point = ca.Function("point", [x, u, w, t, p], [f, L, path]).map(k)
 
         X = ca.SX.sym("X", nx, grid.n_nodes)
         U = ca.SX.sym("U", nu, k)
         T = ca.SX.sym("T") if tr.free_time else None
-        p_all = ca.SX.sym("p_all", npar + (0 if tr.free_time else 1))
+        p_all = ca.SX.sym("p_all", npar + nw * k + (0 if tr.free_time else 1))
         params = p_all[:npar, :]
-        horizon = T if tr.free_time else p_all[npar]
+        Win = ca.reshape(p_all[npar : npar + nw * k], nw, k)
+        horizon = T if tr.free_time else p_all[npar + nw * k]
         t_eval = tr.t0 + horizon * ca.DM(grid.eval_tau).T
-        F, Lv, G = point(X[:, grid.eval_index.tolist()], U, t_eval, params)
+        F, Lv, G = point(X[:, grid.eval_index.tolist()], U, Win, t_eval, params)
         D, W, q = grid.matrices
         defects = X @ ca.DM(D.T) - horizon * (F @ ca.DM(W.T))
 
@@ -124,10 +130,13 @@ class CasadiModel(CompiledModel):
         T = float(w[-1]) if self.tr.free_time else params_T
         return X, U, T
 
-    def solve(self, parameters: dict[str, float] | None = None, guess: Result | None = None) -> Result:
+    def solve(
+        self, parameters: dict[str, float] | None = None, guess: Result | None = None, inputs: Inputs = None
+    ) -> Result:
         tr = self.tr
         params = tr.ocp.parameter_values(parameters)
         b = tr.bounds(params)
+        Win = tr.input_values(params, inputs)
         if guess is None and self._last is not None and self.options.warm_start:
             w0 = self._last
         else:
@@ -135,7 +144,8 @@ class CasadiModel(CompiledModel):
             w0 = self._pack(start.X, start.U, start.T)
         lbx = self._pack(b.x_lower, b.u_lower, b.t_lower)
         ubx = self._pack(b.x_upper, b.u_upper, b.t_upper)
-        p_val = [params[n] for n in tr.ocp.parameters] + ([] if tr.free_time else [b.t_lower])
+        horizon = [] if tr.free_time else [b.t_lower]
+        p_val = np.concatenate([[params[n] for n in tr.ocp.parameters], Win.ravel(order="F"), horizon])
         tic = time.perf_counter()
         sol = self.solver(x0=np.clip(w0, lbx, ubx), lbx=lbx, ubx=ubx, lbg=self.lbg, ubg=self.ubg, p=p_val)
         elapsed = time.perf_counter() - tic
@@ -154,6 +164,7 @@ class CasadiModel(CompiledModel):
             T=T,
             objective=float(sol["f"]) * tr.ocp.sign if status.ok else None,
             params=params,
+            inputs=Win,
             status=status,
             message=native,
             solve_time_s=elapsed,

@@ -1,13 +1,15 @@
 """The ``cvxpy`` backend for the ``lq_stochastic_game`` kind (chapter 4).
 
 The mean steering upper game (eq. 4.43, Prop. 10) is a CVXPY QP; the constrained covariance game is
-Algorithm 2 (Jacobi) with the stopper's best response (concave QP, eq. 4.59b) and the controller's
-best response under the relaxed terminal constraint eq. 4.61 in the form eq. 4.62
-(``σ_max(W) ≤ 1``, an SDP). Each player's problem is built once with ``cp.Parameter``s and
-re-solved every iteration. When the controller's problem is infeasible, a third problem on the same
-parameters, ``min σ_max(W)``, gives the smallest achievable scaling ``γ* = σ²`` of ``Σ_N``. Without
-a terminal covariance the covariance game is the UCSG closed form (eq. 4.59). cvxpy is imported
-only when this backend is used.
+Algorithm 2 on the best-response engine with the stopper's best response (eq. 4.59b, closed form)
+and the controller's best response under the relaxed terminal constraint eq. 4.61 in the form
+eq. 4.62 (``σ_max(W) ≤ 1``, an SDP in whitened gains, :mod:`gamespec.lqgame.scaling`), built once
+with ``cp.Parameter``s and re-solved every iteration. A step the solver fails on numerically is
+retried on ``fallback_solver`` when the options name one, and otherwise stops the run with the last
+iterate and the status ``numerical_error``. When the controller's problem is infeasible, a second
+problem on the same parameters, ``min σ_max(W)``, gives the smallest achievable scaling
+``γ* = σ²`` of ``Σ_N``. Without a terminal covariance the covariance game is the UCSG closed form
+(eq. 4.59). cvxpy is imported only when this backend is used.
 """
 
 from __future__ import annotations
@@ -17,9 +19,13 @@ import warnings
 from typing import Any, ClassVar
 
 import numpy as np
+from pydantic import Field
 
+from gamespec.best_response import Settings, StepReport
+from gamespec.errors import BackendError
 from gamespec.lqgame.backend import LQBackend, LQCompiledModel, LQSolverOptions
-from gamespec.lqgame.covariance import gains_to_vector, jacobi
+from gamespec.lqgame.covariance import CONTROLLER, STOPPER, algorithm_2, gains_to_vector
+from gamespec.lqgame.scaling import ControllerScaling
 from gamespec.lqgame.solution import CovarianceOutcome, GameModel, MeanOutcome, fallback_mean
 from gamespec.result import Result, Status
 from gamespec.specs.base import StrictModel
@@ -36,36 +42,83 @@ STATUS_MAP = {
 }
 
 
+RETRY_SOLVER_OPTIONS: dict[str, dict[str, Any]] = {"CLARABEL": {"chordal_decomposition_enable": False}}
+"""Settings of a second attempt at a step a solver fails on numerically (the same tolerances).
+Clarabel splits the PSD cone of eq. 4.62 by chordal decomposition, a heuristic whose interior point
+can stall where the controller cannot steer some terminal states (the rows of ``W`` it leaves
+constant, e.g. the target's acceleration in the missile endgame); on the whole cone it reports
+``optimal`` or ``infeasible``."""
+
+
 class CvxpyOptions(LQSolverOptions):
-    """Options of the ``cvxpy`` backend: the conic solver's name and its keyword arguments."""
+    """Options of the ``cvxpy`` backend: the conic solver's name and its keyword arguments, how to
+    retry a step it fails on numerically, and an optional second solver for such a step."""
 
     solver: str = "CLARABEL"
+    retry_solver_options: dict[str, Any] | None = Field(
+        None,
+        description="solver_options added for a second attempt at a step the solver fails on "
+        "numerically; default: RETRY_SOLVER_OPTIONS for the solver (none for most solvers), {} to disable.",
+    )
+    fallback_solver: str | None = Field(
+        None,
+        description="Solver (default settings) that takes a step both attempts failed on numerically; "
+        "none by default, so a failure is reported rather than hidden.",
+    )
+
+    @property
+    def retry(self) -> dict[str, Any]:
+        """The solver options of the second attempt (empty: no second attempt)."""
+        if self.retry_solver_options is not None:
+            return self.retry_solver_options
+        return RETRY_SOLVER_OPTIONS.get(self.solver.upper(), {})
 
 
 class _Problem:
     """A CVXPY problem re-solved with new parameter values; returns our Status (an inaccurate
-    solution is ``feasible``, so cvxpy's warning about it is not repeated)."""
+    solution is ``feasible``, so cvxpy's warning about it is not repeated). A numerical failure is
+    retried with the options' ``retry`` settings, then on ``fallback_solver`` when the options name
+    one; ``note`` says what was needed."""
 
     def __init__(self, problem: Any, options: CvxpyOptions) -> None:
         self.problem = problem
         self.options = options
         self.seconds = 0.0
+        self.note = ""
+        self.raised = False
 
-    def solve(self) -> Status:
+    def _run(self, solver: str, solver_options: dict[str, Any]) -> Status:
         import cvxpy as cp
 
         start = time.perf_counter()
+        self.raised = False
         try:
             with warnings.catch_warnings():
                 warnings.filterwarnings("ignore", message="Solution may be inaccurate")
-                self.problem.solve(solver=self.options.solver, warm_start=True, **self.options.solver_options)
+                self.problem.solve(solver=solver, warm_start=True, **solver_options)
         except cp.SolverError:
+            self.raised = True
             return Status.NUMERICAL_ERROR
-        except (TypeError, ValueError) as err:
-            raise self.options.rejected(err) from None
         finally:
             self.seconds += time.perf_counter() - start
         return STATUS_MAP.get(self.problem.status, Status.ERROR)
+
+    def solve(self) -> Status:
+        options = self.options
+        self.note = ""
+        status = self._run(options.solver, options.solver_options)
+        if status is Status.NUMERICAL_ERROR and options.retry:
+            status = self._run(options.solver, {**options.solver_options, **options.retry})
+            self.note = f"{options.solver} failed numerically, again with {options.retry}: {status.value}"
+        if status is Status.NUMERICAL_ERROR and options.fallback_solver:
+            status = self._run(options.fallback_solver, {})
+            self.note += f"{'; ' if self.note else ''}{options.fallback_solver}: {status.value}"
+        return status
+
+    @property
+    def reported(self) -> str:
+        """What the solver reported last (cvxpy's status, or that it raised)."""
+        return "a solver error" if self.raised else self.problem.status
 
 
 class MeanProblem:
@@ -84,7 +137,9 @@ class MeanProblem:
     def solve(self, model: GameModel) -> MeanOutcome:
         start = self.problem.seconds
         status = self.problem.solve()
-        reported = f"mean QP: solver reported {self.problem.problem.status}"
+        reported = f"mean QP: solver reported {self.problem.reported}"
+        if self.problem.note:
+            reported += f" ({self.problem.note})"
         if self.U.value is None or not status.ok:
             return fallback_mean(model, status, reported)
         U = np.asarray(self.U.value)
@@ -92,65 +147,52 @@ class MeanProblem:
             U,
             model.mean.stopper_response(U),
             status,
-            message=reported if status is Status.FEASIBLE else "",
+            message=reported if status is Status.FEASIBLE or self.problem.note else "",
             iterations=self.problem.problem.solver_stats.num_iters,
             solve_time_s=self.problem.seconds - start,
         )
 
 
 class CovariancePlayers:
-    """Both players' best-response problems of Algorithm 2, built once on ``cp.Parameter``s."""
+    """Both players' best responses of Algorithm 2: the stopper's in closed form (eq. 4.59b, an
+    unconstrained strictly concave QP, solved exactly by one linear solve rather than to a conic
+    solver's tolerance) and the controller's SDP under eq. 4.62, built once on ``cp.Parameter``s in
+    the whitened, normalized gains ``κ = s R_K⁻¹ ζ`` of :mod:`gamespec.lqgame.scaling`, so the solver
+    sees a unit Hessian and a unit constraint map whatever the problem's magnitudes."""
 
     def __init__(self, model: GameModel, options: CvxpyOptions) -> None:
         import cvxpy as cp
 
         cov = model.covariance
         self.model = model
-        self.w0, self.T_WK, self.T_WL = cov.terminal_map()
+        self.w0, T_WK, self.T_WL = cov.terminal_map()
+        self.gains = ControllerScaling.of(cov.H_KK, T_WK)
         n = model.game.n
         p = self.w0.size // n
-        self.kappa = cp.Variable(cov.g_K.size)
-        self.ell = cp.Variable(cov.g_L.size)
-        self.c_K = cp.Parameter(cov.g_K.size)
-        self.c_L = cp.Parameter(cov.g_L.size)
+        self.zeta = cp.Variable(cov.g_K.size)
+        self.c = cp.Parameter(cov.g_K.size)
         self.offset = cp.Parameter(self.w0.size)
-        W = cp.reshape(self.offset + self.T_WK @ self.kappa, (n, p), order="F")
-        root_K = np.linalg.cholesky(cov.H_KK).T
-        root_L = np.linalg.cholesky(-cov.H_LL).T
-        self.controller = _Problem(
-            cp.Problem(
-                cp.Minimize(cp.sum_squares(root_K @ self.kappa) + 2 * self.c_K @ self.kappa),
-                [cp.sigma_max(W) <= 1],
-            ),
-            options,
-        )
-        self.stopper = _Problem(
-            cp.Problem(cp.Maximize(-cp.sum_squares(root_L @ self.ell) + 2 * self.c_L @ self.ell)),
-            options,
-        )
+        W = cp.reshape(self.offset + self.gains.map(T_WK) @ self.zeta, (n, p), order="F")
+        payoff = cp.sum_squares(self.zeta) + 2 * self.c @ self.zeta
+        self.controller = _Problem(cp.Problem(cp.Minimize(payoff), [cp.sigma_max(W) <= 1]), options)
         self.scaling = _Problem(cp.Problem(cp.Minimize(cp.sigma_max(W))), options)
-        self.steps = {"stopper": 0, "controller": 0}
-        self.inaccurate = {"stopper": "", "controller": ""}
+        self.steps = 0
 
-    def _step(self, player: str, problem: _Problem, variable: Any) -> tuple[Status, np.ndarray | None]:
-        """Solve one player's problem; remember the step when the solver was only inaccurate."""
-        status = problem.solve()
-        self.steps[player] += 1
-        self.inaccurate[player] = (
-            f"{player} step {self.steps[player]}: solver reported {problem.problem.status}"
-            if status is Status.FEASIBLE
-            else ""
-        )
-        return status, (np.asarray(variable.value) if status.ok else None)
+    def stopper_step(self, kappa: np.ndarray) -> tuple[np.ndarray, StepReport]:
+        """eq. 4.59b: ``ℓ = −H_LL⁻¹(g_L + H_LK κ)``."""
+        return self.model.covariance.stopper_response(kappa), StepReport(Status.OPTIMAL)
 
-    def stopper_step(self, kappa: np.ndarray) -> tuple[Status, np.ndarray | None]:
-        self.c_L.value = self.model.covariance.stopper_linear_term(kappa)
-        return self._step("stopper", self.stopper, self.ell)
-
-    def controller_step(self, ell: np.ndarray) -> tuple[Status, np.ndarray | None]:
-        self.c_K.value = self.model.covariance.controller_linear_term(ell)
+    def controller_step(self, ell: np.ndarray) -> tuple[np.ndarray | None, StepReport]:
+        """The controller's best response in ``𝒦(ℓ)`` (eq. 4.62), ``κ = s R_K⁻¹ ζ``; the report names
+        the step when the solver was only inaccurate or needed the fallback."""
+        self.c.value = self.gains.linear_term(self.model.covariance.controller_linear_term(ell))
         self.offset.value = self.w0 + self.T_WL @ ell
-        return self._step("controller", self.controller, self.kappa)
+        status = self.controller.solve()
+        self.steps += 1
+        notes = [f"solver reported {self.controller.reported}"] if status is not Status.OPTIMAL else []
+        notes += [self.controller.note] if self.controller.note else []
+        report = StepReport(status, f"step {self.steps}: {'; '.join(notes)}" if notes else "")
+        return (self.gains.unscale(np.asarray(self.zeta.value)) if status.ok else None), report
 
     def smallest_scaling(self) -> float | None:
         """``min_K ‖W‖₂²`` for the current parameters: the least ``γ`` with ``Σ_N(K) ⪯ γ Σ_N``."""
@@ -160,29 +202,31 @@ class CovariancePlayers:
 
     @property
     def seconds(self) -> float:
-        return self.controller.seconds + self.stopper.seconds + self.scaling.seconds
+        return self.controller.seconds + self.scaling.seconds
 
     def solve(
-        self, tolerance: float, max_iterations: int, start_gains: tuple[np.ndarray, np.ndarray] | None = None
+        self, settings: Settings, start_gains: tuple[np.ndarray, np.ndarray] | None = None
     ) -> CovarianceOutcome:
         """Algorithm 2 from ``start_gains`` ``(K, L)`` (arrays (N, m, n), (N, ℓ, n)), or else from the
         UCSG saddle point (the thesis leaves ``K_0, L_0`` open)."""
         start = self.seconds
-        self.steps = dict.fromkeys(self.steps, 0)
+        self.steps = 0
         if start_gains is None:
             kappa0, ell0 = self.model.covariance.unconstrained_saddle()
         else:
             kappa0, ell0 = (gains_to_vector(G) for G in start_gains)
-        run = jacobi(self.stopper_step, self.controller_step, kappa0, ell0, tolerance, max_iterations)
+        run = algorithm_2(self.stopper_step, self.controller_step, kappa0, ell0, settings)
         outcome = CovarianceOutcome(
-            run.kappa,
-            run.ell,
+            run.strategies[CONTROLLER],
+            run.strategies[STOPPER],
             run.status,
-            "jacobi (Algorithm 2, eq. 4.62)",
+            f"{settings.scheme} (Algorithm 2, eq. 4.62)",
+            message=run.message,
             iterations=run.iterations,
-            history=run.history,
+            history=list(zip(run.changes(CONTROLLER), run.changes(STOPPER), strict=True)),
+            best_response=run.as_metrics(),
         )
-        if run.status is Status.INFEASIBLE and run.failed_step == "controller":
+        if run.status is Status.INFEASIBLE and run.failed_player == CONTROLLER:
             gamma = self.smallest_scaling()
             outcome.min_covariance_scaling = gamma
             scaling = (
@@ -194,10 +238,6 @@ class CovariancePlayers:
                 f"terminal covariance cannot be met at Jacobi iteration {run.iterations + 1}: {scaling}; "
                 "gains shown are the last iterate"
             )
-        elif not run.status.ok:
-            outcome.message = f"Jacobi stopped: {run.failed_step or 'iteration limit'} ({run.status.value})"
-        elif run.status is Status.FEASIBLE:
-            outcome.message = "; ".join(note for note in self.inaccurate.values() if note)
         outcome.solve_time_s = self.seconds - start
         return outcome
 
@@ -230,7 +270,13 @@ class CvxpyModel(LQCompiledModel):
         if self.players is None:
             return super()._solve_covariance(guess)
         method = self.spec.method
-        return self.players.solve(method.tolerance, method.max_iterations, self._start_gains(guess))
+        settings = Settings(
+            scheme=method.scheme,
+            tolerance=method.tolerance,
+            max_iterations=method.max_iterations,
+            damping=method.damping,
+        )
+        return self.players.solve(settings, self._start_gains(guess))
 
 
 class CvxpyBackend(LQBackend):
@@ -247,3 +293,24 @@ class CvxpyBackend(LQBackend):
         import cvxpy as cp
 
         return list(cp.installed_solvers())
+
+    @classmethod
+    def probe_options(cls, options: LQSolverOptions) -> None:
+        """Solve ``min (x − 1)² s.t. x ≥ 0`` with the user's solver options; a fallback solver must be
+        installed."""
+        import cvxpy as cp
+
+        assert isinstance(options, CvxpyOptions)
+        fallback = options.fallback_solver
+        if fallback is not None and fallback.upper() not in cls.installed_solvers():
+            raise BackendError(f"fallback_solver {fallback!r} is not installed for cvxpy")
+        x = cp.Variable()
+        try:
+            problem = cp.Problem(cp.Minimize(cp.square(x - 1)), [x >= 0])
+            with warnings.catch_warnings():
+                warnings.simplefilter("ignore")
+                problem.solve(solver=options.solver, **options.solver_options)
+        except (TypeError, ValueError) as err:
+            raise options.rejected(err) from None
+        except cp.SolverError:
+            return

@@ -12,7 +12,7 @@ from typing import ClassVar, Literal
 
 from pydantic import Field
 
-from gamespec.backend import Backend, CompiledModel
+from gamespec.backend import Backend, CompiledModel, Inputs, refuse_inputs
 from gamespec.errors import SpecError
 from gamespec.loader import spec_from_dict
 from gamespec.result import Result, Status
@@ -38,8 +38,11 @@ class CompiledScenario(CompiledModel):
         self.spec = spec
         self.options = options
 
-    def solve(self, parameters: dict[str, float] | None = None, guess: Result | None = None) -> Result:
+    def solve(
+        self, parameters: dict[str, float] | None = None, guess: Result | None = None, inputs: Inputs = None
+    ) -> Result:
         """Simulate (``guess`` is not used: the simulation has no iterate to warm-start)."""
+        refuse_inputs(inputs, self.spec.kind)
         unknown = set(parameters or {}) - set(self.TUNABLE)
         if unknown:
             raise SpecError(

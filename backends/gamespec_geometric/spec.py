@@ -15,7 +15,6 @@ from typing import Annotated, ClassVar, Literal
 import numpy as np
 from pydantic import (
     Field,
-    FiniteFloat,
     ValidationError,
     ValidatorFunctionWrapHandler,
     field_validator,
@@ -23,11 +22,11 @@ from pydantic import (
 )
 
 from gamespec.errors import ExpressionError, SpecError
-from gamespec.specs.base import SpecBase, StrictModel
+from gamespec.specs.base import Number, SpecBase, StrictModel
 from gamespec.symbolic.language import parse
 
-Position = tuple[FiniteFloat, FiniteFloat]
-PositiveFloat = Annotated[float, Field(gt=0, allow_inf_nan=False)]
+Position = tuple[Number, Number]
+PositiveFloat = Annotated[Number, Field(gt=0)]
 
 
 def _constant(value: object) -> object:

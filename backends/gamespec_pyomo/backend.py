@@ -2,8 +2,8 @@
 through AMPL NL/SOL files (the bundled ``ripopt``, or ``ipopt`` when one is on PATH).
 
 The model (:mod:`gamespec_pyomo.model`) is the CasADi backend's discretization written in Pyomo and
-is built once. A re-solve sets the parameter Params and the bounds, starts from the last solution
-(or from a guess Result of any backend) and writes a fresh NL file: Pyomo's NL interface has no
+is built once. A re-solve sets the parameter and grid-input Params and the bounds, starts from the
+last solution (or from a guess Result of any backend) and writes a fresh NL file: Pyomo's NL interface has no
 persistent solver, so NL writing counts in the solve time. Costates come from the defect
 multipliers the SOL file returns (Suffix ``dual``), as in the CasADi backend.
 """
@@ -20,9 +20,9 @@ from typing import Any, ClassVar, Literal
 import numpy as np
 from pydantic import Field
 
-from gamespec.backend import Availability, CompiledModel
+from gamespec.backend import Availability, Inputs
 from gamespec.errors import BackendError
-from gamespec.ocp.transcription import Bounds, CollocationBackend, Transcription
+from gamespec.ocp.transcription import Bounds, CollocationBackend, CollocationModel, Transcription
 from gamespec.result import Result
 from gamespec.specs.base import StrictModel
 from gamespec.specs.ocp import OptimalControlSpec
@@ -55,7 +55,7 @@ def _bound(value: float) -> float | None:
     return float(value) if math.isfinite(value) else None
 
 
-class PyomoModel(CompiledModel):
+class PyomoModel(CollocationModel):
     """The Pyomo model and the solver that runs on it, built once."""
 
     def __init__(self, spec: OptimalControlSpec, options: PyomoOptions) -> None:
@@ -135,11 +135,16 @@ class PyomoModel(CompiledModel):
             self.model.solutions.load_from(results)
         return True
 
-    def solve(self, parameters: dict[str, float] | None = None, guess: Result | None = None) -> Result:
+    def solve(
+        self, parameters: dict[str, float] | None = None, guess: Result | None = None, inputs: Inputs = None
+    ) -> Result:
         tr, m = self.tr, self.model
         params = tr.ocp.parameter_values(parameters)
+        Win = tr.input_values(params, inputs)
         for name, value in params.items():
             m.p[name] = value
+        for (i, col), param in m.w.items():
+            param.set_value(float(Win[i, col]))
         b = tr.bounds(params)
         self._set_bounds(b)
         if guess is not None or not (self._solved and self.options.warm_start):
@@ -161,6 +166,7 @@ class PyomoModel(CompiledModel):
             T=T,
             objective=float(self.pyo.value(m.objective)) * tr.ocp.sign if loaded else None,
             params=params,
+            inputs=Win,
             status=status_of(termination, message),
             message=message,
             solve_time_s=elapsed,

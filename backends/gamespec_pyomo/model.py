@@ -4,7 +4,8 @@ solve the identical discretization.
 
 Variables ``X[i, node]``, ``U[j, point]`` and the horizon ``T``, a Var when the final time is free
 (time scaling ``t = t0 + tau * T``) and a mutable Param otherwise. The problem's parameters are
-mutable Params indexed by name, so a re-solve changes values, not the model. Constraints: the
+mutable Params indexed by name, and the grid inputs mutable Params ``w[input, point]`` indexed by
+evaluation point, so a re-solve changes values, not the model. Constraints: the
 defects ``D X - T W F(X, U, t) = 0``, path constraints at every evaluation point and boundary
 constraints over the end values; objective ``Phi + T q^T L`` in minimization form.
 """
@@ -12,7 +13,7 @@ constraints over the end values; objective ``Phi + T q^T L`` in minimization for
 from __future__ import annotations
 
 import math
-from collections.abc import Mapping
+from collections.abc import Callable, Mapping
 from typing import Any
 
 import numpy as np
@@ -31,19 +32,33 @@ def _maximum(a: Any, b: Any) -> Any:
     return 0.5 * (a + b + abs(a - b))
 
 
-def _no_atan2(y: Any, x: Any) -> Any:
-    raise UnsupportedFeature(
-        "backend 'pyomo' cannot take atan2: Pyomo's expressions have no atan2, and ripopt "
-        "differentiates the conditional (Expr_if) form wrongly; use the casadi backend"
-    )
+def _refused(name: str) -> Callable[..., Any]:
+    """A library entry that refuses ``name``: Pyomo's expressions have no such function, and ripopt
+    differentiates the conditional (Expr_if) form that would emulate it wrongly."""
+
+    def refuse(*args: Any) -> Any:
+        raise UnsupportedFeature(
+            f"backend 'pyomo' cannot take {name}: Pyomo's expressions have no {name}, and ripopt "
+            "differentiates the conditional (Expr_if) form wrongly; use the casadi backend"
+        )
+
+    return refuse
 
 
 def pyomo_library() -> Library:
     """Pyomo's intrinsic functions by gamespec's names (min/max through ``abs``, which the NL
-    format has; no atan2)."""
+    format has; no atan2, sign or heaviside: they are refused when a problem uses them)."""
     import pyomo.environ as pyo
 
-    return Library.from_namespace(pyo, atan2=_no_atan2, abs=abs, min=_minimum, max=_maximum)
+    return Library.from_namespace(
+        pyo,
+        atan2=_refused("atan2"),
+        sign=_refused("sign"),
+        heaviside=_refused("heaviside"),
+        abs=abs,
+        min=_minimum,
+        max=_maximum,
+    )
 
 
 def _finite(value: float) -> float | None:
@@ -67,6 +82,7 @@ def build_model(tr: Transcription, params: Mapping[str, float]) -> Any:
     k = len(grid.eval_index)
     m = pyo.ConcreteModel(name=tr.spec.name)
     m.p = pyo.Param(ocp.parameters, mutable=True, initialize=dict(params))
+    m.w = pyo.Param(range(tr.n_w), range(k), mutable=True, initialize=0.0)
     m.X = pyo.Var(range(tr.n_x), range(grid.n_nodes), initialize=0.0)
     m.U = pyo.Var(range(tr.n_u), range(k), initialize=0.0)
     if tr.free_time:
@@ -82,6 +98,7 @@ def build_model(tr: Transcription, params: Mapping[str, float]) -> Any:
         values = symbols | {ocp.t: tr.t0 + tau * m.T}
         values |= {s: m.X[i, int(node)] for i, s in enumerate(ocp.x)}
         values |= {s: m.U[j, col] for j, s in enumerate(ocp.u)}
+        values |= {s: m.w[i, col] for i, s in enumerate(ocp.w)}
         F[:, col] = [translate(f, values, lib) for f in ocp.dynamics]
         L.append(translate(ocp.lagrange, values, lib))
         path.append([_relation(r, translate(r.expr, values, lib)) for r in ocp.path])

@@ -6,12 +6,17 @@ which gives the saddle point of Prop. 9). The covariance part is the UCSG closed
 A QP solver cannot take the controller's terminal covariance constraint (an SDP, eq. 4.62), so the
 backend does not declare the ``covariance_constraint`` feature and refuses a file that sets
 ``terminal.covariance`` (UnsupportedFeature); use the ``cvxpy`` backend for those.
+
+A solve's status is qpsolvers' own verdict (``Solution.found`` and ``Solution.is_optimal`` at a
+tolerance relative to the data's scale) through ``STATUS_MAP``; its primal and dual residuals and
+duality gap go into the Result's checks. Solver options are tried on a one-variable QP at compile
+time, so a rejected option is a one-line error and no exception is caught around a real solve.
 """
 
 from __future__ import annotations
 
 import time
-from typing import ClassVar
+from typing import TYPE_CHECKING, ClassVar
 
 import numpy as np
 from scipy.sparse import csc_matrix
@@ -20,6 +25,72 @@ from gamespec.lqgame.backend import LQBackend, LQCompiledModel, LQSolverOptions
 from gamespec.lqgame.solution import MeanOutcome, fallback_mean
 from gamespec.result import Result, Status
 from gamespec.specs.base import StrictModel
+
+if TYPE_CHECKING:
+    import qpsolvers
+
+
+QP_TOLERANCE = 1e-7
+"""Residuals (primal, dual, duality gap) allowed relative to the QP's data scale (see :func:`verdict`);
+above the defaults of the solvers qpsolvers wraps (1e-8 to 1e-9 in their own scaled norms)."""
+
+STATUS_MAP = {
+    "optimal": Status.OPTIMAL,
+    "primal_feasible": Status.FEASIBLE,
+    "infeasible_point": Status.NUMERICAL_ERROR,
+    "not_found": Status.NUMERICAL_ERROR,
+}
+"""qpsolvers' verdicts on a Solution (``found`` and ``is_optimal``) to our statuses. The mean QP is
+feasible by Lemma 11 (checked before it is solved), so a solver that finds no point failed
+numerically."""
+
+
+_MESSAGES = {
+    "optimal": "",
+    "primal_feasible": "mean QP: {solver}'s point meets 𝒢Ū = h, but its dual residual or duality gap "
+    "exceeds {eps:.2g} (qpsolvers' is_optimal)",
+    "infeasible_point": "mean QP: {solver}'s point misses 𝒢Ū = h by more than {eps:.2g}",
+    "not_found": "mean QP: {solver} found no solution",
+}
+
+
+def data_scale(solution: qpsolvers.Solution) -> float:
+    """``max(1, ‖q‖∞, ‖b‖∞, ‖P x‖∞, |xᵀPx|)``: the size of the terms the residuals compare."""
+    P, q, _, _, _, b, _, _ = solution.problem.unpack()
+    x = solution.x
+    terms = [1.0, float(np.abs(q).max(initial=0.0))]
+    if b is not None:
+        terms.append(float(np.abs(b).max(initial=0.0)))
+    if x is not None:
+        Px = P @ x
+        terms += [float(np.abs(Px).max(initial=0.0)), abs(float(x @ Px))]
+    return max(terms)
+
+
+def verdict(solution: qpsolvers.Solution) -> str:
+    """A key of STATUS_MAP: qpsolvers' own ``found`` and ``is_optimal(eps)`` with
+    ``eps = QP_TOLERANCE · data_scale``; a found point whose primal residual alone is within eps is
+    ``primal_feasible``."""
+    if not solution.found or solution.x is None:
+        return "not_found"
+    eps = QP_TOLERANCE * data_scale(solution)
+    if solution.is_optimal(eps):
+        return "optimal"
+    return "primal_feasible" if solution.primal_residual() < eps else "infeasible_point"
+
+
+def residuals(solution: qpsolvers.Solution) -> dict[str, float | None]:
+    """qpsolvers' primal and dual residuals and duality gap (None where undefined), and the scale."""
+
+    def finite(value: float) -> float | None:
+        return float(value) if np.isfinite(value) else None
+
+    return {
+        "qp_primal_residual": finite(solution.primal_residual()),
+        "qp_dual_residual": finite(solution.dual_residual()),
+        "qp_duality_gap": finite(solution.duality_gap()),
+        "qp_data_scale": data_scale(solution),
+    }
 
 
 class QpOptions(LQSolverOptions):
@@ -50,24 +121,29 @@ class QpModel(LQCompiledModel):
         return np.column_stack(columns).ravel()
 
     def _solve_mean_qp(self, guess: Result | None) -> MeanOutcome:
-        """The QP, warm-started from ``guess``'s controls."""
+        """The QP, warm-started from ``guess``'s controls; its status from qpsolvers' residuals."""
         import qpsolvers
 
-        initvals = self._initial_controls(guess)
         start = time.perf_counter()
-        try:
-            solution = qpsolvers.solve_problem(
-                self.problem, solver=self.options.solver, initvals=initvals, **self.options.solver_options
-            )
-        except (TypeError, ValueError, qpsolvers.ParamError) as err:
-            raise self.options.rejected(err) from None
+        solution = qpsolvers.solve_problem(
+            self.problem,
+            solver=self.options.solver,
+            initvals=self._initial_controls(guess),
+            **self.options.solver_options,
+        )
         seconds = time.perf_counter() - start
-        if not solution.found or solution.x is None:
-            return fallback_mean(
-                self.model, Status.NUMERICAL_ERROR, f"{self.options.solver} found no solution"
-            )
+        key = verdict(solution)
+        status, checks = STATUS_MAP[key], residuals(solution)
+        eps = QP_TOLERANCE * checks["qp_data_scale"]
+        message = _MESSAGES[key].format(solver=self.options.solver, eps=eps)
+        if not status.ok:
+            outcome = fallback_mean(self.model, status, message)
+            outcome.checks = checks
+            return outcome
         U = np.asarray(solution.x)
-        return MeanOutcome(U, self.model.mean.stopper_response(U), Status.OPTIMAL, solve_time_s=seconds)
+        return MeanOutcome(
+            U, self.model.mean.stopper_response(U), status, message, solve_time_s=seconds, checks=checks
+        )
 
 
 class QpBackend(LQBackend):
@@ -84,3 +160,14 @@ class QpBackend(LQBackend):
         import qpsolvers
 
         return list(qpsolvers.available_solvers)
+
+    @classmethod
+    def probe_options(cls, options: LQSolverOptions) -> None:
+        """Solve ``min ½x² − x`` with the user's solver options."""
+        import qpsolvers
+
+        probe = qpsolvers.Problem(np.eye(1), -np.ones(1))
+        try:
+            qpsolvers.solve_problem(probe, solver=options.solver, **options.solver_options)
+        except (TypeError, ValueError, qpsolvers.ParamError) as err:
+            raise options.rejected(err) from None

@@ -17,7 +17,7 @@ from typing import Any, ClassVar
 
 from pydantic import Field
 
-from gamespec.backend import Availability, Backend, CompiledModel
+from gamespec.backend import Availability, Backend, CompiledModel, Inputs, refuse_inputs
 from gamespec.errors import BackendError
 from gamespec.lqgame.solution import (
     CovarianceOutcome,
@@ -85,8 +85,11 @@ class LQCompiledModel(CompiledModel):
             return fallback_mean(self.model, Status.INFEASIBLE, unreachable)
         return self._solve_mean_qp(guess)
 
-    def solve(self, parameters: dict[str, float] | None = None, guess: Result | None = None) -> Result:
+    def solve(
+        self, parameters: dict[str, float] | None = None, guess: Result | None = None, inputs: Inputs = None
+    ) -> Result:
         """Rebuild if the effective parameter values changed, then the mean and covariance games."""
+        refuse_inputs(inputs, self.spec.kind)
         values = {**self.spec.problem.parameters, **(parameters or {})}
         if values != self.values:
             self._build(values)
@@ -120,6 +123,12 @@ class LQBackend(Backend):
         """The solvers ``library`` finds here (imports it; ImportError when it is missing)."""
 
     @classmethod
+    @abstractmethod
+    def probe_options(cls, options: LQSolverOptions) -> None:
+        """Raise ``options.rejected(...)`` when the solver refuses ``options.solver_options`` (a
+        one-variable problem at compile time, so no real solve needs an exception handler)."""
+
+    @classmethod
     def available(cls) -> Availability:
         try:
             solvers = cls.installed_solvers()
@@ -139,4 +148,6 @@ class LQBackend(Backend):
                 f"solver {options.solver!r} is not installed for {self.library} "
                 f"(installed: {', '.join(solvers)})"
             )
-        return self.model_class(spec, options.model_copy(update={"solver": found[0]}))
+        options = options.model_copy(update={"solver": found[0]})
+        self.probe_options(options)
+        return self.model_class(spec, options)

@@ -10,20 +10,20 @@ whose blocks are the structured parts of ``Σ_s ⊗ (ℬᵀQ̄ℬ + R̄)``, ``Σ
 ``Σ_s ⊗ (𝒞ᵀQ̄𝒞 − S̄)`` and of ``ℬᵀQ̄Σ_s``, ``𝒞ᵀQ̄Σ_s``. Its stationary point is eq. 4.59 (UCSG).
 The relaxed terminal constraint eq. 4.61 reads ``‖W‖₂ ≤ 1`` (eq. 4.62) with
 ``vec W = w_0 + T_WK κ + T_WL ℓ``, ``W = Σ_N^{-1/2} E_N (I + ℬK + 𝒞L) F``.
-:func:`jacobi` is Algorithm 2 with the players' best responses supplied by a backend.
+:func:`algorithm_2` is Algorithm 2 on the best-response engine (:mod:`gamespec.best_response`)
+with the players' best responses supplied by a backend.
 """
 
 from __future__ import annotations
 
 from collections.abc import Callable
-from dataclasses import dataclass, field
 
 import numpy as np
 from scipy.linalg import sqrtm
 
+from gamespec.best_response import BestResponseRun, Response, Settings, VectorPlayer, iterate
 from gamespec.lqgame.game import LQGame
 from gamespec.lqgame.lifting import Lifted
-from gamespec.result import Status
 
 
 def _blocks(M: np.ndarray, rows: int, cols: int, N: int) -> np.ndarray:
@@ -130,53 +130,30 @@ class CovarianceGame:
         return np.stack([full[k * n : (k + 1) * n, k * n : (k + 1) * n] for k in range(N + 1)])
 
 
-Step = Callable[[np.ndarray], tuple[Status, np.ndarray | None]]
+STOPPER, CONTROLLER = "stopper", "controller"
+"""The players' names in Algorithm 2's history."""
+
+Step = Callable[[np.ndarray], tuple[np.ndarray | None, Response]]
+"""A player's best response to the other's gains: its own gains (None when the step failed) and
+how the step went."""
 
 
-@dataclass
-class JacobiOutcome:
-    """Algorithm 2's last iterate, the history ``(ε_k, ε_ℓ)`` per iteration and why it stopped."""
-
-    kappa: np.ndarray
-    ell: np.ndarray
-    status: Status
-    converged: bool
-    history: list[tuple[float, float]] = field(default_factory=list)
-    failed_step: str = ""
-
-    @property
-    def iterations(self) -> int:
-        return len(self.history)
-
-
-def jacobi(
+def algorithm_2(
     stopper_step: Step,
     controller_step: Step,
     kappa0: np.ndarray,
     ell0: np.ndarray,
-    tolerance: float,
-    max_iterations: int,
-) -> JacobiOutcome:
-    """Algorithm 2: ``L_{i+1} = argmax_L J(K_i, L)``, ``K_{i+1} = argmin_{K ∈ 𝒦(L_i)} J(K, L_i)``
-    until ``ε_k = ‖K_{i+1} − K_i‖`` and ``ε_ℓ = ‖L_{i+1} − L_i‖`` are both at most ``tolerance``.
-
-    A step that fails (e.g. the controller's set ``𝒦(L_i)`` is empty) stops the procedure with that
-    step's status; the last iterate is kept. A converged run is ``feasible`` rather than ``optimal``
-    when a last step was solved only inaccurately.
+    settings: Settings,
+) -> BestResponseRun:
+    """Algorithm 2 on the best-response engine: ``L_{i+1} = argmax_L J(K_i, L)`` (the stopper) and
+    ``K_{i+1} = argmin_{K ∈ 𝒦(L_i)} J(K, L_i)`` (the controller) until ``ε_k = ‖K_{i+1} − K_i‖``
+    and ``ε_ℓ = ‖L_{i+1} − L_i‖`` are both at most the tolerance (section 4.5). Jacobi is the
+    thesis' scheme; Gauss–Seidel lets the controller answer ``L_{i+1}``. A step that fails (e.g.
+    the controller's set ``𝒦(L_i)`` is empty) stops the run with that step's status, keeping the
+    last iterate; a run that cycles or diverges says so (``settings``' stopping rule).
     """
-    kappa, ell = kappa0, ell0
-    history: list[tuple[float, float]] = []
-    for _ in range(max_iterations):
-        stopper_status, ell_next = stopper_step(kappa)
-        if ell_next is None:
-            return JacobiOutcome(kappa, ell, stopper_status, False, history, "stopper")
-        controller_status, kappa_next = controller_step(ell)
-        if kappa_next is None:
-            return JacobiOutcome(kappa, ell, controller_status, False, history, "controller")
-        eps = (float(np.linalg.norm(kappa_next - kappa)), float(np.linalg.norm(ell_next - ell)))
-        history.append(eps)
-        kappa, ell = kappa_next, ell_next
-        if max(eps) <= tolerance:
-            exact = stopper_status is Status.OPTIMAL and controller_status is Status.OPTIMAL
-            return JacobiOutcome(kappa, ell, Status.OPTIMAL if exact else Status.FEASIBLE, True, history)
-    return JacobiOutcome(kappa, ell, Status.ITERATION_LIMIT, False, history)
+    players = [
+        VectorPlayer(STOPPER, lambda others: stopper_step(others[CONTROLLER])),
+        VectorPlayer(CONTROLLER, lambda others: controller_step(others[STOPPER])),
+    ]
+    return iterate(players, {STOPPER: ell0, CONTROLLER: kappa0}, settings)

@@ -63,7 +63,7 @@ class GameModel:
 
 @dataclass
 class MeanOutcome:
-    """Stacked mean inputs ``Ū``, ``V̄`` and how the solve went."""
+    """Stacked mean inputs ``Ū``, ``V̄``, how the solve went and the solver's own residuals."""
 
     U: np.ndarray
     V: np.ndarray
@@ -71,11 +71,14 @@ class MeanOutcome:
     message: str = ""
     iterations: int | None = None
     solve_time_s: float = 0.0
+    checks: dict[str, float | None] = field(default_factory=dict)
 
 
 @dataclass
 class CovarianceOutcome:
-    """Vectorized gains ``κ``, ``ℓ`` (see :mod:`gamespec.lqgame.covariance`) and how they were found."""
+    """Vectorized gains ``κ``, ``ℓ`` (see :mod:`gamespec.lqgame.covariance`) and how they were found:
+    ``history`` holds ``(ε_k, ε_ℓ)`` per iteration, ``best_response`` the engine's metrics
+    (:meth:`~gamespec.best_response.BestResponseRun.as_metrics`) when Algorithm 2 ran."""
 
     kappa: np.ndarray
     ell: np.ndarray
@@ -86,6 +89,7 @@ class CovarianceOutcome:
     history: list[tuple[float, float]] = field(default_factory=list)
     min_covariance_scaling: float | None = None
     solve_time_s: float = 0.0
+    best_response: dict[str, object] | None = None
 
 
 def unconstrained_covariance(model: GameModel, note: str = "") -> CovarianceOutcome:
@@ -130,6 +134,7 @@ def assemble(
     covariances = model.covariance.state_covariances(K, L)
     closed_U, _ = model.mean.upper_game()
     checks: dict[str, float | None] = {
+        **mean.checks,
         "mean_closed_form_gap": float(np.max(np.abs(mean.U - closed_U))),
         "stopper_response_gap": float(np.max(np.abs(cov.ell - model.covariance.stopper_response(cov.kappa)))),
     }
@@ -157,6 +162,8 @@ def assemble(
     violations = [checks[k] for k in ("terminal_mean_error", "terminal_covariance_violation") if k in checks]
     if violations:
         checks["max_constraint_violation"] = max(violations)
+    if cov.best_response is not None:
+        metrics["best_response"] = cov.best_response
     if cov.min_covariance_scaling is not None:
         metrics["min_covariance_scaling"] = cov.min_covariance_scaling
     if cov.history:

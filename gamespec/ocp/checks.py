@@ -1,10 +1,15 @@
 """Checks of an OCP solution computed from the Result's arrays alone, never from the solver.
 
 - ``max_defect``: each interval re-integrated with RK4 (``RK4_STEPS`` steps) from its first node
-  under the interpolated control; the largest gap to the next interval's first node.
+  under the interpolated control and grid inputs; the largest gap to the next interval's first node.
+  Inputs are interpolated as the controls are and as the transcription sees them: through the
+  interval's collocation points (the degree d-1 polynomial, Radau) or linearly between nodes
+  (trapezoidal), so the check measures the discretization, not how a signal was tabulated.
 - ``max_constraint_violation``: bounds, fixed end values, path and boundary constraints.
 - ``hamiltonian_variation``: ``max |H - mean H|`` along the solution for autonomous problems, with
-  ``H = sign*L + lambda^T f`` from the costate estimates (constant on an optimal arc).
+  ``H = sign*L + lambda^T f`` from the costate estimates (constant on an optimal arc). A grid input
+  that enters f or L and varies along the grid makes the problem non-autonomous
+  (``dH/dt = dH/dw * dw/dt``): both Hamiltonian checks are then left out.
 - ``hamiltonian_end_error``: ``max |H + dPhi/dt_f|`` on free-final-time autonomous problems, where
   the transversality condition fixes the constant (``H = 0`` for minimum time, eqs. 2.22–2.23).
 """
@@ -12,6 +17,7 @@
 from __future__ import annotations
 
 from collections.abc import Mapping
+from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
 import numpy as np
@@ -25,14 +31,26 @@ if TYPE_CHECKING:
 RK4_STEPS = 16
 
 
-def _dynamics(tr: Transcription, x: np.ndarray, u: np.ndarray, t: np.ndarray, params: Mapping[str, float]):
-    values = _values(tr, x, u, t, params)
+@dataclass(frozen=True)
+class Trajectory:
+    """A transcribed solution: states ``X`` (n_x × nodes), controls ``U`` and grid inputs ``Win``
+    (n_u, n_w × evaluation points), the horizon ``T``."""
+
+    X: np.ndarray
+    U: np.ndarray
+    Win: np.ndarray
+    T: float
+
+
+def _dynamics(tr: Transcription, x, u, w, t: np.ndarray, params: Mapping[str, float]) -> np.ndarray:
+    values = _values(tr, x, u, w, t, params)
     return np.array([np.broadcast_to(translate(f, values, NUMPY), t.shape) for f in tr.ocp.dynamics])
 
 
-def _values(tr: Transcription, x, u, t, params) -> dict:
+def _values(tr: Transcription, x, u, w, t, params) -> dict:
     ocp = tr.ocp
     values = {s: x[i] for i, s in enumerate(ocp.x)} | {s: u[j] for j, s in enumerate(ocp.u)}
+    values |= {s: w[k] for k, s in enumerate(ocp.w)}
     return values | {symbol(k): v for k, v in params.items()} | {ocp.t: t}
 
 
@@ -50,32 +68,35 @@ def _control_basis(tr: Transcription, s: np.ndarray) -> np.ndarray:
     return basis
 
 
-def max_defect(
-    tr: Transcription, X: np.ndarray, U: np.ndarray, T: float, params: Mapping[str, float]
-) -> float:
+def _per_interval(tr: Transcription, V: np.ndarray) -> np.ndarray:
+    """Values at the evaluation points (rows × n_eval) as (rows, intervals, points of one interval)."""
+    grid = tr.grid
+    if grid.scheme == "radau":
+        return V.reshape(V.shape[0], grid.intervals, grid.points_per_interval)
+    return np.stack([V[:, :-1], V[:, 1:]], axis=2)
+
+
+def max_defect(tr: Transcription, sol: Trajectory, params: Mapping[str, float]) -> float:
     """Largest gap between an RK4 re-integration of each interval and the collocated state."""
+    X, T = sol.X, sol.T
     grid = tr.grid
     starts = grid.interval_start_index
     h = np.diff(grid.breaks) * T
     t0 = tr.t0 + T * grid.breaks[:-1]
-    d = grid.points_per_interval
-    if grid.scheme == "radau":
-        Ui = U.reshape(tr.n_u, grid.intervals, d)
-    else:
-        Ui = np.stack([U[:, :-1], U[:, 1:]], axis=2)
+    Ui, Wi = _per_interval(tr, sol.U), _per_interval(tr, sol.Win)
     x = X[:, starts[:-1]].astype(float)
     ds = 1.0 / RK4_STEPS
 
-    def control(s: float) -> np.ndarray:
-        return Ui @ _control_basis(tr, np.array([s]))[0]
+    def f(x: np.ndarray, s: float) -> np.ndarray:
+        basis = _control_basis(tr, np.array([s]))[0]
+        return _dynamics(tr, x, Ui @ basis, Wi @ basis, t0 + s * h, params)
 
     for step in range(RK4_STEPS):
         s = step * ds
-        t = t0 + s * h
-        k1 = _dynamics(tr, x, control(s), t, params)
-        k2 = _dynamics(tr, x + 0.5 * ds * h * k1, control(s + ds / 2), t + 0.5 * ds * h, params)
-        k3 = _dynamics(tr, x + 0.5 * ds * h * k2, control(s + ds / 2), t + 0.5 * ds * h, params)
-        k4 = _dynamics(tr, x + ds * h * k3, control(s + ds), t + ds * h, params)
+        k1 = f(x, s)
+        k2 = f(x + 0.5 * ds * h * k1, s + ds / 2)
+        k3 = f(x + 0.5 * ds * h * k2, s + ds / 2)
+        k4 = f(x + ds * h * k3, s + ds)
         x = x + ds * h / 6.0 * (k1 + 2 * k2 + 2 * k3 + k4)
     return float(np.max(np.abs(x - X[:, starts[1:]]))) if x.size else 0.0
 
@@ -91,15 +112,14 @@ def _relation_violation(rel: Relation, values: dict, shape: tuple[int, ...]) -> 
     return _violation(v, rel.lower, rel.upper)
 
 
-def max_constraint_violation(
-    tr: Transcription, X: np.ndarray, U: np.ndarray, T: float, params: Mapping[str, float]
-) -> float:
+def max_constraint_violation(tr: Transcription, sol: Trajectory, params: Mapping[str, float]) -> float:
     """Largest violation of bounds, fixed end values, path and boundary constraints."""
+    X, U, T = sol.X, sol.U, sol.T
     b = tr.bounds(params)
     worst = [_violation(X, b.x_lower, b.x_upper), _violation(U, b.u_lower, b.u_upper)]
     worst.append(_violation(np.array([T]), b.t_lower, b.t_upper))
     t_eval = tr.t0 + T * tr.grid.eval_tau
-    running = _values(tr, X[:, tr.grid.eval_index], U, t_eval, params)
+    running = _values(tr, X[:, tr.grid.eval_index], U, sol.Win, t_eval, params)
     worst += [_relation_violation(r, running, t_eval.shape) for r in tr.ocp.path]
     ends = _end_values(tr, X, T, params)
     worst += [_relation_violation(r, ends, ()) for r in tr.ocp.boundary]
@@ -113,36 +133,37 @@ def _end_values(tr: Transcription, X: np.ndarray, T: float, params: Mapping[str,
 
 
 def hamiltonian(
-    tr: Transcription, X: np.ndarray, U: np.ndarray, T: float, params: Mapping[str, float], lam: np.ndarray
+    tr: Transcription, sol: Trajectory, params: Mapping[str, float], lam: np.ndarray
 ) -> np.ndarray:
     """``H = sign*L + lambda^T f`` at the collocation points (eq. 2.22 in general form)."""
-    t_eval = tr.t0 + T * tr.grid.eval_tau
-    xe = X[:, tr.grid.eval_index]
-    f = _dynamics(tr, xe, U, t_eval, params)
-    values = _values(tr, xe, U, t_eval, params)
+    t_eval = tr.t0 + sol.T * tr.grid.eval_tau
+    xe = sol.X[:, tr.grid.eval_index]
+    f = _dynamics(tr, xe, sol.U, sol.Win, t_eval, params)
+    values = _values(tr, xe, sol.U, sol.Win, t_eval, params)
     running = np.broadcast_to(translate(tr.ocp.lagrange, values, NUMPY), t_eval.shape)
     return running + np.sum(lam * f, axis=0)
 
 
+def _time_invariant(tr: Transcription, Win: np.ndarray) -> bool:
+    """No explicit time in f and L, and every grid input that enters them constant on the grid."""
+    used = Win[tr.ocp.inputs_in_hamiltonian]
+    return tr.ocp.autonomous and bool(np.all(used == used[:, :1]))
+
+
 @np.errstate(all="ignore")
 def solution_checks(
-    tr: Transcription,
-    X: np.ndarray,
-    U: np.ndarray,
-    T: float,
-    params: Mapping[str, float],
-    lam: np.ndarray | None,
+    tr: Transcription, sol: Trajectory, params: Mapping[str, float], lam: np.ndarray | None
 ) -> dict[str, float | None]:
     """All checks that apply to this problem and solution (NaN where a value cannot be computed,
     e.g. a diverging re-integration of a failed solve)."""
     checks: dict[str, float | None] = {
-        "max_constraint_violation": max_constraint_violation(tr, X, U, T, params),
-        "max_defect": max_defect(tr, X, U, T, params),
+        "max_constraint_violation": max_constraint_violation(tr, sol, params),
+        "max_defect": max_defect(tr, sol, params),
     }
-    if lam is not None and tr.ocp.autonomous:
-        H = hamiltonian(tr, X, U, T, params, lam)
+    if lam is not None and _time_invariant(tr, sol.Win):
+        H = hamiltonian(tr, sol, params, lam)
         checks["hamiltonian_variation"] = float(np.max(np.abs(H - H.mean())))
         if tr.free_time:
-            end = translate(tr.ocp.hamiltonian_end_value, _end_values(tr, X, T, params), NUMPY)
+            end = translate(tr.ocp.hamiltonian_end_value, _end_values(tr, sol.X, sol.T, params), NUMPY)
             checks["hamiltonian_end_error"] = float(np.max(np.abs(H - float(end))))
     return checks

@@ -36,6 +36,11 @@ class SymbolicOcp:
     def parameters(self) -> list[str]:
         return list(self.spec.problem.parameters)
 
+    @property
+    def inputs(self) -> list[str]:
+        """Names of the grid inputs (signals tabulated at the evaluation points)."""
+        return list(self.spec.problem.inputs)
+
     @cached_property
     def x(self) -> list[sp.Symbol]:
         return [symbol(n) for n in self.states]
@@ -47,6 +52,10 @@ class SymbolicOcp:
     @cached_property
     def p(self) -> list[sp.Symbol]:
         return [symbol(n) for n in self.parameters]
+
+    @cached_property
+    def w(self) -> list[sp.Symbol]:
+        return [symbol(n) for n in self.inputs]
 
     @property
     def t(self) -> sp.Symbol:
@@ -66,7 +75,7 @@ class SymbolicOcp:
 
     @cached_property
     def _running(self) -> dict[str, sp.Expr]:
-        names = [*self.parameters, *self.states, *self.controls]
+        names = [*self.parameters, *self.inputs, *self.states, *self.controls]
         return {n: symbol(n) for n in names} | {"t": TIME}
 
     @cached_property
@@ -113,8 +122,17 @@ class SymbolicOcp:
 
     @property
     def autonomous(self) -> bool:
+        """No explicit ``t`` in the dynamics and the running cost (grid inputs aside: see
+        :meth:`inputs_in_hamiltonian`)."""
         exprs = [*self.dynamics, self.lagrange]
         return not any(TIME in e.free_symbols for e in exprs)
+
+    @cached_property
+    def inputs_in_hamiltonian(self) -> list[int]:
+        """Indices of the grid inputs that enter the dynamics or the running cost: a time-varying
+        one makes H time-varying (``dH/dt = dH/dw * dw/dt`` on an optimal arc)."""
+        used = set().union(*(e.free_symbols for e in [*self.dynamics, self.lagrange]))
+        return [i for i, s in enumerate(self.w) if s in used]
 
     def parameter_values(self, overrides: Mapping[str, float] | None = None) -> dict[str, float]:
         """The file's parameter values with ``overrides`` applied (unknown names are an error)."""

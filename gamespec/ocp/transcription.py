@@ -1,7 +1,9 @@
 """What every direct-collocation backend shares: the grid, bounds and initial guesses as arrays, and
 the assembly of a Result from a solution (with the solver-independent checks).
 
-Variables: ``X`` (n_x × n_nodes), ``U`` (n_u × n_eval), and the horizon ``T = t_f - t0``.
+Variables: ``X`` (n_x × n_nodes), ``U`` (n_u × n_eval), and the horizon ``T = t_f - t0``. Grid
+inputs ``Win`` (n_w × n_eval) are data at the evaluation points, where the controls are
+(:mod:`gamespec.ocp.inputs`).
 """
 
 from __future__ import annotations
@@ -13,13 +15,14 @@ from typing import ClassVar
 
 import numpy as np
 
-from gamespec.backend import Backend
+from gamespec.backend import Backend, CompiledModel
 from gamespec.errors import SpecError
-from gamespec.ocp.checks import solution_checks
+from gamespec.ocp.checks import Trajectory, solution_checks
 from gamespec.ocp.collocation import Grid
+from gamespec.ocp.inputs import InputGrid, InputValue, on_grid
 from gamespec.ocp.symbolic import SymbolicOcp
 from gamespec.result import Result, Status
-from gamespec.specs.ocp import OptimalControlSpec
+from gamespec.specs.ocp import NORMALIZED_TIME, OptimalControlSpec
 from gamespec.symbolic.language import ExpressionError, parse, symbol
 from gamespec.symbolic.translate import NUMPY, translate
 
@@ -51,8 +54,18 @@ class CollocationBackend(Backend):
 
     kinds: ClassVar[frozenset[str]] = frozenset({"optimal_control"})
     features: ClassVar[frozenset[str]] = frozenset(
-        {"ode", "free_final_time", "path_constraints", "boundary_constraints"}
+        {"ode", "free_final_time", "path_constraints", "boundary_constraints", "grid_inputs"}
     )
+
+
+class CollocationModel(CompiledModel):
+    """A compiled model of a :class:`Transcription` (``tr``), re-solvable with new grid inputs."""
+
+    tr: Transcription
+
+    def input_grid(self, parameters: Mapping[str, float] | None = None) -> InputGrid:
+        """Where ``solve(inputs=...)`` expects its values (see :meth:`Transcription.input_grid`)."""
+        return self.tr.input_grid(parameters)
 
 
 class Transcription:
@@ -74,8 +87,46 @@ class Transcription:
         return len(self.ocp.controls)
 
     @property
+    def n_w(self) -> int:
+        return len(self.ocp.inputs)
+
+    @property
     def free_time(self) -> bool:
         return self.spec.problem.time.free
+
+    def input_grid(self, params: Mapping[str, float] | None = None) -> InputGrid:
+        """Where grid inputs are tabulated: the evaluation points in normalized time and, for a fixed
+        horizon, in time (the Result's ``control_time``) for these parameter values."""
+        tau = self.grid.eval_tau
+        if self.free_time:
+            return InputGrid(tau, None)
+        _, tf, _ = self.ocp.final_time(self.ocp.parameter_values(params))
+        return InputGrid(tau, self.t0 + (tf - self.t0) * tau)
+
+    def input_values(
+        self, params: Mapping[str, float], given: Mapping[str, InputValue] | None = None
+    ) -> np.ndarray:
+        """The inputs at the evaluation points (n_w × n_eval): ``given`` ones (values per point, or
+        ``(times, values)`` samples resampled), the spec's defaults for the rest; a SpecError naming
+        an unknown input or a bad value."""
+        given = dict(given or {})
+        unknown = sorted(set(given) - set(self.ocp.inputs))
+        if unknown:
+            raise SpecError(
+                f"unknown input(s) {', '.join(unknown)} (declared: {', '.join(self.ocp.inputs) or 'none'})",
+                field="inputs",
+                source=self.spec.source,
+            )
+        grid = self.input_grid(params)
+        rows = [
+            on_grid(name, given[name], grid, self.spec.source)
+            if name in given
+            else self._profile(
+                spec.default, grid.tau, params, f"problem.inputs.{name}.default", None, None, 0.0, 0.0
+            )
+            for name, spec in self.spec.problem.inputs.items()
+        ]
+        return np.array(rows, dtype=float).reshape(self.n_w, len(grid))
 
     def bounds(self, params: Mapping[str, float]) -> Bounds:
         """Bounds on X, U and T; fixed initial/final states are bounds with lower == upper."""
@@ -140,12 +191,12 @@ class Transcription:
             a = start if start is not None else (end if end is not None else mid)
             b = end if end is not None else a
             return a + (b - a) * tau
-        symbols = {n: symbol(n) for n in params} | {"tau": symbol("tau")}
+        symbols = {n: symbol(n) for n in params} | {NORMALIZED_TIME: symbol(NORMALIZED_TIME)}
         try:
             expr = parse(raw, symbols)
         except ExpressionError as err:
             raise SpecError(str(err), field=field, source=self.spec.source) from None
-        values = {symbol(k): v for k, v in params.items()} | {symbol("tau"): tau}
+        values = {symbol(k): v for k, v in params.items()} | {symbol(NORMALIZED_TIME): tau}
         return np.broadcast_to(np.asarray(translate(expr, values, NUMPY), dtype=float), tau.shape).copy()
 
     def _guess_from_result(self, previous: Result) -> Guess:
@@ -180,19 +231,21 @@ class Transcription:
         message: str,
         solve_time_s: float,
         iterations: int | None,
+        inputs: np.ndarray,
         defect_multipliers: np.ndarray | None = None,
         solver_stats: dict | None = None,
     ) -> Result:
-        """A Result from a solution, with costates from the defect multipliers and the checks."""
+        """A Result from a solution, with costates from the defect multipliers, the checks, and the
+        grid inputs used (``arrays["input/<name>"]``, on ``control_time``)."""
         t_nodes = self.t0 + T * self.grid.nodes
         t_eval = self.t0 + T * self.grid.eval_tau
         costates: dict[str, np.ndarray] = {}
-        arrays: dict[str, np.ndarray] = {}
+        arrays = {f"input/{n}": inputs[i] for i, n in enumerate(self.ocp.inputs)}
         lam = None
         if defect_multipliers is not None and self.grid.scheme == "radau":
             lam = defect_multipliers * self.costate_rows[None, :]
             costates = {f"lambda_{n}": lam[i] for i, n in enumerate(self.ocp.states)}
-        checks = solution_checks(self, X, U, T, params, lam)
+        checks = solution_checks(self, Trajectory(X, U, inputs, T), params, lam)
         if lam is not None:
             arrays["costate_time"] = t_eval
         return Result(

@@ -19,7 +19,7 @@ from __future__ import annotations
 import time
 from typing import ClassVar
 
-from gamespec.backend import Backend, CompiledModel
+from gamespec.backend import Backend, CompiledModel, Inputs, refuse_inputs
 from gamespec.pursuit import constant_bearing, pure_pursuit
 from gamespec.pursuit.reduced import observe, reduce
 from gamespec.pursuit.report import engagement_report
@@ -36,7 +36,10 @@ class AnalyticModel(CompiledModel):
         self.spec = spec
         self.players = Players.from_spec(spec)
 
-    def solve(self, parameters: dict[str, float] | None = None, guess: Result | None = None) -> Result:
+    def solve(
+        self, parameters: dict[str, float] | None = None, guess: Result | None = None, inputs: Inputs = None
+    ) -> Result:
+        refuse_inputs(inputs, self.spec.kind)
         tic = time.perf_counter()
         players = self.players
         if set(players.strategies) == {"cb"}:

@@ -4,16 +4,38 @@ Constant bearing: the best constant heading (§2.4.1; the optimum whenever one h
 Pure pursuit: the suboptimal heading of eq. 2.27. Anything else (mixed strategies, relay
 pursuit): the best constant heading found by simulating the true dynamics over a grid of headings,
 discarding those that enter a stationary pursuer's Voronoi cell (eq. 2.28). The guess trajectory is
-that heading simulated to capture.
+that heading simulated to capture, carried into the optimal-control problem's ``guess`` section as
+least-squares polynomials in normalized time τ (:func:`polynomial`, written by the printer).
 """
 
 from __future__ import annotations
 
 import numpy as np
+import sympy as sp
 
 from gamespec.pursuit import constant_bearing, pure_pursuit
 from gamespec.pursuit.relay import voronoi_margin
 from gamespec.pursuit.simulation import Players, simulate_to_capture
+from gamespec.symbolic.language import symbol
+from gamespec.symbolic.printer import to_text
+
+GUESS_DEGREE = 5
+"""Degree of the polynomials in normalized time τ that carry the simulated guess."""
+
+NEGLIGIBLE = 1e-10
+"""Fitted coefficients of smaller magnitude are left out of the guess polynomial."""
+
+
+def fit_polynomial(tau: np.ndarray, values: np.ndarray) -> np.ndarray:
+    """Coefficients (lowest degree first) of the least-squares polynomial of :data:`GUESS_DEGREE`."""
+    return np.polynomial.polynomial.polyfit(tau, values, GUESS_DEGREE)
+
+
+def polynomial(tau: np.ndarray, values: np.ndarray) -> str:
+    """The least-squares polynomial in ``tau`` through ``values``, as an expression of the language."""
+    coefficients = enumerate(fit_polynomial(tau, values))
+    tau_symbol = symbol("tau")
+    return to_text(sp.Add(*(sp.Float(c) * tau_symbol**k for k, c in coefficients if abs(c) > NEGLIGIBLE)))
 
 
 def ranked_simulated_headings(players: Players, samples: int = 48) -> list[float]:

@@ -1,4 +1,4 @@
-"""The reduced-state dynamics of an engagement, generated as expression strings.
+"""The reduced-state dynamics of an engagement, built in SymPy and written in the expression language.
 
 Fixed frame (eqs. 2.8, 2.34, 3.2, 3.15–3.16), control θ_E (``theta_E``):
 
@@ -24,9 +24,12 @@ from __future__ import annotations
 from dataclasses import dataclass, field, replace
 
 import numpy as np
+import sympy as sp
 
 from gamespec.pursuit.simulation import Players, Trajectory
 from gamespec.specs.engagement import EngagementSpec
+from gamespec.symbolic.language import symbol
+from gamespec.symbolic.printer import to_text
 
 T_MAX_FACTOR = 1.25
 """Final-time upper bound relative to the latest possible capture min_i (r_i(0) − ε)/(u_i − v): no
@@ -36,7 +39,8 @@ transversality condition H(t_c) = 0 holds even for pure evasion."""
 
 @dataclass(frozen=True)
 class Reduction:
-    """An engagement's reduced-state problem: names, parameters and expression strings."""
+    """An engagement's reduced-state problem: names, parameters and expressions, written in the
+    language by :func:`~gamespec.symbolic.printer.to_text` from SymPy."""
 
     frame: str
     control: str
@@ -56,6 +60,16 @@ def _angle_name(frame: str, index: int, n: int) -> str:
     return "psi" if n == 2 else f"psi{index + 1}"
 
 
+V = symbol("v")
+
+
+def _initial(red: Reduction, state: str, value: float) -> None:
+    """``state(0)`` is the parameter ``<state>_init`` of value ``value``."""
+    start = symbol(f"{state}_init")
+    red.parameters[start.name] = value
+    red.initial[state] = to_text(start)
+
+
 def reduce(spec: EngagementSpec) -> Reduction:
     """The reduced-state dynamics, initial values and constraints of ``spec`` (see module doc)."""
     players = Players.from_spec(spec)
@@ -64,56 +78,66 @@ def reduce(spec: EngagementSpec) -> Reduction:
     r0, phi0 = players.distances(), players.los_angles()
     red = Reduction(frame=frame, control="theta_E" if frame == "fixed" else "theta")
     red.parameters.update(v=players.v, eps=players.eps)
+    control = symbol(red.control)
     for i, strategy in enumerate(players.strategies):
         k = i + 1
-        r, ang = f"r{k}", _angle_name(frame, i, n)
-        red.distance[i] = r
-        red.parameters[f"r{k}_init"] = float(r0[i])
-        red.initial[r] = f"r{k}_init"
+        r, ang = symbol(f"r{k}"), symbol(_angle_name(frame, i, n))
+        red.distance[i] = r.name
+        if frame == "fixed" or i > 0:
+            red.angle[i] = ang.name
+        _initial(red, r.name, float(r0[i]))
+        speed = symbol(f"u{k}")
         if strategy != "stationary":
-            red.parameters[f"u{k}"] = float(players.speeds[i])
-            red.capture_states.append(r)
+            red.parameters[speed.name] = float(players.speeds[i])
+            red.capture_states.append(r.name)
+        closing = speed if strategy == "pp" else sp.Integer(0)
         if frame == "fixed":
-            _fixed_frame(red, strategy, k, r, ang, float(phi0[i]))
+            dynamics = _fixed_frame(red, strategy, r, ang, speed, closing, control, float(phi0[i]))
         elif i == 0:
-            red.dynamics[r] = "-u1 + v*cos(theta)"
+            dynamics = {r: -speed + V * sp.cos(control)}
         else:
             psi0 = float(np.angle(np.exp(1j * (np.pi - phi0[0] + phi0[i]))))
-            _line_of_sight_frame(red, strategy, k, r, ang, psi0)
+            _initial(red, ang.name, psi0)
+            dynamics = _line_of_sight_frame(strategy, r, ang, speed, closing, control)
+        red.dynamics.update({state.name: to_text(rate) for state, rate in dynamics.items()})
     active = [i for i, s in enumerate(players.strategies) if s != "stationary"]
+    guard = symbol(red.distance[active[0]])
     for i, strategy in enumerate(players.strategies):
         if strategy == "stationary":
-            red.path_constraints.append(f"0.5*({red.distance[active[0]]}**2 - {red.distance[i]}**2) <= 0")
+            voronoi = sp.Rational(1, 2) * (guard**2 - symbol(red.distance[i]) ** 2)
+            red.path_constraints.append(to_text(sp.Le(voronoi, 0)))
     latest = (r0[active] - players.eps) / (players.speeds[active] - players.v)
     return replace(red, t_max=T_MAX_FACTOR * float(np.min(latest)))
 
 
-def _fixed_frame(red: Reduction, strategy: str, k: int, r: str, ang: str, phi0: float) -> None:
-    rel = f"theta_E - {ang}"
+def _fixed_frame(
+    red: Reduction,
+    strategy: str,
+    r: sp.Symbol,
+    ang: sp.Symbol,
+    speed: sp.Symbol,
+    closing: sp.Expr,
+    control: sp.Symbol,
+    phi0: float,
+) -> dict[sp.Symbol, sp.Expr]:
+    """Eqs. 2.8 (constant bearing: φ_i a parameter), 3.15–3.16 and 2.34b–c (φ_i a state)."""
+    rel = control - ang
     if strategy == "cb":
-        red.parameters[ang] = phi0
-        red.dynamics[r] = f"v*cos({rel}) - sqrt(u{k}**2 - v**2*sin({rel})**2)"
-        red.angle[k - 1] = ang
-        return
-    red.dynamics[r] = (f"-u{k} + " if strategy == "pp" else "") + f"v*cos({rel})"
-    red.dynamics[ang] = f"v*sin({rel})/{r}"
-    red.parameters[f"{ang}_init"] = phi0
-    red.initial[ang] = f"{ang}_init"
-    red.angle[k - 1] = ang
+        red.parameters[ang.name] = phi0
+        return {r: V * sp.cos(rel) - sp.sqrt(speed**2 - V**2 * sp.sin(rel) ** 2)}
+    _initial(red, ang.name, phi0)
+    return {r: -closing + V * sp.cos(rel), ang: V * sp.sin(rel) / r}
 
 
-def _line_of_sight_frame(red: Reduction, strategy: str, k: int, r: str, ang: str, psi0: float) -> None:
-    rel = f"{ang} - theta"
-    turn = "v*sin(theta)/r1"
+def _line_of_sight_frame(
+    strategy: str, r: sp.Symbol, ang: sp.Symbol, speed: sp.Symbol, closing: sp.Expr, control: sp.Symbol
+) -> dict[sp.Symbol, sp.Expr]:
+    """Eqs. 2.21 and 2.42 for pursuer i ≥ 2 at angle ψ_i, with the turn of pursuer 1's line of sight."""
+    rel = ang - control
+    turn = V * sp.sin(control) / symbol("r1")
     if strategy == "cb":
-        red.dynamics[r] = f"-v*cos({rel}) - sqrt(u{k}**2 - v**2*sin({rel})**2)"
-        red.dynamics[ang] = f"-{turn}"
-    else:
-        red.dynamics[r] = (f"-u{k} " if strategy == "pp" else "") + f"-v*cos({rel})"
-        red.dynamics[ang] = f"v*sin({rel})/{r} - {turn}"
-    red.parameters[f"{ang}_init"] = psi0
-    red.initial[ang] = f"{ang}_init"
-    red.angle[k - 1] = ang
+        return {r: -V * sp.cos(rel) - sp.sqrt(speed**2 - V**2 * sp.sin(rel) ** 2), ang: -turn}
+    return {r: -closing - V * sp.cos(rel), ang: V * sp.sin(rel) / r - turn}
 
 
 def observe(red: Reduction, traj: Trajectory) -> dict[str, np.ndarray]:

@@ -20,7 +20,7 @@ from typing import ClassVar
 import numpy as np
 from pydantic import Field
 
-from gamespec.backend import Backend, CompiledModel
+from gamespec.backend import Backend, CompiledModel, Inputs, refuse_inputs
 from gamespec.errors import UnsupportedFeature
 from gamespec.pursuit import study
 from gamespec.result import Result, Status
@@ -59,7 +59,10 @@ class StudyModel(CompiledModel):
         self.spec = spec
         self.options = options
 
-    def solve(self, parameters: dict[str, float] | None = None, guess: Result | None = None) -> Result:
+    def solve(
+        self, parameters: dict[str, float] | None = None, guess: Result | None = None, inputs: Inputs = None
+    ) -> Result:
+        refuse_inputs(inputs, self.spec.kind)
         if parameters:
             raise UnsupportedFeature("a pursuit_suboptimal_study takes no parameters; edit the file")
         tic = time.perf_counter()

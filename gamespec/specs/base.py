@@ -8,7 +8,14 @@ from __future__ import annotations
 
 from typing import Any, ClassVar
 
-from pydantic import BaseModel, ConfigDict, Field, PrivateAttr
+from pydantic import BaseModel, ConfigDict, Field, FiniteFloat, PrivateAttr
+
+Number = FiniteFloat
+"""A finite number: NaN and ±inf are refused at load, with the field named."""
+
+Value = Number | str
+"""A finite number, or an expression over the problem's parameters (each kind checks that the
+expression evaluates to a finite number)."""
 
 
 class StrictModel(BaseModel):

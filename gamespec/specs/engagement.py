@@ -14,9 +14,9 @@ from __future__ import annotations
 from typing import Literal
 
 import numpy as np
-from pydantic import Field, FiniteFloat, model_validator
+from pydantic import Field, model_validator
 
-from gamespec.specs.base import SpecBase, StrictModel
+from gamespec.specs.base import Number, SpecBase, StrictModel
 from gamespec.specs.ocp import MethodSpec
 
 Strategy = Literal["cb", "pp", "stationary"]
@@ -30,16 +30,16 @@ class PursuerSpec(StrictModel):
     """
 
     name: str = Field(description="Label used in reports and plots (P1, P2, ...).")
-    position: tuple[FiniteFloat, FiniteFloat]
-    speed: FiniteFloat = Field(1.0, ge=0, description="Speed u_i; unused while the pursuer is stationary.")
+    position: tuple[Number, Number]
+    speed: Number = Field(1.0, ge=0, description="Speed u_i; unused while the pursuer is stationary.")
     strategy: Strategy = Field(description="cb (constant bearing), pp (pure pursuit) or stationary.")
 
 
 class EvaderSpec(StrictModel):
     """The evader: its initial position and speed v."""
 
-    position: tuple[FiniteFloat, FiniteFloat]
-    speed: FiniteFloat = Field(gt=0)
+    position: tuple[Number, Number]
+    speed: Number = Field(gt=0)
 
 
 class EngagementSpec(SpecBase):
@@ -54,10 +54,10 @@ class EngagementSpec(SpecBase):
     kind: Literal["engagement"] = "engagement"
     pursuers: list[PursuerSpec] = Field(min_length=1)
     evader: EvaderSpec
-    capture_radius: FiniteFloat = Field(0.001, gt=0, description="Capture radius ε.")
+    capture_radius: Number = Field(0.001, gt=0, description="Capture radius ε.")
     frame: Literal["auto", "fixed", "line_of_sight"] = "auto"
     method: MethodSpec = Field(default_factory=MethodSpec)
-    guess_heading: FiniteFloat | None = Field(
+    guess_heading: Number | None = Field(
         None,
         description="Constant inertial-frame evader heading simulated to capture as the OCP's initial "
         "guess; default: the best constant heading (eq. 2.27 for pure pursuit), see gamespec.pursuit.guess.",

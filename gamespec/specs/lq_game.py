@@ -16,19 +16,16 @@ from __future__ import annotations
 
 from collections import Counter
 from collections.abc import Mapping
-from typing import Literal
+from typing import Annotated, Any, Literal
 
 import numpy as np
 import sympy as sp
-from pydantic import Field, field_validator, model_validator
+from pydantic import Discriminator, Field, Tag, field_validator, model_validator
 
 from gamespec.errors import ExpressionError, SpecError
 from gamespec.lqgame.game import LQGame, zero_order_hold
-from gamespec.specs.base import SpecBase, StrictModel
+from gamespec.specs.base import Number, SpecBase, StrictModel, Value
 from gamespec.symbolic.language import RESERVED, parse, symbol
-
-Value = float | str
-"""A number, or an expression over the problem's parameters."""
 
 
 class Diagonal(StrictModel):
@@ -43,7 +40,29 @@ class Identity(StrictModel):
     identity: Value = 1.0
 
 
-MatrixValue = list[list[Value]] | Diagonal | Identity
+_KEYS = {"diag": "matrix-diag", "identity": "matrix-identity", "per_step": "matrix-per-step"}
+
+
+def _form(value: Any) -> str | None:
+    """Which form a matrix is written in (a list of rows, or the key of its mapping or model), so a
+    bad entry's error names that form's field rather than every member of the union (the tags hold
+    a ``-``, which the loader leaves out of locations)."""
+    if isinstance(value, list):
+        return "matrix-rows"
+    keys = value if isinstance(value, dict) else getattr(type(value), "model_fields", {})
+    return next((tag for key, tag in _KEYS.items() if key in keys), None)
+
+
+_MATRIX_FORM = Discriminator(
+    _form,
+    custom_error_type="matrix_form",
+    custom_error_message="a matrix is a list of rows, {diag: [...]}, {identity: scale} or {per_step: [...]}",
+)
+_Rows = Annotated[list[list[Value]], Tag("matrix-rows")]
+_Diagonal = Annotated[Diagonal, Tag("matrix-diag")]
+_Identity = Annotated[Identity, Tag("matrix-identity")]
+
+MatrixValue = Annotated[_Rows | _Diagonal | _Identity, _MATRIX_FORM]
 
 
 class PerStep(StrictModel):
@@ -52,7 +71,9 @@ class PerStep(StrictModel):
     per_step: list[MatrixValue] = Field(min_length=1)
 
 
-StepMatrix = MatrixValue | PerStep
+_PerStep = Annotated[PerStep, Tag("matrix-per-step")]
+
+StepMatrix = Annotated[_Rows | _Diagonal | _Identity | _PerStep, _MATRIX_FORM]
 
 
 class DiscreteModel(StrictModel):
@@ -99,7 +120,7 @@ class TerminalTarget(StrictModel):
 class LQGameProblem(StrictModel):
     """The mathematics of the game."""
 
-    parameters: dict[str, float] = Field(default_factory=dict)
+    parameters: dict[str, Number] = Field(default_factory=dict)
     horizon: int = Field(ge=1, le=10_000, description="Number of steps N.")
     states: list[str] | None = Field(None, description="State names (default x1, x2, ...).")
     discrete: DiscreteModel | None = None
@@ -140,10 +161,17 @@ class MonteCarloSpec(StrictModel):
 
 
 class LQMethodSpec(StrictModel):
-    """Stopping rule of the Jacobi procedure (Algorithm 2) and the Monte Carlo check."""
+    """The best-response iteration of the covariance game (Algorithm 2: scheme, stopping rule,
+    damping; :mod:`gamespec.best_response`) and the Monte Carlo check."""
 
-    tolerance: float = Field(1e-5, gt=0, description="Bound on ε_k and ε_ℓ (section 4.5).")
+    tolerance: Number = Field(1e-5, gt=0, description="Bound on ε_k and ε_ℓ (section 4.5).")
     max_iterations: int = Field(100, ge=1)
+    scheme: Literal["jacobi", "gauss_seidel"] = Field(
+        "jacobi", description="jacobi (Algorithm 2) or gauss_seidel (the controller answers L_{i+1})."
+    )
+    damping: float = Field(
+        1.0, gt=0, le=1, description="Weight w of a new response: K_{i+1} = (1 − w) K_i + w BR (1: none)."
+    )
     monte_carlo: MonteCarloSpec = Field(default_factory=MonteCarloSpec)
 
 

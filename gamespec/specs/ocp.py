@@ -9,21 +9,20 @@ symbols it may use, so a typo stops at load time with the field that holds it.
 from __future__ import annotations
 
 import math
-from collections.abc import Mapping
+from collections.abc import Callable, Mapping
 from dataclasses import dataclass
 from typing import Literal
 
-from pydantic import Field, FiniteFloat, field_validator, model_validator
+from pydantic import Field, field_validator, model_validator
 
 from gamespec.errors import ExpressionError, SpecError
-from gamespec.specs.base import SpecBase, StrictModel
+from gamespec.specs.base import Number, SpecBase, StrictModel, Value
 from gamespec.symbolic.language import RESERVED, parse, parse_relation, symbol
 from gamespec.symbolic.translate import numeric
 
-Value = FiniteFloat | str
-"""A finite number, or an expression over the problem's parameters."""
-
 INF = math.inf
+NORMALIZED_TIME = "tau"
+"""The name of normalized time ``(t - t0) / (t_f - t0)`` in guess and input-default expressions."""
 
 
 class StateSpec(StrictModel):
@@ -42,6 +41,15 @@ class ControlSpec(StrictModel):
     upper: Value | None = None
 
 
+class InputSpec(StrictModel):
+    """One grid input: a signal tabulated at the transcription's evaluation points (the Result's
+    ``control_time``), used in the dynamics, the Lagrange integrand and path constraints like a
+    parameter that varies along the horizon. ``default`` is a number or an expression of normalized
+    time ``tau`` (in [0, 1]) and the parameters; ``CompiledModel.solve(inputs=...)`` replaces it."""
+
+    default: Value = 0.0
+
+
 class ObjectiveSpec(StrictModel):
     """Mayer term (over ``<state>_0``, ``<state>_f``, ``t_f``, parameters) plus Lagrange integrand."""
 
@@ -53,10 +61,10 @@ class ObjectiveSpec(StrictModel):
 class TimeSpec(StrictModel):
     """Initial time, and the final time: a value, or ``free`` within ``bounds`` from ``guess``."""
 
-    initial: FiniteFloat = 0.0
+    initial: Number = 0.0
     final: Value | Literal["free"] = 1.0
-    bounds: tuple[FiniteFloat, FiniteFloat] | None = None
-    guess: FiniteFloat | None = None
+    bounds: tuple[Number, Number] | None = None
+    guess: Number | None = None
 
     @model_validator(mode="after")
     def _free_needs_bounds(self) -> TimeSpec:
@@ -78,9 +86,10 @@ class TimeSpec(StrictModel):
 class OcpProblem(StrictModel):
     """The mathematics of an optimal-control problem."""
 
-    parameters: dict[str, FiniteFloat] = Field(default_factory=dict)
+    parameters: dict[str, Number] = Field(default_factory=dict)
     states: dict[str, StateSpec]
     controls: dict[str, ControlSpec] = Field(default_factory=dict)
+    inputs: dict[str, InputSpec] = Field(default_factory=dict)
     dynamics: dict[str, Value]
     objective: ObjectiveSpec = Field(default_factory=ObjectiveSpec)
     time: TimeSpec = Field(default_factory=TimeSpec)
@@ -96,10 +105,10 @@ class OcpProblem(StrictModel):
 
     @model_validator(mode="after")
     def _consistent(self) -> OcpProblem:
-        names = [*self.parameters, *self.states, *self.controls]
+        names = [*self.parameters, *self.states, *self.controls, *self.inputs]
         boundary = [f"{s}_0" for s in self.states] + [f"{s}_f" for s in self.states] + ["t_f"]
         for name in names:
-            if not name.isidentifier() or name in RESERVED:
+            if not name.isidentifier() or name in RESERVED or name == NORMALIZED_TIME:
                 raise ValueError(f"{name!r} cannot be a symbol name (reserved or not an identifier)")
         clashes = {n for n in names if names.count(n) > 1} | (set(names) & set(boundary))
         if clashes:
@@ -162,8 +171,11 @@ class OcpProblem(StrictModel):
         return EvaluatedValues(states, controls, t_final)
 
     def _check_expressions(self) -> None:
+        """Parse every expression over the symbols its field may use; an input where it may not
+        appear (bounds, end values, Mayer and boundary terms, the final time) is named as such."""
         params = {n: symbol(n) for n in self.parameters}
-        running = {**params, **{n: symbol(n) for n in [*self.states, *self.controls, "t"]}}
+        inputs = {n: symbol(n) for n in self.inputs}
+        running = {**params, **inputs, **{n: symbol(n) for n in [*self.states, *self.controls, "t"]}}
         ends = {
             **params,
             **{f"{s}_{e}": symbol(f"{s}_{e}") for s in self.states for e in "0f"},
@@ -175,6 +187,11 @@ class OcpProblem(StrictModel):
                 for key, value in spec.model_dump().items():
                     if isinstance(value, str):
                         checks.append((f"{group}.{name}.{key}", value, params, False))
+        checks += [
+            (f"inputs.{n}.default", i.default, params | {NORMALIZED_TIME: symbol(NORMALIZED_TIME)}, False)
+            for n, i in self.inputs.items()
+            if isinstance(i.default, str)
+        ]
         checks += [(f"dynamics.{k}", v, running, False) for k, v in self.dynamics.items()]
         checks += [
             ("objective.mayer", self.objective.mayer, ends, False),
@@ -187,10 +204,30 @@ class OcpProblem(StrictModel):
             (f"boundary_constraints.{i}", c, ends, True) for i, c in enumerate(self.boundary_constraints)
         ]
         for field, text, symbols, relation in checks:
+            read = parse_relation if relation else parse
             try:
-                (parse_relation if relation else parse)(text, symbols)
+                read(text, symbols)
             except ExpressionError as err:
-                raise SpecError(str(err), field=f"problem.{field}") from None
+                used = _inputs_in(read, text, symbols, inputs)
+                reason = (
+                    f"uses grid input(s) {', '.join(used)}: inputs are signals along the horizon and "
+                    "may appear only in dynamics, the Lagrange integrand and path constraints"
+                    if used
+                    else str(err)
+                )
+                raise SpecError(reason, field=f"problem.{field}") from None
+
+
+def _inputs_in(read: Callable, text: str, symbols: dict, inputs: dict) -> list[str]:
+    """The grid inputs that ``text`` uses, when it parses once they are allowed (else none)."""
+    if not inputs or set(inputs) <= set(symbols):
+        return []
+    try:
+        parsed = read(text, symbols | inputs)
+    except ExpressionError:
+        return []
+    expr = getattr(parsed, "expr", parsed)
+    return sorted(n for n, s in inputs.items() if s in expr.free_symbols)
 
 
 @dataclass(frozen=True)
@@ -218,7 +255,7 @@ class MethodSpec(StrictModel):
     scheme: Literal["radau", "trapezoidal"] = "radau"
     intervals: int = Field(40, ge=1, le=100_000)
     degree: int = Field(3, ge=1, le=12)
-    grading: FiniteFloat = Field(1.0, gt=0, le=1e4)
+    grading: Number = Field(1.0, gt=0, le=1e4)
 
 
 class GuessSpec(StrictModel):
@@ -228,7 +265,7 @@ class GuessSpec(StrictModel):
 
     states: dict[str, Value] = Field(default_factory=dict)
     controls: dict[str, Value] = Field(default_factory=dict)
-    t_final: FiniteFloat | None = None
+    t_final: Number | None = None
     result: str | None = None
 
 
@@ -263,4 +300,6 @@ class OptimalControlSpec(SpecBase):
             needed.add("path_constraints")
         if p.boundary_constraints:
             needed.add("boundary_constraints")
+        if p.inputs:
+            needed.add("grid_inputs")
         return frozenset(needed)

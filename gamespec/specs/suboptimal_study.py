@@ -13,7 +13,7 @@ from typing import ClassVar, Literal
 
 from pydantic import Field, ValidationError, ValidationInfo, field_validator
 
-from gamespec.specs.base import SpecBase, StrictModel
+from gamespec.specs.base import Number, SpecBase, StrictModel
 from gamespec.specs.ocp import MethodSpec
 
 MethodChange = dict[str, int | float | str]
@@ -32,14 +32,14 @@ class SuboptimalStudySpec(SpecBase):
     speed u on pure pursuit, the evader at each of ``speeds``."""
 
     kind: Literal["pursuit_suboptimal_study"] = "pursuit_suboptimal_study"
-    r1: float = Field(1.0, gt=0, description="Initial distance r1(0) from P1 to the evader.")
-    u: float = Field(1.0, gt=0, description="Speed of both pursuers.")
-    speeds: list[float] = Field(
+    r1: Number = Field(1.0, gt=0, description="Initial distance r1(0) from P1 to the evader.")
+    u: Number = Field(1.0, gt=0, description="Speed of both pursuers.")
+    speeds: list[Number] = Field(
         default_factory=lambda: [0.3, 0.4, 0.5, 0.6, 0.7],
         min_length=1,
         description="Evader speeds v, each in (0, u).",
     )
-    capture_radius: float = Field(0.001, gt=0)
+    capture_radius: Number = Field(0.001, gt=0)
     grid: StudyGrid = Field(default_factory=StudyGrid)
     method: MethodSpec = Field(default_factory=lambda: MethodSpec(intervals=40, grading=10.0))
     refinements: list[MethodChange] = Field(

@@ -32,13 +32,22 @@ FUNCTIONS: dict[str, tuple[int, object]] = {
     "tanh": (1, sp.tanh),
     "min": (2, sp.Min),
     "max": (2, sp.Max),
+    "sign": (1, sp.sign),
+    "heaviside": (1, sp.Heaviside),
 }
+"""The whitelisted functions: name → (arity, SymPy function). ``sign(0) = 0`` and
+``heaviside(0) = 1/2`` (SymPy's conventions), so that derivatives of ``abs``, ``min`` and ``max``
+print and parse back (:mod:`gamespec.symbolic.printer`)."""
 CONSTANTS: dict[str, sp.Expr] = {"pi": sp.pi}
 RESERVED = frozenset(FUNCTIONS) | frozenset(CONSTANTS) | {"t"}
 TIME = sp.Symbol("t", real=True)
 
 MAX_NODES = 2_000
 """Largest number of syntax-tree nodes in one expression."""
+
+MAX_EXACT_EXPONENT = 1_024
+"""Largest exponent magnitude for which a power of two exact numbers stays exact (``2**(1/3)``,
+``pi**2``); larger ones are computed in floating point, not expanded."""
 
 _BINARY = {
     ast.Add: lambda a, b: a + b,
@@ -89,8 +98,10 @@ class _Translator:
         raise self.fail(node, f"{type(node).__name__} is not allowed")
 
     def power(self, node: ast.BinOp) -> sp.Expr:
-        """``a ** b``; a power of two numbers is computed in floating point, so that towers such
-        as ``9**9**9`` fail fast instead of being expanded exactly."""
+        """``a ** b``; a power of two numbers is first computed in floating point, so that towers
+        such as ``9**9**9`` fail fast instead of being expanded exactly. Within range it is SymPy's
+        own power (exact ``sqrt(2)``, ``2**(1/3)``, ``pi**2``; ``2.0**pi`` as SymPy keeps it), so
+        that printed SymPy parses back to itself."""
         base, exponent = self(node.left), self(node.right)
         if base.is_number and exponent.is_number:
             try:
@@ -99,6 +110,9 @@ class _Translator:
                 raise self.fail(node, "number out of range") from None
             if isinstance(value, complex):
                 raise self.fail(node, "power of a negative number is not real")
+            inexact = base.has(sp.Float) or exponent.has(sp.Float)
+            if inexact or abs(float(exponent)) <= MAX_EXACT_EXPONENT:
+                return self.finite(node, base**exponent)
             return self.finite(node, sp.Float(value) if value != int(value) else sp.Integer(int(value)))
         return self.finite(node, base**exponent)
 

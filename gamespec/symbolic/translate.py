@@ -51,7 +51,15 @@ _SYMPY_NAMES: dict[type, str] = {
     sp.tanh: "tanh",
     sp.Min: "min",
     sp.Max: "max",
+    sp.sign: "sign",
+    sp.Heaviside: "heaviside",
 }
+
+
+def _numpy_heaviside(x: Any) -> Any:
+    """The unit step with SymPy's value ``heaviside(0) = 1/2``."""
+    return np.heaviside(x, 0.5)
+
 
 NUMPY = Library.from_namespace(
     np,
@@ -61,6 +69,7 @@ NUMPY = Library.from_namespace(
     atan2=np.arctan2,
     min=np.minimum,
     max=np.maximum,
+    heaviside=_numpy_heaviside,
     power=np.power,
 )
 
@@ -90,6 +99,10 @@ def translate(expr: sp.Expr, values: Mapping[sp.Symbol, Any], library: Library) 
                 out = 1.0 / walk(base)
             else:
                 out = library.power(walk(base), walk(exponent))
+        elif isinstance(node, sp.Heaviside):
+            if node.args[1] != sp.S.Half:
+                raise ExpressionError(str(expr), f"heaviside with value {node.args[1]} at 0 (only 1/2)")
+            out = library.functions["heaviside"](walk(node.args[0]))
         elif type(node) in _SYMPY_NAMES:
             func = library.functions[_SYMPY_NAMES[type(node)]]
             args = [walk(a) for a in node.args]

@@ -26,9 +26,10 @@ from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
+import sympy as sp
 
 from gamespec import registry
-from gamespec.pursuit.guess import default_heading, ranked_simulated_headings
+from gamespec.pursuit.guess import default_heading, polynomial, ranked_simulated_headings
 from gamespec.pursuit.reduced import Reduction, observe, reduce
 from gamespec.pursuit.relay import detect_arcs
 from gamespec.pursuit.report import engagement_report
@@ -44,10 +45,9 @@ from gamespec.specs.ocp import (
     StateSpec,
     TimeSpec,
 )
+from gamespec.symbolic.language import symbol
+from gamespec.symbolic.printer import to_text
 from gamespec.transforms.base import Transform
-
-GUESS_DEGREE = 5
-"""Degree of the polynomials in normalized time τ that carry the simulated guess."""
 
 ARC_TOL = 1e-5
 """|S| below this counts as on the Voronoi boundary when splitting a relay path into arcs."""
@@ -74,19 +74,12 @@ class EngagementInverse:
     guess_capture_time: float
 
 
-def polynomial(tau: np.ndarray, values: np.ndarray) -> str:
-    """A least-squares polynomial in ``tau`` through ``values``, as an expression string."""
-    coeffs = np.polynomial.polynomial.polyfit(tau, values, GUESS_DEGREE)
-    terms = [f"({c:.12g})*tau**{k}" if k else f"({c:.12g})" for k, c in enumerate(coeffs) if abs(c) > 1e-10]
-    return " + ".join(terms) or "0"
-
-
 def _control_bounds(red: Reduction) -> ControlSpec:
     """θ ∈ [−π, π] in the line-of-sight frame; θ_E within π of pursuer 1's initial line of sight."""
     if red.frame == "line_of_sight":
         return ControlSpec(lower="-pi", upper="pi")
-    ref = red.angle[0] if red.angle[0] in red.parameters else f"{red.angle[0]}_init"
-    return ControlSpec(lower=f"{ref} - pi", upper=f"{ref} + pi")
+    ref = symbol(red.angle[0] if red.angle[0] in red.parameters else red.initial[red.angle[0]])
+    return ControlSpec(lower=to_text(ref - sp.pi), upper=to_text(ref + sp.pi))
 
 
 def to_ocp(spec: EngagementSpec) -> tuple[OptimalControlSpec, EngagementInverse]:

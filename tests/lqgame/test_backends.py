@@ -88,3 +88,68 @@ def test_eq_4_27_within_roundoff_of_singular_fails():
     assert model.assumptions.stopper_concavity_min_eig == 0
     assert model.assumption_failure().startswith("eq. 4.27 fails")
     assert model.unreachable_mean() is None
+
+
+class _FailsFirst:
+    """A stand-in for a cvxpy Problem whose first solve raises SolverError (a numerical failure)."""
+
+    def __init__(self) -> None:
+        self.calls: list[tuple[str, dict]] = []
+        self.status = None
+
+    def solve(self, solver: str, warm_start: bool, **options) -> None:
+        import cvxpy as cp
+
+        self.calls.append((solver, options))
+        if len(self.calls) == 1:
+            raise cp.SolverError("numerical trouble")
+        self.status = "optimal"
+
+
+@pytest.mark.parametrize(
+    ("options", "second_call", "note"),
+    [
+        ({}, ("CLARABEL", {"chordal_decomposition_enable": False}), "CLARABEL failed numerically"),
+        ({"retry_solver_options": {}, "fallback_solver": "SCS"}, ("SCS", {}), "SCS: optimal"),
+    ],
+)
+def test_a_numerically_failed_step_is_retried_and_says_so(options: dict, second_call: tuple, note: str):
+    """Clarabel's second attempt goes without chordal decomposition (same tolerances); a fallback
+    solver is used only when the options name one; the note says what was needed."""
+    from gamespec_cvxpy.backend import CvxpyOptions, _Problem
+
+    problem = _Problem(_FailsFirst(), CvxpyOptions(**options))
+    assert problem.solve() is Status.OPTIMAL
+    assert problem.problem.calls[1] == second_call
+    assert problem.note.startswith(note)
+
+
+def test_without_a_retry_a_numerical_failure_is_reported():
+    from gamespec_cvxpy.backend import CvxpyOptions, _Problem
+
+    problem = _Problem(_FailsFirst(), CvxpyOptions(retry_solver_options={}))
+    assert problem.solve() is Status.NUMERICAL_ERROR
+    assert problem.reported == "a solver error" and len(problem.problem.calls) == 1
+
+
+@pytest.mark.parametrize("solver", ["proxqp", "osqp", "clarabel"])
+def test_qp_status_is_qpsolvers_own_optimality_check(solver: str):
+    """An ``optimal`` mean QP has qpsolvers' primal and dual residuals and duality gap below
+    ``QP_TOLERANCE`` times the data scale (``Solution.is_optimal``), and they are in the checks."""
+    from gamespec_qp.backend import QP_TOLERANCE
+
+    result = gamespec.solve(MEAN_STEERING, "qp", options={"solver": solver})
+    assert result.status is Status.OPTIMAL, result.message
+    eps = QP_TOLERANCE * result.checks["qp_data_scale"]
+    assert max(result.checks[k] for k in ("qp_primal_residual", "qp_dual_residual", "qp_duality_gap")) < eps
+
+
+@pytest.mark.parametrize(
+    "solver_options", [{"eps_abs": 1e-2, "eps_rel": 1e-2}, {"max_iter": 10}], ids=["loose", "starved"]
+)
+def test_a_qp_solution_that_fails_the_check_is_not_optimal(solver_options: dict):
+    """OSQP stopped far from the optimum: not reported as optimal, and the message says why."""
+    options = {"solver": "osqp", "solver_options": solver_options}
+    result = gamespec.solve(MEAN_STEERING, "qp", options=options)
+    assert result.status is not Status.OPTIMAL
+    assert result.message.startswith("mean QP: osqp")

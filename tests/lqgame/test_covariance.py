@@ -9,10 +9,15 @@ import pytest
 from gamespec_cvxpy.backend import CovariancePlayers, CvxpyOptions
 from scipy.linalg import sqrtm
 
+import gamespec
+from gamespec.best_response import Settings
 from gamespec.lqgame.covariance import lift_gains, vector_to_gains
 from gamespec.lqgame.solution import GameModel
 from gamespec.result import Status
+from tests.conftest import PROBLEMS
 from tests.lqgame.conftest import random_game
+
+EXAMPLE = PROBLEMS / "ch4" / "test_example.yaml"
 
 
 def _direct_payoff(model: GameModel, kappa: np.ndarray, ell: np.ndarray) -> float:
@@ -67,12 +72,27 @@ def test_terminal_map_is_the_scaled_terminal_factor(model: GameModel):
     np.testing.assert_allclose(w0 + T_K @ kappa + T_L @ ell, W.T.ravel(), atol=1e-10)
 
 
-def test_cvxpy_stopper_problem_matches_the_closed_form(model: GameModel):
-    players = CovariancePlayers(model, CvxpyOptions())
-    kappa, _ = _random_gains(model, 3)
-    status, ell = players.stopper_step(kappa)
-    assert status is Status.OPTIMAL
-    np.testing.assert_allclose(ell, model.covariance.stopper_response(kappa), atol=1e-6)
+def test_whitened_controller_step_is_the_unscaled_problems_minimizer(model: GameModel):
+    """The controller's SDP in whitened gains (``κ = R⁻¹z``, :mod:`gamespec.lqgame.scaling`) has
+    the minimizer of eq. 4.56 under eq. 4.62 written in the gains themselves (a strictly convex
+    problem: one minimizer), here with a target halfway between the UCSG's Σ_N and zero."""
+    import cvxpy as cp
+
+    g = model.game
+    kappa0, ell = model.covariance.unconstrained_saddle()
+    free = model.covariance.state_covariances(
+        vector_to_gains(kappa0, g.m, g.n), vector_to_gains(ell, g.ell, g.n)
+    )
+    tight = GameModel.build(type(g)(**{**g.__dict__, "SigmaN": 0.9 * free[-1] + 1e-3 * np.eye(g.n)}))
+    cov = tight.covariance
+    kappa, report = CovariancePlayers(tight, CvxpyOptions()).controller_step(ell)
+    assert report.status is Status.OPTIMAL
+    w0, T_K, T_L = cov.terminal_map()
+    x = cp.Variable(kappa.size)
+    W = cp.reshape(w0 + T_L @ ell + T_K @ x, (g.n, w0.size // g.n), order="F")
+    payoff = cp.quad_form(x, cp.psd_wrap(cov.H_KK)) + 2 * cov.controller_linear_term(ell) @ x
+    cp.Problem(cp.Minimize(payoff), [cp.sigma_max(W) <= 1]).solve(solver="CLARABEL")
+    np.testing.assert_allclose(kappa, x.value, atol=1e-5 * max(1.0, np.abs(x.value).max()))
 
 
 @pytest.mark.parametrize("seed", [0, 1])
@@ -92,7 +112,7 @@ def test_jacobi_meets_the_terminal_constraint(seed: int):
     assert gamma < 1
     target = (1 + gamma) / 2 * free[-1]
     model = GameModel.build(type(g)(**{**g.__dict__, "SigmaN": target}))
-    outcome = CovariancePlayers(model, CvxpyOptions()).solve(tolerance=1e-7, max_iterations=200)
+    outcome = CovariancePlayers(model, CvxpyOptions()).solve(Settings(tolerance=1e-7, max_iterations=200))
     assert outcome.status.ok and outcome.iterations > 0
     reached = model.covariance.state_covariances(
         vector_to_gains(outcome.kappa, g.m, g.n), vector_to_gains(outcome.ell, g.ell, g.n)
@@ -110,7 +130,7 @@ def test_smallest_scaling_is_tight():
     last_noise = g.D[-1] @ g.D[-1].T
     SigmaN = 0.5 * last_noise + 1e-4 * np.eye(g.n)
     model = GameModel.build(type(g)(**{**g.__dict__, "SigmaN": SigmaN}))
-    outcome = CovariancePlayers(model, CvxpyOptions()).solve(tolerance=1e-7, max_iterations=50)
+    outcome = CovariancePlayers(model, CvxpyOptions()).solve(Settings(tolerance=1e-7, max_iterations=50))
     assert outcome.status is Status.INFEASIBLE
     gamma = outcome.min_covariance_scaling
     root_inv = np.linalg.inv(np.real(sqrtm(SigmaN)))
@@ -118,5 +138,67 @@ def test_smallest_scaling_is_tight():
     _, ell0 = model.covariance.unconstrained_saddle()
     for factor, feasible in ((1 + 1e-3, True), (1 - 1e-3, False)):
         scaled = GameModel.build(type(g)(**{**g.__dict__, "SigmaN": factor * gamma * SigmaN}))
-        status, _ = CovariancePlayers(scaled, CvxpyOptions()).controller_step(ell0)
-        assert status.ok is feasible
+        _, report = CovariancePlayers(scaled, CvxpyOptions()).controller_step(ell0)
+        assert report.status.ok is feasible
+
+
+HORIZON_25 = ["problem.horizon=25", "method.monte_carlo.samples=0"]
+"""§4.5.1 at N = 25, where Jacobi's iterates spiral outwards: ε_k and ε_ℓ alternate and each grows
+by about 1.4 every two iterations."""
+
+
+def test_jacobi_that_diverges_says_so():
+    """Algorithm 2 on the engine with a window of three periods of the alternation: the run stops
+    as ``diverged`` (status not_converged) with the history, keeping the last iterate; it is not a
+    solution."""
+    spec = gamespec.load(EXAMPLE, HORIZON_25)
+    players = CovariancePlayers(GameModel.build(spec.game()), CvxpyOptions())
+    outcome = players.solve(Settings(tolerance=1e-5, max_iterations=30, window=6))
+    assert outcome.status is Status.NOT_CONVERGED and "diverge" in outcome.message
+    metrics = outcome.best_response
+    assert metrics["outcome"] == "diverged" and not metrics["converged"]
+    largest = [max(h["changes"].values()) for h in metrics["history"]]
+    assert len(largest) == outcome.iterations < 30
+    assert max(largest[-6:]) >= 2 * max(largest[-12:-6])
+
+
+def test_a_covariance_game_past_its_iteration_limit_is_not_ok():
+    """Through the solving chain: the Result's status is the engine's, with its message and
+    history, and the objective is not passed off as a saddle value."""
+    result = gamespec.solve(gamespec.load(EXAMPLE, [*HORIZON_25, "method.max_iterations=6"]))
+    assert result.status is Status.ITERATION_LIMIT and not result.ok
+    assert "did not converge in 6 iterations" in result.message
+    assert result.metrics["best_response"]["iterations"] == 6
+    assert len(result.metrics["convergence_history"]) == 6
+
+
+@pytest.mark.slow
+def test_damping_makes_the_horizon_25_game_converge():
+    """With w = 1/2 the relaxed Jacobi map's spectrum is pulled towards 1 − w: the N = 25 game
+    converges, to a point where the stopper's gains answer the controller's (eq. 4.59b) and
+    Σ_N(K, L) ⪯ Σ_N."""
+    result = gamespec.solve(gamespec.load(EXAMPLE, [*HORIZON_25, "method.damping=0.5"]))
+    assert result.status is Status.OPTIMAL, result.message
+    assert result.checks["terminal_covariance_violation"] < 1e-6
+    assert result.checks["stopper_response_gap"] < 1e-4
+
+
+def test_gauss_seidel_finds_the_jacobi_fixed_point():
+    """Both schemes stop near a fixed point of the same best responses (§4.5.1, N = 10): a run
+    stopped at a change ≤ tol is within ``tol·ρ/(1 − ρ)`` of it, ``ρ`` the contraction rate
+    estimated from the run's own history."""
+    settings = ["method.monte_carlo.samples=0"]
+    runs = {
+        s: gamespec.solve(gamespec.load(EXAMPLE, [*settings, f"method.scheme={s}"]))
+        for s in ("jacobi", "gauss_seidel")
+    }
+    assert all(r.status is Status.OPTIMAL for r in runs.values())
+    tol = gamespec.load(EXAMPLE).method.tolerance
+    bound = 0.0
+    for run in runs.values():
+        largest = [max(h) for h in run.metrics["convergence_history"]]
+        rate = (largest[-1] / largest[0]) ** (1 / (len(largest) - 1))
+        bound += tol * rate / (1 - rate)
+    for gains in ("K", "L"):
+        gap = np.abs(runs["gauss_seidel"].arrays[gains] - runs["jacobi"].arrays[gains]).max()
+        assert gap <= bound + 1e-7

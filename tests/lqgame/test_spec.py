@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+import yaml
 
 from gamespec import SpecError, spec_from_dict
 from gamespec.lqgame.game import zero_order_hold
@@ -102,6 +103,11 @@ def test_null_terminal_mean_entries_are_free():
             "semidefinite",
         ),
         ({"terminal": {"mean": [0]}}, "problem.terminal.mean", "expected 2"),
+        (
+            {"initial": {"mean": [1, 0], "covariance": {"diagonal": [1, 1]}}},
+            "problem.initial.covariance",
+            "a matrix is a list of rows",
+        ),
         ({"states": ["x", "x"]}, "problem.states", "repeated: x"),
         (
             {"states": ["a", "b", "c"]},
@@ -129,3 +135,44 @@ def test_per_step_length_is_checked():
     with pytest.raises(SpecError) as err:
         spec_from_dict(data)
     assert "3 matrices" in err.value.reason
+
+
+NAN, INF = float("nan"), float("inf")
+
+
+@pytest.mark.parametrize(
+    ("location", "value"),
+    [
+        (("discrete", "A", 0, 1), NAN),
+        (("discrete", "B", 1, 0), INF),
+        (("cost", "S", 0, 0), -INF),
+        (("cost", "Q", "identity"), NAN),
+        (("initial", "mean", 0), NAN),
+        (("initial", "covariance", "diag", 1), INF),
+        (("parameters", "dt"), NAN),
+    ],
+)
+def test_non_finite_numbers_are_refused_with_the_field(location: tuple, value: float):
+    """NaN and ±inf are not numbers a matrix, mean, covariance or parameter may hold (the one finite
+    ``Value``/``Number`` of :mod:`gamespec.specs.base`); the error names the entry."""
+    data = _data()
+    slot = data["problem"]
+    for key in location[:-1]:
+        slot = slot[key]
+    slot[location[-1]] = value
+    with pytest.raises(SpecError) as err:
+        spec_from_dict(data)
+    dotted = ".".join(str(k) for k in ("problem", *location))
+    assert err.value.field.startswith(dotted), err.value.field
+    assert "finite" in err.value.reason
+
+
+def test_a_terminal_covariance_entry_read_as_nan_from_yaml_is_refused(cli, tmp_path):
+    """YAML's ``.nan`` and ``.inf`` in a file: exit 2 and one line naming the field."""
+    text = yaml.safe_dump(_data(terminal={"mean": [0, 0], "covariance": {"diag": [1, 1]}}))
+    path = tmp_path / "nan.yaml"
+    path.write_text(text.replace("- 1\n      - 1\n", "- .nan\n      - 1\n", 1))
+    assert ".nan" in path.read_text()
+    code, _, err = cli("validate", path)
+    assert code == 2 and len(err.strip().splitlines()) == 1
+    assert "problem.terminal.covariance.diag.0" in err

@@ -2,12 +2,14 @@
 
 from __future__ import annotations
 
+import math
+
 import pytest
 import sympy as sp
 
 import gamespec
 from gamespec.specs.ocp import OptimalControlSpec
-from gamespec.symbolic.language import parse, symbol
+from gamespec.symbolic.language import parse, parse_relation, symbol
 from gamespec.transforms.engagement import to_ocp
 from tests.conftest import PROBLEMS
 
@@ -69,6 +71,31 @@ def test_generated_dynamics_are_the_thesis_equations(equation: str, name: str, o
     assert set(dynamics) == set(THESIS[equation])
     for state, expected in THESIS[equation].items():
         assert sp.simplify(parse(dynamics[state], S) - expected) == 0, (equation, state)
+
+
+@pytest.mark.parametrize(
+    ("name", "overrides", "reference"),
+    [
+        ("relay_pure_pursuit.yaml", [], None),
+        ("relay_constant_bearing.yaml", [], "phi1"),
+        ("pure_pursuit_two_on_one.yaml", ["frame=fixed"], "phi1_init"),
+    ],
+)
+def test_generated_constraints_and_bounds(name: str, overrides: list[str], reference: str | None) -> None:
+    """The Voronoi constraint ½(r_1² − r_2²) ≤ 0 of a stationary P2 (eq. 2.36), and the heading
+    bounds: θ ∈ [−π, π] in the line-of-sight frame, θ_E within π of φ_1(0) in the fixed frame."""
+    problem = to_ocp(gamespec.load(PROBLEMS / "ch2" / name, overrides))[0].problem
+    symbols = S | {"phi1_init": symbol("phi1_init")}
+    if name.startswith("relay"):
+        (constraint,) = [parse_relation(c, symbols) for c in problem.path_constraints]
+        assert (constraint.lower, constraint.upper) == (-math.inf, 0.0)
+        assert sp.simplify(constraint.expr - (r1**2 - r2**2) / 2) == 0
+    else:
+        assert problem.path_constraints == []
+    centre = sp.Integer(0) if reference is None else symbol(reference)
+    (bounds,) = problem.controls.values()
+    assert sp.simplify(parse(bounds.lower, symbols) - (centre - sp.pi)) == 0
+    assert sp.simplify(parse(bounds.upper, symbols) - (centre + sp.pi)) == 0
 
 
 def test_eq_3_2_for_five_pursuers_and_initial_conditions_from_positions() -> None:

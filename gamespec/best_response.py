@@ -20,9 +20,12 @@ that largest change at least ``growth`` times the one before); or ``player_faile
 whose status carries no solution). :class:`BestResponseRun` maps the outcome to a
 :class:`~gamespec.result.Status` and packs the history for ``Result.metrics["best_response"]``.
 
-This module imports nothing but NumPy and :mod:`gamespec.result`, so the numerics of a problem
-family (``lqgame``) can drive it as well as the game drivers of :mod:`gamespec.games` that compile
-their players through :mod:`gamespec.solving`.
+It sits in the bottom layer, beside :mod:`gamespec.result` (the only gamespec module it imports):
+the numerics of a problem family (chapter 4's ``lqgame``, chapter 5's ``flowfield``) drive it with
+players that solve convex steps, and the game drivers above :mod:`gamespec.solving` drive it with
+players compiled as ``optimal_control`` problems. DESIGN.md places the engine in ``games/``, above
+the solving layer; that would make chapter 4's numerics import a higher layer, so the engine lives
+here and ``games/`` keeps only what compiles players through the solving chain.
 """
 
 from __future__ import annotations
@@ -186,10 +189,6 @@ class BestResponseRun:
         }
 
 
-def _finite(x: float) -> bool:
-    return bool(np.isfinite(x))
-
-
 class _Iterator:
     """The state of one run of :func:`iterate`."""
 
@@ -273,7 +272,7 @@ class _Iterator:
         changes = {p.name: float(p.distance(following[p.name], self.current[p.name])) for p in self.players}
         payoff = float(self.payoff(following)) if self.payoff is not None else None
         self.history.append(Iteration(changes, payoff))
-        if not all(_finite(c) for c in changes.values()):
+        if not np.isfinite(list(changes.values())).all():
             return Outcome.DIVERGED
         self.current = following
         if max(changes.values()) <= self.settings.tolerance:

@@ -1,1 +1,0 @@
-"""Games built from solves: the best-response engine (:mod:`gamespec.games.best_response`)."""

@@ -1,0 +1,213 @@
+"""The printer writes SymPy back to the language: ``parse(to_text(e)) == e`` over random expression
+trees and over their derivatives (which bring ``sign``, ``heaviside``, ``abs``, ``min``, ``max``),
+and what the language cannot hold is refused in one line."""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable
+
+import numpy as np
+import pytest
+import sympy as sp
+from hypothesis import HealthCheck, assume, given, settings
+from hypothesis import strategies as st
+
+from gamespec.errors import ExpressionError
+from gamespec.symbolic.language import parse, parse_relation, symbol
+from gamespec.symbolic.printer import to_text
+from gamespec.symbolic.translate import NUMPY, translate
+
+SYMBOLS = {name: symbol(name) for name in ("x", "y", "t")}
+X, Y, T = SYMBOLS.values()
+
+numbers = st.one_of(
+    st.integers(-20, 20).map(sp.Integer),
+    st.fractions(max_denominator=12).map(lambda f: sp.Rational(f.numerator, f.denominator)),
+    st.floats(-10.0, 10.0, allow_nan=False).map(sp.Float),
+    st.sampled_from([sp.pi, sp.E]),
+)
+leaves = st.one_of(st.sampled_from([X, Y, T]), numbers)
+
+Unary = Callable[[sp.Expr], sp.Expr]
+Binary = Callable[[sp.Expr, sp.Expr], sp.Expr]
+
+REAL_UNARY: list[Unary] = [
+    sp.sin,
+    sp.cos,
+    sp.tan,
+    sp.atan,
+    sp.exp,
+    sp.tanh,
+    sp.Abs,
+    lambda a: sp.sqrt(1 + a**2),
+    lambda a: sp.log(1 + a**2),
+    lambda a: -a,
+    lambda a: a**2,
+    lambda a: a**3,
+]
+"""Functions SymPy knows to stay real over real arguments, so that derivatives of ``abs`` are
+``sign`` (not ``re``/``im``)."""
+REAL_BINARY: list[Binary] = [
+    lambda a, b: a + b,
+    lambda a, b: a - b,
+    lambda a, b: a * b,
+    lambda a, b: a / (1 + b**2),
+    sp.Min,
+    sp.Max,
+    sp.atan2,
+]
+MORE_UNARY: list[Unary] = [
+    sp.asin,
+    sp.acos,
+    sp.sign,
+    sp.Heaviside,
+    sp.sqrt,
+    sp.log,
+    lambda a: a ** sp.Rational(1, 3),
+    lambda a: a**-1,
+    lambda a: a ** sp.Float(2.5),
+]
+MORE_BINARY: list[Binary] = [lambda a, b: a / b, lambda a, b: a ** sp.tanh(b)]
+
+
+def apply(func: Callable[..., sp.Expr], *args: sp.Expr) -> sp.Expr:
+    """``func(*args)``, or NaN (filtered out by :func:`representable`) where an argument holds a
+    long exact number (whose powers SymPy would expand for minutes), SymPy's floating-point
+    arithmetic raises (a float divided by 0.0), a function refuses a complex argument or SymPy
+    fails inside its own evaluation of floats (``AttributeError``)."""
+    if any(max(abs(r.p), r.q).bit_length() > 200 for a in args for r in a.atoms(sp.Rational)):
+        return sp.nan
+    try:
+        return func(*args)
+    except (ZeroDivisionError, OverflowError, ValueError, AttributeError):
+        return sp.nan
+
+
+def trees(unary: list[Unary], binary: list[Binary]) -> st.SearchStrategy[sp.Expr]:
+    def extend(children: st.SearchStrategy[sp.Expr]) -> st.SearchStrategy[sp.Expr]:
+        return st.one_of(
+            st.builds(apply, st.sampled_from(unary), children),
+            st.builds(apply, st.sampled_from(binary), children, children),
+        )
+
+    return st.recursive(leaves, extend, max_leaves=12)
+
+
+def representable(expr: sp.Expr) -> bool:
+    """Finite, real, every float within double precision and every power of two numbers real:
+    what the language can hold (it refuses the rest when parsing)."""
+    if expr.has(sp.zoo, sp.oo, -sp.oo, sp.nan, sp.I):
+        return False
+    if not all(math.isfinite(float(f)) and (float(f) != 0.0 or f.is_zero) for f in expr.atoms(sp.Float)):
+        return False
+    if any(max(abs(r.p), r.q).bit_length() > 1_000 for r in expr.atoms(sp.Rational)):
+        return False
+    for power in expr.atoms(sp.Pow):
+        if power.base.is_number and power.exp.is_number:
+            try:
+                value = float(power.base) ** float(power.exp)
+            except (OverflowError, ZeroDivisionError, TypeError):
+                return False
+            if isinstance(value, complex):
+                return False
+    return True
+
+
+SETTINGS = settings(max_examples=300, deadline=None, suppress_health_check=[HealthCheck.filter_too_much])
+
+
+def assert_round_trip(expr: sp.Expr) -> None:
+    text = to_text(expr)
+    assert parse(text, SYMBOLS) == expr, text
+
+
+@SETTINGS
+@given(trees(REAL_UNARY + MORE_UNARY, REAL_BINARY + MORE_BINARY))
+def test_round_trip_of_random_trees(expr: sp.Expr) -> None:
+    assume(representable(expr))
+    assert_round_trip(expr)
+
+
+@SETTINGS
+@given(trees(REAL_UNARY, REAL_BINARY), st.sampled_from([X, Y, T]))
+def test_round_trip_of_derivatives(expr: sp.Expr, wrt: sp.Symbol) -> None:
+    """First and second derivatives: sign, heaviside, abs, min and max print and parse back."""
+    assume(representable(expr))
+    first = sp.diff(expr, wrt)
+    assume(representable(first))
+    assert_round_trip(first)
+    second = sp.diff(first, wrt)
+    assume(not second.has(sp.DiracDelta) and representable(second))
+    assert_round_trip(second)
+
+
+@pytest.mark.parametrize(
+    ("expr", "appears"),
+    [
+        (sp.diff(sp.Abs(X - Y), X), "sign(x - y)"),
+        (sp.diff(sp.Max(X, Y**2), Y), "heaviside("),
+        (sp.diff(sp.Min(X, Y, T), X), "min("),
+        (sp.Max(X, Y, T, 2), "max("),
+        (sp.E * X + sp.pi, "exp(1)"),
+        (sp.Rational(-3, 7) * X, "3*x/7"),
+        (X ** sp.Rational(2, 3), "x**(2/3)"),
+        (sp.Float(0.1) * X, "0.1*x"),
+        (sp.Float(1 / 3) + X, repr(1 / 3)),
+    ],
+)
+def test_language_names_and_exact_numbers(expr: sp.Expr, appears: str) -> None:
+    text = to_text(expr)
+    assert appears in text
+    assert parse(text, SYMBOLS) == expr
+
+
+@given(st.floats(allow_nan=False, allow_infinity=False))
+def test_floats_round_trip_bit_for_bit(value: float) -> None:
+    assert float(parse(to_text(sp.Float(value) * X), SYMBOLS).coeff(X)) == value or value == 0.0
+
+
+@pytest.mark.parametrize(
+    ("relation", "text"),
+    [
+        (sp.Le(sp.Rational(1, 2) * (X**2 - Y**2), 0), "0.5*(x**2 - y**2) <= 0"),
+        (sp.Ge(sp.sin(X), sp.cos(Y)), "sin(x) >= cos(y)"),
+        (sp.Eq(X, 2 * Y), "x == 2*y"),
+        (sp.Lt(sp.Abs(X), 1), "abs(x) <= 1"),
+    ],
+)
+def test_relations_print_for_constraints(relation: sp.Basic, text: str) -> None:
+    printed = parse_relation(to_text(relation), SYMBOLS)
+    expected = parse_relation(text, SYMBOLS)
+    assert (printed.lower, printed.upper) == (expected.lower, expected.upper)
+    assert sp.simplify(printed.expr - expected.expr) == 0
+
+
+@pytest.mark.parametrize(
+    ("expr", "reason"),
+    [
+        (sp.Piecewise((X, X > 0), (0, True)), "Piecewise"),
+        (sp.diff(sp.sign(X), X), "DiracDelta"),
+        (sp.sinh(X), "sinh"),
+        (sp.Heaviside(X, 0), "heaviside"),
+        (sp.oo * X, "Infinity"),
+        (sp.Float("1e400") * X, "range of a double"),
+        (sp.Float("1e-400") * X, "range of a double"),
+        (sp.Symbol("sin") + X, "sin"),
+        (sp.Function("f")(X), "f"),
+        (sp.Ne(X, Y), "Unequality"),
+    ],
+)
+def test_what_the_language_cannot_hold_is_refused(expr: sp.Basic, reason: str) -> None:
+    with pytest.raises(ExpressionError, match=reason):
+        to_text(expr)
+
+
+def test_printed_derivative_evaluates_like_sympy() -> None:
+    """heaviside(0) = 1/2 and sign(0) = 0 in the NumPy translation, as in SymPy."""
+    expr = sp.diff(sp.Max(X, Y) + sp.Abs(X - 1), X)
+    parsed = parse(to_text(expr), SYMBOLS)
+    for x, y in [(0.0, 0.0), (1.0, 0.0), (2.0, 3.0), (1.0, 1.0)]:
+        expected = float(expr.subs({X: x, Y: y}))
+        got = float(translate(parsed, {X: np.float64(x), Y: np.float64(y)}, NUMPY))
+        assert got == pytest.approx(expected, abs=1e-15)

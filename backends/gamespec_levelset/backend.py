@@ -20,7 +20,8 @@ from typing import Any, ClassVar
 import numpy as np
 from pydantic import Field
 
-from gamespec.backend import Availability, Backend, CompiledModel
+from gamespec.backend import Availability, Backend, CompiledModel, Inputs, refuse_inputs
+from gamespec.best_response import Settings, iterate
 from gamespec.flowfield.capture_probability import capture_probabilities
 from gamespec.flowfield.covariance_game import PLAYERS, CovarianceGame, Strategy
 from gamespec.flowfield.extremals import capture_by_extremals
@@ -30,7 +31,6 @@ from gamespec.flowfield.linearize import lifted, zero_order_hold
 from gamespec.flowfield.nominal import NominalPaths, from_extremals, from_level_sets
 from gamespec.flowfield.problem import FlowGameData
 from gamespec.flowfield.simulation import simulate
-from gamespec.games.best_response import Settings, iterate
 from gamespec.montecarlo import proportion
 from gamespec.result import Result, Status
 from gamespec.specs.base import SpecBase, StrictModel
@@ -161,7 +161,10 @@ class FlowGameModel(CompiledModel):
             "capture_point_difference": float(np.linalg.norm(other.capture_point - reach.capture_point)),
         }
 
-    def solve(self, parameters: dict[str, float] | None = None, guess: Result | None = None) -> Result:
+    def solve(
+        self, parameters: dict[str, float] | None = None, guess: Result | None = None, inputs: Inputs = None
+    ) -> Result:
+        refuse_inputs(inputs, self.spec.kind)
         start = time.perf_counter()
         values = {**self.spec.problem.parameters, **(parameters or {})}
         data = self.spec.data(values)

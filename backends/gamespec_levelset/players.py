@@ -23,8 +23,8 @@ from typing import Any
 
 import numpy as np
 
+from gamespec.best_response import StepReport
 from gamespec.flowfield.covariance_game import PLAYERS, CovarianceGame, Strategy
-from gamespec.games.best_response import StepReport
 from gamespec.result import Status
 
 PROXIMAL = 1e-6
@@ -192,7 +192,7 @@ class EvaderStep(_PlayerProblem):
 
 @dataclass(frozen=True)
 class GamePlayer:
-    """A player of :mod:`gamespec.games.best_response`: its strategy is a :class:`Strategy`,
+    """A player of :mod:`gamespec.best_response`: its strategy is a :class:`Strategy`,
     distance ``max(‖ΔV‖, ‖ΔK‖)`` (the stopping rule of section 5.4)."""
 
     name: str

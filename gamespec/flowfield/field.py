@@ -1,5 +1,6 @@
 """The flow field of eq. 5.3: drift ``f(x)`` and diffusion ``g(x)`` as SymPy expressions of the
-position, evaluated vectorized through the NumPy translator, with the Jacobian ``∂f/∂x`` (eq. 5.6)."""
+position, evaluated vectorized by :func:`gamespec.symbolic.calculus.numeric_function`, with the
+Jacobian ``∂f/∂x`` (eq. 5.6) from :func:`gamespec.symbolic.calculus.jacobian`."""
 
 from __future__ import annotations
 
@@ -9,18 +10,14 @@ from functools import cached_property
 import numpy as np
 import sympy as sp
 
-from gamespec.symbolic.translate import NUMPY, translate
+from gamespec.symbolic.calculus import jacobian, numeric_function
 
 
 def _evaluate(exprs: sp.Matrix, names: tuple[sp.Symbol, sp.Symbol], points: np.ndarray) -> np.ndarray:
     """Each entry of ``exprs`` at ``points`` (..., 2): an array (..., *exprs.shape)."""
     points = np.asarray(points, dtype=float)
-    values = {names[0]: points[..., 0], names[1]: points[..., 1]}
-    base = points.shape[:-1]
-    out = np.empty(base + exprs.shape)
-    for index in np.ndindex(exprs.shape):
-        out[(..., *index)] = np.broadcast_to(translate(exprs[index], values, NUMPY), base)
-    return out
+    values = numeric_function(list(exprs), names)(points[..., 0], points[..., 1])
+    return np.moveaxis(values, 0, -1).reshape(points.shape[:-1] + exprs.shape)
 
 
 @dataclass(frozen=True)
@@ -35,7 +32,7 @@ class FlowField:
     @cached_property
     def jacobian_exprs(self) -> sp.Matrix:
         """``∂f/∂x`` (eq. 5.6), symbolically."""
-        return self.drift_exprs.jacobian(sp.Matrix(self.position))
+        return jacobian(self.drift_exprs, self.position)
 
     @cached_property
     def constant_diffusion(self) -> bool:

@@ -17,7 +17,19 @@ import numpy as np
 from gamespec.flowfield.field import FlowField
 from gamespec.flowfield.grid import Grid
 from gamespec.flowfield.hamiltonian import FlowHamiltonian
-from gamespec.symbolic.translate import Library, translate
+from gamespec.symbolic.translate import NUMPY, Library, translate
+
+
+def jax_library() -> Library:
+    """The NumPy translator's functions, each replaced by its ``jax.numpy`` namesake."""
+    import jax.numpy as jnp
+
+    def twin(name: str, func: Any) -> Any:
+        if name == "heaviside":
+            return lambda x: jnp.heaviside(x, 0.5)
+        return getattr(jnp, func.__name__)
+
+    return Library({name: twin(name, f) for name, f in NUMPY.functions.items()}, power=jnp.power)
 
 
 def drift_dynamics(flow: FlowField, speed: float) -> Any:
@@ -26,16 +38,7 @@ def drift_dynamics(flow: FlowField, speed: float) -> Any:
     import hj_reachability as hj
     import jax.numpy as jnp
 
-    library = Library.from_namespace(
-        jnp,
-        asin=jnp.arcsin,
-        acos=jnp.arccos,
-        atan=jnp.arctan,
-        atan2=jnp.arctan2,
-        min=jnp.minimum,
-        max=jnp.maximum,
-        power=jnp.power,
-    )
+    library = jax_library()
 
     class Drift(hj.ControlAndDisturbanceAffineDynamics):
         def __init__(self) -> None:

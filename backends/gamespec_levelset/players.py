@@ -22,22 +22,13 @@ from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
+from gamespec_cvxpy.backend import STATUS_MAP
 
 from gamespec.best_response import StepReport
 from gamespec.flowfield.covariance_game import PLAYERS, CovarianceGame, Strategy
 from gamespec.result import Status
 
 PROXIMAL = 1e-6
-STATUS_MAP = {
-    "optimal": Status.OPTIMAL,
-    "optimal_inaccurate": Status.FEASIBLE,
-    "infeasible": Status.INFEASIBLE,
-    "infeasible_inaccurate": Status.INFEASIBLE,
-    "unbounded": Status.UNBOUNDED,
-    "unbounded_inaccurate": Status.UNBOUNDED,
-    "user_limit": Status.ITERATION_LIMIT,
-    "solver_error": Status.NUMERICAL_ERROR,
-}
 
 
 def _root(M: np.ndarray) -> np.ndarray:

@@ -236,6 +236,7 @@ def _game(spec: FlowGameSpec, options: FlowGameOptions, data: FlowGameData, reac
         "game_converged": run.converged,
         "best_response": run.as_metrics(),
         "evader_convex_concave": {"payoffs": evader.log.steps, "converged": evader.log.converged},
+        "evader_alternation": evader.log.alternation(),
         "payoff": data.payoff,
         "payoff_open_loop": scale,
         "steps": N,

@@ -130,6 +130,19 @@ class ConvexConcaveLog:
 
     steps: list[list[float]] = field(default_factory=list)
     converged: list[bool] = field(default_factory=list)
+    responses: list[Strategy] = field(default_factory=list)
+
+    def alternation(self) -> dict[str, float] | None:
+        """How far the last response lies from the one before and from the one two before
+        (``max(‖ΔV‖, ‖ΔK‖)``): a period-two cycle of Gauss–Seidel shows as the second far smaller."""
+        if len(self.responses) < 3:
+            return None
+        last, previous, before = self.responses[-1], self.responses[-2], self.responses[-3]
+        return {"to_previous": _distance(last, previous), "to_one_before": _distance(last, before)}
+
+
+def _distance(a: Strategy, b: Strategy) -> float:
+    return float(max(np.linalg.norm(a.V - b.V), np.linalg.norm(a.kappa - b.kappa)))
 
 
 class EvaderStep(_PlayerProblem):
@@ -173,6 +186,7 @@ class EvaderStep(_PlayerProblem):
                 converged = True
                 break
         self.current = current
+        self.log.responses.append(current)
         self.log.steps.append(values)
         self.log.converged.append(converged)
         if not converged:
@@ -194,4 +208,4 @@ class GamePlayer:
         return self.step.respond(other)
 
     def distance(self, a: Strategy, b: Strategy) -> float:
-        return float(max(np.linalg.norm(a.V - b.V), np.linalg.norm(a.kappa - b.kappa)))
+        return _distance(a, b)

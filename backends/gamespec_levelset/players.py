@@ -174,7 +174,8 @@ class EvaderStep(_PlayerProblem):
         values = [self.game.value((pursuer, current)) / self.scale]
         converged = self.slope is None
         for _ in range(0 if converged else self.max_iterations):
-            self.slope.value = self.game.gradient((pursuer, current), 1)[1:].reshape(-1) / self.scale
+            slope = self.game.gradient((pursuer, current), 1)[1:].reshape(-1)
+            self.slope.value = slope / max(np.linalg.norm(slope), 1e-300)  # the maximizer is scale-free
             status = self.run(self.problem)
             if not status.ok:
                 self.log.steps.append(values)

@@ -91,7 +91,7 @@ def _level_set_reach(
     metrics |= {
         "levels": reach.levels.tolist(),
         "level_capture_times": reach.level_times.tolist(),
-        "offset_correction": float(reach.capture_time - reach.level_times[0]),
+        "level_offset": float(reach.level_times[1] - reach.level_times[0]),
     }
     arrays |= {
         "grid_x": data.grid.axes[0],

@@ -1,7 +1,7 @@
 """Plots of a ``flow_field_game`` Result (registered as that kind's plotter), red the pursuer and
 blue the evader as in the thesis:
 
-- ``reachable_sets.png``: both reachable sets at ``T̂`` (the lower level read, or the extremal
+- ``reachable_sets.png``: both reachable sets at ``T̂`` (the upper level read, or the extremal
   fronts) with the nominal paths and the capture point (Figs. 5.1, 5.4(a));
 - ``dispersion.png``: closed-loop Monte Carlo paths of both agents (Figs. 5.3, 5.4(b));
 - ``capture_probability.png``: eq. 5.39 per step, open and closed loop.
@@ -29,13 +29,13 @@ COLORS = ("tab:red", "tab:blue")
 
 def _level(result: Result) -> str:
     levels = result.metrics["reachability"].get("levels")
-    return f"{levels[0]:.3g}" if levels else "0"
+    return f"{levels[1]:.3g}" if levels else "0"
 
 
 def _sets(ax: Axes, result: Result) -> None:
     arrays = result.arrays
     if "phi_final" in arrays:
-        level = result.metrics["reachability"]["levels"][0]
+        level = result.metrics["reachability"]["levels"][1]
         for phi, color in zip(arrays["phi_final"], COLORS, strict=True):
             ax.contour(arrays["grid_x"], arrays["grid_y"], phi.T, levels=[level], colors=color, linewidths=1)
     elif "front_final" in arrays:

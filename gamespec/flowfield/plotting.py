@@ -22,6 +22,7 @@ import matplotlib.pyplot as plt
 import numpy as np
 from matplotlib.axes import Axes
 
+from gamespec.plotting import LEGEND_RIGHT, headline
 from gamespec.result import Result
 
 COLORS = ("tab:red", "tab:blue")
@@ -46,6 +47,7 @@ def _sets(ax: Axes, result: Result) -> None:
         ax.plot(path[:, 0], path[:, 1], "--", color=color, label=f"{name} (nominal)")
         ax.plot(*path[0], "o", color=color)
     ax.plot(*result.metrics["capture_point"], "k*", ms=10, label="capture point")
+    ax.set(xlabel="x", ylabel="y")
     ax.set_title(f"reachable sets at T̂ = {result.metrics['capture_time']:.3f} (level {_level(result)})")
 
 
@@ -56,6 +58,7 @@ def _dispersion(ax: Axes, result: Result) -> None:
             ax.plot(sample[:, 2 * i], sample[:, 2 * i + 1], color=color, lw=0.3, alpha=0.3)
     for path in result.arrays["nominal_positions"]:
         ax.plot(path[:, 0], path[:, 1], "k--", lw=0.8)
+    ax.set(xlabel="x", ylabel="y")
     ax.set_title("closed-loop trajectory dispersion")
 
 
@@ -78,14 +81,14 @@ def plot(result: Result, output_dir: Path, *, animate: bool = False) -> list[Pat
         figures.append(("dispersion.png", _dispersion))
     written = []
     for name, draw in figures:
-        fig, ax = plt.subplots(figsize=(6, 4.5))
+        fig, ax = plt.subplots(figsize=(7.5, 4.5))
         draw(ax, result)
+        fig.suptitle(headline(result), fontsize="medium")
         if name != "dispersion.png":
-            ax.legend(fontsize=8)
+            ax.legend(**LEGEND_RIGHT)
         if name != "capture_probability.png":
             ax.set_aspect("equal")
-        fig.tight_layout()
-        fig.savefig(output_dir / name, dpi=120)
+        fig.savefig(output_dir / name, dpi=120, bbox_inches="tight")
         plt.close(fig)
         written.append(output_dir / name)
     return written

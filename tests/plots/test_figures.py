@@ -51,6 +51,7 @@ def test_shipped_problem_figures(path: Path, tmp_path: Path) -> None:
         "pursuit_scenario": _check_scenario,
         "lq_stochastic_game": _check_lq,
         "optimal_control": _check_ocp,
+        "flow_field_game": _check_flow,
     }[result.kind]
     check(result, {s.name: s for s in saved})
 
@@ -97,6 +98,11 @@ def _check_lq(result, saved) -> None:
         assert "target 3σ" in labels and colours["target 3σ"] != colours["initial 3σ"]
     zoom = ax.child_axes
     assert len(zoom) == 1 and "zoom" in zoom[0].get_title()
+
+
+def _check_flow(result, saved) -> None:
+    if "reachable_sets.png" in saved:
+        assert "capture point" in legend_texts(saved["reachable_sets.png"].axes[0])
 
 
 def _check_ocp(result, saved) -> None:

@@ -17,8 +17,8 @@ from gamespec.games.equilibrium import GameModel, GameSolution, status_of
 from gamespec.games.problems import initial_state
 from gamespec.games.simulate import TrueSystem, control_signal, grid_of
 from gamespec.result import Result
-from gamespec.specs.differential_game import DifferentialGameSpec
 from gamespec.specs.base import SpecBase, StrictModel
+from gamespec.specs.differential_game import DifferentialGameSpec
 
 
 def true_parameters(model: GameModel) -> dict[str, float]:
@@ -39,7 +39,9 @@ def open_loop(model: GameModel) -> Result:
     own = {name: _own(solutions, name) for name in game.problem.players}
     first = solutions[0].states
     tc = first.control_time + t0
-    controls = {c: own[p].results[p].controls[c] for p, pl in game.problem.players.items() for c in pl.controls}
+    controls = {
+        c: own[p].results[p].controls[c] for p, pl in game.problem.players.items() for c in pl.controls
+    }
     arrays = {}
     if len(solutions) == 1:
         time, states = first.time + t0, dict(first.states)

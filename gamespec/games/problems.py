@@ -140,7 +140,5 @@ def views(game: DifferentialGameSpec) -> list[str]:
     """The games to solve: one per player (``G^i``), or one for all when every player's problems
     are the same in every player's game (no private beliefs or transforms)."""
     names = list(game.problem.players)
-    dumps = [[player_problem(game, j, i).problem.model_dump() for j in names] for i in names]
-    transforms = [[applies_transforms(game, j, i) for j in names] for i in names]
-    same = all(d == dumps[0] and t == transforms[0] for d, t in zip(dumps, transforms, strict=True))
-    return names[:1] if same else names
+    games = [[player_problem(game, j, i).model_dump(exclude={"name"}) for j in names] for i in names]
+    return names[:1] if all(g == games[0] for g in games) else names

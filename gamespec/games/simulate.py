@@ -10,6 +10,7 @@ far below the transcription's.
 
 from __future__ import annotations
 
+import itertools
 from collections.abc import Callable, Mapping
 
 import numpy as np
@@ -25,7 +26,9 @@ Signal = Callable[[float], float]
 
 
 def grid_of(method: MethodSpec) -> Grid:
-    return Grid(method.scheme, method.intervals, method.degree if method.scheme == "radau" else 1, method.grading)
+    return Grid(
+        method.scheme, method.intervals, method.degree if method.scheme == "radau" else 1, method.grading
+    )
 
 
 def control_signal(grid: Grid, values: np.ndarray, start: float, horizon: float) -> Signal:
@@ -38,7 +41,8 @@ def control_signal(grid: Grid, values: np.ndarray, start: float, horizon: float)
     d = grid.degree
     breaks = grid.breaks
     coefficients = [
-        np.polyfit(tau_eval[k * d : (k + 1) * d], values[k * d : (k + 1) * d], d - 1) for k in range(grid.intervals)
+        np.polyfit(tau_eval[k * d : (k + 1) * d], values[k * d : (k + 1) * d], d - 1)
+        for k in range(grid.intervals)
     ]
 
     def signal(t: float) -> float:
@@ -66,7 +70,12 @@ class TrueSystem:
         return np.asarray(self._f(*self.params, *x, *u, t), dtype=float).ravel()
 
     def advance(
-        self, x0: Mapping[str, float], controls: Mapping[str, Signal], t0: float, duration: float, breaks: np.ndarray
+        self,
+        x0: Mapping[str, float],
+        controls: Mapping[str, Signal],
+        t0: float,
+        duration: float,
+        breaks: np.ndarray,
     ) -> tuple[np.ndarray, np.ndarray]:
         """States from ``x0`` at ``t0`` over ``duration``, integrated piece by piece between the
         absolute times ``breaks``: the times (one per piece end, ``t0`` first) and states (rows)."""
@@ -74,7 +83,7 @@ class TrueSystem:
         times = [t0]
         rows = [x]
         edges = np.unique(np.clip(np.concatenate([[t0, t0 + duration], breaks]), t0, t0 + duration))
-        for a, b in zip(edges[:-1], edges[1:], strict=True):
+        for a, b in itertools.pairwise(edges):
             inside = 1e-9 * (b - a)
 
             def rhs(t, y, lo=a + inside, hi=b - inside):

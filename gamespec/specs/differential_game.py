@@ -23,7 +23,7 @@ from typing import Literal
 
 from pydantic import Field, model_validator
 
-from gamespec.errors import ExpressionError
+from gamespec.errors import ExpressionError, SpecError
 from gamespec.specs.base import Number, ProblemParameters, RequestedTransforms, SpecBase, StrictModel, Value
 from gamespec.specs.ocp import ControlSpec, MethodSpec, StateSpec
 from gamespec.symbolic.language import RESERVED, parse, parse_relation, symbol
@@ -117,6 +117,8 @@ class GameProblem(StrictModel):
             if unknown:
                 raise ValueError(f"uncertain.{pname}.beliefs names unknown players {sorted(unknown)}")
         self._check_expressions()
+        for name, player in self.players.items():
+            _check_transforms(name, player)
         return self
 
     def _check_player(self, name: str, player: PlayerSpec) -> None:
@@ -144,14 +146,38 @@ class GameProblem(StrictModel):
             checks += [(f"{field}.mayer", payoff.mayer, ends, False)]
             checks += [(f"{field}.lagrange", payoff.lagrange, running, False)]
         for n, p in self.players.items():
-            checks += [(f"players.{n}.path_constraints.{i}", c, running, True) for i, c in enumerate(p.path_constraints)]
-        checks += [(f"terminal_constraints.{i}", c, ends, True) for i, c in enumerate(self.terminal_constraints)]
+            checks += [
+                (f"players.{n}.path_constraints.{i}", c, running, True)
+                for i, c in enumerate(p.path_constraints)
+            ]
+        checks += [
+            (f"terminal_constraints.{i}", c, ends, True) for i, c in enumerate(self.terminal_constraints)
+        ]
         checks += [("time.final", self.time.final, params, False)]
         for field, text, symbols, relation in checks:
             try:
                 (parse_relation if relation else parse)(text, symbols)
             except ExpressionError as err:
                 raise ValueError(f"{field}: {err}") from None
+
+
+def _check_transforms(name: str, player: PlayerSpec) -> None:
+    """Each of the player's transforms is a requested ``optimal_control`` transform with valid
+    options (a SpecError naming ``problem.players.<name>.transforms.<i>`` otherwise)."""
+    from gamespec.specs.requested import entry, transform_class, validated_options
+
+    for index, item in enumerate(player.transforms):
+        try:
+            tname, options = entry(item, index)
+            cls = transform_class(tname, field=f"transforms.{index}")
+            if not cls.requested or cls.source_kind != "optimal_control":
+                raise SpecError(
+                    f"transform {tname!r} is not a requested optimal_control transform",
+                    field=f"transforms.{index}",
+                )
+            validated_options(cls, tname, options, index)
+        except SpecError as err:
+            raise SpecError(err.reason, field=f"problem.players.{name}.{err.field}") from None
 
 
 class GameSettings(StrictModel):

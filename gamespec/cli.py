@@ -196,9 +196,16 @@ def plot(
     out: OutOpt = None,
     animate: Annotated[bool, typer.Option(help="Also write an animation where the kind has one.")] = False,
 ) -> None:
-    """Draw a saved Result (states, controls, paths; kind-specific figures)."""
+    """Draw a saved Result (states, controls, paths; kind-specific figures), or a sweep folder's
+    cost/sensitivity trade-off when its points are desensitized Results."""
     from gamespec.plotting import plot_result
 
+    if (result / "points").is_dir():
+        from gamespec.desensitize.plotting import plot_tradeoff
+
+        for path in plot_tradeoff(result, writable_folder(out or result)):
+            console.print(f"wrote {path}")
+        return
     loaded = Result.load(result)
     folder = writable_folder(out or (result if result.is_dir() else result.parent))
     for path in plot_result(loaded, folder, animate=animate):

@@ -61,6 +61,10 @@ def plot_trajectories(result: Result, output_dir: Path, *, animate: bool = False
             plt.close(fig)
             paths.append(path)
             break
+    if "desensitization" in result.metrics:
+        from gamespec.desensitize.plotting import plot_desensitized
+
+        paths += plot_desensitized(result, output_dir)
     return paths
 
 

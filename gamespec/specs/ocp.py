@@ -17,6 +17,7 @@ from pydantic import Field, field_validator, model_validator
 
 from gamespec.errors import ExpressionError, SpecError
 from gamespec.specs.base import Number, ProblemParameters, SpecBase, StrictModel, Value
+from gamespec.specs.uncertainty import UncertainParameter
 from gamespec.symbolic.language import RESERVED, parse, parse_relation, symbol
 from gamespec.symbolic.translate import numeric
 
@@ -93,6 +94,9 @@ class OcpProblem(StrictModel):
     time: TimeSpec = Field(default_factory=TimeSpec)
     path_constraints: list[str] = Field(default_factory=list)
     boundary_constraints: list[str] = Field(default_factory=list)
+    uncertain: dict[str, UncertainParameter] = Field(
+        default_factory=dict, description="Uncertain parameters (chapter 6) and their distributions."
+    )
 
     @field_validator("states")
     @classmethod
@@ -118,6 +122,9 @@ class OcpProblem(StrictModel):
                 f" dynamics for undeclared states {sorted(extra)}" if extra else ""
             )
             raise ValueError(f"dynamics must give one equation per state: {what.strip()}")
+        unknown = set(self.uncertain) - set(self.parameters)
+        if unknown:
+            raise ValueError(f"uncertain names undeclared parameters: {sorted(unknown)}")
         self._check_expressions()
         self.evaluate(self.parameters)
         return self

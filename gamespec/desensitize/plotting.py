@@ -1,0 +1,122 @@
+"""Figures of desensitized Results (chapter 6): the nominal path with the Monte Carlo bundle
+(Figs. 6.1(c), 6.2(a), 6.4), the sensitivity trajectories S(t) (Fig. 6.1(b)), and the trade-off of
+the original cost against the sensitivity measure across a sweep of the weight (Fig. 6.3(b)).
+Plots read Results (or a sweep folder's saved rows) only.
+"""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+from typing import Any
+
+from gamespec.errors import GamespecError
+from gamespec.result import Result
+
+SENSITIVITY_PREFIXES = ("S_", "mu_", "Phi_")
+
+
+def _pyplot():
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    return plt
+
+
+def _original_states(result: Result) -> list[str]:
+    return list(result.metrics["monte_carlo"]["final_state_mean"]) if "monte_carlo" in result.metrics else []
+
+
+def plot_desensitized(result: Result, output_dir: Path) -> list[Path]:
+    """The Monte Carlo bundle about the nominal path, and the sensitivity trajectories."""
+    plt = _pyplot()
+    output_dir.mkdir(parents=True, exist_ok=True)
+    paths = []
+    states = _original_states(result)
+    if states:
+        planar = states[:2] if len(states) >= 2 else None
+        fig, ax = plt.subplots(figsize=(6.5, 4.5))
+        for prefix, color, label in (
+            ("monte_carlo", "0.6", "open loop"),
+            ("tracking", "tab:green", "LQR tracking"),
+        ):
+            if f"{prefix}_{states[0]}" not in result.arrays:
+                continue
+            xs = (
+                result.arrays[f"{prefix}_{planar[0]}"]
+                if planar
+                else result.arrays["monte_carlo_time"][:, None]
+            )
+            ys = result.arrays[f"{prefix}_{planar[1] if planar else states[0]}"]
+            lines = ax.plot(xs if planar else xs.repeat(ys.shape[1], 1), ys, color=color, lw=0.6, alpha=0.5)
+            lines[0].set_label(
+                f"{label} ({result.metrics['monte_carlo']['samples']} samples, first {ys.shape[1]})"
+            )
+        x_nominal = result.states[planar[0]] if planar else result.time
+        ax.plot(x_nominal, result.states[planar[1] if planar else states[0]], "k-", lw=2, label="nominal")
+        ax.set_xlabel(planar[0] if planar else "t")
+        ax.set_ylabel(planar[1] if planar else states[0])
+        ax.grid(alpha=0.3)
+        ax.legend(loc="best", fontsize=8)
+        ax.set_title(f"{result.problem}: Monte Carlo about the nominal")
+        paths.append(output_dir / f"{result.problem}_monte_carlo.png")
+        fig.savefig(paths[-1], dpi=120)
+        plt.close(fig)
+    curves = {k: v for k, v in result.states.items() if k.startswith(SENSITIVITY_PREFIXES)}
+    if curves:
+        fig, ax = plt.subplots(figsize=(6.5, 4))
+        for name, values in curves.items():
+            ax.plot(result.time, values, label=name)
+        ax.set_xlabel("t")
+        ax.set_ylabel("sensitivity")
+        ax.grid(alpha=0.3)
+        ax.legend(loc="best", fontsize=7, ncol=2)
+        ax.set_title(f"{result.problem}: sensitivities ({result.metrics['desensitization']['method']})")
+        paths.append(output_dir / f"{result.problem}_sensitivity.png")
+        fig.savefig(paths[-1], dpi=120)
+        plt.close(fig)
+    return paths
+
+
+def sweep_rows(folder: Path) -> list[dict[str, Any]]:
+    """The saved rows of a sweep folder (``points/*.json``) that carry desensitization metrics."""
+    rows = []
+    for path in sorted((folder / "points").glob("*.json")):
+        value = json.loads(path.read_text())["value"]
+        if "nominal_objective" in value.get("metrics", {}):
+            rows.append(value)
+    return rows
+
+
+def plot_tradeoff(folder: Path, output_dir: Path) -> list[Path]:
+    """Original cost against the sensitivity measure, one point per swept value (Fig. 6.3(b))."""
+    rows = sweep_rows(folder)
+    if not rows:
+        raise GamespecError(f"{folder}: the sweep holds no solved desensitized points to plot")
+    plt = _pyplot()
+    name = next(iter(rows[0]))  # a sweep row starts with its parameter values
+    rows.sort(key=lambda r: r.get(name, 0.0))
+    cost = [r["metrics"]["nominal_objective"] for r in rows]
+    measure = [r["metrics"]["sensitivity_measure"] for r in rows]
+    fig, ax = plt.subplots(figsize=(6, 4.5))
+    ax.plot(measure, cost, "o-")
+    for r, x, y in zip(rows, measure, cost, strict=True):
+        ax.annotate(
+            f"{name}={r.get(name, float('nan')):g}",
+            (x, y),
+            textcoords="offset points",
+            xytext=(5, 5),
+            fontsize=8,
+        )
+    ax.set_xlabel("sensitivity measure")
+    ax.set_ylabel("original cost")
+    ax.grid(alpha=0.3)
+    ax.set_title(f"{rows[0].get('problem', '')}: cost against sensitivity")
+    fig.tight_layout()
+    path = output_dir / "tradeoff.png"
+    output_dir.mkdir(parents=True, exist_ok=True)
+    fig.savefig(path, dpi=120)
+    plt.close(fig)
+    return [path]

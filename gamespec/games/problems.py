@@ -123,6 +123,7 @@ def player_problem(game: DifferentialGameSpec, player: str, view: str) -> Optima
         "time": {"initial": 0.0, "final": to_text(horizon)},
         "path_constraints": path,
         "boundary_constraints": terminal,
+        "uncertain": {n: u.distribution.model_dump() for n, u in p.uncertain.items() if u.distribution},
     }
     return OptimalControlSpec.model_validate(
         {

@@ -26,6 +26,7 @@ from pydantic import Field, model_validator
 from gamespec.errors import ExpressionError, SpecError
 from gamespec.specs.base import Number, ProblemParameters, RequestedTransforms, SpecBase, StrictModel, Value
 from gamespec.specs.ocp import ControlSpec, MethodSpec, StateSpec
+from gamespec.specs.uncertainty import UncertainParameter
 from gamespec.symbolic.language import RESERVED, parse, parse_relation, symbol
 
 INITIAL_PREFIX = "initial_"
@@ -42,12 +43,15 @@ class PayoffSpec(StrictModel):
     lagrange: Value = 0.0
 
 
-class UncertainParameter(StrictModel):
+class BelievedParameter(StrictModel):
     """A parameter some players do not know (eq. 7.2): its ``true`` value (what moves the true
-    system) and each player's belief; a player not in ``beliefs`` knows the true value."""
+    system) and each player's belief; a player not in ``beliefs`` knows the true value. An optional
+    ``distribution`` about a player's belief (as chapter 6's ``problem.uncertain``) is passed to
+    every player's problem, where the sensitivity transforms (``desensitize``, ``rcs``) read it."""
 
     true: Number
     beliefs: dict[str, Number] = Field(default_factory=dict)
+    distribution: UncertainParameter | None = None
 
     def belief(self, player: str) -> float:
         return self.beliefs.get(player, self.true)
@@ -87,7 +91,7 @@ class GameProblem(StrictModel):
     """The mathematics of a differential game (section 7.1.1)."""
 
     parameters: dict[str, Number] = Field(default_factory=dict)
-    uncertain: dict[str, UncertainParameter] = Field(default_factory=dict)
+    uncertain: dict[str, BelievedParameter] = Field(default_factory=dict)
     states: dict[str, StateSpec]
     dynamics: dict[str, Value]
     players: dict[str, PlayerSpec]

@@ -20,7 +20,7 @@ from gamespec.games.problems import parameter_values, player_problem, views
 from gamespec.loader import with_values
 from gamespec.result import Result, Status
 from gamespec.solving import Solver, compile_spec
-from gamespec.specs.differential_game import INITIAL_PREFIX, START_TIME, DifferentialGameSpec
+from gamespec.specs.differential_game import INITIAL_PREFIX, NOMINAL_PREFIX, START_TIME, DifferentialGameSpec
 from gamespec.specs.ocp import OptimalControlSpec
 
 
@@ -109,14 +109,24 @@ class GameModel:
                 out[name] = np.array([np.full(r.points, start.get(c, 0.0)) for c in r.controls])
         return out
 
-    def values(self, view: str, player: str, state: Mapping[str, float], time: float) -> dict[str, float]:
+    def values(
+        self,
+        view: str,
+        player: str,
+        state: Mapping[str, float],
+        time: float,
+        sensitivities: Mapping[str, float] | None = None,
+    ) -> dict[str, float]:
         """The runtime parameters of ``player``'s problem in game ``view`` starting at ``state`` and
-        absolute ``time``."""
+        absolute ``time``, with the predicted ``sensitivities`` (by generated parameter name)."""
+        beliefs = parameter_values(self.game, player, view)
         return (
             dict(self.parameters)
-            | parameter_values(self.game, player, view)
+            | beliefs
             | {f"{INITIAL_PREFIX}{s}": float(v) for s, v in state.items()}
             | {START_TIME: float(time)}
+            | {f"{NOMINAL_PREFIX}{u}": v for u, v in beliefs.items()}
+            | dict(sensitivities or {})
         )
 
     def solve(
@@ -125,12 +135,13 @@ class GameModel:
         state: Mapping[str, float],
         time: float,
         start: Mapping[str, np.ndarray] | None = None,
+        sensitivities: Mapping[str, float] | None = None,
     ) -> GameSolution:
         """Iterate best responses of game ``view`` from ``state`` at ``time`` (see module doc)."""
         settings = self.game.game
         order = [r for (v, _), r in self.responders.items() if v == view]
         for r in order:
-            r.set_values(self.values(view, r.name, state, time))
+            r.set_values(self.values(view, r.name, state, time, sensitivities))
         last: list[str] = [order[-1].name]
 
         def responder(r: BestResponder):

@@ -25,7 +25,14 @@ from dataclasses import dataclass
 
 import sympy as sp
 
-from gamespec.specs.differential_game import INITIAL_PREFIX, START_TIME, DifferentialGameSpec, PayoffSpec
+from gamespec.specs.differential_game import (
+    INITIAL_PREFIX,
+    NOMINAL_PREFIX,
+    START_TIME,
+    DifferentialGameSpec,
+    PayoffSpec,
+    sensitivity_name,
+)
 from gamespec.specs.ocp import OptimalControlSpec, StateSpec
 from gamespec.symbolic.language import parse, parse_relation, symbol
 from gamespec.symbolic.printer import to_text
@@ -84,6 +91,28 @@ def initial_state(game: DifferentialGameSpec) -> dict[str, float]:
     return {n: float(s.initial) if s.initial is not None else 0.0 for n, s in game.problem.states.items()}
 
 
+def predicted_states(game: DifferentialGameSpec, view: str) -> list[str]:
+    """The states the player ``view`` predicts, whose initial values in its game carry their
+    accumulated sensitivity (``receding_horizon.sensitivity_time: absolute``)."""
+    rh, observes = game.receding_horizon, game.problem.players[view].observes
+    if rh is None or rh.sensitivity_time == "relative" or observes is None or not game.problem.uncertain:
+        return []
+    return [s for s in game.problem.states if s not in observes]
+
+
+def _initial_value(name: str, predicted: bool, uncertain: list[str]) -> str:
+    """``initial_<x>``, or for a predicted state the first-order expansion of eq. 7.14,
+    ``initial_<x> + Σ_ρ initial_S_<x>_<ρ> (ρ − nominal_ρ)``, equal to ``initial_<x>`` at the problem's
+    parameter values and with ``∂x0/∂ρ`` the predicted sensitivity."""
+    value = symbol(f"{INITIAL_PREFIX}{name}")
+    if predicted:
+        value += sum(
+            symbol(sensitivity_name(name, u)) * (symbol(u) - symbol(f"{NOMINAL_PREFIX}{u}"))
+            for u in uncertain
+        )
+    return to_text(value)
+
+
 def player_problem(game: DifferentialGameSpec, player: str, view: str) -> OptimalControlSpec:
     """``player``'s best-response problem in the game ``view`` solves (see module doc)."""
     p = game.problem
@@ -91,15 +120,22 @@ def player_problem(game: DifferentialGameSpec, player: str, view: str) -> Optima
     sym = symbols_of(game)
     running, ends, shift = sym.running, sym.ends, sym.shift
     x0 = initial_state(game)
+    beliefs = parameter_values(game, player, view)
+    predicted = predicted_states(game, view)
     parameters = (
         dict(p.parameters)
-        | parameter_values(game, player, view)
+        | beliefs
         | {f"{INITIAL_PREFIX}{s}": v for s, v in x0.items()}
         | {START_TIME: float(game.problem.time.initial)}
+        | {f"{NOMINAL_PREFIX}{u}": v for u, v in beliefs.items()}
+        | {sensitivity_name(s, u): 0.0 for s in predicted for u in p.uncertain}
     )
     states = {
         name: StateSpec(
-            initial=to_text(symbol(f"{INITIAL_PREFIX}{name}")), lower=s.lower, upper=s.upper, final=s.final
+            initial=_initial_value(name, name in predicted, list(p.uncertain)),
+            lower=s.lower,
+            upper=s.upper,
+            final=s.final,
         )
         for name, s in p.states.items()
     }

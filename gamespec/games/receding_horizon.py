@@ -27,16 +27,19 @@ from rich.progress import BarColumn, Progress, TextColumn, TimeElapsedColumn
 from gamespec.errors import SpecError
 from gamespec.games.backend import true_parameters
 from gamespec.games.equilibrium import GameModel, GameSolution
-from gamespec.games.problems import initial_state
+from gamespec.games.problems import initial_state, predicted_states
 from gamespec.games.simulate import TrueSystem, control_signal, grid_of
 from gamespec.result import Result, Status
-from gamespec.specs.differential_game import DifferentialGameSpec
+from gamespec.specs.differential_game import DifferentialGameSpec, sensitivity_name
 from gamespec.symbolic.calculus import numeric_function
 from gamespec.symbolic.language import parse, parse_relation, symbol
 from gamespec.symbolic.translate import numeric
 
 SAMPLES_PER_STEP = 10
 """Points of the true trajectory per step at which capture and collisions are checked."""
+DIFFERENCE_STEP = 1e-4
+"""Relative step of the central differences of a prediction in an uncertain parameter (the
+integration's relative tolerance 1e-11 leaves an error near 1e-7 in the quotient)."""
 
 
 def believed_parameters(model: GameModel, player: str) -> dict[str, float]:
@@ -64,6 +67,57 @@ class StateFunction:
 
     def __call__(self, states: Mapping[str, np.ndarray], params: Mapping[str, float]) -> np.ndarray:
         return self._f(*(states[n] if n in states else params[n] for n in self.names))[0]
+
+
+class Predictor:
+    """What a player that does not observe every state predicts of them: its model of the true
+    system at its beliefs, from the observed states reset at every step, and the sensitivity of its
+    predictions to each uncertain parameter by central differences of the same integration."""
+
+    def __init__(self, model: GameModel, player: str, x0: Mapping[str, float]) -> None:
+        game = model.game
+        self.player = player
+        self.observes = game.problem.players[player].observes
+        believed = believed_parameters(model, player)
+        self.system = TrueSystem(game, believed)
+        self.state = dict(x0)
+        self.predicted = predicted_states(game, player)
+        self.perturbed: dict[str, list[tuple[TrueSystem, dict[str, float], float]]] = {}
+        for u in game.problem.uncertain if self.predicted else ():
+            h = DIFFERENCE_STEP * max(1.0, abs(believed[u]))
+            self.perturbed[u] = [
+                (TrueSystem(game, believed | {u: believed[u] + sign * h}), dict(x0), sign * h)
+                for sign in (1, -1)
+            ]
+
+    def _merged(self, x: Mapping[str, float], own: Mapping[str, float]) -> dict[str, float]:
+        return {s: x[s] if s in self.observes else own[s] for s in x}
+
+    def start(self, x: Mapping[str, float]) -> dict[str, float]:
+        """The state the player's game starts from: observed from ``x``, the rest predicted."""
+        return self._merged(x, self.state)
+
+    def sensitivities(self) -> dict[str, float]:
+        """The predicted states' sensitivities, by their generated parameter names."""
+        out = {}
+        for u, ((_, plus, hp), (_, minus, hm)) in self.perturbed.items():
+            for s in self.predicted:
+                out[sensitivity_name(s, u)] = (plus[s] - minus[s]) / (hp - hm)
+        return out
+
+    def advance(
+        self, x: Mapping[str, float], signals: Mapping, t: float, step: float, times: np.ndarray
+    ) -> np.ndarray:
+        """Advance the predictions over the step; the nominal prediction's rows at ``times``."""
+        _, rows = self.system.advance(self.start(x), signals, t, step, times)
+        self.state = dict(zip(self.system.states, rows[-1], strict=True))
+        for u, runs in self.perturbed.items():
+            updated = []
+            for system, state, h in runs:
+                _, prow = system.advance(self._merged(x, state), signals, t, step, times)
+                updated.append((system, dict(zip(system.states, prow[-1], strict=True)), h))
+            self.perturbed[u] = updated
+        return rows
 
 
 def _horizon(game: DifferentialGameSpec, params: Mapping[str, float]) -> float:
@@ -102,7 +156,6 @@ class RecedingHorizon:
         self.players = list(game.problem.players)
         self.truth = TrueSystem(game, true_parameters(model))
         self.predicting = [n for n, pl in game.problem.players.items() if pl.observes is not None]
-        self.beliefs = {n: TrueSystem(game, believed_parameters(model, n)) for n in self.predicting}
         self.horizon = _horizon(game, model.parameters)
         intervals = game.method.intervals
         self.interval = self.horizon / intervals
@@ -155,7 +208,7 @@ class RecedingHorizon:
         if rh.horizon == "shrinking":
             end = min(end, t + self.horizon)
         x = initial_state(game)
-        predicted = {n: dict(x) for n in self.players}
+        predictors = {n: Predictor(self.model, n, x) for n in self.predicting}
         record = Record(times=[t], states=[np.array([x[s] for s in self.truth.states])])
         record.predicted = {n: [record.states[0]] for n in self.predicting}
         previous: dict[str, dict[str, np.ndarray]] = {}
@@ -169,9 +222,10 @@ class RecedingHorizon:
                 model = self._model(intervals, t) if rh.horizon == "shrinking" else self.model
                 solutions = {}
                 for view in model.views:
-                    start = previous.get(view)
-                    state = self._observed(view, x, predicted[view])
-                    solutions[view] = model.solve(view, state, t, start)
+                    predictor = predictors.get(view)
+                    state = predictor.start(x) if predictor else x
+                    sensitivities = predictor.sensitivities() if predictor else None
+                    solutions[view] = model.solve(view, state, t, previous.get(view), sensitivities)
                 keep = rh.horizon == "receding"
                 previous = {
                     v: {n: _shifted(a, self.points_per_step, keep) for n, a in s.run.strategies.items()}
@@ -191,11 +245,8 @@ class RecedingHorizon:
                 times, rows = self.truth.advance(
                     x, signals, t, rh.step, np.linspace(t, t + rh.step, SAMPLES_PER_STEP + 1)
                 )
-                for n in self.predicting:
-                    start_state = self._observed(n, x, predicted[n])
-                    _, prows = self.beliefs[n].advance(start_state, signals, t, rh.step, times)
-                    record.predicted[n].extend(prows[1:])
-                    predicted[n] = dict(zip(self.truth.states, prows[-1], strict=True))
+                for n, predictor in predictors.items():
+                    record.predicted[n].extend(predictor.advance(x, signals, t, rh.step, times)[1:])
                 record.times.extend(times[1:])
                 record.states.extend(rows[1:])
                 x = dict(zip(self.truth.states, rows[-1], strict=True))

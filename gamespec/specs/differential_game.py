@@ -33,6 +33,14 @@ INITIAL_PREFIX = "initial_"
 """A generated player problem takes the initial state ``<state>`` as the parameter ``initial_<state>``."""
 START_TIME = "start_time"
 """The generated parameter holding the absolute time at which a player's problem starts."""
+NOMINAL_PREFIX = "nominal_"
+"""``nominal_<parameter>``: the value an uncertain parameter has in a generated player problem."""
+
+
+def sensitivity_name(state: str, parameter: str) -> str:
+    """``initial_S_<state>_<parameter>``: the predicted sensitivity of an unobserved state at the
+    start of a player's problem."""
+    return f"{INITIAL_PREFIX}S_{state}_{parameter}"
 
 
 class PayoffSpec(StrictModel):
@@ -105,6 +113,8 @@ class GameProblem(StrictModel):
             raise ValueError("a game needs at least two players")
         controls = [c for p in self.players.values() for c in p.controls]
         generated = [f"{INITIAL_PREFIX}{s}" for s in self.states] + [START_TIME]
+        generated += [f"{NOMINAL_PREFIX}{u}" for u in self.uncertain]
+        generated += [sensitivity_name(s, u) for s in self.states for u in self.uncertain]
         names = [*self.parameters, *self.uncertain, *self.states, *controls, *generated]
         for name in names:
             if not name.isidentifier() or name in RESERVED or name == "tau":
@@ -236,6 +246,12 @@ class RecedingHorizonSpec(StrictModel):
     on_not_converged: Literal["last_iterate", "previous_plan"] = "last_iterate"
     positions: dict[str, tuple[str, str]] = Field(default_factory=dict)
     """Each player's position states, for the figures."""
+    sensitivity_time: Literal["absolute", "relative"] = "absolute"
+    """The sensitivity to the uncertain parameters a player's problem starts with, for a state the
+    player predicts (does not observe): ``absolute`` — the sensitivity its prediction has
+    accumulated since the start of the run (eq. 7.26 with t the absolute time; the prediction's
+    first-order expansion of eq. 7.14 is the state's initial value, so ``S(t_k) = ∂x_k/∂ρ``), or
+    ``relative`` — none (``S(t_k) = 0``: t counted from the step's start)."""
 
 
 class DifferentialGameSpec(ProblemParameters, SpecBase):

@@ -140,3 +140,28 @@ def test_asymmetric_obstacle_first_steps_and_the_pursuers_belief():
     np.testing.assert_allclose(gap, direction * (rho.true - rho.beliefs["pursuer"]) * result.time, atol=1e-9)
     assert result.arrays["lookahead/pursuer/xp"].shape == (3, spec.method.intervals + 1)
     assert set(m["per_step"][0]["games"]) == {"pursuer", "evader"}
+
+
+@pytest.mark.parametrize("timing", ["absolute", "relative"])
+def test_sensitivity_time_of_the_predicted_obstacle(timing):
+    """With ``desensitize`` in the pursuer's game, the sensitivity of the obstacle it predicts,
+    z = d + direction·ρ̂·t, starts each step at ∂z/∂ρ = direction·t_k (absolute time: the initial value
+    is the prediction's first-order expansion, eq. 7.14) or at 0 (relative), and grows by
+    direction·(t − t_k) along the step's horizon."""
+    spec = load(
+        PROBLEMS / "ch7" / "asymmetric_obstacle.yaml",
+        [
+            "receding_horizon.time_limit=0.3",
+            f"receding_horizon.sensitivity_time={timing}",
+            "problem.uncertain.rho.distribution={normal: {std: 0.1}}",
+            "problem.players.pursuer.transforms=[{desensitize: {trajectory: {S_yp_rho: Q}, "
+            "monte_carlo: {samples: 0}}}]",
+        ],
+    )
+    solver = compile_spec(spec)
+    result = solver.solve()
+    assert result.ok, result.message
+    last = solver.compiled.model.responders[("pursuer", "pursuer")].last
+    direction, t_k = spec.problem.parameters["direction"], result.control_time[-1]
+    start = direction * t_k if timing == "absolute" else 0.0
+    np.testing.assert_allclose(last.states["S_z_rho"], start + direction * last.time, atol=1e-6)

@@ -7,6 +7,7 @@ import numpy as np
 import pytest
 from gamespec_casadi import backend as casadi_backend
 
+from gamespec import registry
 from gamespec.errors import SpecError
 from gamespec.games.problems import player_problem, views
 from gamespec.loader import load
@@ -144,9 +145,11 @@ def test_asymmetric_obstacle_first_steps_and_the_pursuers_belief():
 
 @pytest.mark.parametrize("timing", ["absolute", "relative"])
 def test_sensitivity_time_of_the_predicted_obstacle(timing):
-    """With ``desensitize`` in the pursuer's game, the sensitivity of the obstacle it predicts,
-    z = d + direction·ρ̂·t, starts each step at ∂z/∂ρ = direction·t_k (absolute time: the initial value
-    is the prediction's first-order expansion, eq. 7.14) or at 0 (relative), and grows by
+    """The pursuer's payoff modification is chapter 6's registered transform, applied by the chain
+    to its own problem only. With ``desensitize`` in the pursuer's game, the sensitivity of the
+    obstacle it predicts, z = d + direction·ρ̂·t, starts each step at ∂z/∂ρ = direction·t_k
+    (absolute time: the initial value is the prediction's first-order expansion, eq. 7.14) or at 0
+    (relative), and grows by
     direction·(t − t_k) along the step's horizon."""
     spec = load(
         PROBLEMS / "ch7" / "asymmetric_obstacle.yaml",
@@ -159,9 +162,14 @@ def test_sensitivity_time_of_the_predicted_obstacle(timing):
         ],
     )
     solver = compile_spec(spec)
+    pursuer = solver.compiled.model.responders[("pursuer", "pursuer")]
+    evader = solver.compiled.model.responders[("pursuer", "evader")]
+    chapter6 = registry.load("gamespec.transforms", "desensitize")
+    assert [type(s.transform) for s in pursuer.solver.steps] == [chapter6]
+    assert not evader.solver.steps
     result = solver.solve()
     assert result.ok, result.message
-    last = solver.compiled.model.responders[("pursuer", "pursuer")].last
+    last = pursuer.last
     direction, t_k = spec.problem.parameters["direction"], result.control_time[-1]
     start = direction * t_k if timing == "absolute" else 0.0
     np.testing.assert_allclose(last.states["S_z_rho"], start + direction * last.time, atol=1e-6)

@@ -294,9 +294,12 @@ class RecedingHorizon:
         }
 
     def _lookahead(self, record: Record, solutions: dict[str, GameSolution], t: float) -> None:
+        """Each game's look-ahead trajectories (NaN when its last solve failed: no solution)."""
         for view, s in solutions.items():
             r = s.states
-            record.lookahead.setdefault(view, []).append({"time": r.time + t, **r.states})
+            blank = {k: np.full_like(v, np.nan, dtype=float) for k, v in r.states.items()}
+            states = r.states if r.ok else blank
+            record.lookahead.setdefault(view, []).append({"time": r.time + t, **states})
 
     def _samples(self, record: Record) -> dict[str, np.ndarray]:
         rows = np.array(record.states)

@@ -54,9 +54,11 @@ def expected(spec) -> dict:
     return closed_form(p["s"], p["r"], p["q"], p["T"], delta0) | {"x0": x0}
 
 
-@pytest.mark.parametrize("scheme", ["gauss_seidel", "jacobi"])
-def test_iteration_converges_to_the_closed_form_saddle(scheme):
-    spec = load(FILE, [f"game.scheme={scheme}"])
+@pytest.mark.parametrize(
+    ("scheme", "backend"), [("gauss_seidel", "casadi"), ("jacobi", "casadi"), ("gauss_seidel", "pyomo")]
+)
+def test_iteration_converges_to_the_closed_form_saddle(scheme, backend):
+    spec = load(FILE, [f"game.scheme={scheme}", f"game.backend={backend}"])
     result = compile_spec(spec).solve()
     want = expected(spec)
     run = result.metrics["best_response"]["pursuer"]

@@ -14,6 +14,7 @@ import gamespec
 from gamespec.pursuit import study
 from gamespec.pursuit.simulation import simulate_to_capture
 from gamespec.result import Status
+from gamespec.studies import suboptimal_study
 from tests.conftest import PROBLEMS
 
 CASES = {
@@ -71,10 +72,10 @@ def test_table_2_1_points(benchmark, monkeypatch, suboptimal: str) -> None:
     against the integrated true dynamics (the path before) as the baseline; the same variations."""
     benchmark.group = "Table 2.1, 60 points"
     points = _every_twelfth_point()
-    expected = [study.evaluate(p).get("variation_percent") for p in points]
+    expected = [suboptimal_study.evaluate(p).get("variation_percent") for p in points]
     if suboptimal == "integrated":
-        monkeypatch.setattr(study, "constant_heading_pursuit", simulate_to_capture)
-    rows = benchmark.pedantic(lambda: [study.evaluate(p) for p in points], rounds=1)
+        monkeypatch.setattr(suboptimal_study, "constant_heading_pursuit", simulate_to_capture)
+    rows = benchmark.pedantic(lambda: [suboptimal_study.evaluate(p) for p in points], rounds=1)
     got = [r.get("variation_percent") for r in rows]
     assert [g is None for g in got] == [e is None for e in expected]
     np.testing.assert_allclose(

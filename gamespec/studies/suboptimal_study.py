@@ -1,6 +1,7 @@
 """The ``study`` backend: runs a ``pursuit_suboptimal_study`` (Table 2.1, §2.4.4) point by point.
 
-Every point of :func:`gamespec.pursuit.study.study_points` goes through
+Every point of :func:`gamespec.pursuit.study.study_points` is solved by :func:`evaluate` (the
+generated eq. 2.21 OCP compiled once per speed and process) and goes through
 :func:`gamespec.studies.runner.run_study` into a :class:`~gamespec.studies.store.ResultStore` at the
 spec's ``store`` folder, through an executor plugin (``serial``, ``process`` or ``dask``, see
 :mod:`gamespec.studies.executors`); points already stored are reused, so solving the file again
@@ -16,7 +17,8 @@ averages (no optimum passed the defect check), ``error`` when none solved.
 from __future__ import annotations
 
 import time
-from typing import ClassVar
+from functools import cache
+from typing import Any, ClassVar
 
 import numpy as np
 from pydantic import Field
@@ -24,8 +26,16 @@ from pydantic import Field
 from gamespec.backend import Backend, CompiledModel, Inputs, refuse_inputs
 from gamespec.errors import UnsupportedFeature
 from gamespec.loader import spec_hash
-from gamespec.pursuit import study
+from gamespec.pursuit import pure_pursuit, study
+from gamespec.pursuit.ocp_generation import to_ocp, trajectory_guess
+from gamespec.pursuit.ocp_report import heading_law
+from gamespec.pursuit.pursuit_curve import constant_heading_pursuit
+from gamespec.pursuit.reduced import reduce
+from gamespec.pursuit.report import capture_gap
+from gamespec.pursuit.simulation import Players, simulate_to_capture
+from gamespec.pursuit.study import DEFECT_TOL, StudyPoint, point_engagement
 from gamespec.result import Result, Status
+from gamespec.solving import get_backend
 from gamespec.specs.base import StrictModel
 from gamespec.specs.suboptimal_study import SuboptimalStudySpec
 from gamespec.studies.executors import SCHEDULER_ENV, executor
@@ -44,6 +54,59 @@ POINT_CHECKS = {
     "max_defect": "max_defect",
 }
 """``Result.checks`` entry → the per-point check whose maximum over the solved points it holds."""
+
+
+@cache
+def _model(v: float, r1: float, u: float, eps: float, method: str, backend: str):
+    """The eq. 2.21 OCP of one speed, compiled once per process (P2 far away only sets the bounds)."""
+    reference = StudyPoint(v, 10 * r1, 0.5 * np.pi, r1, u, eps, (method,), backend)
+    ocp, _ = to_ocp(point_engagement(reference))
+    solver = get_backend(backend)
+    return solver.compile(ocp)
+
+
+def _first_accepted(point: StudyPoint, parameters: dict[str, float], guess: Result) -> tuple[int, Result]:
+    """Solve with each of the point's methods in turn; the first that passes the defect check (or
+    the last one tried) and its index."""
+    for attempt, method in enumerate(point.methods):
+        model = _model(point.v, point.r1, point.u, point.eps, method, point.backend)
+        result = model.solve(parameters=parameters, guess=guess)
+        if result.ok and result.checks["max_defect"] < DEFECT_TOL:
+            return attempt, result
+    return len(point.methods) - 1, result
+
+
+def evaluate(point: StudyPoint) -> dict[str, Any]:
+    """Suboptimal and optimal capture times of one point (the row the store keeps)."""
+    spec = point_engagement(point)
+    players = Players.from_spec(spec)
+    red = reduce(spec)
+    choice = pure_pursuit.suboptimal_heading(players)
+    traj = constant_heading_pursuit(players, choice.heading)
+    guess = trajectory_guess(red, traj)
+    parameters = {k: red.parameters[k] for k in ("r2_init", "psi_init")}
+    attempt, result = _first_accepted(point, parameters, guess)
+    row: dict[str, Any] = {
+        "v": point.v,
+        "r2": point.r2,
+        "psi": point.psi,
+        "status": result.status.value,
+        "t_suboptimal": traj.capture_time,
+        "heading_suboptimal": choice.heading,
+        "solve_time_s": result.solve_time_s,
+        "attempt": attempt,
+        "max_defect": result.checks.get("max_defect"),
+    }
+    if not (result.ok and row["max_defect"] < DEFECT_TOL):
+        return row
+    terminal = np.array([result.states[red.distance[i]][-1] for i in (0, 1)])
+    check = simulate_to_capture(players, heading_law(red, result))
+    return row | {
+        "t_optimal": result.t_final,
+        "variation_percent": 100.0 * (result.t_final - traj.capture_time) / result.t_final,
+        "simultaneous_capture_gap": capture_gap(players, terminal),
+        "resimulated_capture_time_error": abs(check.capture_time - result.t_final),
+    }
 
 
 class StudyOptions(StrictModel):
@@ -84,7 +147,7 @@ class StudyModel(CompiledModel):
         store.set_meta("study", {"type": "sweep", "problem": self.spec.name, "parameters": list(SWEPT)})
         run = run_study(
             points,
-            study.evaluate,
+            evaluate,
             store,
             executor=executor(self.options.executor, self.options.workers, self.options.scheduler),
             description=self.spec.name,
@@ -131,7 +194,5 @@ class StudyBackend(Backend):
     options_model: ClassVar[type[StrictModel]] = StudyOptions
 
     def _compile(self, spec: SuboptimalStudySpec, options: StudyOptions) -> StudyModel:
-        from gamespec.solving import get_backend
-
         get_backend(spec.ocp_backend)
         return StudyModel(spec, options)

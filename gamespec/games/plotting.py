@@ -12,7 +12,7 @@ from pathlib import Path
 
 import numpy as np
 
-from gamespec.plotting import plot_trajectories
+from gamespec.plotting import LEGEND_RIGHT, headline, plot_trajectories
 from gamespec.result import Result
 
 COLORS = ("tab:blue", "tab:red", "tab:purple", "tab:orange")
@@ -86,7 +86,7 @@ def _draw(ax, result: Result, upto: int, step: int | None) -> None:
 def _summary(result: Result) -> str:
     m = result.metrics
     end = f"captured at t = {m['capture_time']:.2f}" if m.get("captured") else f"stopped: {m.get('stop')}"
-    return f"{result.problem}: {end}"
+    return f"{headline(result)}\n{end}"
 
 
 def plot_game(result: Result, output_dir: Path, *, animate: bool = False) -> list[Path]:
@@ -97,11 +97,10 @@ def plot_game(result: Result, output_dir: Path, *, animate: bool = False) -> lis
     output_dir.mkdir(parents=True, exist_ok=True)
     fig, ax = plt.subplots(figsize=(7, 6))
     _draw(ax, result, len(result.time) - 1, None)
-    ax.set_title(_summary(result))
-    ax.legend(loc="best", fontsize=8)
-    fig.tight_layout()
+    ax.set_title(_summary(result), fontsize="medium")
+    ax.legend(**LEGEND_RIGHT)
     paths = [output_dir / f"{result.problem}_paths.png"]
-    fig.savefig(paths[0], dpi=120)
+    fig.savefig(paths[0], dpi=120, bbox_inches="tight")
     plt.close(fig)
     if animate:
         paths.append(_animation(result, output_dir))
@@ -112,7 +111,8 @@ def _animation(result: Result, output_dir: Path) -> Path:
     from matplotlib.animation import FuncAnimation, PillowWriter
 
     plt = _pyplot()
-    fig, ax = plt.subplots(figsize=(7, 6))
+    fig, ax = plt.subplots(figsize=(8.5, 6))
+    fig.subplots_adjust(left=0.1, right=0.72)
     steps = result.control_time
     samples = np.searchsorted(result.time, steps)
     limits = _limits(result)
@@ -123,7 +123,7 @@ def _animation(result: Result, output_dir: Path) -> Path:
         ax.set_xlim(*limits[0])
         ax.set_ylim(*limits[1])
         ax.set_title(f"{result.problem} — t = {steps[k]:.2f}")
-        ax.legend(loc="upper left", fontsize=7)
+        ax.legend(**LEGEND_RIGHT)
 
     anim = FuncAnimation(fig, frame, frames=len(steps))
     path = output_dir / f"{result.problem}.gif"

@@ -52,6 +52,7 @@ def test_shipped_problem_figures(path: Path, tmp_path: Path) -> None:
         "lq_stochastic_game": _check_lq,
         "optimal_control": _check_ocp,
         "flow_field_game": _check_flow,
+        "differential_game": _check_differential_game,
     }[result.kind]
     check(result, {s.name: s for s in saved})
 
@@ -98,6 +99,12 @@ def _check_lq(result, saved) -> None:
         assert "target 3σ" in labels and colours["target 3σ"] != colours["initial 3σ"]
     zoom = ax.child_axes
     assert len(zoom) == 1 and "zoom" in zoom[0].get_title()
+
+
+def _check_differential_game(result, saved) -> None:
+    paths = saved.get(f"{result.problem}_paths.png")
+    if paths is not None:
+        assert legend_texts(paths.axes[0]), "each player is in the legend"
 
 
 def _check_flow(result, saved) -> None:

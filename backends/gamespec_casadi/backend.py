@@ -48,7 +48,7 @@ class CasadiOptions(StrictModel):
     warm_start: bool = Field(True, description="Re-solves start from the previous solution.")
 
 
-def _library(ca) -> Library:
+def casadi_library(ca: Any) -> Library:
     """CasADi's functions by gamespec's names; ``heaviside(x) = (1 + sign(x))/2``, which is 1/2 at 0
     as SymPy's ``Heaviside`` (CasADi's ``sign(0) = 0``)."""
     return Library.from_namespace(
@@ -68,7 +68,7 @@ class CasadiModel(CollocationModel):
         self.tr = tr = Transcription(spec)
         self.options = options
         ocp, grid = tr.ocp, tr.grid
-        lib = _library(ca)
+        lib = casadi_library(ca)
         nx, nu, nw, npar = tr.n_x, tr.n_u, tr.n_w, len(ocp.p)
         x, u, w = ca.SX.sym("x", nx), ca.SX.sym("u", nu), ca.SX.sym("w", nw)
         p, t = ca.SX.sym("p", npar), ca.SX.sym("t")

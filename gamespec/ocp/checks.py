@@ -42,9 +42,10 @@ class Trajectory:
     T: float
 
 
-def _dynamics(tr: Transcription, x, u, w, t: np.ndarray, params: Mapping[str, float]) -> np.ndarray:
-    values = _values(tr, x, u, w, t, params)
-    return np.array([np.broadcast_to(translate(f, values, NUMPY), t.shape) for f in tr.ocp.dynamics])
+def _running(tr: Transcription, x, u, w, t: np.ndarray, params: Mapping[str, float]) -> np.ndarray:
+    """The dynamics (first ``n_x`` rows) and the Lagrange integrand (last row) along ``t``."""
+    p = [params[n] for n in tr.ocp.parameters]
+    return tr.ocp.running_function(*x, *u, *w, *p, t)
 
 
 def _values(tr: Transcription, x, u, w, t, params) -> dict:
@@ -89,7 +90,7 @@ def max_defect(tr: Transcription, sol: Trajectory, params: Mapping[str, float]) 
 
     def f(x: np.ndarray, s: float) -> np.ndarray:
         basis = _control_basis(tr, np.array([s]))[0]
-        return _dynamics(tr, x, Ui @ basis, Wi @ basis, t0 + s * h, params)
+        return _running(tr, x, Ui @ basis, Wi @ basis, t0 + s * h, params)[:-1]
 
     for step in range(RK4_STEPS):
         s = step * ds
@@ -138,10 +139,8 @@ def hamiltonian(
     """``H = sign*L + lambda^T f`` at the collocation points (eq. 2.22 in general form)."""
     t_eval = tr.t0 + sol.T * tr.grid.eval_tau
     xe = sol.X[:, tr.grid.eval_index]
-    f = _dynamics(tr, xe, sol.U, sol.Win, t_eval, params)
-    values = _values(tr, xe, sol.U, sol.Win, t_eval, params)
-    running = np.broadcast_to(translate(tr.ocp.lagrange, values, NUMPY), t_eval.shape)
-    return running + np.sum(lam * f, axis=0)
+    values = _running(tr, xe, sol.U, sol.Win, t_eval, params)
+    return values[-1] + np.sum(lam * values[:-1], axis=0)
 
 
 def _time_invariant(tr: Transcription, Win: np.ndarray) -> bool:

@@ -7,14 +7,16 @@ Everything is stated for minimization: ``J = sign * (Mayer + integral of Lagrang
 from __future__ import annotations
 
 import math
-from collections.abc import Mapping
+from collections.abc import Callable, Mapping
 from dataclasses import dataclass
 from functools import cached_property
 
+import numpy as np
 import sympy as sp
 
 from gamespec.errors import SpecError
 from gamespec.specs.ocp import EvaluatedValues, OptimalControlSpec
+from gamespec.symbolic.calculus import numeric_function
 from gamespec.symbolic.language import TIME, Relation, parse, parse_relation, symbol
 
 
@@ -126,6 +128,17 @@ class SymbolicOcp:
         :meth:`inputs_in_hamiltonian`)."""
         exprs = [*self.dynamics, self.lagrange]
         return not any(TIME in e.free_symbols for e in exprs)
+
+    @cached_property
+    def running_arguments(self) -> list[sp.Symbol]:
+        """The symbols a running expression may use, in the order of :attr:`running_function`."""
+        return [*self.x, *self.u, *self.w, *self.p, self.t]
+
+    @cached_property
+    def running_function(self) -> Callable[..., np.ndarray]:
+        """The dynamics and the Lagrange integrand, translated once: called with one array per
+        :attr:`running_arguments` it returns ``(n_x + 1, *shape)`` (the checks evaluate them often)."""
+        return numeric_function([*self.dynamics, self.lagrange], self.running_arguments)
 
     @cached_property
     def inputs_in_hamiltonian(self) -> list[int]:

@@ -2,8 +2,8 @@
 equations, chapter 5's linearization about a nominal trajectory).
 
 :func:`jacobian` and :func:`gradient` are SymPy's derivatives of an expression map;
-:func:`numeric_function` evaluates expressions over arrays by walking the tree with
-:func:`~gamespec.symbolic.translate.translate` (no ``lambdify``, no code generation);
+:func:`numeric_function` evaluates expressions over arrays through a tape recorded once by
+:func:`~gamespec.symbolic.tape.record` (no ``lambdify``, no code generation);
 :func:`linearize` gives ``A(t) = ∂f/∂x`` (eq. 5.6) and ``B(t) = ∂f/∂u`` along a trajectory, the
 matrices of the linearized dynamics ``dx ≈ (B u + r + A x) dt`` (eq. 5.5).
 """
@@ -16,7 +16,8 @@ import numpy as np
 import sympy as sp
 
 from gamespec.errors import ExpressionError
-from gamespec.symbolic.translate import NUMPY, Library, translate
+from gamespec.symbolic.tape import as_array, record
+from gamespec.symbolic.translate import NUMPY, Library
 
 
 def jacobian(exprs: Sequence[sp.Expr] | sp.Matrix, wrt: Sequence[sp.Symbol]) -> sp.Matrix:
@@ -44,14 +45,13 @@ def numeric_function(
         names = ", ".join(sorted(map(str, free)))
         raise ExpressionError(", ".join(map(str, exprs)), f"symbols {names} are not arguments")
 
+    tape = record(exprs, args, library)
+
     def evaluate(*values: np.ndarray | float) -> np.ndarray:
         if len(values) != len(args):
             raise TypeError(f"expected {len(args)} arrays ({', '.join(map(str, args))}), got {len(values)}")
         arrays = [np.asarray(v, dtype=float) for v in values]
-        shape = np.broadcast_shapes(*(a.shape for a in arrays))
-        env = dict(zip(args, arrays, strict=True))
-        rows = [np.broadcast_to(np.asarray(translate(e, env, library), dtype=float), shape) for e in exprs]
-        return np.stack(rows) if rows else np.empty((0, *shape))
+        return as_array(tape(arrays), np.broadcast_shapes(*(a.shape for a in arrays)))
 
     return evaluate
 

@@ -17,6 +17,7 @@ from __future__ import annotations
 
 import keyword
 import math
+import sys
 from typing import Any
 
 import sympy as sp
@@ -67,9 +68,11 @@ class LanguagePrinter(StrPrinter):
         return name
 
     def _print_Float(self, expr: sp.Float) -> str:
-        """The nearest double, in full (``repr``): a double-precision Float parses back to itself."""
+        """The nearest double, in full (``repr``): a double-precision Float parses back to itself
+        (one of more precision is rounded); one beyond the doubles' range, or among the subnormals
+        where a double holds fewer digits, is refused."""
         value = float(expr)
-        if not math.isfinite(value) or (value == 0.0 and not expr.is_zero):
+        if not math.isfinite(value) or (abs(value) < sys.float_info.min and sp.Float(value) != expr):
             raise self.fail(f"number {sp.sstr(expr)} is outside the range of a double")
         return repr(value)
 
@@ -134,7 +137,9 @@ class LanguagePrinter(StrPrinter):
 
 def to_text(expr: sp.Basic) -> str:
     """``expr`` in the gamespec expression language, such that ``parse(to_text(expr), symbols) ==
-    expr`` (``parse_relation`` for a relation), ``symbols`` mapping each name to its symbol."""
+    expr`` (``parse_relation`` for a relation), ``symbols`` mapping each name to its symbol, for
+    ``expr`` in SymPy's canonical form (the rare product SymPy leaves nested in a product comes back
+    flattened)."""
     expr = sp.sympify(expr)
     printer = LanguagePrinter(expr)
     if type(expr) in _RELATIONS:

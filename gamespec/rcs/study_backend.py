@@ -73,6 +73,7 @@ class RcsStudyModel(CompiledModel):
                 "table": study.summarize(rows),
                 "sigma": self.spec.std,
                 "sigma_is": self.spec.sigma_is,
+                "radius": self.spec.radius,
                 "layout": {str(n): study.layout(self.spec, n) for n in self.spec.obstacles},
                 "seconds": {f"N={r['obstacles']},alpha={r['alpha']:g}": r["seconds"] for r in rows},
                 "computed": computed,

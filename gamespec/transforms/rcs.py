@@ -65,6 +65,7 @@ class ObstacleData:
 
     positions: dict[str, tuple[sp.Expr, sp.Expr]]
     radii: dict[str, sp.Expr]
+    power: sp.Expr
 
 
 class MovingObstacles(Transform):
@@ -91,7 +92,7 @@ class MovingObstacles(Transform):
         new.with_source(spec.source, spec.file_hash)
         positions = {n: geometry.position(o, read, t0) for n, o in options.obstacles.items()}
         radii = {n: read(o.radius) for n, o in options.obstacles.items()}
-        return new, ObstacleData(positions, radii)
+        return new, ObstacleData(positions, radii, power)
 
     def invert(self, result: Result, spec: SpecBase, inverse_data: ObstacleData) -> Result:
         arrays, metrics = dict(result.arrays), dict(result.metrics)
@@ -102,6 +103,7 @@ class MovingObstacles(Transform):
             for name, (px, py) in inverse_data.positions.items():
                 xy = evaluate([px, py], values, t.shape)
                 arrays[f"obstacle_{name}_x"], arrays[f"obstacle_{name}_y"] = xy[0], xy[1]
+            metrics["obstacle_power"] = float(evaluate([inverse_data.power], params, ())[0])
             metrics["obstacles"] = {
                 n: float(evaluate([r], params, ())[0]) for n, r in inverse_data.radii.items()
             }

@@ -22,17 +22,19 @@ from gamespec.symbolic.calculus import numeric_function
 from gamespec.symbolic.language import parse, symbol
 
 W = symbol("w")
-_S = 1 / (1 + sp.exp(-W))
+_E = sp.exp(W)
 
 NAMED: dict[str, sp.Expr] = {
-    "logistic_derivative": _S * (1 - _S),
+    "logistic_derivative": _E / (1 + _E) ** 2,
     "gaussian": sp.exp(-(W**2)),
     "hat": sp.Max(0, 1 - sp.Abs(W)),
-    "logistic": _S,
+    "logistic": _E / (1 + _E),
     "inverse_quadratic": 1 / (1 + W**2),
     "inverse_abs_square": 1 / (1 + sp.Abs(W)) ** 2,
 }
-"""The r̃ of §6.4 by name (eq. 6.35 and the five of §6.4.1)."""
+"""The r̃ of §6.4 by name (eq. 6.35 and the five of §6.4.1). The logistic s(w) = 1/(1+e^{-w}) and
+s(1-s) are written with e^{w}, equal forms that cannot overflow at the w = min(g, 0) <= 0 they see
+(g_β of eq. 6.41 with β = 4 reaches -10⁴ far from the obstacle)."""
 
 CHECK_GRID = np.concatenate([-np.logspace(2, -3, 400), [0.0]])
 """Where a user's r̃ is checked: increasing points of (-100, 0]."""

@@ -148,7 +148,7 @@ def summarize(rows: list[dict[str, Any]]) -> list[dict[str, Any]]:
 def _percent(value: float | None, base: float | None, sign: int) -> float | None:
     if value is None or not base:
         return None
-    return float(sign * 100.0 * (value - base) / base)
+    return float(sign * 100.0 * (value - base) / base) + 0.0  # no -0.0
 
 
 def arrays(rows: list[dict[str, Any]]) -> dict[str, np.ndarray]:

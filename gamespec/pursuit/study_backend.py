@@ -26,9 +26,7 @@ from gamespec.pursuit import study
 from gamespec.result import Result, Status
 from gamespec.specs.base import StrictModel
 from gamespec.specs.suboptimal_study import SuboptimalStudySpec
-from gamespec.studies.executors import executor
-from gamespec.studies.runner import run_study
-from gamespec.studies.store import ResultStore
+from gamespec.studies.runner import stored_rows
 
 POINT_ARRAYS = ("v", "r2", "psi", "t_suboptimal", "t_optimal", "variation_percent")
 """Per-point values copied into ``Result.arrays`` (the plot's scatter)."""
@@ -66,18 +64,14 @@ class StudyModel(CompiledModel):
         if parameters:
             raise UnsupportedFeature("a pursuit_suboptimal_study takes no parameters; edit the file")
         tic = time.perf_counter()
-        points = study.study_points(self.spec)
-        store = ResultStore(self.spec.store)
-        computed = len(points.keys() - store.done())
-        values = run_study(
-            points,
+        rows, computed = stored_rows(
+            study.study_points(self.spec),
             study.evaluate,
-            store,
-            executor=executor(self.options.workers),
+            self.spec.store,
+            workers=self.options.workers,
             description=self.spec.name,
             show_progress=self.options.progress,
         )
-        rows = [values[key] for key in points]
         solved = [r for r in rows if "variation_percent" in r]
         status, message = _outcome(len(rows), len(solved))
         reused = len(rows) - computed

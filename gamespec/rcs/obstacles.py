@@ -20,7 +20,9 @@ from gamespec.symbolic.language import TIME
 
 def position(obstacle: Obstacle, parse, t0: float) -> tuple[sp.Expr, sp.Expr]:
     """The obstacle's centre at time ``t`` (eq. 6.38 integrated)."""
-    return tuple(parse(c) + parse(v) * (TIME - t0) for c, v in zip(obstacle.center, obstacle.velocity))
+    return tuple(
+        parse(c) + parse(v) * (TIME - t0) for c, v in zip(obstacle.center, obstacle.velocity, strict=True)
+    )
 
 
 def avoidance(

@@ -148,7 +148,9 @@ def plot_rcs(result: Result, output_dir: Path) -> list[Path]:
     return paths
 
 
-def plot_levels(results: Sequence[Result], labels: Sequence[str], path: Path, control: str | None = None) -> Path:
+def plot_levels(
+    results: Sequence[Result], labels: Sequence[str], path: Path, control: str | None = None
+) -> Path:
     """Several weight levels overlaid: the paths with the obstacles (Figs. 6.7(a), 6.8), or one
     control against time when ``control`` is given (Fig. 6.9(b))."""
     plt = _pyplot()
@@ -178,7 +180,9 @@ def plot_study(result: Result, output_dir: Path, *, animate: bool = False) -> li
     fig, ax = plt.subplots(figsize=(6.5, 4.5))
     for n in counts:
         rows = sorted((r for r in table if r["obstacles"] == n), key=lambda r: r["alpha"])
-        ax.plot([r["t_final"] for r in rows], [r["collision_probability"] for r in rows], "o-", label=f"N = {n}")
+        ax.plot(
+            [r["t_final"] for r in rows], [r["collision_probability"] for r in rows], "o-", label=f"N = {n}"
+        )
         for r in rows:
             ax.annotate(f"α={r['alpha']:g}", (r["t_final"], r["collision_probability"]), fontsize=7)
     ax.set_xlabel("t_f")
@@ -197,7 +201,11 @@ def plot_study(result: Result, output_dir: Path, *, animate: bool = False) -> li
         for r in sorted((r for r in table if r["obstacles"] == n), key=lambda r: r["alpha"]):
             tag = f"N{n}_alpha{r['alpha']:g}"
             if f"path_{tag}_x" in result.arrays:
-                ax.plot(result.arrays[f"path_{tag}_x"], result.arrays[f"path_{tag}_y"], label=f"α = {r['alpha']:g}")
+                ax.plot(
+                    result.arrays[f"path_{tag}_x"],
+                    result.arrays[f"path_{tag}_y"],
+                    label=f"α = {r['alpha']:g}",
+                )
         ax.set_aspect("equal", adjustable="datalim")
         ax.set_title(f"N = {n} (obstacles drawn where they cross y = 0)", fontsize=9)
         ax.legend(loc="best", fontsize=7)

@@ -20,9 +20,7 @@ from gamespec.rcs import study
 from gamespec.result import Result, Status
 from gamespec.specs.base import StrictModel
 from gamespec.specs.rcs_study import RcsStudySpec
-from gamespec.studies.executors import executor
-from gamespec.studies.runner import run_study
-from gamespec.studies.store import ResultStore
+from gamespec.studies.runner import stored_rows
 
 
 class RcsStudyOptions(StrictModel):
@@ -44,20 +42,16 @@ class RcsStudyModel(CompiledModel):
     ) -> Result:
         refuse_inputs(inputs, self.spec.kind)
         if parameters:
-            raise UnsupportedFeature("an rcs_multi_obstacle_study takes no parameters; use --set on its fields")
+            raise UnsupportedFeature("an rcs_multi_obstacle_study takes no parameters: --set its fields")
         tic = time.perf_counter()
-        points = study.study_points(self.spec)
-        store = ResultStore(self.spec.store)
-        computed = len(points.keys() - store.done())
-        values = run_study(
-            points,
+        rows, computed = stored_rows(
+            study.study_points(self.spec),
             study.evaluate,
-            store,
-            executor=executor(self.options.workers),
+            self.spec.store,
+            workers=self.options.workers,
             description=self.spec.name,
             show_progress=self.options.progress,
         )
-        rows = [values[key] for key in points]
         solved = sum(r["status"] != "error" for r in rows)
         if solved == len(rows):
             status, message = Status.OPTIMAL, f"all {len(rows)} points solved"
@@ -66,7 +60,7 @@ class RcsStudyModel(CompiledModel):
             message = f"{len(rows) - solved} of {len(rows)} points failed from every guess"
         return Result(
             status=status,
-            message=f"{message} ({computed} computed now, {len(rows) - computed} read from {self.spec.store})",
+            message=f"{message} ({computed} computed now, {len(rows) - computed} from {self.spec.store})",
             solve_time_s=time.perf_counter() - tic,
             arrays=study.arrays(rows),
             metrics={

@@ -4,12 +4,13 @@ as it completes, and show a progress bar."""
 from __future__ import annotations
 
 from collections.abc import Callable, Mapping
+from pathlib import Path
 from typing import Any
 
 from rich.console import Console
 from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeRemainingColumn
 
-from gamespec.studies.executors import Executor, SerialExecutor
+from gamespec.studies.executors import Executor, SerialExecutor, executor
 from gamespec.studies.store import ResultStore
 
 
@@ -47,3 +48,22 @@ def run_study(
 def _call(job: tuple[Callable[[Any], Any], tuple[str, Any]]) -> Any:
     fn, (_key, point) = job
     return fn(point)
+
+
+def stored_rows(
+    points: Mapping[str, Any],
+    fn: Callable[[Any], Any],
+    folder: str | Path,
+    *,
+    workers: int = 1,
+    description: str = "study",
+    show_progress: bool = False,
+) -> tuple[list[Any], int]:
+    """:func:`run_study` into the :class:`ResultStore` at ``folder`` with ``workers`` processes: the
+    values in the order of ``points``, and how many were computed now (the others were stored)."""
+    store = ResultStore(folder)
+    computed = len(points.keys() - store.done())
+    values = run_study(
+        points, fn, store, executor=executor(workers), description=description, show_progress=show_progress
+    )
+    return [values[key] for key in points], computed

@@ -1,6 +1,8 @@
 """RCS against theory: S_g against finite differences of g along re-simulations (eq. 6.31), the
 trade-off on the single-obstacle file, and the collision probability against a closed form."""
 
+from itertools import pairwise
+
 import numpy as np
 import pytest
 import yaml
@@ -77,8 +79,8 @@ def test_time_rises_and_collisions_fall_with_the_weight():
         mc = r.metrics["monte_carlo"]
         rows.append((r.t_final, mc["collision_probability"], mc["collision_probability_ci"]))
     times = [row[0] for row in rows]
-    assert all(b > a for a, b in zip(times, times[1:], strict=False))
-    for (_, p, _), (_, q, ci) in zip(rows, rows[1:], strict=False):
+    assert all(b > a for a, b in pairwise(times))
+    for (_, p, _), (_, q, ci) in pairwise(rows):
         assert q <= p + (ci[1] - ci[0])  # non-increasing up to sampling error (same seed)
     assert rows[-1][2][1] < rows[0][2][0]  # the heaviest weight is safer beyond both intervals
 
@@ -99,7 +101,11 @@ def straight_past_one_obstacle(samples: int, std: float) -> dict:
             "time": {"final": 12.0},
         },
         "transforms": [
-            {"moving_obstacles": {"obstacles": {"o": {"center": ["c", "-d"], "velocity": [0, "rho"], "radius": "r_o"}}}},
+            {
+                "moving_obstacles": {
+                    "obstacles": {"o": {"center": ["c", "-d"], "velocity": [0, "rho"], "radius": "r_o"}}
+                }
+            },
             {"rcs": {"weight": 0.0, "monte_carlo": {"samples": samples, "seed": 3, "steps": 3000}}},
         ],
         "method": {"scheme": "radau", "intervals": 10, "degree": 3},
@@ -141,5 +147,6 @@ def test_plain_constraint_sensitivity_option():
     result = solve(spec_from_dict(data))
     assert result.ok
     np.testing.assert_allclose(
-        result.metrics["sensitivity_cost"], result.metrics["sensitivity_measure"] * data["problem"]["parameters"]["Q"]
+        result.metrics["sensitivity_cost"],
+        result.metrics["sensitivity_measure"] * data["problem"]["parameters"]["Q"],
     )

@@ -36,6 +36,7 @@ def avoidance(
         boxcar = sp.exp(-(across**obstacle.track.gamma))
         return boxcar * (r**2 - (agent[1] - py) ** 2)
     squared = (agent[0] - px) ** 2 + (agent[1] - py) ** 2
+    power = sp.nsimplify(power) if power.is_number else power  # 1.0 → 1, 0.5 → 1/2
     if power == 1:
         return r - sp.sqrt(squared)
     return r**power - squared ** (power / 2)

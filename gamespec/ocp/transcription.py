@@ -11,11 +11,9 @@ from __future__ import annotations
 from collections.abc import Mapping
 from dataclasses import dataclass
 from functools import cached_property
-from typing import ClassVar
 
 import numpy as np
 
-from gamespec.backend import Backend, CompiledModel
 from gamespec.errors import SpecError
 from gamespec.ocp.checks import Trajectory, solution_checks
 from gamespec.ocp.collocation import Grid
@@ -46,26 +44,6 @@ class Guess:
     X: np.ndarray
     U: np.ndarray
     T: float
-
-
-class CollocationBackend(Backend):
-    """Base of the backends that solve ``optimal_control`` specs by direct collocation of a
-    :class:`Transcription` (the same kinds and features for each of them)."""
-
-    kinds: ClassVar[frozenset[str]] = frozenset({"optimal_control"})
-    features: ClassVar[frozenset[str]] = frozenset(
-        {"ode", "free_final_time", "path_constraints", "boundary_constraints", "grid_inputs"}
-    )
-
-
-class CollocationModel(CompiledModel):
-    """A compiled model of a :class:`Transcription` (``tr``), re-solvable with new grid inputs."""
-
-    tr: Transcription
-
-    def input_grid(self, parameters: Mapping[str, float] | None = None) -> InputGrid:
-        """Where ``solve(inputs=...)`` expects its values (see :meth:`Transcription.input_grid`)."""
-        return self.tr.input_grid(parameters)
 
 
 class Transcription:
@@ -152,7 +130,8 @@ class Transcription:
             try:
                 previous = Result.load(self.spec.guess.result)
             except SpecError as err:
-                raise SpecError(err.reason, field="guess.result", source=self.spec.source) from None
+                reason = f"{err.source}: {err.reason}"
+                raise SpecError(reason, field="guess.result", source=self.spec.source) from None
         if previous is not None and previous.time is not None and previous.states:
             return self._guess_from_result(previous)
         *_, tf_guess = self.ocp.final_time(params)

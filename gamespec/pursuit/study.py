@@ -7,7 +7,8 @@ For each evader speed v, r1(0) = r1 and u1 = u2 = u, a grid of non-degenerate in
 - r2(0) at ``grid.fractions`` points (k + ½)/fractions of the way from the curve F (eq. 2.6) to the
   ellipse E (§2.3.2) along the ray from E at angle ψ(0): the region N of that ray.
 
-Each point: t_c of the suboptimal heading (true dynamics simulated, eq. 2.1), and the optimal t_c of
+Each point: t_c of the suboptimal heading (true dynamics eq. 2.1 in closed form: the pursuit curve
+of :mod:`~gamespec.pursuit.pursuit_curve`), and the optimal t_c of
 the generated eq. 2.21 OCP, compiled once per speed and re-solved with the point's r2(0), ψ(0) and
 the simulated suboptimal path as initial guess. A solution whose re-integrated defect exceeds
 ``DEFECT_TOL`` (the grid too coarse near capture, or the solver exploiting it, which happens for a
@@ -29,6 +30,7 @@ import numpy as np
 from gamespec.pursuit import pure_pursuit
 from gamespec.pursuit.ocp_generation import to_ocp, trajectory_guess
 from gamespec.pursuit.ocp_report import heading_law
+from gamespec.pursuit.pursuit_curve import constant_heading_pursuit
 from gamespec.pursuit.reduced import reduce
 from gamespec.pursuit.regions import classify
 from gamespec.pursuit.report import capture_gap
@@ -139,7 +141,7 @@ def evaluate(point: StudyPoint) -> dict[str, Any]:
     players = Players.from_spec(spec)
     red = reduce(spec)
     choice = pure_pursuit.suboptimal_heading(players)
-    traj = simulate_to_capture(players, choice.heading)
+    traj = constant_heading_pursuit(players, choice.heading)
     guess = trajectory_guess(red, traj)
     parameters = {k: red.parameters[k] for k in ("r2_init", "psi_init")}
     attempt, result = _first_accepted(point, parameters, guess)

@@ -2,8 +2,9 @@
 
 Every point of :func:`gamespec.pursuit.study.study_points` goes through
 :func:`gamespec.studies.runner.run_study` into a :class:`~gamespec.studies.store.ResultStore` at the
-spec's ``store`` folder, in this process or in ``workers`` local processes; points already stored
-are reused, so solving the file again resumes where it stopped.
+spec's ``store`` folder, through an executor plugin (``serial``, ``process`` or ``dask``, see
+:mod:`gamespec.studies.executors`); points already stored are reused, so solving the file again
+resumes where it stopped.
 
 The Result: ``metrics["table"]`` holds one Table 2.1 row per speed, ``arrays`` the per-point
 values (NaN where a point has no accepted optimum), ``checks`` the worst simultaneous-capture gap,
@@ -22,14 +23,20 @@ from pydantic import Field
 
 from gamespec.backend import Backend, CompiledModel, Inputs, refuse_inputs
 from gamespec.errors import UnsupportedFeature
+from gamespec.loader import spec_hash
 from gamespec.pursuit import study
 from gamespec.result import Result, Status
 from gamespec.specs.base import StrictModel
 from gamespec.specs.suboptimal_study import SuboptimalStudySpec
-from gamespec.studies.runner import stored_rows
+from gamespec.studies.executors import SCHEDULER_ENV, executor
+from gamespec.studies.runner import run_study
+from gamespec.studies.store import ResultStore
 
 POINT_ARRAYS = ("v", "r2", "psi", "t_suboptimal", "t_optimal", "variation_percent")
 """Per-point values copied into ``Result.arrays`` (the plot's scatter)."""
+
+SWEPT = ("v", "r2", "psi")
+"""The per-point fields that vary over the grid (what ``gamespec results`` and ``plot`` show)."""
 
 POINT_CHECKS = {
     "max_simultaneous_capture_gap": "simultaneous_capture_gap",
@@ -42,7 +49,15 @@ POINT_CHECKS = {
 class StudyOptions(StrictModel):
     """Options of the ``study`` backend (``solver.options.study``)."""
 
-    workers: int = Field(1, ge=1, description="Local processes (1: everything in this process).")
+    workers: int = Field(1, ge=1, description="Worker processes (1: everything in this process).")
+    executor: str | None = Field(
+        None,
+        description="Executor plugin: serial, process or dask (default: serial for one worker, "
+        "process for more, dask when a scheduler is given).",
+    )
+    scheduler: str | None = Field(
+        None, description=f"Address of a running Dask scheduler (default: ${SCHEDULER_ENV})."
+    )
     progress: bool = Field(
         False,
         description="Show a progress bar on stderr (`gamespec pursuit study` does; `gamespec solve` "
@@ -64,20 +79,25 @@ class StudyModel(CompiledModel):
         if parameters:
             raise UnsupportedFeature("a pursuit_suboptimal_study takes no parameters; edit the file")
         tic = time.perf_counter()
-        rows, computed = stored_rows(
-            study.study_points(self.spec),
+        points = study.study_points(self.spec)
+        store = ResultStore(self.spec.store)
+        store.set_meta("study", {"type": "sweep", "problem": self.spec.name, "parameters": list(SWEPT)})
+        run = run_study(
+            points,
             study.evaluate,
-            self.spec.store,
-            workers=self.options.workers,
+            store,
+            executor=executor(self.options.executor, self.options.workers, self.options.scheduler),
             description=self.spec.name,
             show_progress=self.options.progress,
+            spec_hash=spec_hash(self.spec),
         )
+        rows = [run.values[key] for key in points]
         solved = [r for r in rows if "variation_percent" in r]
         status, message = _outcome(len(rows), len(solved))
-        reused = len(rows) - computed
+        computed = run.computed
         return Result(
             status=status,
-            message=f"{message} ({computed} computed now, {reused} read from {self.spec.store})",
+            message=f"{message} ({computed} computed now, {run.reused} read from {self.spec.store})",
             solve_time_s=time.perf_counter() - tic,
             arrays={name: np.array([r.get(name, np.nan) for r in rows]) for name in POINT_ARRAYS},
             checks={name: max((r[key] for r in solved), default=None) for name, key in POINT_CHECKS.items()},

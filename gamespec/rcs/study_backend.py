@@ -12,28 +12,23 @@ from __future__ import annotations
 import time
 from typing import ClassVar
 
-from pydantic import Field
-
 from gamespec.backend import Backend, CompiledModel, Inputs, refuse_inputs
 from gamespec.errors import UnsupportedFeature
+from gamespec.loader import spec_hash
+from gamespec.pursuit.study_backend import StudyOptions
 from gamespec.rcs import study
 from gamespec.result import Result, Status
 from gamespec.specs.base import StrictModel
 from gamespec.specs.rcs_study import RcsStudySpec
-from gamespec.studies.runner import stored_rows
-
-
-class RcsStudyOptions(StrictModel):
-    """Options of the ``rcs_study`` backend (``solver.options.rcs_study``)."""
-
-    workers: int = Field(1, ge=1, description="Local processes (1: everything in this process).")
-    progress: bool = Field(False, description="Show a progress bar on stderr.")
+from gamespec.studies.executors import executor
+from gamespec.studies.runner import run_study
+from gamespec.studies.store import ResultStore
 
 
 class RcsStudyModel(CompiledModel):
     """A study ready to run (or resume) into its store."""
 
-    def __init__(self, spec: RcsStudySpec, options: RcsStudyOptions) -> None:
+    def __init__(self, spec: RcsStudySpec, options: StudyOptions) -> None:
         self.spec = spec
         self.options = options
 
@@ -44,14 +39,17 @@ class RcsStudyModel(CompiledModel):
         if parameters:
             raise UnsupportedFeature("an rcs_multi_obstacle_study takes no parameters: --set its fields")
         tic = time.perf_counter()
-        rows, computed = stored_rows(
-            study.study_points(self.spec),
+        points = study.study_points(self.spec)
+        run = run_study(
+            points,
             study.evaluate,
-            self.spec.store,
-            workers=self.options.workers,
+            ResultStore(self.spec.store),
+            executor=executor(self.options.executor, self.options.workers, self.options.scheduler),
             description=self.spec.name,
             show_progress=self.options.progress,
+            spec_hash=spec_hash(self.spec),
         )
+        rows, computed = [run.values[key] for key in points], run.computed
         solved = sum(r["status"] != "error" for r in rows)
         if solved == len(rows):
             status, message = Status.OPTIMAL, f"all {len(rows)} points solved"
@@ -81,9 +79,9 @@ class RcsStudyBackend(Backend):
 
     name: ClassVar[str] = "rcs_study"
     kinds: ClassVar[frozenset[str]] = frozenset({"rcs_multi_obstacle_study"})
-    options_model: ClassVar[type[StrictModel]] = RcsStudyOptions
+    options_model: ClassVar[type[StrictModel]] = StudyOptions
 
-    def _compile(self, spec: RcsStudySpec, options: RcsStudyOptions) -> RcsStudyModel:
+    def _compile(self, spec: RcsStudySpec, options: StudyOptions) -> RcsStudyModel:
         from gamespec.solving import get_backend
 
         get_backend(spec.ocp_backend)

@@ -6,9 +6,11 @@ dotted location and the nearest valid key (see :func:`gamespec.loader.format_val
 
 from __future__ import annotations
 
-from typing import Any, ClassVar
+from typing import Annotated, Any, ClassVar
 
 from pydantic import BaseModel, ConfigDict, Field, FiniteFloat, PrivateAttr, model_validator
+
+from gamespec.limits import MAX_COORDINATE, MAX_SPEED
 
 Number = FiniteFloat
 """A finite number: NaN and ±inf are refused at load, with the field named."""
@@ -16,6 +18,12 @@ Number = FiniteFloat
 Value = Number | str
 """A finite number, or an expression over the problem's parameters (each kind checks that the
 expression evaluates to a finite number)."""
+
+Coordinate = Annotated[Number, Field(ge=-MAX_COORDINATE, le=MAX_COORDINATE)]
+"""A position coordinate, finite and within :data:`~gamespec.limits.MAX_COORDINATE`."""
+
+Speed = Annotated[Number, Field(ge=0, le=MAX_SPEED)]
+"""A player's speed, finite, non-negative and within :data:`~gamespec.limits.MAX_SPEED`."""
 
 
 class StrictModel(BaseModel):

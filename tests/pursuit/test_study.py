@@ -12,6 +12,7 @@ import pytest
 import gamespec
 from gamespec.pursuit import regions, study
 from gamespec.pursuit.study import StudyPoint
+from gamespec.studies.store import ResultStore
 from tests.conftest import PROBLEMS
 
 STUDY = PROBLEMS / "ch2" / "pure_pursuit_suboptimal_study.yaml"
@@ -57,7 +58,7 @@ def test_solve_saves_points_resumes_and_plots(tmp_path, monkeypatch, cli) -> Non
     first = json.loads(out)
     assert first["status"] == "optimal"
     assert first["metrics"]["points"] == first["metrics"]["solved"] == first["metrics"]["computed"] == 4
-    assert len(list(store.glob("*.json"))) == 4
+    assert len(ResultStore(store).done()) == 4
     row = first["metrics"]["table"][0]
     assert row["points"] == row["solved"] == 4
     variation = np.array(first["arrays"]["variation_percent"])

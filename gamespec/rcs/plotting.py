@@ -12,6 +12,7 @@ from pathlib import Path
 import numpy as np
 import sympy as sp
 
+from gamespec.plotting import LEGEND_RIGHT, headline
 from gamespec.rcs.obstacles import avoidance
 from gamespec.rcs.relevance import relevance
 from gamespec.result import Result
@@ -60,8 +61,9 @@ def sensitivity_map(
     return X, Y, G, np.abs(Sg), np.abs(Sr)
 
 
-def plot_sensitivity_map(path: Path, **setting) -> Path:
-    """Fig. 6.6: |S_g| and |S_r| side by side, the infeasible disc (g > 0) left white."""
+def plot_sensitivity_map(path: Path, heading: str = "", **setting) -> Path:
+    """Fig. 6.6: |S_g| and |S_r| side by side, the infeasible disc (g > 0) left white; ``heading``
+    heads the figure (a Result's :func:`~gamespec.plotting.headline`)."""
     plt = _pyplot()
     X, Y, G, Sg, Sr = sensitivity_map(**setting)
     fig, axes = plt.subplots(1, 2, figsize=(10, 4.4))
@@ -73,6 +75,8 @@ def plot_sensitivity_map(path: Path, **setting) -> Path:
         ax.set_aspect("equal")
         ax.set_xlabel("x")
         ax.set_ylabel("y")
+    if heading:
+        fig.suptitle(heading, fontsize="medium")
     fig.tight_layout()
     fig.savefig(path, dpi=120)
     plt.close(fig)
@@ -113,9 +117,14 @@ def plot_rcs(result: Result, output_dir: Path) -> list[Path]:
         ax.set_aspect("equal", adjustable="datalim")
         ax.set_xlabel("x")
         ax.set_ylabel("y")
-        ax.set_title(f"{result.problem}: obstacles at {OBSTACLE_SNAPSHOTS} times (same colour as the agent)")
+        ax.set_title(
+            f"{headline(result)}\nobstacles at {OBSTACLE_SNAPSHOTS} times (same colour as the agent)",
+            fontsize="medium",
+        )
+        if ax.get_legend_handles_labels()[0]:
+            ax.legend(**LEGEND_RIGHT)
         paths.append(output_dir / f"{result.problem}_obstacles.png")
-        fig.savefig(paths[-1], dpi=120)
+        fig.savefig(paths[-1], dpi=120, bbox_inches="tight")
         plt.close(fig)
     keys = sorted(k for k in result.arrays if k.startswith(("S_g", "S_r")))
     if keys:
@@ -126,9 +135,10 @@ def plot_rcs(result: Result, output_dir: Path) -> list[Path]:
         axes[1].set_ylabel("|S_g|")
         axes[1].set_xlabel("t")
         for ax in axes:
-            ax.legend(loc="best", fontsize=7)
+            ax.legend(**LEGEND_RIGHT)
+        fig.suptitle(headline(result), fontsize="medium")
         paths.append(output_dir / f"{result.problem}_rcs.png")
-        fig.savefig(paths[-1], dpi=120)
+        fig.savefig(paths[-1], dpi=120, bbox_inches="tight")
         plt.close(fig)
     names = _obstacle_names(result)
     if names and "x" in result.states and "y" in result.states:
@@ -144,7 +154,11 @@ def plot_rcs(result: Result, output_dir: Path) -> list[Path]:
             "power": result.metrics.get("obstacle_power", 1.0),
             "choice": result.metrics["rcs"]["relevance"],
         }
-        paths.append(plot_sensitivity_map(output_dir / f"{result.problem}_sensitivity_map.png", **setting))
+        paths.append(
+            plot_sensitivity_map(
+                output_dir / f"{result.problem}_sensitivity_map.png", headline(result), **setting
+            )
+        )
     return paths
 
 

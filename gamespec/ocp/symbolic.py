@@ -77,8 +77,17 @@ class SymbolicOcp:
 
     @cached_property
     def _running(self) -> dict[str, sp.Expr]:
+        """Running symbols, and each definition by its expanded expression (substituted where named)."""
         names = [*self.parameters, *self.inputs, *self.states, *self.controls]
-        return {n: symbol(n) for n in names} | {"t": TIME}
+        symbols = {n: symbol(n) for n in names} | {"t": TIME}
+        for name, raw in self.spec.problem.definitions.items():
+            symbols[name] = parse(raw, symbols)
+        return symbols
+
+    @cached_property
+    def definitions(self) -> dict[str, sp.Expr]:
+        """Each named expression with the earlier ones substituted (over running symbols only)."""
+        return {n: self._running[n] for n in self.spec.problem.definitions}
 
     @cached_property
     def _ends(self) -> dict[str, sp.Expr]:
@@ -148,9 +157,18 @@ class SymbolicOcp:
         return [i for i, s in enumerate(self.w) if s in used]
 
     def parameter_values(self, overrides: Mapping[str, float] | None = None) -> dict[str, float]:
-        """The file's parameter values with ``overrides`` applied (unknown names are an error)."""
-        values = dict(self.spec.problem.parameters)
+        """The file's parameter values with ``overrides`` applied, derived parameters recomputed
+        from them (unknown names, and a derived parameter set on its own, are an error)."""
+        problem = self.spec.problem
+        values = {n: v for n, v in problem.parameters.items() if not isinstance(v, str)}
         for name, value in (overrides or {}).items():
+            if name in problem.derived_parameters:
+                raise SpecError(
+                    f"parameter {name!r} is derived ({name}: {problem.parameters[name]}); set the "
+                    "parameters it is computed from, or replace it by a number with --set at load",
+                    field=f"problem.parameters.{name}",
+                    source=self.spec.source,
+                )
             if name not in values:
                 raise SpecError(
                     f"unknown parameter {name!r} (declared: {', '.join(values) or 'none'})",
@@ -160,7 +178,10 @@ class SymbolicOcp:
             if not math.isfinite(float(value)):
                 raise SpecError(f"parameter {name!r} must be finite, got {value}", source=self.spec.source)
             values[name] = float(value)
-        return values
+        try:
+            return problem.parameter_values(values)
+        except SpecError as err:
+            raise SpecError(err.reason, field=err.field, source=self.spec.source) from None
 
     def state_bounds(
         self, params: Mapping[str, float]

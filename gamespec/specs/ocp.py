@@ -83,9 +83,24 @@ class TimeSpec(StrictModel):
 
 
 class OcpProblem(StrictModel):
-    """The mathematics of an optimal-control problem."""
+    """The mathematics of an optimal-control problem.
 
-    parameters: dict[str, Number] = Field(default_factory=dict)
+    ``parameters`` are numbers, or expressions of the parameters declared before them (*derived*
+    parameters such as ``Dc: 0.5*620``, recomputed whenever a parameter they use changes; the
+    runtime parameters of a compiled model are the numeric ones). ``definitions`` are named
+    expressions, in order, over the parameters, states, controls, inputs, ``t`` and the earlier
+    definitions, substituted symbolically wherever a running expression (dynamics, the Lagrange
+    integrand, path constraints) names them.
+    """
+
+    parameters: dict[str, Value] = Field(
+        default_factory=dict,
+        description="Numbers, or expressions of earlier parameters (derived, recomputed from them).",
+    )
+    definitions: dict[str, Value] = Field(
+        default_factory=dict,
+        description="Named expressions used in dynamics, the Lagrange integrand and path constraints.",
+    )
     states: dict[str, StateSpec]
     controls: dict[str, ControlSpec] = Field(default_factory=dict)
     inputs: dict[str, InputSpec] = Field(default_factory=dict)
@@ -107,7 +122,7 @@ class OcpProblem(StrictModel):
 
     @model_validator(mode="after")
     def _consistent(self) -> OcpProblem:
-        names = [*self.parameters, *self.states, *self.controls, *self.inputs]
+        names = [*self.parameters, *self.states, *self.controls, *self.inputs, *self.definitions]
         boundary = [f"{s}_0" for s in self.states] + [f"{s}_f" for s in self.states] + ["t_f"]
         for name in names:
             if not name.isidentifier() or name in RESERVED or name == NORMALIZED_TIME:
@@ -125,9 +140,33 @@ class OcpProblem(StrictModel):
         unknown = set(self.uncertain) - set(self.parameters)
         if unknown:
             raise ValueError(f"uncertain names undeclared parameters: {sorted(unknown)}")
+        derived = set(self.uncertain) & self.derived_parameters
+        if derived:
+            raise ValueError(f"uncertain names derived parameters (give a number instead): {sorted(derived)}")
         self._check_expressions()
-        self.evaluate(self.parameters)
+        self.evaluate(self.parameter_values())
         return self
+
+    @property
+    def derived_parameters(self) -> set[str]:
+        """The parameters given as expressions of earlier ones."""
+        return {n for n, v in self.parameters.items() if isinstance(v, str)}
+
+    def parameter_values(self, base: Mapping[str, float] | None = None) -> dict[str, float]:
+        """Every parameter's value, in declaration order: the numeric ones from ``base`` (else the
+        file), each derived one evaluated over the values before it."""
+        base = base or {}
+        values: dict[str, float] = {}
+        for name, raw in self.parameters.items():
+            if isinstance(raw, str):
+                expr = parse(raw, {n: symbol(n) for n in values})
+                value = numeric(expr, {symbol(k): v for k, v in values.items()})
+                if not math.isfinite(value):
+                    raise SpecError(f"evaluates to {value}", field=f"problem.parameters.{name}")
+                values[name] = value
+            else:
+                values[name] = float(base.get(name, raw))
+        return values
 
     def evaluate(self, params: Mapping[str, float]) -> EvaluatedValues:
         """Bounds, fixed end values and a fixed final time as floats for these parameter values;
@@ -186,12 +225,20 @@ class OcpProblem(StrictModel):
         params = {n: symbol(n) for n in self.parameters}
         inputs = {n: symbol(n) for n in self.inputs}
         running = {**params, **inputs, **{n: symbol(n) for n in [*self.states, *self.controls, "t"]}}
+        checks: list[tuple[str, object, dict, bool]] = []
+        earlier: dict = {}
+        for name, raw in self.parameters.items():
+            if isinstance(raw, str):
+                checks.append((f"parameters.{name}", raw, dict(earlier), False))
+            earlier[name] = params[name]
+        for name, raw in self.definitions.items():
+            checks.append((f"definitions.{name}", raw, dict(running), False))
+            running[name] = symbol(name)
         ends = {
             **params,
             **{f"{s}_{e}": symbol(f"{s}_{e}") for s in self.states for e in "0f"},
             "t_f": symbol("t_f"),
         }
-        checks: list[tuple[str, object, dict, bool]] = []
         for group, items in (("states", self.states), ("controls", self.controls)):
             for name, spec in items.items():
                 for key, value in spec.model_dump().items():
@@ -306,6 +353,10 @@ class OptimalControlSpec(ProblemParameters, SpecBase):
     @property
     def objective_sense(self) -> str:
         return self.problem.objective.sense
+
+    def runtime_parameters(self) -> dict[str, float]:
+        """The numeric parameters (derived ones follow them and are not set on their own)."""
+        return {n: float(v) for n, v in self.problem.parameters.items() if not isinstance(v, str)}
 
     def required_features(self) -> frozenset[str]:
         p = self.problem

@@ -1,0 +1,51 @@
+"""Optimal-control modelling constructs (issue 17) against what they replace: definitions against
+the expressions written out, derived parameters against the number they evaluate to."""
+
+from __future__ import annotations
+
+import pytest
+import sympy as sp
+
+import gamespec
+from gamespec.errors import SpecError
+from gamespec.ocp.symbolic import SymbolicOcp
+from tests.conftest import PROBLEMS
+
+HANG_GLIDER = PROBLEMS / "ocp" / "hang_glider.yaml"
+SMALL = ["method.intervals=10"]
+
+
+def test_definitions_are_substituted_into_the_dynamics() -> None:
+    ocp = SymbolicOcp(gamespec.load(HANG_GLIDER))
+    x, vx, vy, cL = sp.symbols("x vx vy cL", real=True)
+    uc, r0, m, c0, c1, q = sp.symbols("uc r0 m c0 c1 q", real=True)
+    r = (x / r0 - 2.5) ** 2
+    w = vy - uc * (1 - r) * sp.exp(-r)
+    v = sp.sqrt(vx**2 + w**2)
+    drag, lift = q * (c0 + c1 * cL**2) * v**2, q * cL * v**2
+    gap = ocp.dynamics[2] - (-lift * w / v - drag * vx / v) / m
+    point = {x: 310.0, vx: 12.0, vy: -1.1, cL: 0.9, uc: 2.5, r0: 100.0, m: 100.0, c0: 0.03, c1: 0.07, q: 7.9}
+    assert abs(float(gap.subs(point))) < 1e-12
+    assert not set(ocp.dynamics[3].free_symbols) & {sp.Symbol(n, real=True) for n in ("w", "v", "lift")}
+
+
+def test_a_derived_parameter_follows_the_parameters_it_uses() -> None:
+    spec = gamespec.load(HANG_GLIDER, SMALL)
+    solver = gamespec.compile_spec(spec)
+    moved = solver.solve(parameters={"S": 15.0})
+    assert moved.ok
+    assert SymbolicOcp(spec).parameter_values({"S": 15.0})["q"] == pytest.approx(0.5 * 1.13 * 15.0)
+    fixed = gamespec.solve(gamespec.load(HANG_GLIDER, [*SMALL, "problem.parameters.S=15.0"]))
+    assert moved.objective == pytest.approx(fixed.objective, rel=1e-8)
+    assert "q" not in spec.runtime_parameters()
+
+
+def test_a_derived_parameter_is_not_set_on_its_own() -> None:
+    spec = gamespec.load(HANG_GLIDER, SMALL)
+    with pytest.raises(SpecError, match="derived"):
+        SymbolicOcp(spec).parameter_values({"q": 1.0})
+
+
+def test_a_derived_parameter_may_only_use_earlier_ones() -> None:
+    with pytest.raises(SpecError, match="undefined symbol 'rho'"):
+        gamespec.load(HANG_GLIDER, ["problem.parameters.uc=0.5*rho"])

@@ -1,7 +1,7 @@
 """The ``casadi`` backend: an ``optimal_control`` spec as a CasADi NLP by direct collocation.
 
 The NLP is built once from the backend-neutral :class:`~gamespec.ocp.transcription.Transcription`:
-decision variables ``[vec(X); vec(U); T]``, defects ``D X - T W F`` with ``F`` a mapped CasADi
+decision variables ``[vec(X); vec(U); d; T]`` (d: the design variables), defects ``D X - T W F`` with ``F`` a mapped CasADi
 function over the evaluation points, and the problem's parameters, the grid inputs (one block of
 n_w × n_eval values) and a fixed horizon as NLP parameters ``p = [params; vec(Win); T]``, so a re-solve
 with new values reuses the solver and warm-starts from the last solution.
@@ -71,9 +71,9 @@ class CasadiModel(CollocationModel):
         lib = casadi_library(ca)
         nx, nu, nw, npar = tr.n_x, tr.n_u, tr.n_w, len(ocp.p)
         x, u, w = ca.SX.sym("x", nx), ca.SX.sym("u", nu), ca.SX.sym("w", nw)
-        p, t = ca.SX.sym("p", npar), ca.SX.sym("t")
+        p, t = ca.SX.sym("p", npar + tr.n_d), ca.SX.sym("t")
         values = {ocp.t: t}
-        for symbols, var in ((ocp.x, x), (ocp.u, u), (ocp.w, w), (ocp.p, p)):
+        for symbols, var in ((ocp.x, x), (ocp.u, u), (ocp.w, w), (ocp.p + ocp.d, p)):
             values |= dict(zip(symbols, ca.vertsplit(var), strict=True))
         f = ca.vertcat(*(translate(e, values, lib) for e in ocp.dynamics))
         L = translate(ocp.lagrange, values, lib)
@@ -84,8 +84,9 @@ class CasadiModel(CollocationModel):
         X = ca.SX.sym("X", nx, grid.n_nodes)
         U = ca.SX.sym("U", nu, k)
         T = ca.SX.sym("T") if tr.free_time else None
+        design = ca.SX.sym("d", tr.n_d)
         p_all = ca.SX.sym("p_all", npar + nw * k + (0 if tr.free_time else 1))
-        params = p_all[:npar, :]
+        params = ca.vertcat(p_all[:npar, :], design)
         Win = ca.reshape(p_all[npar : npar + nw * k], nw, k)
         horizon = T if tr.free_time else p_all[npar + nw * k]
         t_eval = tr.t0 + horizon * ca.DM(grid.eval_tau).T
@@ -95,14 +96,14 @@ class CasadiModel(CollocationModel):
 
         ends = dict(zip(ocp.x0, ca.vertsplit(X[:, 0]), strict=True))
         ends |= dict(zip(ocp.xf, ca.vertsplit(X[:, -1]), strict=True)) | {ocp.tf: tr.t0 + horizon}
-        ends |= dict(zip(ocp.p, ca.vertsplit(params), strict=True))
+        ends |= dict(zip(ocp.p + ocp.d, ca.vertsplit(params), strict=True))
         mayer = translate(ocp.mayer, ends, lib)
         boundary = [translate(r.expr, ends, lib) for r in ocp.boundary]
         objective = mayer + horizon * (Lv @ ca.DM(q))
 
         self.n_defects = defects.numel()
         g = ca.vertcat(ca.vec(defects), ca.vec(G.T), *boundary)
-        w = ca.vertcat(ca.vec(X), ca.vec(U), *([T] if tr.free_time else []))
+        w = ca.vertcat(ca.vec(X), ca.vec(U), design, *([T] if tr.free_time else []))
         lower = [np.zeros(self.n_defects)]
         upper = [np.zeros(self.n_defects)]
         for r in ocp.path:
@@ -119,16 +120,17 @@ class CasadiModel(CollocationModel):
         self.shape = (nx, grid.n_nodes, nu, k)
         self._last: np.ndarray | None = None
 
-    def _pack(self, X: np.ndarray, U: np.ndarray, T: float) -> np.ndarray:
-        parts = [X.ravel(order="F"), U.ravel(order="F")]
+    def _pack(self, X: np.ndarray, U: np.ndarray, d: np.ndarray, T: float) -> np.ndarray:
+        parts = [X.ravel(order="F"), U.ravel(order="F"), d]
         return np.concatenate([*parts, [T]] if self.tr.free_time else parts)
 
-    def _unpack(self, w: np.ndarray, params_T: float) -> tuple[np.ndarray, np.ndarray, float]:
+    def _unpack(self, w: np.ndarray, params_T: float) -> tuple[np.ndarray, np.ndarray, np.ndarray, float]:
         nx, n, nu, k = self.shape
         X = w[: nx * n].reshape((nx, n), order="F")
         U = w[nx * n : nx * n + nu * k].reshape((nu, k), order="F")
+        d = w[nx * n + nu * k : nx * n + nu * k + self.tr.n_d]
         T = float(w[-1]) if self.tr.free_time else params_T
-        return X, U, T
+        return X, U, d, T
 
     def solve(
         self, parameters: dict[str, float] | None = None, guess: Result | None = None, inputs: Inputs = None
@@ -141,9 +143,9 @@ class CasadiModel(CollocationModel):
             w0 = self._last
         else:
             start: Guess = tr.guess(params, guess)
-            w0 = self._pack(start.X, start.U, start.T)
-        lbx = self._pack(b.x_lower, b.u_lower, b.t_lower)
-        ubx = self._pack(b.x_upper, b.u_upper, b.t_upper)
+            w0 = self._pack(start.X, start.U, start.d, start.T)
+        lbx = self._pack(b.x_lower, b.u_lower, b.d_lower, b.t_lower)
+        ubx = self._pack(b.x_upper, b.u_upper, b.d_upper, b.t_upper)
         horizon = [] if tr.free_time else [b.t_lower]
         p_val = np.concatenate([[params[n] for n in tr.ocp.parameters], Win.ravel(order="F"), horizon])
         tic = time.perf_counter()
@@ -155,7 +157,7 @@ class CasadiModel(CollocationModel):
         w = np.asarray(sol["x"]).ravel()
         if status.ok:
             self._last = w
-        X, U, T = self._unpack(w, b.t_lower)
+        X, U, d, T = self._unpack(w, b.t_lower)
         nx = self.shape[0]
         nu_def = np.asarray(sol["lam_g"]).ravel()[: self.n_defects].reshape((nx, -1), order="F")
         return tr.result(
@@ -165,6 +167,7 @@ class CasadiModel(CollocationModel):
             objective=float(sol["f"]) * tr.ocp.sign if status.ok else None,
             params=params,
             inputs=Win,
+            design=d,
             status=status,
             message=native,
             solve_time_s=elapsed,

@@ -2,7 +2,7 @@
 of :mod:`gamespec.ocp.collocation`, row for row the NLP the CasADi backend builds, so both backends
 solve the identical discretization.
 
-Variables ``X[i, node]``, ``U[j, point]`` and the horizon ``T``, a Var when the final time is free
+Variables ``X[i, node]``, ``U[j, point]``, the design variables ``d[name]`` and the horizon ``T``, a Var when the final time is free
 (time scaling ``t = t0 + tau * T``) and a mutable Param otherwise. The problem's parameters are
 mutable Params indexed by name, and the grid inputs mutable Params ``w[input, point]`` indexed by
 evaluation point, so a re-solve changes values, not the model. Constraints: the
@@ -85,11 +85,13 @@ def build_model(tr: Transcription, params: Mapping[str, float]) -> Any:
     m.w = pyo.Param(range(tr.n_w), range(k), mutable=True, initialize=0.0)
     m.X = pyo.Var(range(tr.n_x), range(grid.n_nodes), initialize=0.0)
     m.U = pyo.Var(range(tr.n_u), range(k), initialize=0.0)
+    m.d = pyo.Var(ocp.design, initialize=0.0)
     if tr.free_time:
         m.T = pyo.Var(initialize=1.0)
     else:
         m.T = pyo.Param(mutable=True, initialize=1.0)
     symbols = {s: m.p[name] for s, name in zip(ocp.p, ocp.parameters, strict=True)}
+    symbols |= {s: m.d[name] for s, name in zip(ocp.d, ocp.design, strict=True)}
 
     F = np.empty((tr.n_x, k), dtype=object)
     L = []

@@ -43,8 +43,9 @@ class Trajectory:
 
 
 def _running(tr: Transcription, x, u, w, t: np.ndarray, params: Mapping[str, float]) -> np.ndarray:
-    """The dynamics (first ``n_x`` rows) and the Lagrange integrand (last row) along ``t``."""
-    p = [params[n] for n in tr.ocp.parameters]
+    """The dynamics (first ``n_x`` rows) and the Lagrange integrand (last row) along ``t``
+    (``params`` holds the design variables' values too)."""
+    p = [params[n] for n in [*tr.ocp.parameters, *tr.ocp.design]]
     return tr.ocp.running_function(*x, *u, *w, *p, t)
 
 
@@ -114,11 +115,13 @@ def _relation_violation(rel: Relation, values: dict, shape: tuple[int, ...]) -> 
 
 
 def max_constraint_violation(tr: Transcription, sol: Trajectory, params: Mapping[str, float]) -> float:
-    """Largest violation of bounds, fixed end values, path and boundary constraints."""
+    """Largest violation of bounds (the design variables' too), fixed end values, path and
+    boundary constraints."""
     X, U, T = sol.X, sol.U, sol.T
     b = tr.bounds(params)
     worst = [_violation(X, b.x_lower, b.x_upper), _violation(U, b.u_lower, b.u_upper)]
     worst.append(_violation(np.array([T]), b.t_lower, b.t_upper))
+    worst.append(_violation(np.array([params[n] for n in tr.ocp.design]), b.d_lower, b.d_upper))
     t_eval = tr.t0 + T * tr.grid.eval_tau
     running = _values(tr, X[:, tr.grid.eval_index], U, sol.Win, t_eval, params)
     worst += [_relation_violation(r, running, t_eval.shape) for r in tr.ocp.path]

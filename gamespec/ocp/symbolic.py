@@ -39,6 +39,11 @@ class SymbolicOcp:
         return list(self.spec.problem.parameters)
 
     @property
+    def design(self) -> list[str]:
+        """Names of the free static parameters (decision variables of the NLP)."""
+        return list(self.spec.problem.design)
+
+    @property
     def inputs(self) -> list[str]:
         """Names of the grid inputs (signals tabulated at the evaluation points)."""
         return list(self.spec.problem.inputs)
@@ -54,6 +59,10 @@ class SymbolicOcp:
     @cached_property
     def p(self) -> list[sp.Symbol]:
         return [symbol(n) for n in self.parameters]
+
+    @cached_property
+    def d(self) -> list[sp.Symbol]:
+        return [symbol(n) for n in self.design]
 
     @cached_property
     def w(self) -> list[sp.Symbol]:
@@ -78,7 +87,7 @@ class SymbolicOcp:
     @cached_property
     def _running(self) -> dict[str, sp.Expr]:
         """Running symbols, and each definition by its expanded expression (substituted where named)."""
-        names = [*self.parameters, *self.inputs, *self.states, *self.controls]
+        names = [*self.parameters, *self.design, *self.inputs, *self.states, *self.controls]
         symbols = {n: symbol(n) for n in names} | {"t": TIME}
         for name, raw in self.spec.problem.definitions.items():
             symbols[name] = parse(raw, symbols)
@@ -92,7 +101,7 @@ class SymbolicOcp:
     @cached_property
     def _ends(self) -> dict[str, sp.Expr]:
         ends = {str(s): s for s in [*self.x0, *self.xf, self.tf]}
-        return {n: symbol(n) for n in self.parameters} | ends
+        return {n: symbol(n) for n in [*self.parameters, *self.design]} | ends
 
     @cached_property
     def _params(self) -> dict[str, sp.Expr]:
@@ -141,7 +150,7 @@ class SymbolicOcp:
     @cached_property
     def running_arguments(self) -> list[sp.Symbol]:
         """The symbols a running expression may use, in the order of :attr:`running_function`."""
-        return [*self.x, *self.u, *self.w, *self.p, self.t]
+        return [*self.x, *self.u, *self.w, *self.p, *self.d, self.t]
 
     @cached_property
     def running_function(self) -> Callable[..., np.ndarray]:
@@ -191,6 +200,10 @@ class SymbolicOcp:
 
     def control_bounds(self, params: Mapping[str, float]) -> list[tuple[float, float]]:
         return self._evaluated(params).controls
+
+    def design_bounds(self, params: Mapping[str, float]) -> list[tuple[float, float, float]]:
+        """Per design variable: ``(lower, upper, guess)``."""
+        return self._evaluated(params).design
 
     def _evaluated(self, params: Mapping[str, float]) -> EvaluatedValues:
         try:

@@ -22,7 +22,7 @@ from gamespec.ocp.collocation import Grid
 from gamespec.ocp.inputs import InputGrid, InputValue, on_grid
 from gamespec.ocp.symbolic import SymbolicOcp
 from gamespec.result import Result, Status
-from gamespec.specs.ocp import NORMALIZED_TIME, OptimalControlSpec
+from gamespec.specs.ocp import NORMALIZED_TIME, OptimalControlSpec, bounds_midpoint
 from gamespec.symbolic.language import ExpressionError, parse, symbol
 from gamespec.symbolic.translate import NUMPY, translate
 
@@ -37,15 +37,18 @@ class Bounds:
     u_upper: np.ndarray
     t_lower: float
     t_upper: float
+    d_lower: np.ndarray
+    d_upper: np.ndarray
 
 
 @dataclass(frozen=True)
 class Guess:
-    """A starting point: X, U and the horizon T."""
+    """A starting point: X, U, the horizon T and the design variables d."""
 
     X: np.ndarray
     U: np.ndarray
     T: float
+    d: np.ndarray
 
 
 class CollocationBackend(Backend):
@@ -54,7 +57,14 @@ class CollocationBackend(Backend):
 
     kinds: ClassVar[frozenset[str]] = frozenset({"optimal_control"})
     features: ClassVar[frozenset[str]] = frozenset(
-        {"ode", "free_final_time", "path_constraints", "boundary_constraints", "grid_inputs"}
+        {
+            "ode",
+            "free_final_time",
+            "path_constraints",
+            "boundary_constraints",
+            "grid_inputs",
+            "design_parameters",
+        }
     )
 
 
@@ -89,6 +99,10 @@ class Transcription:
     @property
     def n_w(self) -> int:
         return len(self.ocp.inputs)
+
+    @property
+    def n_d(self) -> int:
+        return len(self.ocp.design)
 
     @property
     def free_time(self) -> bool:
@@ -143,7 +157,8 @@ class Transcription:
         ul = np.repeat(cb[:, :1], k, axis=1)
         uu = np.repeat(cb[:, 1:], k, axis=1)
         tf_lo, tf_hi, _ = self.ocp.final_time(params)
-        return Bounds(xl, xu, ul, uu, tf_lo - self.t0, tf_hi - self.t0)
+        db = np.array(self.ocp.design_bounds(params)).reshape(self.n_d, 3)
+        return Bounds(xl, xu, ul, uu, tf_lo - self.t0, tf_hi - self.t0, db[:, 0], db[:, 1])
 
     def guess(self, params: Mapping[str, float], previous: Result | None = None) -> Guess:
         """The starting point: from ``previous`` (or the spec's ``guess.result`` file), else from the
@@ -171,7 +186,8 @@ class Transcription:
             U[j] = self._profile(
                 raw, self.grid.eval_tau, params, f"guess.controls.{name}", None, None, lo, hi
             )
-        return Guess(X, U, tf_guess - self.t0)
+        d = np.array([g for *_, g in self.ocp.design_bounds(params)], dtype=float)
+        return Guess(X, U, tf_guess - self.t0, d)
 
     def _profile(
         self,
@@ -187,7 +203,7 @@ class Transcription:
         if isinstance(raw, int | float):
             return np.full_like(tau, float(raw))
         if raw == "linear":
-            mid = _midpoint(lo, hi)
+            mid = bounds_midpoint(lo, hi)
             a = start if start is not None else (end if end is not None else mid)
             b = end if end is not None else a
             return a + (b - a) * tau
@@ -213,7 +229,10 @@ class Transcription:
         tc = np.asarray(previous.control_time if previous.control_time is not None else t)
         tau_c = (tc - t[0]) / span
         U = np.array([np.interp(self.grid.eval_tau, tau_c, previous.controls[n]) for n in self.ocp.controls])
-        return Guess(X.reshape(self.n_x, -1), U.reshape(self.n_u, -1), float(span))
+        design = previous.metrics.get("design", {})
+        defaults = [g for *_, g in self.ocp.design_bounds(previous.parameters or self.ocp.parameter_values())]
+        d = np.array([design.get(n, g) for n, g in zip(self.ocp.design, defaults, strict=True)], dtype=float)
+        return Guess(X.reshape(self.n_x, -1), U.reshape(self.n_u, -1), float(span), d)
 
     @cached_property
     def costate_rows(self) -> np.ndarray:
@@ -232,11 +251,15 @@ class Transcription:
         solve_time_s: float,
         iterations: int | None,
         inputs: np.ndarray,
+        design: np.ndarray | None = None,
         defect_multipliers: np.ndarray | None = None,
         solver_stats: dict | None = None,
     ) -> Result:
-        """A Result from a solution, with costates from the defect multipliers, the checks, and the
-        grid inputs used (``arrays["input/<name>"]``, on ``control_time``)."""
+        """A Result from a solution, with costates from the defect multipliers, the checks, the
+        grid inputs used (``arrays["input/<name>"]``, on ``control_time``) and the optimized design
+        variables (``metrics["design"]``)."""
+        values = np.zeros(self.n_d) if design is None else np.asarray(design, dtype=float)
+        optimized = {n: float(v) for n, v in zip(self.ocp.design, values, strict=True)}
         t_nodes = self.t0 + T * self.grid.nodes
         t_eval = self.t0 + T * self.grid.eval_tau
         costates: dict[str, np.ndarray] = {}
@@ -245,7 +268,7 @@ class Transcription:
         if defect_multipliers is not None and self.grid.scheme == "radau":
             lam = defect_multipliers * self.costate_rows[None, :]
             costates = {f"lambda_{n}": lam[i] for i, n in enumerate(self.ocp.states)}
-        checks = solution_checks(self, Trajectory(X, U, inputs, T), params, lam)
+        checks = solution_checks(self, Trajectory(X, U, inputs, T), {**params, **optimized}, lam)
         if lam is not None:
             arrays["costate_time"] = t_eval
         return Result(
@@ -263,15 +286,6 @@ class Transcription:
             arrays=arrays,
             parameters=dict(params),
             checks=checks,
+            metrics={"design": optimized} if optimized else {},
             solver_stats=solver_stats or {},
         )
-
-
-def _midpoint(lo: float, hi: float) -> float:
-    if np.isfinite(lo) and np.isfinite(hi):
-        return 0.5 * (lo + hi)
-    if np.isfinite(lo):
-        return max(lo, 0.0)
-    if np.isfinite(hi):
-        return min(hi, 0.0)
-    return 0.0

@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable, Mapping
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import Literal
 
 from pydantic import Field, field_validator, model_validator
@@ -49,6 +49,16 @@ class InputSpec(StrictModel):
     time ``tau`` (in [0, 1]) and the parameters; ``CompiledModel.solve(inputs=...)`` replaces it."""
 
     default: Value = 0.0
+
+
+class DesignSpec(StrictModel):
+    """A free static parameter (design variable): one number optimized with the trajectory, used
+    wherever a parameter may be used in dynamics, costs and constraints; bounds are numbers or
+    expressions of the parameters, the guess defaults to the middle of finite bounds."""
+
+    lower: Value | None = None
+    upper: Value | None = None
+    guess: Number | None = None
 
 
 class ObjectiveSpec(StrictModel):
@@ -104,6 +114,9 @@ class OcpProblem(StrictModel):
     states: dict[str, StateSpec]
     controls: dict[str, ControlSpec] = Field(default_factory=dict)
     inputs: dict[str, InputSpec] = Field(default_factory=dict)
+    design: dict[str, DesignSpec] = Field(
+        default_factory=dict, description="Free static parameters optimized with the trajectory."
+    )
     dynamics: dict[str, Value]
     objective: ObjectiveSpec = Field(default_factory=ObjectiveSpec)
     time: TimeSpec = Field(default_factory=TimeSpec)
@@ -122,7 +135,14 @@ class OcpProblem(StrictModel):
 
     @model_validator(mode="after")
     def _consistent(self) -> OcpProblem:
-        names = [*self.parameters, *self.states, *self.controls, *self.inputs, *self.definitions]
+        names = [
+            *self.parameters,
+            *self.states,
+            *self.controls,
+            *self.inputs,
+            *self.definitions,
+            *self.design,
+        ]
         boundary = [f"{s}_0" for s in self.states] + [f"{s}_f" for s in self.states] + ["t_f"]
         for name in names:
             if not name.isidentifier() or name in RESERVED or name == NORMALIZED_TIME:
@@ -207,6 +227,19 @@ class OcpProblem(StrictModel):
             )
             _ordered(lo, hi, f"controls.{name}")
             controls.append((lo, hi))
+        design = []
+        for name, d in self.design.items():
+            lo, hi = (
+                number(d.lower, -INF, f"design.{name}.lower"),
+                number(d.upper, INF, f"design.{name}.upper"),
+            )
+            _ordered(lo, hi, f"design.{name}")
+            guess = d.guess if d.guess is not None else bounds_midpoint(lo, hi)
+            if not lo <= guess <= hi:
+                raise SpecError(
+                    f"{guess:g} lies outside [{lo:g}, {hi:g}]", field=f"problem.design.{name}.guess"
+                )
+            design.append((lo, hi, guess))
         t_final = t_bounds = None
         if self.time.free:
             lo, hi = (number(b, 0.0, f"time.bounds.{i}") for i, b in enumerate(self.time.bounds))
@@ -217,14 +250,16 @@ class OcpProblem(StrictModel):
             t_final = number(self.time.final, 1.0, "time.final")
             if t_final <= self.time.initial:
                 raise SpecError("final time must be after the initial time", field="problem.time.final")
-        return EvaluatedValues(states, controls, t_final, t_bounds)
+        return EvaluatedValues(states, controls, t_final, t_bounds, design)
 
     def _check_expressions(self) -> None:
         """Parse every expression over the symbols its field may use; an input where it may not
         appear (bounds, end values, Mayer and boundary terms, the final time) is named as such."""
         params = {n: symbol(n) for n in self.parameters}
         inputs = {n: symbol(n) for n in self.inputs}
-        running = {**params, **inputs, **{n: symbol(n) for n in [*self.states, *self.controls, "t"]}}
+        design = {n: symbol(n) for n in self.design}
+        running = {**params, **design, **inputs}
+        running |= {n: symbol(n) for n in [*self.states, *self.controls, "t"]}
         checks: list[tuple[str, object, dict, bool]] = []
         earlier: dict = {}
         for name, raw in self.parameters.items():
@@ -236,10 +271,11 @@ class OcpProblem(StrictModel):
             running[name] = symbol(name)
         ends = {
             **params,
+            **design,
             **{f"{s}_{e}": symbol(f"{s}_{e}") for s in self.states for e in "0f"},
             "t_f": symbol("t_f"),
         }
-        for group, items in (("states", self.states), ("controls", self.controls)):
+        for group, items in (("states", self.states), ("controls", self.controls), ("design", self.design)):
             for name, spec in items.items():
                 for key, value in spec.model_dump().items():
                     if isinstance(value, str):
@@ -293,12 +329,25 @@ def _inputs_in(read: Callable, text: str, symbols: dict, inputs: dict) -> list[s
 @dataclass(frozen=True)
 class EvaluatedValues:
     """Per state ``(lower, upper, initial, final)`` (initial/final None when free), per control
-    ``(lower, upper)``, the fixed final time (None when free) and the bounds of a free one."""
+    ``(lower, upper)``, the fixed final time (None when free), the bounds of a free one, and per
+    design variable ``(lower, upper, guess)``."""
 
     states: list[tuple[float, float, float | None, float | None]]
     controls: list[tuple[float, float]]
     t_final: float | None
     t_bounds: tuple[float, float] | None = None
+    design: list[tuple[float, float, float]] = field(default_factory=list)
+
+
+def bounds_midpoint(lo: float, hi: float) -> float:
+    """The middle of finite bounds, the finite one (or 0 when inside) of half-bounded ones, else 0."""
+    if math.isfinite(lo) and math.isfinite(hi):
+        return 0.5 * (lo + hi)
+    if math.isfinite(lo):
+        return max(lo, 0.0)
+    if math.isfinite(hi):
+        return min(hi, 0.0)
+    return 0.0
 
 
 def _ordered(lower: float, upper: float, field: str) -> None:
@@ -369,4 +418,6 @@ class OptimalControlSpec(ProblemParameters, SpecBase):
             needed.add("boundary_constraints")
         if p.inputs:
             needed.add("grid_inputs")
+        if p.design:
+            needed.add("design_parameters")
         return frozenset(needed)

@@ -8,6 +8,7 @@ import sympy as sp
 
 import gamespec
 from gamespec.errors import SpecError
+from gamespec.loader import spec_from_dict
 from gamespec.ocp.symbolic import SymbolicOcp
 from tests.conftest import PROBLEMS
 
@@ -49,3 +50,41 @@ def test_a_derived_parameter_is_not_set_on_its_own() -> None:
 def test_a_derived_parameter_may_only_use_earlier_ones() -> None:
     with pytest.raises(SpecError, match="undefined symbol 'rho'"):
         gamespec.load(HANG_GLIDER, ["problem.parameters.uc=0.5*rho"])
+
+
+def _design_problem(workaround: bool, backend: str) -> dict:
+    """min integral(u**2) + (a - 1)**2 with x' = u, x(0) = 0, x(1) = a: J(a) = a**2 + (a - 1)**2,
+    so a = 1/2 and J = 1/2; ``a`` a design variable, or a constant state with a free start."""
+    problem: dict = {
+        "states": {"x": {"initial": 0.0}},
+        "controls": {"u": {}},
+        "dynamics": {"x": "u"},
+        "objective": {"lagrange": "u**2"},
+    }
+    if workaround:
+        problem["states"]["a"] = {"lower": -5.0, "upper": 5.0}
+        problem["dynamics"]["a"] = "0"
+        problem["objective"]["mayer"] = "(a_0 - 1)**2"
+        problem["boundary_constraints"] = ["x_f == a_f"]
+    else:
+        problem["design"] = {"a": {"lower": -5.0, "upper": 5.0, "guess": 2.0}}
+        problem["objective"]["mayer"] = "(a - 1)**2"
+        problem["boundary_constraints"] = ["x_f == a"]
+    return {
+        "kind": "optimal_control",
+        "problem": problem,
+        "method": {"intervals": 8},
+        "solver": {"backend": backend},
+    }
+
+
+@pytest.mark.parametrize("backend", ["casadi", "pyomo"])
+def test_a_design_variable_matches_the_constant_state_workaround(backend: str) -> None:
+    design = gamespec.solve(spec_from_dict(_design_problem(False, backend)))
+    constant = gamespec.solve(spec_from_dict(_design_problem(True, backend)))
+    assert design.status == constant.status == gamespec.Status.OPTIMAL
+    assert design.metrics["design"]["a"] == pytest.approx(0.5, abs=1e-7)
+    assert design.metrics["design"]["a"] == pytest.approx(constant.states["a"][0], abs=1e-7)
+    assert design.objective == pytest.approx(0.5, abs=1e-7)
+    assert design.objective == pytest.approx(constant.objective, abs=1e-7)
+    assert design.checks["max_constraint_violation"] < 1e-7

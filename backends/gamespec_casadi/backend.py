@@ -1,8 +1,8 @@
 """The ``casadi`` backend: an ``optimal_control`` spec as a CasADi NLP by direct collocation.
 
 The NLP is built once from the backend-neutral :class:`~gamespec.ocp.transcription.Transcription`:
-decision variables ``[vec(X); vec(U); d; T]`` (d: the design variables), defects ``D X - T W F`` with ``F`` a mapped CasADi
-function over the evaluation points, and the problem's parameters, the grid inputs (one block of
+decision variables ``[vec(X); vec(U); d; T]`` (d: the design variables), defects ``D X - T W F``
+with ``F`` a mapped CasADi function over the evaluation points, and the problem's parameters, the grid inputs (one block of
 n_w × n_eval values) and a fixed horizon as NLP parameters ``p = [params; vec(Win); T]``, so a re-solve
 with new values reuses the solver and warm-starts from the last solution.
 """

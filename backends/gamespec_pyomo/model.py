@@ -2,8 +2,8 @@
 of :mod:`gamespec.ocp.collocation`, row for row the NLP the CasADi backend builds, so both backends
 solve the identical discretization.
 
-Variables ``X[i, node]``, ``U[j, point]``, the design variables ``d[name]`` and the horizon ``T``, a Var when the final time is free
-(time scaling ``t = t0 + tau * T``) and a mutable Param otherwise. The problem's parameters are
+Variables ``X[i, node]``, ``U[j, point]``, the design variables ``d[name]`` and the horizon ``T``,
+a Var when the final time is free (time scaling ``t = t0 + tau * T``) and a mutable Param otherwise. The problem's parameters are
 mutable Params indexed by name, and the grid inputs mutable Params ``w[input, point]`` indexed by
 evaluation point, so a re-solve changes values, not the model. Constraints: the
 defects ``D X - T W F(X, U, t) = 0``, path constraints at every evaluation point and boundary

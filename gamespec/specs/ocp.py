@@ -10,7 +10,8 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable, Mapping
-from dataclasses import dataclass, field
+import dataclasses
+from dataclasses import dataclass
 from typing import Literal
 
 from pydantic import Field, field_validator, model_validator
@@ -336,7 +337,7 @@ class EvaluatedValues:
     controls: list[tuple[float, float]]
     t_final: float | None
     t_bounds: tuple[float, float] | None = None
-    design: list[tuple[float, float, float]] = field(default_factory=list)
+    design: list[tuple[float, float, float]] = dataclasses.field(default_factory=list)
 
 
 def bounds_midpoint(lo: float, hi: float) -> float:

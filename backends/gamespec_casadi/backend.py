@@ -2,9 +2,10 @@
 
 The NLP is built once from the backend-neutral :class:`~gamespec.ocp.transcription.Transcription`:
 decision variables ``[vec(X); vec(U); d; T]`` (d: the design variables), defects ``D X - T W F``
-with ``F`` a mapped CasADi function over the evaluation points, and the problem's parameters, the grid inputs (one block of
-n_w × n_eval values) and a fixed horizon as NLP parameters ``p = [params; vec(Win); T]``, so a re-solve
-with new values reuses the solver and warm-starts from the last solution.
+with ``F`` a mapped CasADi function over the evaluation points, and the problem's parameters, the
+grid inputs (one block of n_w × n_eval values) and a fixed horizon as NLP parameters ``p = [params;
+vec(Win); T]``, so a re-solve with new values reuses the solver and warm-starts from the last
+solution.
 """
 
 from __future__ import annotations

@@ -1,13 +1,13 @@
-"""A :class:`~gamespec.ocp.transcription.Transcription` as a Pyomo model: the explicit collocation
-of :mod:`gamespec.ocp.collocation`, row for row the NLP the CasADi backend builds, so both backends
+"""A :class:`~gamespec.ocp.transcription.Transcription` as a Pyomo model: the explicit collocation of
+:mod:`gamespec.ocp.collocation`, row for row the NLP the CasADi backend builds, so both backends
 solve the identical discretization.
 
-Variables ``X[i, node]``, ``U[j, point]``, the design variables ``d[name]`` and the horizon ``T``,
-a Var when the final time is free (time scaling ``t = t0 + tau * T``) and a mutable Param otherwise. The problem's parameters are
-mutable Params indexed by name, and the grid inputs mutable Params ``w[input, point]`` indexed by
-evaluation point, so a re-solve changes values, not the model. Constraints: the
-defects ``D X - T W F(X, U, t) = 0``, path constraints at every evaluation point and boundary
-constraints over the end values; objective ``Phi + T q^T L`` in minimization form.
+Variables ``X[i, node]``, ``U[j, point]``, the design variables ``d[name]`` and the horizon ``T``, a
+Var when the final time is free (time scaling ``t = t0 + tau * T``) and a mutable Param otherwise.
+The problem's parameters are mutable Params indexed by name, and the grid inputs mutable Params
+``w[input, point]`` indexed by evaluation point, so a re-solve changes values, not the model.
+Constraints: the defects ``D X - T W F(X, U, t) = 0``, path constraints at every evaluation point
+and boundary constraints over the end values; objective ``Phi + T q^T L`` in minimization form.
 """
 
 from __future__ import annotations

@@ -8,9 +8,9 @@ symbols it may use, so a typo stops at load time with the field that holds it.
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from collections.abc import Callable, Mapping
-import dataclasses
 from dataclasses import dataclass
 from typing import Literal
 

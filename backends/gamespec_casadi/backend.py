@@ -79,8 +79,9 @@ class CasadiModel(CollocationModel):
         f = ca.vertcat(*(translate(e, values, lib) for e in ocp.dynamics))
         L = translate(ocp.lagrange, values, lib)
         path = ca.vertcat(*(translate(r.expr, values, lib) for r in ocp.path))
+        integrand = ca.vertcat(*(translate(r.expr, values, lib) for r in ocp.integrals))
         k = len(grid.eval_index)
-        point = ca.Function("point", [x, u, w, t, p], [f, L, path]).map(k)
+        point = ca.Function("point", [x, u, w, t, p], [f, L, path, integrand]).map(k)
 
         X = ca.SX.sym("X", nx, grid.n_nodes)
         U = ca.SX.sym("U", nu, k)
@@ -91,7 +92,7 @@ class CasadiModel(CollocationModel):
         Win = ca.reshape(p_all[npar : npar + nw * k], nw, k)
         horizon = T if tr.free_time else p_all[npar + nw * k]
         t_eval = tr.t0 + horizon * ca.DM(grid.eval_tau).T
-        F, Lv, G = point(X[:, grid.eval_index.tolist()], U, Win, t_eval, params)
+        F, Lv, G, Iv = point(X[:, grid.eval_index.tolist()], U, Win, t_eval, params)
         D, W, q = grid.matrices
         defects = X @ ca.DM(D.T) - horizon * (F @ ca.DM(W.T))
 
@@ -103,7 +104,8 @@ class CasadiModel(CollocationModel):
         objective = mayer + horizon * (Lv @ ca.DM(q))
 
         self.n_defects = defects.numel()
-        g = ca.vertcat(ca.vec(defects), ca.vec(G.T), *boundary)
+        integrals = horizon * (Iv @ ca.DM(q))
+        g = ca.vertcat(ca.vec(defects), ca.vec(G.T), *boundary, integrals)
         w = ca.vertcat(ca.vec(X), ca.vec(U), design, *([T] if tr.free_time else []))
         lower = [np.zeros(self.n_defects)]
         upper = [np.zeros(self.n_defects)]
@@ -112,6 +114,8 @@ class CasadiModel(CollocationModel):
             upper.append(np.full(k, r.upper))
         lower += [np.array([r.lower for r in ocp.boundary])]
         upper += [np.array([r.upper for r in ocp.boundary])]
+        lower += [np.array([r.lower for r in ocp.integrals])]
+        upper += [np.array([r.upper for r in ocp.integrals])]
         self.lbg, self.ubg = np.concatenate(lower), np.concatenate(upper)
         ipopt = {"print_level": 0, "sb": "yes", "tol": options.tol, "max_iter": options.max_iter}
         nlp_opts = {"ipopt": ipopt | options.ipopt, "print_time": False}

@@ -96,6 +96,7 @@ def build_model(tr: Transcription, params: Mapping[str, float]) -> Any:
     F = np.empty((tr.n_x, k), dtype=object)
     L = []
     path = []
+    integrands = []
     for col, (node, tau) in enumerate(zip(grid.eval_index, grid.eval_tau, strict=True)):
         values = symbols | {ocp.t: tr.t0 + tau * m.T}
         values |= {s: m.X[i, int(node)] for i, s in enumerate(ocp.x)}
@@ -104,6 +105,7 @@ def build_model(tr: Transcription, params: Mapping[str, float]) -> Any:
         F[:, col] = [translate(f, values, lib) for f in ocp.dynamics]
         L.append(translate(ocp.lagrange, values, lib))
         path.append([_relation(r, translate(r.expr, values, lib)) for r in ocp.path])
+        integrands.append([translate(r.expr, values, lib) for r in ocp.integrals])
 
     def defect(_m: Any, i: int, row: int) -> Any:
         dx = sum(v * m.X[i, int(c)] for c, v in _row(D, row))
@@ -117,6 +119,13 @@ def build_model(tr: Transcription, params: Mapping[str, float]) -> Any:
     ends |= {s: m.X[i, grid.n_nodes - 1] for i, s in enumerate(ocp.xf)}
     boundary = [_relation(r, translate(r.expr, ends, lib)) for r in ocp.boundary]
     m.boundary = pyo.Constraint(range(len(boundary)), rule=lambda _m, r: boundary[r])
+    integral = [
+        m.T * sum(float(w) * terms[r] for w, terms in zip(q, integrands, strict=True))
+        for r in range(len(ocp.integrals))
+    ]
+    m.integral = pyo.Constraint(
+        range(len(ocp.integrals)), rule=lambda _m, r: _relation(ocp.integrals[r], integral[r])
+    )
     running = sum(float(w) * term for w, term in zip(q, L, strict=True))
     m.objective = pyo.Objective(expr=translate(ocp.mayer, ends, lib) + m.T * running)
     m.dual = pyo.Suffix(direction=pyo.Suffix.IMPORT)

@@ -5,7 +5,7 @@
   Inputs are interpolated as the controls are and as the transcription sees them: through the
   interval's collocation points (the degree d-1 polynomial, Radau) or linearly between nodes
   (trapezoidal), so the check measures the discretization, not how a signal was tabulated.
-- ``max_constraint_violation``: bounds, fixed end values, path and boundary constraints.
+- ``max_constraint_violation``: bounds, fixed end values, path, boundary and integral constraints.
 - ``hamiltonian_variation``: ``max |H - mean H|`` along the solution for autonomous problems, with
   ``H = sign*L + lambda^T f`` from the costate estimates (constant on an optimal arc). A grid input
   that enters f or L and varies along the grid makes the problem non-autonomous
@@ -115,8 +115,8 @@ def _relation_violation(rel: Relation, values: dict, shape: tuple[int, ...]) -> 
 
 
 def max_constraint_violation(tr: Transcription, sol: Trajectory, params: Mapping[str, float]) -> float:
-    """Largest violation of bounds (the design variables' too), fixed end values, path and
-    boundary constraints."""
+    """Largest violation of bounds (the design variables' too), fixed end values, path, boundary
+    and integral constraints (by the transcription's quadrature)."""
     X, U, T = sol.X, sol.U, sol.T
     b = tr.bounds(params)
     worst = [_violation(X, b.x_lower, b.x_upper), _violation(U, b.u_lower, b.u_upper)]
@@ -127,6 +127,10 @@ def max_constraint_violation(tr: Transcription, sol: Trajectory, params: Mapping
     worst += [_relation_violation(r, running, t_eval.shape) for r in tr.ocp.path]
     ends = _end_values(tr, X, T, params)
     worst += [_relation_violation(r, ends, ()) for r in tr.ocp.boundary]
+    q = tr.grid.matrices[2]
+    for r in tr.ocp.integrals:
+        g = np.broadcast_to(np.asarray(translate(r.expr, running, NUMPY), dtype=float), t_eval.shape)
+        worst.append(_violation(np.array([T * q @ g]), r.lower, r.upper))
     return float(np.max(worst))
 
 

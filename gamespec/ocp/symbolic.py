@@ -128,7 +128,28 @@ class SymbolicOcp:
 
     @cached_property
     def path(self) -> list[Relation]:
-        return [parse_relation(c, self._running) for c in self.spec.problem.path_constraints]
+        """The path constraints, then each bound that uses ``t`` as ``x - bound(t) >= 0`` (lower)
+        or ``<= 0`` (upper)."""
+        problem = self.spec.problem
+        relations = [parse_relation(c, self._running) for c in problem.path_constraints]
+        for name, key, raw in problem.time_varying_bounds():
+            gap = symbol(name) - parse(raw, self._running)
+            relations.append(
+                Relation(gap, 0.0, math.inf) if key == "lower" else Relation(gap, -math.inf, 0.0)
+            )
+        return relations
+
+    @cached_property
+    def integrals(self) -> list[Relation]:
+        """Integral constraints: ``lower <= integral of expr dt <= upper`` (integrands not signed)."""
+        return [
+            Relation(
+                parse(c.integrand, self._running),
+                -math.inf if c.lower is None else c.lower,
+                math.inf if c.upper is None else c.upper,
+            )
+            for c in self.spec.problem.integral_constraints
+        ]
 
     @cached_property
     def boundary(self) -> list[Relation]:

@@ -64,6 +64,7 @@ class CollocationBackend(Backend):
             "boundary_constraints",
             "grid_inputs",
             "design_parameters",
+            "integral_constraints",
         }
     )
 

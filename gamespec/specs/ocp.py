@@ -8,6 +8,7 @@ symbols it may use, so a typo stops at load time with the field that holds it.
 
 from __future__ import annotations
 
+import ast
 import dataclasses
 import math
 from collections.abc import Callable, Mapping
@@ -60,6 +61,23 @@ class DesignSpec(StrictModel):
     lower: Value | None = None
     upper: Value | None = None
     guess: Number | None = None
+
+
+class IntegralConstraintSpec(StrictModel):
+    """An isoperimetric constraint ``lower <= integral of integrand dt <= upper`` over the horizon
+    (the integrand is a running expression; an omitted bound is infinite)."""
+
+    integrand: Value
+    lower: Number | None = None
+    upper: Number | None = None
+
+    @model_validator(mode="after")
+    def _some_bound(self) -> IntegralConstraintSpec:
+        if self.lower is None and self.upper is None:
+            raise ValueError("an integral constraint needs lower, upper or both")
+        if self.lower is not None and self.upper is not None and self.lower > self.upper:
+            raise ValueError(f"lower {self.lower:g} exceeds upper {self.upper:g}")
+        return self
 
 
 class ObjectiveSpec(StrictModel):
@@ -123,6 +141,7 @@ class OcpProblem(StrictModel):
     time: TimeSpec = Field(default_factory=TimeSpec)
     path_constraints: list[str] = Field(default_factory=list)
     boundary_constraints: list[str] = Field(default_factory=list)
+    integral_constraints: list[IntegralConstraintSpec] = Field(default_factory=list)
     uncertain: dict[str, UncertainParameter] = Field(
         default_factory=dict, description="Uncertain parameters (chapter 6) and their distributions."
     )
@@ -168,6 +187,17 @@ class OcpProblem(StrictModel):
         self.evaluate(self.parameter_values())
         return self
 
+    def time_varying_bounds(self) -> list[tuple[str, str, str]]:
+        """``(name, "lower" | "upper", expression)`` of each state or control bound that uses ``t``."""
+        found = []
+        for items in (self.states, self.controls):
+            for name, spec in items.items():
+                for key in ("lower", "upper"):
+                    raw = getattr(spec, key)
+                    if is_time_varying(raw):
+                        found.append((name, key, raw))
+        return found
+
     @property
     def derived_parameters(self) -> set[str]:
         """The parameters given as expressions of earlier ones."""
@@ -197,7 +227,7 @@ class OcpProblem(StrictModel):
         values = {symbol(k): float(v) for k, v in params.items()}
 
         def number(raw: float | str | None, default: float, field: str) -> float:
-            if raw is None:
+            if raw is None or (default in (-INF, INF) and is_time_varying(raw)):
                 return default
             if isinstance(raw, str):
                 raw = numeric(parse(raw, symbols), values)
@@ -276,11 +306,15 @@ class OcpProblem(StrictModel):
             **{f"{s}_{e}": symbol(f"{s}_{e}") for s in self.states for e in "0f"},
             "t_f": symbol("t_f"),
         }
+        timed = params | {"t": symbol("t")}
         for group, items in (("states", self.states), ("controls", self.controls), ("design", self.design)):
             for name, spec in items.items():
                 for key, value in spec.model_dump().items():
                     if isinstance(value, str):
-                        checks.append((f"{group}.{name}.{key}", value, params, False))
+                        along = group != "design" and key in ("lower", "upper")
+                        if along:
+                            _bound_over_time(value, timed, running, f"problem.{group}.{name}.{key}")
+                        checks.append((f"{group}.{name}.{key}", value, timed if along else params, False))
         checks += [
             (f"inputs.{n}.default", i.default, params | {NORMALIZED_TIME: symbol(NORMALIZED_TIME)}, False)
             for n, i in self.inputs.items()
@@ -298,6 +332,10 @@ class OcpProblem(StrictModel):
                 checks.append((f"time.bounds.{i}", bound, params, False))
         checks += [(f"path_constraints.{i}", c, running, True) for i, c in enumerate(self.path_constraints)]
         checks += [
+            (f"integral_constraints.{i}.integrand", c.integrand, running, False)
+            for i, c in enumerate(self.integral_constraints)
+        ]
+        checks += [
             (f"boundary_constraints.{i}", c, ends, True) for i, c in enumerate(self.boundary_constraints)
         ]
         for field, text, symbols, relation in checks:
@@ -313,6 +351,34 @@ class OcpProblem(StrictModel):
                     else str(err)
                 )
                 raise SpecError(reason, field=f"problem.{field}") from None
+
+
+def is_time_varying(raw: float | str | None) -> bool:
+    """Whether a bound uses ``t`` (it is then imposed as a path constraint, not a variable bound)."""
+    if not isinstance(raw, str):
+        return False
+    try:
+        tree = ast.parse(raw.strip(), mode="eval")
+    except SyntaxError:
+        return False
+    return any(isinstance(n, ast.Name) and n.id == "t" for n in ast.walk(tree))
+
+
+def _bound_over_time(text: str, timed: dict, running: dict, field: str) -> None:
+    """A bound may use the parameters and ``t``; one over states or controls is refused with a
+    pointer to ``path_constraints``."""
+    try:
+        parse(text, timed)
+    except ExpressionError:
+        try:
+            parse(text, running)
+        except ExpressionError:
+            return
+        raise SpecError(
+            f"bound {text!r} uses states or controls: a bound may use the parameters and t; write it "
+            "as a path constraint (path_constraints: [...])",
+            field=field,
+        ) from None
 
 
 def _inputs_in(read: Callable, text: str, symbols: dict, inputs: dict) -> list[str]:
@@ -413,8 +479,10 @@ class OptimalControlSpec(ProblemParameters, SpecBase):
         needed = {"ode"}
         if p.time.free:
             needed.add("free_final_time")
-        if p.path_constraints:
+        if p.path_constraints or p.time_varying_bounds():
             needed.add("path_constraints")
+        if p.integral_constraints:
+            needed.add("integral_constraints")
         if p.boundary_constraints:
             needed.add("boundary_constraints")
         if p.inputs:

@@ -3,6 +3,7 @@ the expressions written out, derived parameters against the number they evaluate
 
 from __future__ import annotations
 
+import numpy as np
 import pytest
 import sympy as sp
 
@@ -88,3 +89,66 @@ def test_a_design_variable_matches_the_constant_state_workaround(backend: str) -
     assert design.objective == pytest.approx(0.5, abs=1e-7)
     assert design.objective == pytest.approx(constant.objective, abs=1e-7)
     assert design.checks["max_constraint_violation"] < 1e-7
+
+
+def _isoperimetric(quadrature_state: bool, backend: str) -> dict:
+    """min integral(u**2), x' = u, x(0) = 0, x(1) = 1, integral(x) = 1/3: the multiplier makes x
+    quadratic, x = t**2, so J = 4/3 (and the degree-3 collocation is exact)."""
+    problem: dict = {
+        "states": {"x": {"initial": 0.0, "final": 1.0}},
+        "controls": {"u": {}},
+        "dynamics": {"x": "u"},
+        "objective": {"lagrange": "u**2"},
+    }
+    if quadrature_state:
+        problem["states"]["area"] = {"initial": 0.0, "final": 1 / 3}
+        problem["dynamics"]["area"] = "x"
+    else:
+        problem["integral_constraints"] = [{"integrand": "x", "lower": 1 / 3, "upper": 1 / 3}]
+    return {
+        "kind": "optimal_control",
+        "problem": problem,
+        "method": {"intervals": 6},
+        "solver": {"backend": backend},
+    }
+
+
+@pytest.mark.parametrize("backend", ["casadi", "pyomo"])
+def test_an_integral_constraint_matches_a_quadrature_state(backend: str) -> None:
+    integral = gamespec.solve(spec_from_dict(_isoperimetric(False, backend)))
+    state = gamespec.solve(spec_from_dict(_isoperimetric(True, backend)))
+    assert integral.status == state.status == gamespec.Status.OPTIMAL
+    assert integral.objective == pytest.approx(4 / 3, abs=1e-8)
+    assert integral.objective == pytest.approx(state.objective, abs=1e-8)
+    assert np.allclose(integral.states["x"], integral.time**2, atol=1e-7)
+    assert integral.checks["max_constraint_violation"] < 1e-8
+
+
+def _bounded_in_time(as_bound: bool) -> dict:
+    """max x(1), x' = u, with u <= 1 - t: x(1) = 1/2 (the bound is active throughout)."""
+    controls = {"u": {"lower": -1.0, "upper": "1 - t"}} if as_bound else {"u": {"lower": -1.0}}
+    problem = {
+        "states": {"x": {"initial": 0.0}},
+        "controls": controls,
+        "dynamics": {"x": "u"},
+        "objective": {"sense": "maximize", "mayer": "x_f"},
+        "path_constraints": [] if as_bound else ["u <= 1 - t"],
+    }
+    return {"kind": "optimal_control", "problem": problem, "method": {"intervals": 5}}
+
+
+def test_a_bound_over_time_is_the_path_constraint() -> None:
+    bound = gamespec.solve(spec_from_dict(_bounded_in_time(True)))
+    path = gamespec.solve(spec_from_dict(_bounded_in_time(False)))
+    # An active inequality: the interior point stops ~ (points x tol) inside it.
+    assert bound.objective == pytest.approx(0.5, abs=1e-6)
+    assert bound.objective == pytest.approx(path.objective, abs=1e-10)
+    assert np.allclose(bound.controls["u"], 1 - bound.control_time, atol=1e-6)
+
+
+def test_a_bound_over_a_state_points_to_path_constraints() -> None:
+    data = _bounded_in_time(True)
+    data["problem"]["controls"]["u"]["upper"] = "1 - x"
+    with pytest.raises(SpecError, match="path_constraints") as err:
+        spec_from_dict(data)
+    assert err.value.field == "problem.controls.u.upper"

@@ -99,6 +99,8 @@ class CasadiModel(CollocationModel):
         ends = dict(zip(ocp.x0, ca.vertsplit(X[:, 0]), strict=True))
         ends |= dict(zip(ocp.xf, ca.vertsplit(X[:, -1]), strict=True)) | {ocp.tf: tr.t0 + horizon}
         ends |= dict(zip(ocp.p + ocp.d, ca.vertsplit(params), strict=True))
+        first, last = tr.end_controls(U)
+        ends |= dict(zip(ocp.u0, first, strict=True)) | dict(zip(ocp.uf, last, strict=True))
         mayer = translate(ocp.mayer, ends, lib)
         boundary = [translate(r.expr, ends, lib) for r in ocp.boundary]
         objective = mayer + horizon * (Lv @ ca.DM(q))

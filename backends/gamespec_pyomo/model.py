@@ -117,6 +117,8 @@ def build_model(tr: Transcription, params: Mapping[str, float]) -> Any:
     ends = symbols | {ocp.tf: tr.t0 + m.T}
     ends |= {s: m.X[i, 0] for i, s in enumerate(ocp.x0)}
     ends |= {s: m.X[i, grid.n_nodes - 1] for i, s in enumerate(ocp.xf)}
+    first, last = tr.end_controls(m.U)
+    ends |= dict(zip(ocp.u0, first, strict=True)) | dict(zip(ocp.uf, last, strict=True))
     boundary = [_relation(r, translate(r.expr, ends, lib)) for r in ocp.boundary]
     m.boundary = pyo.Constraint(range(len(boundary)), rule=lambda _m, r: boundary[r])
     integral = [

@@ -56,7 +56,7 @@ def _values(tr: Transcription, x, u, w, t, params) -> dict:
     return values | {symbol(k): v for k, v in params.items()} | {ocp.t: t}
 
 
-def _control_basis(tr: Transcription, s: np.ndarray) -> np.ndarray:
+def control_basis(tr: Transcription, s: np.ndarray) -> np.ndarray:
     """Weights (len(s) × points) interpolating an interval's controls at local times ``s``."""
     grid = tr.grid
     if grid.scheme == "trapezoidal":
@@ -90,7 +90,7 @@ def max_defect(tr: Transcription, sol: Trajectory, params: Mapping[str, float]) 
     ds = 1.0 / RK4_STEPS
 
     def f(x: np.ndarray, s: float) -> np.ndarray:
-        basis = _control_basis(tr, np.array([s]))[0]
+        basis = control_basis(tr, np.array([s]))[0]
         return _running(tr, x, Ui @ basis, Wi @ basis, t0 + s * h, params)[:-1]
 
     for step in range(RK4_STEPS):
@@ -125,7 +125,7 @@ def max_constraint_violation(tr: Transcription, sol: Trajectory, params: Mapping
     t_eval = tr.t0 + T * tr.grid.eval_tau
     running = _values(tr, X[:, tr.grid.eval_index], U, sol.Win, t_eval, params)
     worst += [_relation_violation(r, running, t_eval.shape) for r in tr.ocp.path]
-    ends = _end_values(tr, X, T, params)
+    ends = _end_values(tr, X, U, T, params)
     worst += [_relation_violation(r, ends, ()) for r in tr.ocp.boundary]
     q = tr.grid.matrices[2]
     for r in tr.ocp.integrals:
@@ -134,9 +134,13 @@ def max_constraint_violation(tr: Transcription, sol: Trajectory, params: Mapping
     return float(np.max(worst))
 
 
-def _end_values(tr: Transcription, X: np.ndarray, T: float, params: Mapping[str, float]) -> dict:
+def _end_values(
+    tr: Transcription, X: np.ndarray, U: np.ndarray, T: float, params: Mapping[str, float]
+) -> dict:
     ocp = tr.ocp
     values = {s: X[i, 0] for i, s in enumerate(ocp.x0)} | {s: X[i, -1] for i, s in enumerate(ocp.xf)}
+    first, last = tr.end_controls(U)
+    values |= dict(zip(ocp.u0, first, strict=True)) | dict(zip(ocp.uf, last, strict=True))
     return values | {ocp.tf: tr.t0 + T} | {symbol(k): v for k, v in params.items()}
 
 
@@ -170,6 +174,6 @@ def solution_checks(
         H = hamiltonian(tr, sol, params, lam)
         checks["hamiltonian_variation"] = float(np.max(np.abs(H - H.mean())))
         if tr.free_time:
-            end = translate(tr.ocp.hamiltonian_end_value, _end_values(tr, sol.X, sol.T, params), NUMPY)
+            end = translate(tr.ocp.hamiltonian_end_value, _end_values(tr, sol.X, sol.U, sol.T, params), NUMPY)
             checks["hamiltonian_end_error"] = float(np.max(np.abs(H - float(end))))
     return checks

@@ -81,6 +81,15 @@ class SymbolicOcp:
         return [symbol(f"{n}_f") for n in self.states]
 
     @cached_property
+    def u0(self) -> list[sp.Symbol]:
+        """The controls at the initial time (``<control>_0``, in Mayer and boundary terms)."""
+        return [symbol(f"{n}_0") for n in self.controls]
+
+    @cached_property
+    def uf(self) -> list[sp.Symbol]:
+        return [symbol(f"{n}_f") for n in self.controls]
+
+    @cached_property
     def tf(self) -> sp.Symbol:
         return symbol("t_f")
 
@@ -100,7 +109,7 @@ class SymbolicOcp:
 
     @cached_property
     def _ends(self) -> dict[str, sp.Expr]:
-        ends = {str(s): s for s in [*self.x0, *self.xf, self.tf]}
+        ends = {str(s): s for s in [*self.x0, *self.xf, *self.u0, *self.uf, self.tf]}
         return {n: symbol(n) for n in [*self.parameters, *self.design]} | ends
 
     @cached_property

@@ -11,13 +11,13 @@ from __future__ import annotations
 from collections.abc import Mapping
 from dataclasses import dataclass
 from functools import cached_property
-from typing import ClassVar
+from typing import Any, ClassVar
 
 import numpy as np
 
 from gamespec.backend import Backend, CompiledModel
 from gamespec.errors import SpecError
-from gamespec.ocp.checks import Trajectory, solution_checks
+from gamespec.ocp.checks import Trajectory, control_basis, solution_checks
 from gamespec.ocp.collocation import Grid
 from gamespec.ocp.inputs import InputGrid, InputValue, on_grid
 from gamespec.ocp.symbolic import SymbolicOcp
@@ -234,6 +234,22 @@ class Transcription:
         defaults = [g for *_, g in self.ocp.design_bounds(previous.parameters or self.ocp.parameter_values())]
         d = np.array([design.get(n, g) for n, g in zip(self.ocp.design, defaults, strict=True)], dtype=float)
         return Guess(X.reshape(self.n_x, -1), U.reshape(self.n_u, -1), float(span), d)
+
+    @cached_property
+    def start_weights(self) -> np.ndarray:
+        """Weights on the first interval's controls giving the control at the initial time (the
+        interval's interpolating polynomial extrapolated to its start, Radau; the first node's value,
+        trapezoidal)."""
+        return control_basis(self, np.array([0.0]))[0]
+
+    def end_controls(self, U: Any) -> tuple[list[Any], list[Any]]:
+        """The controls at the initial and the final time (``<control>_0``, ``<control>_f``) as linear
+        functions of ``U``, anything indexed ``U[j, point]`` (a NumPy array, a CasADi matrix, a Pyomo
+        Var)."""
+        last_point = len(self.grid.eval_index) - 1
+        first = [sum(float(w) * U[j, c] for c, w in enumerate(self.start_weights)) for j in range(self.n_u)]
+        last = [U[j, last_point] for j in range(self.n_u)]
+        return first, last
 
     @cached_property
     def costate_rows(self) -> np.ndarray:

@@ -81,7 +81,8 @@ class IntegralConstraintSpec(StrictModel):
 
 
 class ObjectiveSpec(StrictModel):
-    """Mayer term (over ``<state>_0``, ``<state>_f``, ``t_f``, parameters) plus Lagrange integrand."""
+    """Mayer term (over ``<state>_0``, ``<state>_f``, ``<control>_0``, ``<control>_f``, ``t_f``,
+    parameters and design variables) plus Lagrange integrand."""
 
     sense: Literal["minimize", "maximize"] = "minimize"
     mayer: Value = 0.0
@@ -163,7 +164,7 @@ class OcpProblem(StrictModel):
             *self.definitions,
             *self.design,
         ]
-        boundary = [f"{s}_0" for s in self.states] + [f"{s}_f" for s in self.states] + ["t_f"]
+        boundary = [f"{s}_{e}" for s in [*self.states, *self.controls] for e in "0f"] + ["t_f"]
         for name in names:
             if not name.isidentifier() or name in RESERVED or name == NORMALIZED_TIME:
                 raise ValueError(f"{name!r} cannot be a symbol name (reserved or not an identifier)")
@@ -303,7 +304,7 @@ class OcpProblem(StrictModel):
         ends = {
             **params,
             **design,
-            **{f"{s}_{e}": symbol(f"{s}_{e}") for s in self.states for e in "0f"},
+            **{f"{s}_{e}": symbol(f"{s}_{e}") for s in [*self.states, *self.controls] for e in "0f"},
             "t_f": symbol("t_f"),
         }
         timed = params | {"t": symbol("t")}

@@ -11,6 +11,7 @@ import gamespec
 from gamespec.errors import SpecError
 from gamespec.loader import spec_from_dict
 from gamespec.ocp.symbolic import SymbolicOcp
+from gamespec.ocp.transcription import Transcription
 from tests.conftest import PROBLEMS
 
 HANG_GLIDER = PROBLEMS / "ocp" / "hang_glider.yaml"
@@ -152,3 +153,35 @@ def test_a_bound_over_a_state_points_to_path_constraints() -> None:
     with pytest.raises(SpecError, match="path_constraints") as err:
         spec_from_dict(data)
     assert err.value.field == "problem.controls.u.upper"
+
+
+def _double_integrator(boundary: list[str], backend: str = "casadi") -> dict:
+    """Minimum energy rest-to-rest, x'' = u on [0, 1] from 0 to 1: u = 6 - 12 t, so u_0 = 6, u_f = -6."""
+    problem = {
+        "states": {"x": {"initial": 0.0, "final": 1.0}, "v": {"initial": 0.0, "final": 0.0}},
+        "controls": {"u": {}},
+        "dynamics": {"x": "v", "v": "u"},
+        "objective": {"lagrange": "u**2/2"},
+        "boundary_constraints": boundary,
+    }
+    return {
+        "kind": "optimal_control",
+        "problem": problem,
+        "method": {"intervals": 4},
+        "solver": {"backend": backend},
+    }
+
+
+@pytest.mark.parametrize("backend", ["casadi", "pyomo"])
+def test_controls_at_the_end_points(backend: str) -> None:
+    free = gamespec.solve(spec_from_dict(_double_integrator([], backend)))
+    inactive = gamespec.solve(spec_from_dict(_double_integrator(["u_0 >= 5.99", "u_f <= -5.99"], backend)))
+    assert inactive.objective == pytest.approx(free.objective, abs=1e-7)
+    assert inactive.objective == pytest.approx(6.0, abs=1e-7)
+    moved = gamespec.solve(spec_from_dict(_double_integrator(["u_0 == 7"], backend)))
+    tr = Transcription(spec_from_dict(_double_integrator([])))
+    first, _ = tr.end_controls(np.atleast_2d(moved.controls["u"]))
+    assert first[0] == pytest.approx(7.0, abs=1e-7)
+    assert moved.checks["max_constraint_violation"] < 1e-7
+    free_first, free_last = tr.end_controls(np.atleast_2d(free.controls["u"]))
+    assert (free_first[0], free_last[0]) == pytest.approx((6.0, -6.0), abs=1e-6)

@@ -314,7 +314,12 @@ class OcpProblem(StrictModel):
                     if isinstance(value, str):
                         along = group != "design" and key in ("lower", "upper")
                         if along:
-                            _bound_over_time(value, timed, running, f"problem.{group}.{name}.{key}")
+                            _bound_over_time(
+                                value,
+                                timed,
+                                {k: v for k, v in running.items() if k not in inputs},
+                                f"problem.{group}.{name}.{key}",
+                            )
                         checks.append((f"{group}.{name}.{key}", value, timed if along else params, False))
         checks += [
             (f"inputs.{n}.default", i.default, params | {NORMALIZED_TIME: symbol(NORMALIZED_TIME)}, False)

@@ -82,13 +82,18 @@ class Backend(ABC):
 
     def options(self, spec: SpecBase, overrides: dict[str, Any] | None = None) -> StrictModel:
         """This backend's options block from the spec's ``solver.options``, validated."""
-        raw = {**spec.solver.options.get(self.name, {}), **(overrides or {})}
+        raw = {**self.shared_options(spec), **spec.solver.options.get(self.name, {}), **(overrides or {})}
         try:
             return self.options_model.model_validate(raw)
         except ValidationError as err:
             first = err.errors()[0]
             loc = ".".join(str(p) for p in first["loc"])
             raise SpecError(first["msg"], field=f"solver.options.{self.name}.{loc}") from None
+
+    def shared_options(self, spec: SpecBase) -> dict[str, Any]:
+        """Option values that blocks other than this backend's own give it (none by default; the
+        collocation backends take ``solver.options.nlp``); the backend's own block wins."""
+        return {}
 
     def compile(self, spec: SpecBase, options: StrictModel | None = None) -> CompiledModel:
         """Check support, then build the backend model once."""

@@ -45,6 +45,7 @@ class CasadiOptions(StrictModel):
     solver: str = Field("ipopt", description="NLP solver plugin of CasADi's nlpsol.")
     tol: float = Field(1e-8, gt=0, description="IPOPT's tol.")
     max_iter: int = Field(3000, ge=1)
+    max_wall_time: float = Field(300.0, gt=0, description="IPOPT's wall-time limit in seconds.")
     ipopt: dict[str, Any] = Field(default_factory=dict, description="Further IPOPT options.")
     warm_start: bool = Field(True, description="Re-solves start from the previous solution.")
 
@@ -120,6 +121,7 @@ class CasadiModel(CollocationModel):
         upper += [np.array([r.upper for r in ocp.integrals])]
         self.lbg, self.ubg = np.concatenate(lower), np.concatenate(upper)
         ipopt = {"print_level": 0, "sb": "yes", "tol": options.tol, "max_iter": options.max_iter}
+        ipopt["max_wall_time"] = options.max_wall_time
         nlp_opts = {"ipopt": ipopt | options.ipopt, "print_time": False}
         self.solver = ca.nlpsol(
             "gamespec", options.solver, {"x": w, "p": p_all, "f": objective, "g": g}, nlp_opts
@@ -189,6 +191,7 @@ class CasadiBackend(CollocationBackend):
 
     name: ClassVar[str] = "casadi"
     options_model = CasadiOptions
+    nlp_field: ClassVar[str] = "ipopt"
 
     @classmethod
     def available(cls) -> Availability:

@@ -45,6 +45,7 @@ class PyomoOptions(StrictModel):
     )
     tol: float = Field(1e-8, gt=0, description="The solver's tol.")
     max_iter: int = Field(3000, ge=1)
+    max_wall_time: float = Field(300.0, gt=0, description="The solver's wall-time limit in seconds.")
     options: dict[str, Any] = Field(
         default_factory=dict, description="Further solver options (key=value on its command line)."
     )
@@ -119,6 +120,7 @@ class PyomoModel(CollocationModel):
 
         name = self.executable.name
         opts = {"tol": self.options.tol, "max_iter": self.options.max_iter, "print_level": PRINT_LEVEL[name]}
+        opts["max_wall_time"] = self.options.max_wall_time
         with tempfile.TemporaryDirectory(prefix="gamespec-pyomo-") as tmp:
             log = Path(tmp) / "solver.log"
             try:
@@ -193,6 +195,7 @@ class PyomoBackend(CollocationBackend):
 
     name: ClassVar[str] = "pyomo"
     options_model = PyomoOptions
+    nlp_field: ClassVar[str] = "options"
 
     @classmethod
     def available(cls) -> Availability:

@@ -22,6 +22,7 @@ from gamespec.ocp.collocation import Grid
 from gamespec.ocp.inputs import InputGrid, InputValue, on_grid
 from gamespec.ocp.symbolic import SymbolicOcp
 from gamespec.result import Result, Status
+from gamespec.specs.base import SpecBase
 from gamespec.specs.ocp import NORMALIZED_TIME, OptimalControlSpec, bounds_midpoint
 from gamespec.symbolic.language import ExpressionError, parse, symbol
 from gamespec.symbolic.translate import NUMPY, translate
@@ -51,9 +52,19 @@ class Guess:
     d: np.ndarray
 
 
+NLP_OPTIONS = "nlp"
+"""The ``solver.options`` block every collocation backend reads: IPOPT options by IPOPT's names
+(``tol``, ``max_iter``, ``max_wall_time``, ``mu_strategy`` ...), given once for casadi and pyomo."""
+
+
 class CollocationBackend(Backend):
     """Base of the backends that solve ``optimal_control`` specs by direct collocation of a
-    :class:`Transcription` (the same kinds and features for each of them)."""
+    :class:`Transcription` (the same kinds and features for each of them). ``solver.options.nlp``
+    holds IPOPT options for all of them: those the backend's options block names (``tol``,
+    ``max_iter``, ``max_wall_time``) set that field, the rest go to its pass-through block
+    (``nlp_field``); the backend's own block overrides either."""
+
+    nlp_field: ClassVar[str] = ""
 
     kinds: ClassVar[frozenset[str]] = frozenset({"optimal_control"})
     features: ClassVar[frozenset[str]] = frozenset(
@@ -67,6 +78,16 @@ class CollocationBackend(Backend):
             "integral_constraints",
         }
     )
+
+    def shared_options(self, spec: SpecBase) -> dict[str, Any]:
+        nlp = dict(spec.solver.options.get(NLP_OPTIONS, {}))
+        own = spec.solver.options.get(self.name, {})
+        named = {
+            k: nlp.pop(k) for k in list(nlp) if k in self.options_model.model_fields and k != self.nlp_field
+        }
+        if nlp:
+            named[self.nlp_field] = {**nlp, **own.get(self.nlp_field, {})}
+        return named
 
 
 class CollocationModel(CompiledModel):

@@ -12,6 +12,7 @@ from gamespec.errors import SpecError
 from gamespec.loader import spec_from_dict
 from gamespec.ocp.symbolic import SymbolicOcp
 from gamespec.ocp.transcription import Transcription
+from gamespec.solving import get_backend
 from tests.conftest import PROBLEMS
 
 HANG_GLIDER = PROBLEMS / "ocp" / "hang_glider.yaml"
@@ -185,3 +186,25 @@ def test_controls_at_the_end_points(backend: str) -> None:
     assert moved.checks["max_constraint_violation"] < 1e-7
     free_first, free_last = tr.end_controls(np.atleast_2d(free.controls["u"]))
     assert (free_first[0], free_last[0]) == pytest.approx((6.0, -6.0), abs=1e-6)
+
+
+def test_one_spelling_of_nlp_options_reaches_both_backends() -> None:
+    spec = gamespec.load(
+        HANG_GLIDER,
+        [
+            "solver.options.nlp.tol=1e-7",
+            "solver.options.nlp.mu_strategy=adaptive",
+            "solver.options.pyomo.tol=1e-6",
+        ],
+    )
+    casadi = get_backend("casadi").options(spec)
+    pyomo = get_backend("pyomo").options(spec)
+    assert casadi.tol == 1e-7 and casadi.ipopt == {"mu_strategy": "adaptive"}
+    assert pyomo.tol == 1e-6 and pyomo.options == {"mu_strategy": "adaptive"}
+    assert casadi.max_wall_time == pyomo.max_wall_time > 0
+
+
+@pytest.mark.parametrize("backend", ["casadi", "pyomo"])
+def test_the_wall_time_limit_stops_a_solve(backend: str) -> None:
+    spec = gamespec.load(HANG_GLIDER, ["solver.options.nlp.max_wall_time=1e-4", f"solver.backend={backend}"])
+    assert gamespec.solve(spec).status == gamespec.Status.TIME_LIMIT

@@ -225,9 +225,7 @@ class Transcription:
         if isinstance(raw, int | float):
             return np.full_like(tau, float(raw))
         if raw == "linear":
-            mid = bounds_midpoint(lo, hi)
-            a = start if start is not None else (end if end is not None else mid)
-            b = end if end is not None else a
+            a, b = _linear_ends(start, end, lo, hi)
             return a + (b - a) * tau
         symbols = {n: symbol(n) for n in params} | {NORMALIZED_TIME: symbol(NORMALIZED_TIME)}
         try:
@@ -327,3 +325,18 @@ class Transcription:
             metrics={"design": optimized} if optimized else {},
             solver_stats=solver_stats or {},
         )
+
+
+def _linear_ends(start: float | None, end: float | None, lo: float, hi: float) -> tuple[float, float]:
+    """The end values of the ``linear`` guess: the fixed end values; from a fixed end toward the
+    middle of the bounds when the other end is free and both bounds are finite (held at the fixed
+    end when a bound is infinite); the middle of the bounds when both ends are free."""
+    mid = bounds_midpoint(lo, hi)
+    bounded = bool(np.isfinite(lo) and np.isfinite(hi))
+    if start is not None and end is not None:
+        return start, end
+    if start is not None:
+        return start, mid if bounded else start
+    if end is not None:
+        return mid if bounded else end, end
+    return mid, mid

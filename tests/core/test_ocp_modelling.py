@@ -8,11 +8,12 @@ import pytest
 import sympy as sp
 
 import gamespec
-from gamespec.errors import SpecError
+from gamespec.errors import ExpressionError, SpecError
 from gamespec.loader import spec_from_dict
 from gamespec.ocp.symbolic import SymbolicOcp
 from gamespec.ocp.transcription import Transcription
 from gamespec.solving import get_backend
+from gamespec.symbolic.language import parse
 from tests.conftest import PROBLEMS
 
 HANG_GLIDER = PROBLEMS / "ocp" / "hang_glider.yaml"
@@ -208,3 +209,23 @@ def test_one_spelling_of_nlp_options_reaches_both_backends() -> None:
 def test_the_wall_time_limit_stops_a_solve(backend: str) -> None:
     spec = gamespec.load(HANG_GLIDER, ["solver.options.nlp.max_wall_time=1e-4", f"solver.backend={backend}"])
     assert gamespec.solve(spec).status == gamespec.Status.TIME_LIMIT
+
+
+def test_a_caret_says_to_use_double_star_at_its_column() -> None:
+    with pytest.raises(ExpressionError, match=r"use \*\* for powers") as err:
+        parse("1 + v^2", {"v": sp.Symbol("v", real=True)})
+    assert err.value.column == 5
+
+
+def test_a_linear_guess_with_one_free_end_heads_for_the_middle_of_the_bounds() -> None:
+    data = _bounded_in_time(False)
+    data["problem"]["states"] = {
+        "x": {"initial": 0.0, "lower": -2.0, "upper": 4.0},
+        "z": {"final": 3.0},
+    }
+    data["problem"]["dynamics"] = {"x": "u", "z": "u"}
+    data["problem"]["objective"]["mayer"] = "x_f"
+    tr = Transcription(spec_from_dict(data))
+    start = tr.guess(tr.ocp.parameter_values())
+    assert start.X[0, 0] == 0.0 and start.X[0, -1] == pytest.approx(1.0)
+    assert np.all(start.X[1] == 3.0)

@@ -104,7 +104,7 @@ class CasadiModel(CollocationModel):
         ends |= dict(zip(ocp.u0, first, strict=True)) | dict(zip(ocp.uf, last, strict=True))
         mayer = translate(ocp.mayer, ends, lib)
         boundary = [translate(r.expr, ends, lib) for r in ocp.boundary]
-        objective = mayer + horizon * (Lv @ ca.DM(q))
+        objective = mayer + horizon * (Lv @ ca.DM(q)) + tr.rate_penalty(U)
 
         self.n_defects = defects.numel()
         integrals = horizon * (Iv @ ca.DM(q))

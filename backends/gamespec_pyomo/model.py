@@ -129,7 +129,7 @@ def build_model(tr: Transcription, params: Mapping[str, float]) -> Any:
         range(len(ocp.integrals)), rule=lambda _m, r: _relation(ocp.integrals[r], integral[r])
     )
     running = sum(float(w) * term for w, term in zip(q, L, strict=True))
-    m.objective = pyo.Objective(expr=translate(ocp.mayer, ends, lib) + m.T * running)
+    m.objective = pyo.Objective(expr=translate(ocp.mayer, ends, lib) + m.T * running + tr.rate_penalty(m.U))
     m.dual = pyo.Suffix(direction=pyo.Suffix.IMPORT)
     return m
 

@@ -6,6 +6,9 @@
   interval's collocation points (the degree d-1 polynomial, Radau) or linearly between nodes
   (trapezoidal), so the check measures the discretization, not how a signal was tabulated.
 - ``max_constraint_violation``: bounds, fixed end values, path, boundary and integral constraints.
+- ``control_swings/<control>``: total variation of the control over the range it spans; ``chattering``
+  is 1 when one sweeps its range more than ``CHATTERING_SWINGS`` times (regularize it with
+  ``method.control_rate_penalty``), else 0.
 - ``hamiltonian_variation``: ``max |H - mean H|`` along the solution for autonomous problems, with
   ``H = sign*L + lambda^T f`` from the costate estimates (constant on an optimal arc). A grid input
   that enters f or L and varies along the grid makes the problem non-autonomous
@@ -29,6 +32,9 @@ if TYPE_CHECKING:
     from gamespec.ocp.transcription import Transcription
 
 RK4_STEPS = 16
+CHATTERING_SWINGS = 10.0
+"""A control that sweeps its range more often than this (total variation over the range it spans)
+chatters: a bang-bang or bang-singular profile sweeps it a few times, on every mesh."""
 
 
 @dataclass(frozen=True)
@@ -103,6 +109,16 @@ def max_defect(tr: Transcription, sol: Trajectory, params: Mapping[str, float]) 
     return float(np.max(np.abs(x - X[:, starts[1:]]))) if x.size else 0.0
 
 
+def control_swings(U: np.ndarray) -> np.ndarray:
+    """Per control, its total variation ``sum_k |u_{k+1} - u_k|`` over the evaluation points divided
+    by the range it spans (0 for a constant control): how many times it sweeps that range."""
+    if U.shape[1] < 2:
+        return np.zeros(U.shape[0])
+    variation = np.sum(np.abs(np.diff(U, axis=1)), axis=1)
+    span = np.ptp(U, axis=1)
+    return np.where(span > 0, variation / np.where(span > 0, span, 1.0), 0.0)
+
+
 def _violation(values: np.ndarray, lower: np.ndarray | float, upper: np.ndarray | float) -> float:
     if np.size(values) == 0:
         return 0.0
@@ -170,6 +186,10 @@ def solution_checks(
         "max_constraint_violation": max_constraint_violation(tr, sol, params),
         "max_defect": max_defect(tr, sol, params),
     }
+    if tr.n_u:
+        swings = control_swings(sol.U)
+        checks |= {f"control_swings/{n}": float(v) for n, v in zip(tr.ocp.controls, swings, strict=True)}
+        checks["chattering"] = float(np.max(swings) > CHATTERING_SWINGS)
     if lam is not None and _time_invariant(tr, sol.Win):
         H = hamiltonian(tr, sol, params, lam)
         checks["hamiltonian_variation"] = float(np.max(np.abs(H - H.mean())))

@@ -270,6 +270,18 @@ class Transcription:
         last = [U[j, last_point] for j in range(self.n_u)]
         return first, last
 
+    def rate_penalty(self, U: Any) -> Any:
+        """``w * sum_j sum_k (U[j, k+1] - U[j, k])**2 / (tau_{k+1} - tau_k)`` over consecutive
+        evaluation points (``method.control_rate_penalty``; 0 when w is 0), a discrete
+        ``w * integral of |du/dtau|**2``, for NumPy, CasADi or Pyomo ``U`` alike."""
+        weight = self.spec.method.control_rate_penalty
+        if weight == 0.0:
+            return 0.0
+        inverse = 1.0 / np.diff(self.grid.eval_tau)
+        return weight * sum(
+            float(c) * (U[j, k + 1] - U[j, k]) ** 2 for j in range(self.n_u) for k, c in enumerate(inverse)
+        )
+
     @cached_property
     def costate_rows(self) -> np.ndarray:
         return self.grid.costate_scale()
@@ -294,6 +306,8 @@ class Transcription:
         """A Result from a solution, with costates from the defect multipliers, the checks, the
         grid inputs used (``arrays["input/<name>"]``, on ``control_time``) and the optimized design
         variables (``metrics["design"]``)."""
+        if objective is not None:
+            objective -= self.ocp.sign * float(self.rate_penalty(U))
         values = np.zeros(self.n_d) if design is None else np.asarray(design, dtype=float)
         optimized = {n: float(v) for n, v in zip(self.ocp.design, values, strict=True)}
         t_nodes = self.t0 + T * self.grid.nodes

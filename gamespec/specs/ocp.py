@@ -439,6 +439,12 @@ class MethodSpec(StrictModel):
     intervals: int = Field(40, ge=1, le=100_000)
     degree: int = Field(3, ge=1, le=12)
     grading: Number = Field(1.0, gt=0, le=1e4)
+    control_rate_penalty: Number = Field(
+        0.0,
+        ge=0,
+        description="Weight w of the regularization w * sum_k |u_{k+1} - u_k|**2 / (tau_{k+1} - tau_k) "
+        "added to the objective (smooths singular and chattering arcs; not in the Result's objective).",
+    )
 
 
 class GuessSpec(StrictModel):

@@ -229,3 +229,18 @@ def test_a_linear_guess_with_one_free_end_heads_for_the_middle_of_the_bounds() -
     start = tr.guess(tr.ocp.parameter_values())
     assert start.X[0, 0] == 0.0 and start.X[0, -1] == pytest.approx(1.0)
     assert np.all(start.X[1] == 3.0)
+
+
+GODDARD = PROBLEMS / "ocp" / "goddard_rocket.yaml"
+
+
+@pytest.mark.parametrize("backend", ["casadi", "pyomo"])
+def test_the_chattering_check_fires_on_goddard_and_a_rate_penalty_removes_it(backend: str) -> None:
+    """Goddard's thrust is bang-singular-off (monotone: one sweep of its range); the collocated
+    singular arc chatters without regularization. The penalty perturbs h_f by O(w)."""
+    raw = gamespec.solve(GODDARD, backend)
+    smooth = gamespec.solve(gamespec.load(GODDARD, ["method.control_rate_penalty=1.0e-6"]), backend)
+    assert raw.checks["chattering"] == 1.0 and raw.checks["control_swings/T"] > 10
+    assert smooth.checks["chattering"] == 0.0 and smooth.checks["control_swings/T"] < 1.5
+    assert smooth.objective == pytest.approx(smooth.states["h"][-1], abs=1e-12)
+    assert smooth.objective == pytest.approx(raw.objective, rel=1e-4)

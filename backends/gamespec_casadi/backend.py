@@ -141,7 +141,7 @@ class CasadiModel(CollocationModel):
         T = float(w[-1]) if self.tr.free_time else params_T
         return X, U, d, T
 
-    def solve(
+    def solve_once(
         self, parameters: dict[str, float] | None = None, guess: Result | None = None, inputs: Inputs = None
     ) -> Result:
         tr = self.tr

@@ -142,7 +142,7 @@ class PyomoModel(CollocationModel):
             self.model.solutions.load_from(results)
         return True
 
-    def solve(
+    def solve_once(
         self, parameters: dict[str, float] | None = None, guess: Result | None = None, inputs: Inputs = None
     ) -> Result:
         tr, m = self.tr, self.model

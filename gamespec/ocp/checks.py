@@ -5,6 +5,8 @@
   Inputs are interpolated as the controls are and as the transcription sees them: through the
   interval's collocation points (the degree d-1 polynomial, Radau) or linearly between nodes
   (trapezoidal), so the check measures the discretization, not how a signal was tabulated.
+- ``max_defect_relative``: the same gap divided by the state's scale ``max(1, max |x|)`` (what
+  ``method.refine.tolerance`` is compared with).
 - ``max_constraint_violation``: bounds, fixed end values, path, boundary and integral constraints.
 - ``control_swings/<control>``: total variation of the control over the range it spans; ``chattering``
   is 1 when one sweeps its range more than ``CHATTERING_SWINGS`` times (regularize it with
@@ -84,8 +86,9 @@ def _per_interval(tr: Transcription, V: np.ndarray) -> np.ndarray:
     return np.stack([V[:, :-1], V[:, 1:]], axis=2)
 
 
-def max_defect(tr: Transcription, sol: Trajectory, params: Mapping[str, float]) -> float:
-    """Largest gap between an RK4 re-integration of each interval and the collocated state."""
+def interval_defects(tr: Transcription, sol: Trajectory, params: Mapping[str, float]) -> np.ndarray:
+    """Per state and interval (n_x × intervals), the gap between an RK4 re-integration of the
+    interval from its first node and the collocated state at its end."""
     X, T = sol.X, sol.T
     grid = tr.grid
     starts = grid.interval_start_index
@@ -106,7 +109,18 @@ def max_defect(tr: Transcription, sol: Trajectory, params: Mapping[str, float]) 
         k3 = f(x + 0.5 * ds * h * k2, s + ds / 2)
         k4 = f(x + ds * h * k3, s + ds)
         x = x + ds * h / 6.0 * (k1 + 2 * k2 + 2 * k3 + k4)
-    return float(np.max(np.abs(x - X[:, starts[1:]]))) if x.size else 0.0
+    return np.abs(x - X[:, starts[1:]])
+
+
+def state_scale(X: np.ndarray) -> np.ndarray:
+    """Per state, ``max(1, max |x|)`` along the solution: what a defect is relative to."""
+    return np.maximum(1.0, np.max(np.abs(X), axis=1, initial=0.0))
+
+
+def relative_defects(tr: Transcription, sol: Trajectory, params: Mapping[str, float]) -> np.ndarray:
+    """Per interval, the largest defect over the states relative to each state's scale."""
+    gaps = interval_defects(tr, sol, params) / state_scale(sol.X)[:, None]
+    return np.max(gaps, axis=0, initial=0.0)
 
 
 def control_swings(U: np.ndarray) -> np.ndarray:
@@ -184,8 +198,10 @@ def solution_checks(
     e.g. a diverging re-integration of a failed solve)."""
     checks: dict[str, float | None] = {
         "max_constraint_violation": max_constraint_violation(tr, sol, params),
-        "max_defect": max_defect(tr, sol, params),
     }
+    gaps = interval_defects(tr, sol, params)
+    checks["max_defect"] = float(np.max(gaps, initial=0.0))
+    checks["max_defect_relative"] = float(np.max(gaps / state_scale(sol.X)[:, None], initial=0.0))
     if tr.n_u:
         swings = control_swings(sol.U)
         checks |= {f"control_swings/{n}": float(v) for n, v in zip(tr.ocp.controls, swings, strict=True)}

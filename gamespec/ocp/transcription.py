@@ -8,6 +8,7 @@ inputs ``Win`` (n_w × n_eval) are data at the evaluation points, where the cont
 
 from __future__ import annotations
 
+from abc import abstractmethod
 from collections.abc import Mapping
 from dataclasses import dataclass
 from functools import cached_property
@@ -15,7 +16,7 @@ from typing import Any, ClassVar
 
 import numpy as np
 
-from gamespec.backend import Backend, CompiledModel
+from gamespec.backend import Backend, CompiledModel, Inputs
 from gamespec.errors import SpecError
 from gamespec.ocp.checks import Trajectory, control_basis, solution_checks
 from gamespec.ocp.collocation import Grid
@@ -99,6 +100,26 @@ class CollocationModel(CompiledModel):
         """Where ``solve(inputs=...)`` expects its values (see :meth:`Transcription.input_grid`)."""
         return self.tr.input_grid(parameters)
 
+    options: Any
+
+    def solve(
+        self, parameters: dict[str, float] | None = None, guess: Result | None = None, inputs: Inputs = None
+    ) -> Result:
+        """One solve on this mesh, then adaptive refinement when ``method.refine`` asks for it
+        (:mod:`gamespec.ocp.refinement`)."""
+        result = self.solve_once(parameters, guess, inputs)
+        if self.tr.spec.method.refine is None:
+            return result
+        from gamespec.ocp.refinement import refined
+
+        return refined(self, result, parameters, inputs)
+
+    @abstractmethod
+    def solve_once(
+        self, parameters: dict[str, float] | None = None, guess: Result | None = None, inputs: Inputs = None
+    ) -> Result:
+        """Solve on this model's mesh."""
+
 
 class Transcription:
     """The discretized form of an ``optimal_control`` spec, independent of any backend."""
@@ -107,7 +128,8 @@ class Transcription:
         self.spec = spec
         self.ocp = SymbolicOcp(spec)
         m = spec.method
-        self.grid = Grid(m.scheme, m.intervals, m.degree if m.scheme == "radau" else 1, m.grading)
+        mesh = None if m.mesh is None else tuple(m.mesh)
+        self.grid = Grid(m.scheme, m.intervals, m.degree if m.scheme == "radau" else 1, m.grading, mesh)
         self.t0 = spec.problem.time.initial
 
     @property

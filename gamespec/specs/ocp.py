@@ -428,6 +428,15 @@ def _ordered(lower: float, upper: float, field: str) -> None:
         raise SpecError(f"lower bound {lower:g} exceeds upper bound {upper:g}", field=f"problem.{field}")
 
 
+class RefineSpec(StrictModel):
+    """Adaptive h-refinement: solve, split every interval whose defect relative to the state scale
+    (``max_defect_relative``) exceeds ``tolerance`` into two, re-solve from the last solution, until
+    none does or ``max_iterations`` refinements were made."""
+
+    tolerance: Number = Field(1e-6, gt=0)
+    max_iterations: int = Field(8, ge=1, le=30)
+
+
 class MethodSpec(StrictModel):
     """Transcription: Legendre–Gauss–Radau collocation of ``degree`` on ``intervals``, or trapezoidal.
 
@@ -439,6 +448,30 @@ class MethodSpec(StrictModel):
     intervals: int = Field(40, ge=1, le=100_000)
     degree: int = Field(3, ge=1, le=12)
     grading: Number = Field(1.0, gt=0, le=1e4)
+    mesh: list[Number] | None = Field(
+        None, description="Interval boundaries in normalized time, 0 to 1 increasing (sets intervals)."
+    )
+    refine: RefineSpec | None = Field(None, description="Adaptive h-refinement on the defect estimate.")
+
+    @model_validator(mode="before")
+    @classmethod
+    def _intervals_of_mesh(cls, data: object) -> object:
+        if isinstance(data, dict) and isinstance(data.get("mesh"), list):
+            return {**data, "intervals": max(len(data["mesh"]) - 1, 1)}
+        return data
+
+    @field_validator("mesh")
+    @classmethod
+    def _increasing(cls, mesh: list[float] | None) -> list[float] | None:
+        if mesh is not None and (
+            len(mesh) < 2
+            or mesh[0] != 0.0
+            or mesh[-1] != 1.0
+            or any(b <= a for a, b in itertools.pairwise(mesh))
+        ):
+            raise ValueError("mesh must increase strictly from 0 to 1")
+        return mesh
+
     control_rate_penalty: Number = Field(
         0.0,
         ge=0,

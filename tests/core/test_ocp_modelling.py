@@ -3,6 +3,8 @@ the expressions written out, derived parameters against the number they evaluate
 
 from __future__ import annotations
 
+import itertools
+
 import numpy as np
 import pytest
 import sympy as sp
@@ -244,3 +246,17 @@ def test_the_chattering_check_fires_on_goddard_and_a_rate_penalty_removes_it(bac
     assert smooth.checks["chattering"] == 0.0 and smooth.checks["control_swings/T"] < 1.5
     assert smooth.objective == pytest.approx(smooth.states["h"][-1], abs=1e-12)
     assert smooth.objective == pytest.approx(raw.objective, rel=1e-4)
+
+
+@pytest.mark.parametrize("backend", ["casadi", "pyomo"])
+def test_mesh_refinement_reaches_its_tolerance_on_the_hang_glider(backend: str) -> None:
+    tolerance = 1e-6
+    spec = gamespec.load(HANG_GLIDER, ["method.intervals=10", f"method.refine.tolerance={tolerance}"])
+    result = gamespec.solve(spec, backend)
+    history = result.metrics["refinement"]
+    defects = [entry["max_defect_relative"] for entry in history]
+    assert result.status == gamespec.Status.OPTIMAL and result.metrics["refinement_converged"]
+    assert result.checks["max_defect_relative"] <= tolerance
+    assert all(later < earlier for earlier, later in itertools.pairwise(defects))
+    assert [e["intervals"] for e in history] == sorted({e["intervals"] for e in history})
+    assert result.objective == pytest.approx(1.24797e3, rel=1e-5)

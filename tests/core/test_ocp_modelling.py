@@ -259,4 +259,4 @@ def test_mesh_refinement_reaches_its_tolerance_on_the_hang_glider(backend: str) 
     assert result.checks["max_defect_relative"] <= tolerance
     assert all(later < earlier for earlier, later in itertools.pairwise(defects))
     assert [e["intervals"] for e in history] == sorted({e["intervals"] for e in history})
-    assert result.objective == pytest.approx(1.24797e3, rel=1e-5)
+    assert result.objective == pytest.approx(1.24797e3, rel=1e-4)  # COPS 3.0, on its own uniform mesh

@@ -123,6 +123,24 @@ def relative_defects(tr: Transcription, sol: Trajectory, params: Mapping[str, fl
     return np.max(gaps, axis=0, initial=0.0)
 
 
+DEFAULT_TOLERANCES = {"max_constraint_violation": 1e-6, "max_defect_relative": 1e-6, "chattering": 0.0}
+"""What each check is held to when the file sets nothing: a constraint violation and a relative
+defect at the level of IPOPT's default tolerance, and no chattering control."""
+
+
+def verdicts(checks: Mapping[str, float | None], defect_tolerance: float | None) -> dict[str, bool]:
+    """Pass (True) or fail per check that has a tolerance (``method.refine.tolerance`` for the
+    relative defect when the file sets one); a check that could not be computed fails."""
+    tolerances = DEFAULT_TOLERANCES | (
+        {"max_defect_relative": defect_tolerance} if defect_tolerance is not None else {}
+    )
+    return {
+        name: checks[name] is not None and bool(checks[name] <= tol)
+        for name, tol in tolerances.items()
+        if name in checks
+    }
+
+
 def control_swings(U: np.ndarray) -> np.ndarray:
     """Per control, its total variation ``sum_k |u_{k+1} - u_k|`` over the evaluation points divided
     by the range it spans (0 for a constant control): how many times it sweeps that range."""

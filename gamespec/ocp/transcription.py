@@ -18,7 +18,7 @@ import numpy as np
 
 from gamespec.backend import Backend, CompiledModel, Inputs
 from gamespec.errors import SpecError
-from gamespec.ocp.checks import Trajectory, control_basis, solution_checks
+from gamespec.ocp.checks import Trajectory, control_basis, solution_checks, verdicts
 from gamespec.ocp.collocation import Grid
 from gamespec.ocp.inputs import InputGrid, InputValue, on_grid
 from gamespec.ocp.symbolic import SymbolicOcp
@@ -326,8 +326,9 @@ class Transcription:
         solver_stats: dict | None = None,
     ) -> Result:
         """A Result from a solution, with costates from the defect multipliers, the checks, the
-        grid inputs used (``arrays["input/<name>"]``, on ``control_time``) and the optimized design
-        variables (``metrics["design"]``)."""
+        grid inputs used (``arrays["input/<name>"]``, on ``control_time``), the optimized design
+        variables (``metrics["design"]``) and a pass/fail verdict per check against its tolerance
+        (``metrics["checks_passed"]``, see :func:`~gamespec.ocp.checks.verdicts`)."""
         if objective is not None:
             objective -= self.ocp.sign * float(self.rate_penalty(U))
         values = np.zeros(self.n_d) if design is None else np.asarray(design, dtype=float)
@@ -341,6 +342,7 @@ class Transcription:
             lam = defect_multipliers * self.costate_rows[None, :]
             costates = {f"lambda_{n}": lam[i] for i, n in enumerate(self.ocp.states)}
         checks = solution_checks(self, Trajectory(X, U, inputs, T), {**params, **optimized}, lam)
+        refine = self.spec.method.refine
         if lam is not None:
             arrays["costate_time"] = t_eval
         return Result(
@@ -358,7 +360,8 @@ class Transcription:
             arrays=arrays,
             parameters=dict(params),
             checks=checks,
-            metrics={"design": optimized} if optimized else {},
+            metrics=({"design": optimized} if optimized else {})
+            | {"checks_passed": verdicts(checks, refine.tolerance if refine else None)},
             solver_stats=solver_stats or {},
         )
 

@@ -260,3 +260,11 @@ def test_mesh_refinement_reaches_its_tolerance_on_the_hang_glider(backend: str) 
     assert all(later < earlier for earlier, later in itertools.pairwise(defects))
     assert [e["intervals"] for e in history] == sorted({e["intervals"] for e in history})
     assert result.objective == pytest.approx(1.24797e3, rel=1e-4)  # COPS 3.0, on its own uniform mesh
+
+
+def test_each_check_has_a_verdict_against_its_tolerance() -> None:
+    coarse = gamespec.solve(gamespec.load(HANG_GLIDER, SMALL))
+    passed = coarse.metrics["checks_passed"]
+    assert passed["max_constraint_violation"] is (coarse.checks["max_constraint_violation"] <= 1e-6)
+    assert passed["max_defect_relative"] is False  # 10 intervals: a relative defect of order 1e-1
+    assert coarse.checks["max_defect_relative"] <= coarse.checks["max_defect"]  # scales are >= 1

@@ -7,10 +7,14 @@ slow: add ``-m slow`` to time it; it starts from an empty store so nothing is re
 
 from __future__ import annotations
 
+import numpy as np
 import pytest
 
 import gamespec
+from gamespec.pursuit import study
+from gamespec.pursuit.simulation import simulate_to_capture
 from gamespec.result import Status
+from gamespec.studies import suboptimal_study
 from tests.conftest import PROBLEMS
 
 CASES = {
@@ -55,3 +59,25 @@ def test_table_2_1_study_serial(benchmark, tmp_path) -> None:
     spec = gamespec.load(PROBLEMS / "ch2" / "pure_pursuit_suboptimal_study.yaml", [f"store={tmp_path}"])
     result = benchmark.pedantic(gamespec.solve, args=(spec,), rounds=1)
     assert result.status == Status.OPTIMAL, result.message
+
+
+def _every_twelfth_point():
+    spec = gamespec.load(PROBLEMS / "ch2" / "pure_pursuit_suboptimal_study.yaml")
+    return list(study.study_points(spec).values())[::12]
+
+
+@pytest.mark.parametrize("suboptimal", ["pursuit curve", "integrated"])
+def test_table_2_1_points(benchmark, monkeypatch, suboptimal: str) -> None:
+    """Issue 16: 60 of the 720 points, the suboptimal capture from the closed-form pursuit curve
+    against the integrated true dynamics (the path before) as the baseline; the same variations."""
+    benchmark.group = "Table 2.1, 60 points"
+    points = _every_twelfth_point()
+    expected = [suboptimal_study.evaluate(p).get("variation_percent") for p in points]
+    if suboptimal == "integrated":
+        monkeypatch.setattr(suboptimal_study, "constant_heading_pursuit", simulate_to_capture)
+    rows = benchmark.pedantic(lambda: [suboptimal_study.evaluate(p) for p in points], rounds=1)
+    got = [r.get("variation_percent") for r in rows]
+    assert [g is None for g in got] == [e is None for e in expected]
+    np.testing.assert_allclose(
+        [g for g in got if g is not None], [e for e in expected if e is not None], atol=1e-6
+    )

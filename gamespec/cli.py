@@ -1,4 +1,5 @@
-"""The command line (DESIGN.md, "CLI"): validate, solve, compare, show, plot, schema, backends.
+"""The command line (DESIGN.md, "CLI"): validate, solve, compare, sweep, results, show, plot, schema,
+backends.
 
 Area commands (``gamespec pursuit ...``) are Typer apps registered in the ``gamespec.commands``
 entry-point group, mounted under their entry-point name; the core imports none of them by name.
@@ -11,9 +12,11 @@ from __future__ import annotations
 
 import json
 import sys
+import warnings
 from pathlib import Path
 from typing import Annotated
 
+import numpy as np
 import typer
 import yaml
 from rich.console import Console
@@ -87,7 +90,8 @@ def solve(
         from gamespec.plotting import plot_result
 
         for path in plot_result(result, out or Path(".")):
-            err_console.print(f"wrote {path}")
+            if not json_:
+                console.print(f"wrote {path}", markup=False, highlight=False)
     if json_:
         sys.stdout.write(result.to_json() + "\n")
     else:
@@ -140,37 +144,110 @@ def compare(
         raise typer.Exit(1)
 
 
+ExecutorOpt = Annotated[
+    str | None,
+    typer.Option(
+        "--executor",
+        help="serial, process or dask (default: serial for one worker, process for more, dask with "
+        "a scheduler).",
+    ),
+]
+WorkersOpt = Annotated[int, typer.Option(min=1, help="Worker processes (a LocalCluster's size for dask).")]
+SchedulerOpt = Annotated[
+    str | None,
+    typer.Option(
+        "--scheduler",
+        envvar="GAMESPEC_SCHEDULER",
+        help="Address of a running Dask scheduler, e.g. tcp://host:8786 (env GAMESPEC_SCHEDULER).",
+    ),
+]
+
+SWEEP_COLUMNS = ("status", "objective", "t_final", "solve_time_s")
+
+
 @app.command()
 def sweep(
     file: FileArg,
     param: Annotated[list[str], typer.Option(help="name=a:b:n or name=v1,v2 (repeatable: a grid).")],
-    out: Annotated[Path, typer.Option(help="Folder for the per-point results (a rerun resumes).")],
+    out: Annotated[Path, typer.Option(help="Folder of the study store (a rerun resumes).")],
     backend: Annotated[str | None, typer.Option(help="Backend name (default: the file's).")] = None,
-    workers: Annotated[int, typer.Option(min=1, help="Local processes.")] = 1,
+    executor: ExecutorOpt = None,
+    workers: WorkersOpt = 1,
+    scheduler: SchedulerOpt = None,
     set_: SetOpt = None,
     json_: JsonOpt = False,
 ) -> None:
     """Solve a file over a grid of parameter values; one row per point, saved as it finishes."""
+    from gamespec.studies.executors import executor as make_executor
     from gamespec.studies.sweep import parse_range
     from gamespec.studies.sweep import sweep as run_sweep
 
     load(file, set_ or [])
     ranges = [parse_range(p) for p in param]
-    rows = run_sweep(file, ranges, out=out, overrides=tuple(set_ or []), backend=backend, workers=workers)
+    writable_folder(out)
+    runner = make_executor(executor, workers, scheduler)
+    run = run_sweep(file, ranges, out=out, overrides=tuple(set_ or []), backend=backend, executor=runner)
+    rows = list(run.values.values())
     if json_:
         sys.stdout.write(json.dumps(rows, indent=2) + "\n")
-        return
-    names = [name for name, _ in ranges]
-    table = Table(title=f"sweep of {file.name}")
-    for col in [*names, "status", "objective", "t_final", "solve_time_s"]:
-        table.add_column(col, justify="right")
-    for row in rows:
-        table.add_row(*(_fmt(row.get(c)) for c in [*names, "status", "objective", "t_final", "solve_time_s"]))
-    console.print(table)
+    else:
+        names = [name for name, _ in ranges]
+        console.print(_rows_table(rows, [*names, *SWEEP_COLUMNS], f"sweep of {file.name}"))
+        tally = f"{run.computed} computed now, {run.reused} reused"
+        print(f"{len(rows)} points in {out} ({tally})", file=sys.stderr)
     failed = [r for r in rows if r["status"] not in ("optimal", "feasible")]
     if failed:
         print(f"error: {len(failed)} of {len(rows)} points did not solve", file=sys.stderr)
         raise typer.Exit(1)
+
+
+def _rows_table(rows: list[dict], columns: list[str], title: str) -> Table:
+    table = Table(title=title)
+    for col in columns:
+        table.add_column(col, justify="right")
+    for row in rows:
+        table.add_row(*(_fmt(row.get(c)) for c in columns))
+    return table
+
+
+RESULT_COLUMNS = (
+    "backend",
+    "status",
+    "objective",
+    "t_final",
+    "t_suboptimal",
+    "t_optimal",
+    "variation_percent",
+    "solve_time_s",
+)
+"""Columns ``gamespec results`` shows after the swept parameters, where the rows have them."""
+
+
+@app.command()
+def results(
+    folder: Annotated[Path, typer.Argument(help="A study folder (a sweep's or compare's --out).")],
+    csv: Annotated[Path | None, typer.Option("--csv", help="Write every column as CSV here.")] = None,
+    parquet: Annotated[Path | None, typer.Option("--parquet", help="Write a typed Parquet file.")] = None,
+    json_: JsonOpt = False,
+) -> None:
+    """Print a study's table (sweep, compare, Table 2.1) and export it as CSV or Parquet."""
+    from gamespec.studies.export import find_store, study_rows, write_csv, write_parquet
+
+    store = find_store(folder)
+    rows = study_rows(store)
+    for line in store.damaged:
+        print(line, file=sys.stderr)
+    if json_:
+        sys.stdout.write(json.dumps(rows, indent=2) + "\n")
+    else:
+        study = store.meta("study") or {}
+        present = {name for row in rows for name in row}
+        shown = [c for c in [*study.get("parameters", []), *RESULT_COLUMNS] if c in present]
+        title = f"{study.get('type', 'study')} {study.get('problem', '')}: {len(rows)} points".strip()
+        console.print(_rows_table(rows, shown or ["key"], title))
+    for path in (write_csv(rows, csv) if csv else None, write_parquet(rows, parquet) if parquet else None):
+        if path is not None:
+            print(f"wrote {path}", file=sys.stderr)
 
 
 @app.command()
@@ -196,19 +273,20 @@ def plot(
     out: OutOpt = None,
     animate: Annotated[bool, typer.Option(help="Also write an animation where the kind has one.")] = False,
 ) -> None:
-    """Draw a saved Result (states, controls, paths; kind-specific figures), or a sweep folder's
-    cost/sensitivity trade-off when its points are desensitized Results."""
+    """Draw a saved Result (states, controls, paths; kind-specific figures), or a study folder
+    (a sweep: outputs against each parameter, and the cost/sensitivity trade-off when its points are
+    desensitized Results; a compare: bars per backend)."""
     from gamespec.plotting import plot_result
+    from gamespec.studies.store import ResultStore, is_store
 
-    if (result / "points").is_dir():
-        from gamespec.desensitize.plotting import plot_tradeoff
-
-        for path in plot_tradeoff(result, writable_folder(out or result)):
-            console.print(f"wrote {path}")
-        return
-    loaded = Result.load(result)
     folder = writable_folder(out or (result if result.is_dir() else result.parent))
-    for path in plot_result(loaded, folder, animate=animate):
+    if is_store(result):
+        from gamespec.studies.plots import plot_study
+
+        paths = plot_study(ResultStore(result), folder)
+    else:
+        paths = plot_result(Result.load(result), folder, animate=animate)
+    for path in paths:
         console.print(f"wrote {path}")
 
 
@@ -247,16 +325,37 @@ def backends() -> None:
     console.print(table)
 
 
+_ClickException = next(c for c in typer.BadParameter.__mro__ if c.__name__ == "ClickException")
+"""Click's root exception (vendored by recent typer, a separate package before): usage errors."""
+
+
 def run(argv: list[str] | None = None) -> int:
-    """Run the CLI on ``argv`` and return the exit code (user errors → 2, one line on stderr)."""
+    """Run the CLI on ``argv`` and return the exit code: user errors and usage errors → 2 with one
+    line on stderr. Warnings (numpy's, a solver's) are not printed: what a solve found is in its
+    Result's status, message and checks."""
+    command = typer.main.get_command(app)
     try:
-        app(args=argv, prog_name="gamespec")
+        with warnings.catch_warnings(), np.errstate(all="ignore"):
+            warnings.simplefilter("ignore")
+            code = command.main(args=argv, prog_name="gamespec", standalone_mode=False)
     except SystemExit as exit_:
         return exit_.code if isinstance(exit_.code, int) else (0 if exit_.code is None else 1)
     except GamespecError as err:
-        print(f"error: {err}", file=sys.stderr)
+        print(f"error: {_one_line(str(err))}", file=sys.stderr)
         return 2
-    return 0
+    except _ClickException as err:
+        message = _one_line(err.format_message())
+        if message:
+            print(f"error: {message} (see 'gamespec --help')", file=sys.stderr)
+        return err.exit_code
+    except typer.Abort:
+        print("error: aborted", file=sys.stderr)
+        return 1
+    return code if isinstance(code, int) else 0
+
+
+def _one_line(text: str) -> str:
+    return " ".join(text.split())
 
 
 def main() -> None:

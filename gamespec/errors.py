@@ -25,6 +25,11 @@ class SpecError(GamespecError):
         super().__init__(where + reason)
 
 
+class RefusedInput(SpecError):
+    """Well-formed input that gamespec refuses to read: beyond a limit of :mod:`gamespec.limits`, a
+    recursive alias, a duplicate key."""
+
+
 class ExpressionError(GamespecError):
     """An expression string uses something outside the whitelisted language."""
 

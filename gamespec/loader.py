@@ -1,7 +1,7 @@
 """Problem files (YAML, TOML, JSON) → validated spec, with ``--set`` overrides (DESIGN.md, stage 1).
 
-YAML is read with ``yaml.safe_load`` only. Validation errors become one
-:class:`~gamespec.errors.SpecError` that names the file, the dotted field and the reason, and for a
+Files are read by :func:`gamespec.reading.read_file` (within :mod:`gamespec.limits`). Validation errors
+become one :class:`~gamespec.errors.SpecError` that names the file, the dotted field and the reason, and for a
 misspelled key the nearest valid one.
 """
 
@@ -11,7 +11,6 @@ import difflib
 import hashlib
 import json
 import re
-import tomllib
 from collections.abc import Iterable, Mapping
 from pathlib import Path
 from typing import Any
@@ -21,36 +20,8 @@ from pydantic import BaseModel, ValidationError
 
 from gamespec import registry
 from gamespec.errors import SpecError
-from gamespec.specs.base import SpecBase
-
-SUFFIXES = {".yaml": "yaml", ".yml": "yaml", ".toml": "toml", ".json": "json"}
-
-
-def read_file(path: str | Path) -> dict[str, Any]:
-    """The raw mapping in a problem file; a SpecError for a missing, unreadable or malformed file."""
-    path = Path(path)
-    fmt = SUFFIXES.get(path.suffix.lower())
-    if fmt is None:
-        raise SpecError(f"unknown file type {path.suffix!r} (use .yaml, .toml or .json)", source=str(path))
-    try:
-        text = path.read_text(encoding="utf-8")
-    except FileNotFoundError:
-        raise SpecError("file not found", source=str(path)) from None
-    except OSError as err:
-        raise SpecError(f"cannot read file: {err.strerror}", source=str(path)) from None
-    try:
-        if fmt == "yaml":
-            data = yaml.safe_load(text)
-        elif fmt == "toml":
-            data = tomllib.loads(text)
-        else:
-            data = json.loads(text)
-    except (yaml.YAMLError, tomllib.TOMLDecodeError, json.JSONDecodeError) as err:
-        reason = " ".join(str(err).split())
-        raise SpecError(f"malformed {fmt.upper()}: {reason}", source=str(path)) from None
-    if not isinstance(data, dict):
-        raise SpecError("the file must hold a mapping at the top level", source=str(path))
-    return data
+from gamespec.reading import read_file, read_value
+from gamespec.specs.base import NLP_OPTIONS, SpecBase
 
 
 def override_path(key: str, source: str = "--set") -> list[str]:
@@ -136,7 +107,7 @@ def _valid_keys(model: type[BaseModel] | None, loc: tuple[Any, ...]) -> list[str
         if field is None:
             return []
         annotation = field.annotation
-        if getattr(annotation, "__origin__", None) is dict and parts:
+        if getattr(annotation, "__origin__", None) in (dict, list, tuple) and parts:
             parts.pop(0)
         model = _model_in(annotation)
     return list(model.model_fields) if model is not None and not parts else []
@@ -161,13 +132,34 @@ def _is_type_tag(part: object) -> bool:
     return isinstance(part, str) and ("[" in part or "-" in part or part in _TYPE_TAGS)
 
 
-def format_validation_error(err: ValidationError, model: type[BaseModel], source: str) -> SpecError:
-    """The first pydantic error as a SpecError with dotted location and a nearest-key hint."""
+def _user_location(loc: tuple[Any, ...], data: Any) -> tuple[Any, ...]:
+    """``loc`` without pydantic's union tags: a part the file holds at that point (a key such as
+    ``x-notes`` or ``pursuers[1]``, a list index) is always kept; only a part the file does not hold
+    and that looks like a tag is dropped."""
+    kept: list[Any] = []
+    node = data
+    for part in loc:
+        in_list = isinstance(node, list) and isinstance(part, int) and -len(node) <= part < len(node)
+        if in_list or (isinstance(node, Mapping) and part in node):
+            node = node[part]
+        elif _is_type_tag(part):
+            continue
+        else:
+            node = None
+        kept.append(part)
+    return tuple(kept)
+
+
+def format_validation_error(
+    err: ValidationError, model: type[BaseModel], source: str, data: Any = None
+) -> SpecError:
+    """The first pydantic error as a SpecError with dotted location and a nearest-key hint
+    (``data``, the validated input, tells the file's own keys from pydantic's union tags)."""
     first = err.errors()[0]
-    loc = tuple(p for p in first["loc"] if not _is_type_tag(p))
+    loc = _user_location(tuple(first["loc"]), data)
     field = ".".join(str(p) for p in loc)
     reason = first["msg"]
-    if first["type"] == "extra_forbidden":
+    if first["type"] == "extra_forbidden" and loc:
         keys = _valid_keys(model, loc[:-1])
         near = difflib.get_close_matches(str(loc[-1]), keys, n=1)
         reason = f"unknown key {loc[-1]!r}" + (f"; did you mean {near[0]!r}?" if near else "")
@@ -193,11 +185,32 @@ def spec_from_dict(data: Mapping[str, Any], source: str = "<spec>") -> SpecBase:
     except SpecError as err:
         raise SpecError(err.reason, field="kind", source=source) from None
     try:
-        return cls.model_validate(dict(data))
+        spec = cls.model_validate(dict(data))
     except ValidationError as err:
-        raise format_validation_error(err, cls, source) from None
+        raise format_validation_error(err, cls, source, data) from None
     except SpecError as err:
         raise SpecError(err.reason, field=err.field, source=source) from None
+    check_backend_options(spec, source)
+    return spec
+
+
+def check_backend_options(spec: SpecBase, source: str) -> None:
+    """Validate every block of ``solver.options`` with its backend's options model (imported only
+    when the file has a block for it), so a misspelled backend or option fails at load, not at solve.
+    A backend whose module cannot be imported here is left to the solve, which says why."""
+    for name, block in spec.solver.options.items():
+        if name == NLP_OPTIONS:
+            continue
+        known = registry.names("gamespec.backends")
+        if name not in known:
+            near = difflib.get_close_matches(name, known, n=1)
+            hint = f"; did you mean {near[0]!r}?" if near else f" (known: {', '.join(known)})"
+            raise SpecError(f"unknown backend {name!r}{hint}", field=f"solver.options.{name}", source=source)
+        try:
+            backend = registry.backend_class(name)
+        except ImportError:
+            continue
+        backend.validate_options(block, source)
 
 
 def spec_hash(spec: SpecBase) -> str:
@@ -206,8 +219,37 @@ def spec_hash(spec: SpecBase) -> str:
     return hashlib.sha256(text.encode()).hexdigest()[:16]
 
 
+def refuse_undeclared_parameters(data: Mapping[str, Any], assignments: Iterable[str]) -> None:
+    """A SpecError (with the nearest declared name) for a ``--set problem.parameters.NAME=...`` whose
+    NAME the file does not declare: a misspelled parameter would otherwise be added unused and change
+    nothing."""
+    problem = data.get("problem")
+    declared = problem.get("parameters") if isinstance(problem, Mapping) else None
+    if not isinstance(declared, Mapping):
+        return
+    for assignment in assignments:
+        path, _ = parse_override(assignment)
+        if len(path) == 3 and path[:2] == ["problem", "parameters"] and path[2] not in declared:
+            near = difflib.get_close_matches(path[2], [str(k) for k in declared], n=1)
+            hint = f"; did you mean {near[0]!r}?" if near else f" (declared: {', '.join(map(str, declared))})"
+            raise SpecError(f"unknown parameter {path[2]!r}{hint}", field=".".join(path), source="--set")
+
+
+def check_overrides(data: Mapping[str, Any], assignments: Iterable[str]) -> None:
+    """Each ``--set`` value read within the limits of a file (:func:`gamespec.reading.read_value`),
+    and no undeclared parameter set; a SpecError from ``--set`` otherwise."""
+    assignments = list(assignments)
+    for assignment in assignments:
+        _, sep, value = assignment.partition("=")
+        if sep and value.strip():
+            read_value(value)
+    refuse_undeclared_parameters(data, assignments)
+
+
 def load(path: str | Path, overrides: Iterable[str] = ()) -> SpecBase:
     """Read, override and validate a problem file into its spec."""
-    data = apply_overrides(read_file(path), overrides)
+    raw = read_file(path)
+    check_overrides(raw, overrides)
+    data = apply_overrides(raw, overrides)
     spec = spec_from_dict(data, source=str(path))
     return spec.with_source(str(path), hashlib.sha256(Path(path).read_bytes()).hexdigest()[:16])

@@ -40,7 +40,8 @@ def plot_trajectories(result: Result, output_dir: Path, *, animate: bool = False
         axes[1, 0].set_ylabel("controls")
         axes[1, 0].legend(loc="best")
     axes[-1, 0].set_xlabel("t")
-    fig.suptitle(f"{result.problem} — {result.backend}, {result.status.value}, J = {result.objective:.6g}")
+    objective = "" if result.objective is None else f", J = {result.objective:.6g}"
+    fig.suptitle(f"{result.problem} — {result.backend}, {result.status.value}{objective}")
     fig.tight_layout()
     paths = [output_dir / f"{result.problem}_time.png"]
     fig.savefig(paths[0], dpi=120)

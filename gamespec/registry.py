@@ -2,8 +2,9 @@
 
 Groups: ``gamespec.kinds`` (spec classes by ``kind``), ``gamespec.backends`` (backend classes by
 name), ``gamespec.transforms`` (spec → spec reductions), ``gamespec.plotters`` (plot functions by
-kind) and ``gamespec.commands`` (Typer apps of area commands, by sub-command name). Nothing is
-imported until it is asked for, so ``import gamespec`` stays light.
+kind), ``gamespec.executors`` (how a study runs its points) and ``gamespec.commands`` (Typer apps
+of area commands, by sub-command name). Nothing is imported until it is asked for, so
+``import gamespec`` stays light.
 """
 
 from __future__ import annotations
@@ -19,6 +20,7 @@ GROUPS = (
     "gamespec.backends",
     "gamespec.transforms",
     "gamespec.plotters",
+    "gamespec.executors",
     "gamespec.commands",
 )
 

@@ -10,6 +10,7 @@ from __future__ import annotations
 import json
 import math
 import zipfile
+import zlib
 from enum import StrEnum
 from pathlib import Path
 from typing import Any
@@ -28,6 +29,11 @@ class Status(StrEnum):
     OPTIMAL = "optimal"
     FEASIBLE = "feasible"
     INFEASIBLE = "infeasible"
+    """No solution exists: the solver proved it (a convex solver's certificate of infeasibility)."""
+    LOCALLY_INFEASIBLE = "locally_infeasible"
+    """A local NLP solver (IPOPT, ripopt) converged to a point that minimizes the constraint
+    violation without reaching zero: no feasible point *near where it looked*. A solution may still
+    exist; try another initial guess, finer grid or bounds before concluding there is none."""
     UNBOUNDED = "unbounded"
     ITERATION_LIMIT = "iteration_limit"
     NOT_CONVERGED = "not_converged"
@@ -98,6 +104,8 @@ class Result(BaseModel):
     @field_validator("states", "controls", "costates", "arrays", mode="before")
     @classmethod
     def _as_arrays(cls, v: Any) -> ArrayDict:
+        if not isinstance(v, dict | None):
+            raise ValueError("expected a mapping of names to arrays")
         return {k: np.asarray(a) for k, a in (v or {}).items()}
 
     @field_serializer("time", "control_time")
@@ -152,30 +160,74 @@ class Result(BaseModel):
     @classmethod
     def load(cls, path: str | Path) -> Result:
         """Read a Result saved by :meth:`save` (a folder or its ``result.json``), or a ``--json`` dump;
-        a SpecError saying why when it cannot."""
-        try:
-            return cls._load(Path(path))
-        except (OSError, ValueError, KeyError, zipfile.BadZipFile) as err:
-            reason = err.strerror if isinstance(err, OSError) and err.strerror else str(err).splitlines()[0]
-            raise SpecError(f"not a readable Result: {reason}", source=str(path)) from None
-
-    @classmethod
-    def _load(cls, path: Path) -> Result:
+        a SpecError naming the file that cannot be read (missing, empty, corrupt, arrays whose lengths
+        do not match their time grid, a time grid that is not finite) and why."""
+        path = Path(path)
         folder = path if path.is_dir() else path.parent
         json_file = path / "result.json" if path.is_dir() else path
-        data = json.loads(json_file.read_text())
-        if not isinstance(data, dict):
-            raise ValueError("the JSON does not hold a mapping")
+        data = _read_json(json_file)
         npz = folder / "arrays.npz"
         if npz.exists() and json_file.name == "result.json":
-            with np.load(npz) as packed:
-                for key in packed.files:
-                    field, _, name = key.partition("/")
-                    if name:
-                        data.setdefault(field, {})[name] = packed[key]
-                    else:
-                        data[field] = packed[key]
-        return cls.model_validate(data)
+            data.update(_read_arrays(npz))
+        try:
+            result = cls.model_validate(data)
+            result._check_grids()
+        except ValueError as err:
+            source = npz if npz.exists() and json_file.name == "result.json" else json_file
+            raise SpecError(f"not a readable Result: {_first_line(err)}", source=str(source)) from None
+        return result
+
+    def _check_grids(self) -> None:
+        """ValueError unless the time grids are finite vectors and every trajectory has one row per
+        point of its grid (``states`` on ``time``, ``controls`` on ``control_time`` or ``time``,
+        ``costates`` on ``arrays["costate_time"]`` or ``time``)."""
+        grids = {"time": self.time, "control_time": self.control_time, "costate_time": None}
+        if "costate_time" in self.arrays:
+            grids["costate_time"] = np.asarray(self.arrays["costate_time"], dtype=float)
+        for name, grid in grids.items():
+            if grid is not None and (grid.ndim != 1 or not np.all(np.isfinite(grid))):
+                raise ValueError(f"{name} is not a finite vector")
+        for field, grid in (
+            ("states", self.time),
+            ("controls", self.control_time if self.control_time is not None else self.time),
+            ("costates", grids["costate_time"] if grids["costate_time"] is not None else self.time),
+        ):
+            for name, values in getattr(self, field).items():
+                if grid is not None and (values.ndim == 0 or len(values) != len(grid)):
+                    raise ValueError(f"{field}.{name} has {values.shape} values for {len(grid)} time points")
+
+
+def _first_line(err: BaseException) -> str:
+    text = err.strerror if isinstance(err, OSError) and err.strerror else str(err)
+    return " ".join(text.split("\n")[0].split()) or type(err).__name__
+
+
+def _read_json(json_file: Path) -> dict[str, Any]:
+    """The mapping in a Result's JSON file; a SpecError naming it when it is missing or not one."""
+    try:
+        data = json.loads(json_file.read_text(encoding="utf-8"))
+    except (OSError, UnicodeDecodeError, ValueError, RecursionError) as err:
+        raise SpecError(f"not a readable Result: {_first_line(err)}", source=str(json_file)) from None
+    if not isinstance(data, dict):
+        raise SpecError("not a readable Result: the JSON does not hold a mapping", source=str(json_file))
+    return data
+
+
+def _read_arrays(npz: Path) -> dict[str, Any]:
+    """The arrays of ``arrays.npz`` as Result fields; a SpecError naming the file when it is empty,
+    truncated or corrupt (a bad zip, a bad deflate stream, a pickled object)."""
+    fields: dict[str, Any] = {}
+    try:
+        with np.load(npz, allow_pickle=False) as packed:
+            for key in packed.files:
+                field, _, name = key.partition("/")
+                if name:
+                    fields.setdefault(field, {})[name] = packed[key]
+                else:
+                    fields[field] = packed[key]
+    except (OSError, EOFError, ValueError, KeyError, zipfile.BadZipFile, zlib.error) as err:
+        raise SpecError(f"not a readable Result: {_first_line(err)}", source=str(npz)) from None
+    return fields
 
 
 def writable_folder(directory: str | Path) -> Path:

@@ -1,6 +1,7 @@
 """The ``casadi`` backend: an ``optimal_control`` spec as a CasADi NLP by direct collocation.
 
-The NLP is built once from the backend-neutral :class:`~gamespec.ocp.transcription.Transcription`:
+The NLP is built once (on one flat SX graph, or with ``graph: mx`` an MX graph around the mapped
+per-point function) from the backend-neutral :class:`~gamespec.ocp.transcription.Transcription`:
 decision variables ``[vec(X); vec(U); d; T]`` (d: the design variables), defects ``D X - T W F``
 with ``F`` a mapped CasADi function over the evaluation points, and the problem's parameters, the
 grid inputs (one block of n_w × n_eval values) and a fixed horizon as NLP parameters ``p = [params;
@@ -11,14 +12,15 @@ solution.
 from __future__ import annotations
 
 import time
-from typing import Any, ClassVar
+from typing import Any, ClassVar, Literal
 
 import numpy as np
-from pydantic import Field
+from pydantic import Field, ValidationInfo, field_validator
 
 from gamespec.backend import Availability, Inputs
+from gamespec.backend.collocation import CollocationBackend, CollocationModel
 from gamespec.errors import BackendError
-from gamespec.ocp.transcription import CollocationBackend, CollocationModel, Guess, Transcription
+from gamespec.ocp.transcription import Guess, Transcription
 from gamespec.result import Result, Status
 from gamespec.specs.base import StrictModel
 from gamespec.specs.ocp import OptimalControlSpec
@@ -28,7 +30,7 @@ STATUS_MAP = {
     "Solve_Succeeded": Status.OPTIMAL,
     "Solved_To_Acceptable_Level": Status.FEASIBLE,
     "Feasible_Point_Found": Status.FEASIBLE,
-    "Infeasible_Problem_Detected": Status.INFEASIBLE,
+    "Infeasible_Problem_Detected": Status.LOCALLY_INFEASIBLE,
     "Diverging_Iterates": Status.UNBOUNDED,
     "Maximum_Iterations_Exceeded": Status.ITERATION_LIMIT,
     "Maximum_CpuTime_Exceeded": Status.TIME_LIMIT,
@@ -37,6 +39,8 @@ STATUS_MAP = {
     "Error_In_Step_Computation": Status.NUMERICAL_ERROR,
     "Invalid_Number_Detected": Status.NUMERICAL_ERROR,
 }
+"""IPOPT's return status → gamespec's Status. IPOPT is a local solver: ``Infeasible_Problem_Detected``
+means it converged to a point of local infeasibility, hence ``locally_infeasible``."""
 
 
 class CasadiOptions(StrictModel):
@@ -48,6 +52,23 @@ class CasadiOptions(StrictModel):
     max_wall_time: float = Field(300.0, gt=0, description="IPOPT's wall-time limit in seconds.")
     ipopt: dict[str, Any] = Field(default_factory=dict, description="Further IPOPT options.")
     warm_start: bool = Field(True, description="Re-solves start from the previous solution.")
+    graph: Literal["sx", "mx"] = Field(
+        "sx",
+        description="Outer NLP graph: 'sx' flattens every interval into one SX graph (slow nlpsol build"
+        " at large N, fastest IPOPT iterations and re-solves); 'mx' keeps the per-point function as one"
+        " mapped node (a 3-8x faster build at N = 1000, 1.2-2x slower iterations): for one-shot solves"
+        " of large grids.",
+    )
+
+    @field_validator("ipopt")
+    @classmethod
+    def _known_to_ipopt(cls, ipopt: dict[str, Any], info: ValidationInfo) -> dict[str, Any]:
+        """``ipopt`` holds options IPOPT itself knows and accepts (checked against its own list)."""
+        if ipopt and info.data.get("solver") == "ipopt":
+            from gamespec_casadi.ipopt_options import check_ipopt_options
+
+            check_ipopt_options(ipopt)
+        return ipopt
 
 
 def casadi_library(ca: Any) -> Library:
@@ -84,11 +105,12 @@ class CasadiModel(CollocationModel):
         k = len(grid.eval_index)
         point = ca.Function("point", [x, u, w, t, p], [f, L, path, integrand]).map(k)
 
-        X = ca.SX.sym("X", nx, grid.n_nodes)
-        U = ca.SX.sym("U", nu, k)
-        T = ca.SX.sym("T") if tr.free_time else None
-        design = ca.SX.sym("d", tr.n_d)
-        p_all = ca.SX.sym("p_all", npar + nw * k + (0 if tr.free_time else 1))
+        outer = ca.MX if options.graph == "mx" else ca.SX
+        X = outer.sym("X", nx, grid.n_nodes)
+        U = outer.sym("U", nu, k)
+        T = outer.sym("T") if tr.free_time else None
+        design = outer.sym("d", tr.n_d)
+        p_all = outer.sym("p_all", npar + nw * k + (0 if tr.free_time else 1))
         params = ca.vertcat(p_all[:npar, :], design)
         Win = ca.reshape(p_all[npar : npar + nw * k], nw, k)
         horizon = T if tr.free_time else p_all[npar + nw * k]

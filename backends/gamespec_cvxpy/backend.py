@@ -21,9 +21,9 @@ from typing import Any, ClassVar
 import numpy as np
 from pydantic import Field
 
+from gamespec.backend.lq import LQBackend, LQCompiledModel, LQSolverOptions
 from gamespec.best_response import Settings, StepReport
 from gamespec.errors import BackendError
-from gamespec.lqgame.backend import LQBackend, LQCompiledModel, LQSolverOptions
 from gamespec.lqgame.covariance import CONTROLLER, STOPPER, algorithm_2, gains_to_vector
 from gamespec.lqgame.scaling import ControllerScaling
 from gamespec.lqgame.solution import CovarianceOutcome, GameModel, MeanOutcome, fallback_mean

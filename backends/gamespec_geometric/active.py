@@ -17,7 +17,9 @@ Two methods for each strategy:
   meet inside all other disks, lies on the diagram edge between cells ``i`` and ``k``; so ``i`` and
   ``k`` are active when their common circle crosses that edge. With no vertex at all the boundary
   is one whole circle, that of the pursuer with the least ``|p_i - e| / (u_i + v)`` (Lemma 2), which
-  is always active.
+  is always active. Pursuers of one speed on one circle (the natural encirclement) or on one line,
+  and teams of fewer than four, have dual points spanning no volume; their envelope is read from a
+  2-D hull, still ``O(n log n)``. Coincident pursuers share one dual point, hence one status.
 * PP, ``reference``: :func:`active_polygons_clipped` clips every edge of every refined curve
   (polygons from :func:`~gamespec_geometric.apollonius.refined_pp_polygons`) against all other
   curves, ``O(n**2 K**2)``.
@@ -47,7 +49,8 @@ from gamespec_geometric.apollonius import (
 
 Strategy = Literal["cb", "pp"]
 Method = Literal["fast", "reference"]
-_ROUND_OFF = 1e-12
+ROUND_OFF = 1e-12
+_FLAT = 1e-12
 
 
 def _segments_meet_circles(ends: np.ndarray, centers: np.ndarray, radii: np.ndarray) -> np.ndarray:
@@ -108,40 +111,130 @@ def _nearest_capture(circles: ApolloniusCircles, evader: np.ndarray) -> int:
 
 
 def active_cb_lifted(circles: ApolloniusCircles, evader: np.ndarray) -> np.ndarray:
-    """Active pursuers (CB) from the lower convex hull of the lifted disks, ``O(n log n)``.
+    """Active pursuers (CB) from the lower envelope of the lifted disks, ``O(n log n)``.
 
-    See the module docstring. Fewer than four disks, and configurations whose dual points span no
-    volume (all coplanar, as for co-circular or collinear pursuers of equal speed), go to :func:`aapc`.
+    See the module docstring. Coincident circles share one dual point and one status. When the dual
+    points span no volume (fewer than four circles; co-circular or collinear pursuers of one speed)
+    the envelope is read from a 2-D hull instead (:func:`_flat_envelope_edges`).
     """
-    if len(circles.radii) < 4:
-        return aapc(circles)
-    n = len(circles.radii)
     centers = circles.centers - evader
     radii = circles.radii
     scale = float(np.max(np.abs(centers)) + np.max(radii))
     centers, radii = centers / scale, radii / scale
     lifted = np.column_stack([2 * centers, radii**2 - np.sum(centers**2, axis=1)])
-    try:
-        hull = ConvexHull(lifted)
-    except QhullError:
-        return aapc(circles)
-    a, b, start, step, end = _farthest_power_edges(hull, centers)
+    dual, first, inverse = np.unique(lifted, axis=0, return_index=True, return_inverse=True)
+    a, b, start, step, end = _envelope_edges(dual)
+    crosses = _circle_crosses_edge(centers[first[a]], radii[first[a]], start, step, end)
+    status = np.zeros(len(dual), dtype=bool)
+    status[a[crosses]] = True
+    status[b[crosses]] = True
+    status[inverse.ravel()[_nearest_capture(circles, evader)]] = True
+    return status[inverse.ravel()]
 
-    # Does circle a (equivalently b: equal power on the edge) cross the edge start + s step, 0 <= s <= end?
-    offset = start - centers[a]
-    power0 = np.sum(offset**2, axis=1) - radii[a] ** 2
+
+def _circle_crosses_edge(
+    centers: np.ndarray, radii: np.ndarray, start: np.ndarray, step: np.ndarray, end: np.ndarray
+) -> np.ndarray:
+    """Whether each circle meets its diagram edge ``start + s step``, ``0 <= s <= end``.
+
+    The power ``|X - c|**2 - R**2`` is a quadratic in ``s``; the circle meets the edge when its least
+    value on the edge is not positive and its largest (at an end) not negative.
+    """
+    offset = start - centers
+    power0 = np.sum(offset**2, axis=1) - radii**2
     slope = np.sum(offset * step, axis=1)
     curvature = np.sum(step**2, axis=1)
     s = np.clip(-slope / np.maximum(curvature, np.finfo(float).tiny), 0.0, end)
     lowest = power0 + 2 * s * slope + s**2 * curvature
     power1 = np.where(np.isfinite(end), power0 + 2 * slope + curvature, np.inf)
-    crosses = (lowest <= _ROUND_OFF) & (np.maximum(power0, power1) >= -_ROUND_OFF)
+    return (lowest <= ROUND_OFF) & (np.maximum(power0, power1) >= -ROUND_OFF)
 
-    status = np.zeros(n, dtype=bool)
-    status[a[crosses]] = True
-    status[b[crosses]] = True
-    status[_nearest_capture(circles, evader)] = True
-    return status
+
+_Edges = tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray]
+
+
+def _envelope_edges(dual: np.ndarray) -> _Edges:
+    """Edges ``(a, b, start, step, end)`` of the farthest-power diagram of distinct dual points.
+
+    The lower convex hull in 3-D when the points span a volume; otherwise the flat case.
+    """
+    if len(dual) >= 4:
+        spread = np.linalg.svd(dual - dual.mean(axis=0), compute_uv=False)
+        if spread[2] > _FLAT * spread[0]:
+            try:
+                return _farthest_power_edges(ConvexHull(dual), dual[:, :2] / 2)
+            except QhullError:
+                pass
+    return _flat_envelope_edges(dual)
+
+
+def _flat_envelope_edges(dual: np.ndarray) -> _Edges:
+    """Diagram edges when the dual points ``q_i = (x_i, z_i)`` (``x_i = 2 c_i``) span no volume.
+
+    The envelope is ``min_i x_i . X + z_i``. If the ``x_i`` span the plane, the points lie on a
+    plane ``z = alpha . x + beta``, so the envelope is ``beta + min_i x_i . (X + alpha)``: its cells
+    are wedges from the apex ``-alpha``, one per vertex of the 2-D hull of the ``x_i``, split by
+    rays along the inward normals of the hull edges. If the ``x_i`` are collinear along ``d``, the
+    envelope depends on ``d . X`` only: the lower hull of the points ``(d . x_i, z_i)`` orders its
+    cells, slabs split by whole lines (two rays each). On the edge between cells ``a`` and ``b``,
+    ``(x_a - x_b) . X = z_b - z_a``; each edge starts at the point of that line nearest the apex.
+    """
+    x, z = dual[:, :2], dual[:, 2]
+    if len(dual) < 2:
+        return _no_edges()
+    spread, axes = np.linalg.svd(x - x.mean(axis=0), full_matrices=False)[1:]
+    if spread[0] == 0:
+        return _no_edges()
+    if len(dual) == 2 or spread[1] <= _FLAT * spread[0]:
+        t = x @ axes[0]
+        order = np.lexsort((z, t))
+        order = order[np.r_[True, t[order][1:] != t[order][:-1]]]
+        chain = order[_lower_chain(t[order], z[order])]
+        a, b = np.repeat(chain[:-1], 2), np.repeat(chain[1:], 2)
+        apex = np.zeros(2)
+        normal = x[a] - x[b]
+        side = np.tile([1.0, -1.0], len(chain) - 1)[:, None]
+        inward = side * np.column_stack([-normal[:, 1], normal[:, 0]])
+    else:
+        alpha = np.linalg.lstsq(np.column_stack([x, np.ones(len(x))]), z, rcond=None)[0][:2]
+        apex = -alpha
+        ring = _convex_hull_ccw(x)
+        a, b = ring, np.roll(ring, -1)
+        normal = x[a] - x[b]
+        inward = np.column_stack([normal[:, 1], -normal[:, 0]])
+    length2 = np.sum(normal**2, axis=1)
+    start = apex + normal * ((z[b] - z[a] - normal @ apex) / length2)[:, None]
+    step = inward / np.sqrt(length2)[:, None]
+    return a, b, start, step, np.full(len(a), np.inf)
+
+
+def _no_edges() -> _Edges:
+    """One cell covers the plane: the diagram has no edge."""
+    empty = np.zeros(0, dtype=int)
+    return empty, empty, np.zeros((0, 2)), np.zeros((0, 2)), np.zeros(0)
+
+
+def _lower_chain(t: np.ndarray, z: np.ndarray) -> np.ndarray:
+    """Strict vertices of the lower convex hull of points sorted by ``t`` (Andrew's monotone chain)."""
+    chain: list[int] = []
+    ts, zs = t.tolist(), z.tolist()
+    for k in range(len(ts)):
+        while len(chain) >= 2:
+            i, j = chain[-2], chain[-1]
+            if (ts[j] - ts[i]) * (zs[k] - zs[i]) - (zs[j] - zs[i]) * (ts[k] - ts[i]) > 0:
+                break
+            chain.pop()
+        chain.append(k)
+    return np.array(chain, dtype=int)
+
+
+def _convex_hull_ccw(points: np.ndarray) -> np.ndarray:
+    """Strict vertices of the 2-D convex hull, counter-clockwise (lower chain, then upper chain)."""
+    order = np.lexsort((points[:, 1], points[:, 0]))
+    sorted_points = points[order]
+    lower = _lower_chain(sorted_points[:, 0], sorted_points[:, 1])
+    upper = _lower_chain(-sorted_points[::-1, 0], -sorted_points[::-1, 1])
+    return np.concatenate([order[lower[:-1]], order[::-1][upper[:-1]]])
 
 
 def _farthest_power_edges(
@@ -156,7 +249,7 @@ def _farthest_power_edges(
     listed once per lower facet that holds it.
     """
     normals = hull.equations[:, :3]
-    lower = normals[:, 2] < -_ROUND_OFF
+    lower = normals[:, 2] < -ROUND_OFF
     vertex = np.zeros((len(normals), 2))
     vertex[lower] = normals[lower, :2] / normals[lower, 2:3]
     facets = np.flatnonzero(lower)

@@ -15,12 +15,14 @@ way the pair realizing the current shortest time stays assigned (Lemmas 5 and 7)
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Literal
 
 import numpy as np
 
 from gamespec_geometric.active import Method, Strategy, active_in, capture_regions
+from gamespec_geometric.active_many import active_cb_many
 
 Algorithm = Literal["avaa", "a2"]
 UNASSIGNED = -1
@@ -60,18 +62,59 @@ def allocate(
     samples: int = 64,
     max_rounds: int | None = None,
 ) -> Allocation:
-    """Run AVAA or A2 to the final allocation ``F`` (steps (a)–(c) of §3.4)."""
-    n, m = len(pursuers), len(evaders)
+    """Run AVAA or A2 to the final allocation ``F`` (steps (a)–(c) of §3.4).
+
+    The fast CB check runs on all evaders at once (:func:`~gamespec_geometric.active_many.active_cb_many`);
+    PP and the reference check go one evader at a time.
+    """
     cost = tie_break_cost(pursuers, evaders, pursuer_speeds, evader_speeds, algorithm)
+    if strategy == "cb" and method == "fast":
+        check = _all_at_once(pursuers, evaders, pursuer_speeds, evader_speeds)
+    else:
+        check = _one_by_one(pursuers, evaders, pursuer_speeds, evader_speeds, strategy, method, samples)
+    return _iterate(cost, check, max_rounds or len(pursuers) + 1)
+
+
+def _all_at_once(
+    pursuers: np.ndarray, evaders: np.ndarray, pursuer_speeds: np.ndarray, evader_speeds: np.ndarray
+) -> Callable[[np.ndarray], np.ndarray]:
+    """Active sets ``(m, n)`` among candidates (CB, fast), batched over the evaders whose candidates
+    changed since the last round."""
+    seen = np.zeros((len(evaders), len(pursuers)), dtype=bool)
+    initial = np.zeros_like(seen)
+    first = [True]
+
+    def check(candidates: np.ndarray) -> np.ndarray:
+        changed = np.flatnonzero(np.any(candidates != seen, axis=1) | first[0])
+        first[0] = False
+        seen[changed] = candidates[changed]
+        initial[changed] = active_cb_many(
+            pursuers, evaders[changed], pursuer_speeds, evader_speeds[changed], candidates[changed]
+        )
+        return initial.copy()
+
+    return check
+
+
+def _one_by_one(
+    pursuers: np.ndarray,
+    evaders: np.ndarray,
+    pursuer_speeds: np.ndarray,
+    evader_speeds: np.ndarray,
+    strategy: Strategy,
+    method: Method,
+    samples: int,
+) -> Callable[[np.ndarray], np.ndarray]:
+    """Active sets ``(m, n)`` among candidates, one evader at a time, skipping unchanged evaders."""
+    m, n = len(evaders), len(pursuers)
     regions = [
         capture_regions(pursuers, evaders[j], pursuer_speeds, evader_speeds[j], strategy, samples)
         for j in range(m)
     ]
-    candidates = np.ones((m, n), dtype=bool)
     checked: list[np.ndarray | None] = [None] * m
     initial = np.zeros((m, n), dtype=bool)
-    chosen = np.full(n, UNASSIGNED)
-    for rounds in range(1, (max_rounds or n + 1) + 1):
+
+    def check(candidates: np.ndarray) -> np.ndarray:
         for j in range(m):
             members = np.flatnonzero(candidates[j])
             if len(members) and method == "fast":
@@ -82,6 +125,18 @@ def allocate(
             initial[j] = False
             if len(members):
                 initial[j, members] = active_in(regions[j].take(members), method)
+        return initial.copy()
+
+    return check
+
+
+def _iterate(cost: np.ndarray, check: Callable[[np.ndarray], np.ndarray], max_rounds: int) -> Allocation:
+    """Steps (a)–(c) of §3.4 on the ``(n, m)`` tie-break cost, given the active-set check."""
+    n, m = cost.shape
+    candidates = np.ones((m, n), dtype=bool)
+    chosen = np.full(n, UNASSIGNED)
+    for rounds in range(1, max_rounds + 1):
+        initial = check(candidates)
         shared = initial.sum(axis=0)
         chosen = np.where(shared > 0, np.argmin(np.where(initial.T, cost, np.inf), axis=1), UNASSIGNED)
         if shared.max(initial=0) <= 1:

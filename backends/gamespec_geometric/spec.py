@@ -22,11 +22,13 @@ from pydantic import (
 )
 
 from gamespec.errors import ExpressionError, SpecError
-from gamespec.specs.base import Number, SpecBase, StrictModel
+from gamespec.limits import MAX_SIMULATION_VALUES
+from gamespec.specs.base import Coordinate, Number, SpecBase, Speed, StrictModel
 from gamespec.symbolic.language import parse
 
-Position = tuple[Number, Number]
+Position = tuple[Coordinate, Coordinate]
 PositiveFloat = Annotated[Number, Field(gt=0)]
+PositiveSpeed = Annotated[Speed, Field(gt=0)]
 
 
 def _constant(value: object) -> object:
@@ -91,7 +93,7 @@ class Team(StrictModel):
 
     role: ClassVar[str]
     positions: list[Position]
-    speed: PositiveFloat | list[PositiveFloat]
+    speed: PositiveSpeed | list[PositiveSpeed]
 
     @field_validator("positions")
     @classmethod
@@ -120,7 +122,7 @@ class PursuerTeam(Team):
     """Pursuer positions, speeds and pursuit strategy."""
 
     role: ClassVar[str] = "pursuer"
-    speed: PositiveFloat | list[PositiveFloat] = 1.0
+    speed: PositiveSpeed | list[PositiveSpeed] = 1.0
     strategy: Literal["cb", "pp"] = "cb"
 
 
@@ -128,7 +130,7 @@ class EvaderTeam(Team):
     """Evader positions, speeds and strategies (one for all or one each)."""
 
     role: ClassVar[str] = "evader"
-    speed: PositiveFloat | list[PositiveFloat] = 0.6
+    speed: PositiveSpeed | list[PositiveSpeed] = 0.6
     strategy: EvaderStrategy | list[EvaderStrategy] = Field(default_factory=PureEvasion)
 
     def strategies(self) -> list[FixedHeading | PureEvasion | BlindEvasion]:
@@ -183,6 +185,15 @@ class PursuitScenarioSpec(SpecBase):
         self._check_distinct()
         if self.time_step > self.horizon:
             raise SpecError("time_step must not exceed the horizon", field="time_step")
+        recorded = (self.horizon / self.time_step + 1) * (
+            len(self.pursuers.positions) + len(self.evaders.positions)
+        )
+        if recorded > MAX_SIMULATION_VALUES:
+            raise SpecError(
+                f"horizon / time_step × players = {recorded:.3g} recorded positions exceed the limit of "
+                f"{MAX_SIMULATION_VALUES}: take a longer time_step or a shorter horizon",
+                field="time_step",
+            )
         return self
 
     def _check_distinct(self) -> None:

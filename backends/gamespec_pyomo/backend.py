@@ -18,17 +18,19 @@ from pathlib import Path
 from typing import Any, ClassVar, Literal
 
 import numpy as np
-from pydantic import Field
+from pydantic import Field, ValidationInfo, field_validator
 
 from gamespec.backend import Availability, Inputs
+from gamespec.backend.collocation import CollocationBackend, CollocationModel
 from gamespec.errors import BackendError
-from gamespec.ocp.transcription import Bounds, CollocationBackend, CollocationModel, Transcription
+from gamespec.ocp.transcription import Bounds, Transcription
 from gamespec.result import Result
 from gamespec.specs.base import StrictModel
 from gamespec.specs.ocp import OptimalControlSpec
 from gamespec_pyomo.model import build_model
 from gamespec_pyomo.solvers import (
     PRINT_LEVEL,
+    check_options,
     find_executable,
     iterations_in,
     pyomo_solver,
@@ -50,6 +52,14 @@ class PyomoOptions(StrictModel):
         default_factory=dict, description="Further solver options (key=value on its command line)."
     )
     warm_start: bool = Field(True, description="Re-solves start from the previous solution.")
+
+    @field_validator("options")
+    @classmethod
+    def _listed_by_the_solver(cls, options: dict[str, Any], info: ValidationInfo) -> dict[str, Any]:
+        """Every option is one the executable lists (ripopt would ignore an unknown one)."""
+        if options and "solver" in info.data:
+            check_options(info.data["solver"], options)
+        return options
 
 
 def _bound(value: float) -> float | None:

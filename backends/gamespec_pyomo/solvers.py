@@ -7,11 +7,14 @@ executable on PATH when there is one and the bundled ``ripopt`` otherwise.
 
 from __future__ import annotations
 
+import difflib
 import importlib.util
 import os
 import re
 import shutil
+import subprocess
 from dataclasses import dataclass
+from functools import cache
 from importlib.metadata import PackageNotFoundError, version
 from pathlib import Path
 from typing import Any
@@ -26,8 +29,8 @@ STATUS_MAP: dict[str, Status] = {
     "locallyOptimal": Status.OPTIMAL,
     "globallyOptimal": Status.OPTIMAL,
     "feasible": Status.FEASIBLE,
-    "infeasible": Status.INFEASIBLE,
-    "locallyInfeasible": Status.INFEASIBLE,
+    "infeasible": Status.LOCALLY_INFEASIBLE,
+    "locallyInfeasible": Status.LOCALLY_INFEASIBLE,
     "unbounded": Status.UNBOUNDED,
     "maxIterations": Status.ITERATION_LIMIT,
     "maxEvaluations": Status.ITERATION_LIMIT,
@@ -36,7 +39,9 @@ STATUS_MAP: dict[str, Status] = {
     "solverFailure": Status.ERROR,
     "error": Status.ERROR,
 }
-"""Pyomo's ``TerminationCondition`` (read from the SOL file's solve code) → gamespec's Status."""
+"""Pyomo's ``TerminationCondition`` (read from the SOL file's solve code) → gamespec's Status. Both
+executables are local interior-point solvers: what the SOL file calls infeasible is a converged point
+of local infeasibility, so it is ``locally_infeasible``, never a proof that no solution exists."""
 
 PRINT_LEVEL = {"ripopt": 1, "ipopt": 3}
 """The lowest print level at which each executable still reports its iteration count."""
@@ -91,6 +96,42 @@ def find_executable(choice: str = "auto") -> Executable:
         }
         raise BackendError(why[choice])
     return exe
+
+
+_LISTED_OPTION = {
+    "ripopt": re.compile(r"^\s+([a-z][a-z0-9_]*)=<", re.MULTILINE),
+    "ipopt": re.compile(r"^([a-z][a-z0-9_]*)\s", re.MULTILINE),
+}
+_LIST_FLAG = {"ripopt": "--help", "ipopt": "-="}
+
+
+@cache
+def option_names(exe: Executable) -> frozenset[str]:
+    """The options ``exe`` takes as ``key=value``, as it lists them itself (ripopt's ``--help``,
+    the AMPL ``-=`` listing of Ipopt's executable); empty when it lists none."""
+    try:
+        listing = subprocess.run(
+            [exe.path, _LIST_FLAG[exe.name]], capture_output=True, text=True, timeout=30, check=False
+        )
+    except (OSError, subprocess.SubprocessError):
+        return frozenset()
+    return frozenset(_LISTED_OPTION[exe.name].findall(listing.stdout + listing.stderr))
+
+
+def check_options(choice: str, options: dict[str, Any]) -> None:
+    """ValueError naming the first of ``options`` that the executable for ``choice`` does not list
+    (with the nearest name it does), so that no option is silently ignored; nothing to check when
+    there is no executable (the solve then says why)."""
+    try:
+        exe = find_executable(choice)
+    except BackendError:
+        return
+    names = option_names(exe)
+    for key in options:
+        if names and key not in names:
+            near = difflib.get_close_matches(key, names, n=1)
+            hint = f"; did you mean {near[0]!r}?" if near else ""
+            raise ValueError(f"{exe.name} has no option {key!r}{hint}")
 
 
 def pyomo_solver(exe: Executable) -> Any:

@@ -1,12 +1,12 @@
 """Figures of desensitized Results (chapter 6): the nominal path with the Monte Carlo bundle
 (Figs. 6.1(c), 6.2(a), 6.4), the sensitivity trajectories S(t) (Fig. 6.1(b)), and the trade-off of
 the original cost against the sensitivity measure across a sweep of the weight (Fig. 6.3(b)).
-Plots read Results (or a sweep folder's saved rows) only.
+Plots read Results (or the rows a sweep saved) only.
 """
 
 from __future__ import annotations
 
-import json
+from collections.abc import Iterable, Mapping
 from pathlib import Path
 from typing import Any
 
@@ -80,21 +80,17 @@ def plot_desensitized(result: Result, output_dir: Path) -> list[Path]:
     return paths
 
 
-def sweep_rows(folder: Path) -> list[dict[str, Any]]:
-    """The saved rows of a sweep folder (``points/*.json``) that carry desensitization metrics."""
-    rows = []
-    for path in sorted((folder / "points").glob("*.json")):
-        value = json.loads(path.read_text())["value"]
-        if "nominal_objective" in value.get("metrics", {}):
-            rows.append(value)
-    return rows
+def desensitized_rows(values: Iterable[Mapping[str, Any]]) -> list[Mapping[str, Any]]:
+    """The rows of a sweep (its points' saved values) that carry desensitization metrics."""
+    return [value for value in values if "nominal_objective" in value.get("metrics", {})]
 
 
-def plot_tradeoff(folder: Path, output_dir: Path) -> list[Path]:
-    """Original cost against the sensitivity measure, one point per swept value (Fig. 6.3(b))."""
-    rows = sweep_rows(folder)
+def plot_tradeoff(values: Iterable[Mapping[str, Any]], output_dir: Path) -> list[Path]:
+    """Original cost against the sensitivity measure, one point per swept value (Fig. 6.3(b)),
+    from a sweep's rows (:meth:`gamespec.studies.store.ResultStore.items`)."""
+    rows = desensitized_rows(values)
     if not rows:
-        raise GamespecError(f"{folder}: the sweep holds no solved desensitized points to plot")
+        raise GamespecError("the sweep holds no solved desensitized points to plot")
     plt = _pyplot()
     name = next(iter(rows[0]))  # a sweep row starts with its parameter values
     rows.sort(key=lambda r: r.get(name, 0.0))

@@ -22,8 +22,8 @@ import numpy as np
 from scipy.linalg import sqrtm
 
 from gamespec.best_response import BestResponseRun, Response, Settings, VectorPlayer, iterate
-from gamespec.lqgame.game import LQGame
 from gamespec.lqgame.lifting import Lifted
+from gamespec.specs.lq_model import LQGame
 
 
 def _blocks(M: np.ndarray, rows: int, cols: int, N: int) -> np.ndarray:

@@ -13,7 +13,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.linalg import block_diag, sqrtm
 
-from gamespec.lqgame.game import LQGame
+from gamespec.specs.lq_model import LQGame
 
 
 @dataclass(frozen=True)

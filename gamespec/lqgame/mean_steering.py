@@ -14,8 +14,8 @@ from functools import cached_property
 
 import numpy as np
 
-from gamespec.lqgame.game import LQGame
 from gamespec.lqgame.lifting import Lifted
+from gamespec.specs.lq_model import LQGame
 
 
 @dataclass(frozen=True)

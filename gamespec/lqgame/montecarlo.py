@@ -12,8 +12,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from gamespec.lqgame.game import LQGame, Strategies
 from gamespec.montecarlo import MultivariateNormal, Normal, sample
+from gamespec.specs.lq_model import LQGame, Strategies
 
 
 def simulate(game: LQGame, strategies: Strategies, samples: int, seed: int = 0) -> np.ndarray:

@@ -3,7 +3,7 @@
 A backend supplies the mean steering solution (a QP, section 4.3) and the covariance gains
 (eq. 4.59 or Algorithm 2, section 4.4); :func:`assemble` joins them by Props. 7–8
 (``U = Ū + K y``), recomputes the terminal statistics, the closed-form gap, the Monte Carlo check,
-and packs the Result. :mod:`gamespec.lqgame.backend` drives these steps for every backend.
+and packs the Result. :mod:`gamespec.backend.lq` drives these steps for every backend.
 """
 
 from __future__ import annotations
@@ -14,11 +14,11 @@ import numpy as np
 
 from gamespec.lqgame.checks import Assumptions, check_assumptions
 from gamespec.lqgame.covariance import CovarianceGame, vector_to_gains
-from gamespec.lqgame.game import LQGame, Strategies
 from gamespec.lqgame.lifting import Lifted, lift
 from gamespec.lqgame.mean_steering import MeanGame
 from gamespec.lqgame.montecarlo import agreement, simulate
 from gamespec.result import Result, Status
+from gamespec.specs.lq_model import LQGame, Strategies
 
 
 @dataclass

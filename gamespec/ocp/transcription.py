@@ -8,22 +8,19 @@ inputs ``Win`` (n_w × n_eval) are data at the evaluation points, where the cont
 
 from __future__ import annotations
 
-from abc import abstractmethod
 from collections.abc import Mapping
 from dataclasses import dataclass
 from functools import cached_property
-from typing import Any, ClassVar
+from typing import Any
 
 import numpy as np
 
-from gamespec.backend import Backend, CompiledModel, Inputs
 from gamespec.errors import SpecError
 from gamespec.ocp.checks import Trajectory, control_basis, solution_checks, verdicts
 from gamespec.ocp.collocation import Grid
 from gamespec.ocp.inputs import InputGrid, InputValue, on_grid
 from gamespec.ocp.symbolic import SymbolicOcp
 from gamespec.result import Result, Status
-from gamespec.specs.base import SpecBase
 from gamespec.specs.ocp import NORMALIZED_TIME, OptimalControlSpec, bounds_midpoint
 from gamespec.symbolic.language import ExpressionError, parse, symbol
 from gamespec.symbolic.translate import NUMPY, translate
@@ -51,74 +48,6 @@ class Guess:
     U: np.ndarray
     T: float
     d: np.ndarray
-
-
-NLP_OPTIONS = "nlp"
-"""The ``solver.options`` block every collocation backend reads: IPOPT options by IPOPT's names
-(``tol``, ``max_iter``, ``max_wall_time``, ``mu_strategy`` ...), given once for casadi and pyomo."""
-
-
-class CollocationBackend(Backend):
-    """Base of the backends that solve ``optimal_control`` specs by direct collocation of a
-    :class:`Transcription` (the same kinds and features for each of them). ``solver.options.nlp``
-    holds IPOPT options for all of them: those the backend's options block names (``tol``,
-    ``max_iter``, ``max_wall_time``) set that field, the rest go to its pass-through block
-    (``nlp_field``); the backend's own block overrides either."""
-
-    nlp_field: ClassVar[str] = ""
-
-    kinds: ClassVar[frozenset[str]] = frozenset({"optimal_control"})
-    features: ClassVar[frozenset[str]] = frozenset(
-        {
-            "ode",
-            "free_final_time",
-            "path_constraints",
-            "boundary_constraints",
-            "grid_inputs",
-            "design_parameters",
-            "integral_constraints",
-        }
-    )
-
-    def shared_options(self, spec: SpecBase) -> dict[str, Any]:
-        nlp = dict(spec.solver.options.get(NLP_OPTIONS, {}))
-        own = spec.solver.options.get(self.name, {})
-        named = {
-            k: nlp.pop(k) for k in list(nlp) if k in self.options_model.model_fields and k != self.nlp_field
-        }
-        if nlp:
-            named[self.nlp_field] = {**nlp, **own.get(self.nlp_field, {})}
-        return named
-
-
-class CollocationModel(CompiledModel):
-    """A compiled model of a :class:`Transcription` (``tr``), re-solvable with new grid inputs."""
-
-    tr: Transcription
-
-    def input_grid(self, parameters: Mapping[str, float] | None = None) -> InputGrid:
-        """Where ``solve(inputs=...)`` expects its values (see :meth:`Transcription.input_grid`)."""
-        return self.tr.input_grid(parameters)
-
-    options: Any
-
-    def solve(
-        self, parameters: dict[str, float] | None = None, guess: Result | None = None, inputs: Inputs = None
-    ) -> Result:
-        """One solve on this mesh, then adaptive refinement when ``method.refine`` asks for it
-        (:mod:`gamespec.ocp.refinement`)."""
-        result = self.solve_once(parameters, guess, inputs)
-        if self.tr.spec.method.refine is None:
-            return result
-        from gamespec.ocp.refinement import refined
-
-        return refined(self, result, parameters, inputs)
-
-    @abstractmethod
-    def solve_once(
-        self, parameters: dict[str, float] | None = None, guess: Result | None = None, inputs: Inputs = None
-    ) -> Result:
-        """Solve on this model's mesh."""
 
 
 class Transcription:
@@ -211,7 +140,8 @@ class Transcription:
             try:
                 previous = Result.load(self.spec.guess.result)
             except SpecError as err:
-                raise SpecError(err.reason, field="guess.result", source=self.spec.source) from None
+                reason = f"{err.source}: {err.reason}"
+                raise SpecError(reason, field="guess.result", source=self.spec.source) from None
         if previous is not None and previous.time is not None and previous.states:
             return self._guess_from_result(previous)
         *_, tf_guess = self.ocp.final_time(params)

@@ -8,6 +8,7 @@ the first time an active pursuer is within the capture radius (Definition 1).
 
 from __future__ import annotations
 
+import math
 from collections.abc import Callable
 from dataclasses import dataclass
 
@@ -79,11 +80,15 @@ def pursuer_velocities(players: Players, P: np.ndarray, E: np.ndarray, theta_E: 
     PP: θ_i = φ_i. CB: u_i sin(θ_i − φ_i) = v sin(θ_E − φ_i) with cos(θ_i − φ_i) > 0, so that the
     distance decreases (eq. 3.3). Stationary: at rest.
     """
-    phi = line_of_sight_angles(P, E)
-    speeds = players.speeds
-    cb = np.array([s == "cb" for s in players.strategies])
-    heading = np.where(cb, constant_bearing_headings(phi, speeds, players.v, theta_E), phi)
-    return speeds[:, None] * np.column_stack([np.cos(heading), np.sin(heading)])
+    sight = E - P
+    distance = np.hypot(sight[:, 0], sight[:, 1])
+    along = sight / np.where(distance > 0, distance, 1.0)[:, None]
+    if "cb" in players.strategies:
+        cb = np.array([s == "cb" for s in players.strategies])
+        phi = np.arctan2(sight[:, 1], sight[:, 0])
+        heading = constant_bearing_headings(phi, players.speeds, players.v, theta_E)
+        along = np.where(cb[:, None], np.column_stack([np.cos(heading), np.sin(heading)]), along)
+    return players.speeds[:, None] * along
 
 
 @dataclass(frozen=True)
@@ -127,8 +132,10 @@ def simulate(
     def rhs(t: float, z: np.ndarray) -> np.ndarray:
         P, E = unpack(z)
         theta_E = law(t, P, E)
-        vel_E = players.v * np.array([np.cos(theta_E), np.sin(theta_E)])
-        return np.concatenate([pursuer_velocities(players, P, E, theta_E).ravel(), vel_E])
+        rate = np.empty_like(z)
+        rate[: 2 * n] = pursuer_velocities(players, P, E, theta_E).ravel()
+        rate[2 * n :] = players.v * math.cos(theta_E), players.v * math.sin(theta_E)
+        return rate
 
     def capture(t: float, z: np.ndarray) -> float:
         P, E = unpack(z)

@@ -7,7 +7,8 @@ For each evader speed v, r1(0) = r1 and u1 = u2 = u, a grid of non-degenerate in
 - r2(0) at ``grid.fractions`` points (k + ½)/fractions of the way from the curve F (eq. 2.6) to the
   ellipse E (§2.3.2) along the ray from E at angle ψ(0): the region N of that ray.
 
-Each point: t_c of the suboptimal heading (true dynamics simulated, eq. 2.1), and the optimal t_c of
+Each point: t_c of the suboptimal heading (true dynamics eq. 2.1 in closed form: the pursuit curve
+of :mod:`~gamespec.pursuit.pursuit_curve`), and the optimal t_c of
 the generated eq. 2.21 OCP, compiled once per speed and re-solved with the point's r2(0), ψ(0) and
 the simulated suboptimal path as initial guess. A solution whose re-integrated defect exceeds
 ``DEFECT_TOL`` (the grid too coarse near capture, or the solver exploiting it, which happens for a
@@ -21,19 +22,11 @@ from __future__ import annotations
 import hashlib
 import json
 from dataclasses import dataclass
-from functools import cache
 from typing import Any
 
 import numpy as np
 
-from gamespec.pursuit import pure_pursuit
-from gamespec.pursuit.ocp_generation import to_ocp, trajectory_guess
-from gamespec.pursuit.ocp_report import heading_law
-from gamespec.pursuit.reduced import reduce
 from gamespec.pursuit.regions import classify
-from gamespec.pursuit.report import capture_gap
-from gamespec.pursuit.simulation import Players, simulate_to_capture
-from gamespec.result import Result
 from gamespec.specs.engagement import EngagementSpec
 from gamespec.specs.suboptimal_study import SuboptimalStudySpec
 
@@ -109,61 +102,6 @@ def point_engagement(point: StudyPoint) -> EngagementSpec:
             "method": json.loads(point.methods[0]),
         }
     )
-
-
-@cache
-def _model(v: float, r1: float, u: float, eps: float, method: str, backend: str):
-    """The eq. 2.21 OCP of one speed, compiled once per process (P2 far away only sets the bounds)."""
-    from gamespec.solving import get_backend
-
-    reference = StudyPoint(v, 10 * r1, 0.5 * np.pi, r1, u, eps, (method,), backend)
-    ocp, _ = to_ocp(point_engagement(reference))
-    solver = get_backend(backend)
-    return solver.compile(ocp)
-
-
-def _first_accepted(point: StudyPoint, parameters: dict[str, float], guess: Result) -> tuple[int, Result]:
-    """Solve with each of the point's methods in turn; the first that passes the defect check (or
-    the last one tried) and its index."""
-    for attempt, method in enumerate(point.methods):
-        model = _model(point.v, point.r1, point.u, point.eps, method, point.backend)
-        result = model.solve(parameters=parameters, guess=guess)
-        if result.ok and result.checks["max_defect"] < DEFECT_TOL:
-            return attempt, result
-    return len(point.methods) - 1, result
-
-
-def evaluate(point: StudyPoint) -> dict[str, Any]:
-    """Suboptimal and optimal capture times of one point (the row the store keeps)."""
-    spec = point_engagement(point)
-    players = Players.from_spec(spec)
-    red = reduce(spec)
-    choice = pure_pursuit.suboptimal_heading(players)
-    traj = simulate_to_capture(players, choice.heading)
-    guess = trajectory_guess(red, traj)
-    parameters = {k: red.parameters[k] for k in ("r2_init", "psi_init")}
-    attempt, result = _first_accepted(point, parameters, guess)
-    row: dict[str, Any] = {
-        "v": point.v,
-        "r2": point.r2,
-        "psi": point.psi,
-        "status": result.status.value,
-        "t_suboptimal": traj.capture_time,
-        "heading_suboptimal": choice.heading,
-        "solve_time_s": result.solve_time_s,
-        "attempt": attempt,
-        "max_defect": result.checks.get("max_defect"),
-    }
-    if not (result.ok and row["max_defect"] < DEFECT_TOL):
-        return row
-    terminal = np.array([result.states[red.distance[i]][-1] for i in (0, 1)])
-    check = simulate_to_capture(players, heading_law(red, result))
-    return row | {
-        "t_optimal": result.t_final,
-        "variation_percent": 100.0 * (result.t_final - traj.capture_time) / result.t_final,
-        "simultaneous_capture_gap": capture_gap(players, terminal),
-        "resimulated_capture_time_error": abs(check.capture_time - result.t_final),
-    }
 
 
 def summarize(rows: list[dict[str, Any]]) -> list[dict[str, Any]]:

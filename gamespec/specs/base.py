@@ -6,9 +6,11 @@ dotted location and the nearest valid key (see :func:`gamespec.loader.format_val
 
 from __future__ import annotations
 
-from typing import Any, ClassVar
+from typing import Annotated, Any, ClassVar
 
 from pydantic import BaseModel, ConfigDict, Field, FiniteFloat, PrivateAttr, model_validator
+
+from gamespec.limits import MAX_COORDINATE, MAX_SPEED
 
 Number = FiniteFloat
 """A finite number: NaN and ±inf are refused at load, with the field named."""
@@ -17,6 +19,12 @@ Value = Number | str
 """A finite number, or an expression over the problem's parameters (each kind checks that the
 expression evaluates to a finite number)."""
 
+Coordinate = Annotated[Number, Field(ge=-MAX_COORDINATE, le=MAX_COORDINATE)]
+"""A position coordinate, finite and within :data:`~gamespec.limits.MAX_COORDINATE`."""
+
+Speed = Annotated[Number, Field(ge=0, le=MAX_SPEED)]
+"""A player's speed, finite, non-negative and within :data:`~gamespec.limits.MAX_SPEED`."""
+
 
 class StrictModel(BaseModel):
     """A pydantic model that rejects unknown keys and is immutable once built."""
@@ -24,11 +32,17 @@ class StrictModel(BaseModel):
     model_config = ConfigDict(extra="forbid", frozen=True, populate_by_name=True)
 
 
+NLP_OPTIONS = "nlp"
+"""The ``solver.options`` block that is not one backend's: IPOPT options by IPOPT's names (``tol``,
+``max_iter``, ``max_wall_time``, ``mu_strategy`` ...), given once for every collocation backend."""
+
+
 class SolverSection(StrictModel):
     """Which backend solves the problem, and the knobs of each backend (validated by the backend).
 
     ``options`` maps a backend name to that backend's own options block, so the same file can be
-    solved on several backends without re-typing anything.
+    solved on several backends without re-typing anything; ``options.nlp`` gives NLP (IPOPT) options
+    once to every collocation backend.
     """
 
     backend: str | None = Field(None, description="Backend name; the kind's default when omitted.")

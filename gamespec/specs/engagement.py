@@ -16,7 +16,7 @@ from typing import Literal
 import numpy as np
 from pydantic import Field, model_validator
 
-from gamespec.specs.base import Number, SpecBase, StrictModel
+from gamespec.specs.base import Coordinate, Number, SpecBase, Speed, StrictModel
 from gamespec.specs.ocp import MethodSpec
 
 Strategy = Literal["cb", "pp", "stationary"]
@@ -30,16 +30,16 @@ class PursuerSpec(StrictModel):
     """
 
     name: str = Field(description="Label used in reports and plots (P1, P2, ...).")
-    position: tuple[Number, Number]
-    speed: Number = Field(1.0, ge=0, description="Speed u_i; unused while the pursuer is stationary.")
+    position: tuple[Coordinate, Coordinate]
+    speed: Speed = Field(1.0, description="Speed u_i; unused while the pursuer is stationary.")
     strategy: Strategy = Field(description="cb (constant bearing), pp (pure pursuit) or stationary.")
 
 
 class EvaderSpec(StrictModel):
     """The evader: its initial position and speed v."""
 
-    position: tuple[Number, Number]
-    speed: Number = Field(gt=0)
+    position: tuple[Coordinate, Coordinate]
+    speed: Speed = Field(gt=0)
 
 
 class EngagementSpec(SpecBase):

@@ -9,7 +9,7 @@ terminal mean leaves that component free. A terminal covariance makes the file r
 that solve that SDP declare. Every matrix entry is a number or an expression over
 ``parameters``; a matrix is a list of rows, ``{diag: [...]}`` or ``{identity: scale}`` (square:
 n × n for ``A, B, C, D``, ``Q`` and the covariances, m × m for ``R``, ℓ × ℓ for ``S``).
-:meth:`LQGameSpec.game` evaluates all of it into an :class:`~gamespec.lqgame.game.LQGame`.
+:meth:`LQGameSpec.game` evaluates all of it into an :class:`~gamespec.specs.lq_model.LQGame`.
 """
 
 from __future__ import annotations
@@ -23,9 +23,10 @@ import sympy as sp
 from pydantic import Discriminator, Field, Tag, field_validator, model_validator
 
 from gamespec.errors import ExpressionError, SpecError
-from gamespec.lqgame.game import LQGame, zero_order_hold
+from gamespec.limits import MAX_INTERVALS, MAX_MAGNITUDE, MAX_SAMPLE_VALUES, MAX_SAMPLES
 from gamespec.specs.base import Number, ProblemParameters, SpecBase, StrictModel, Value
-from gamespec.symbolic.language import RESERVED, parse, symbol
+from gamespec.specs.lq_model import LQGame, zero_order_hold
+from gamespec.symbolic.language import RESERVED, float_value, parse, symbol
 
 
 class Diagonal(StrictModel):
@@ -121,7 +122,7 @@ class LQGameProblem(StrictModel):
     """The mathematics of the game."""
 
     parameters: dict[str, Number] = Field(default_factory=dict)
-    horizon: int = Field(ge=1, le=10_000, description="Number of steps N.")
+    horizon: int = Field(ge=1, le=MAX_INTERVALS, description="Number of steps N.")
     states: list[str] | None = Field(None, description="State names (default x1, x2, ...).")
     discrete: DiscreteModel | None = None
     continuous: ContinuousModel | None = None
@@ -156,7 +157,7 @@ class LQGameProblem(StrictModel):
 class MonteCarloSpec(StrictModel):
     """Closed-loop samples drawn after the solve (0 to skip)."""
 
-    samples: int = Field(100, ge=0, le=1_000_000)
+    samples: int = Field(100, ge=0, le=MAX_SAMPLES)
     seed: int = 0
 
 
@@ -187,6 +188,19 @@ class LQGameSpec(ProblemParameters, SpecBase):
     @model_validator(mode="after")
     def _evaluates(self) -> LQGameSpec:
         self.game()
+        return self
+
+    @model_validator(mode="after")
+    def _samples_fit(self) -> LQGameSpec:
+        """Monte Carlo samples times (horizon + 1) times states within
+        :data:`~gamespec.limits.MAX_SAMPLE_VALUES` (the memory the sampled trajectories take)."""
+        values = self.method.monte_carlo.samples * (self.problem.horizon + 1) * len(self.problem.initial.mean)
+        if values > MAX_SAMPLE_VALUES:
+            raise SpecError(
+                f"{values} sampled values exceed the limit of {MAX_SAMPLE_VALUES} (samples × (horizon + 1)"
+                " × states): draw fewer samples",
+                field="method.monte_carlo.samples",
+            )
         return self
 
     def required_features(self) -> frozenset[str]:
@@ -224,15 +238,15 @@ class _Evaluator:
         if not isinstance(value, str):
             return float(value)
         try:
-            number = parse(value, self.symbols).xreplace(self.substitution)
-            result = complex(number)
+            return float_value(parse(value, self.symbols).xreplace(self.substitution))
         except ExpressionError as err:
             raise SpecError(str(err), field=f"problem.{field}") from None
-        except (TypeError, ValueError):
-            raise SpecError(f"{value!r} does not evaluate to a number", field=f"problem.{field}") from None
-        if result.imag != 0 or not np.isfinite(result.real):
-            raise SpecError(f"{value!r} evaluates to {result}", field=f"problem.{field}")
-        return result.real
+        except OverflowError:
+            reason = f"{value!r} is out of range (beyond {MAX_MAGNITUDE:g})"
+            raise SpecError(reason, field=f"problem.{field}") from None
+        except (TypeError, ValueError, RecursionError):
+            reason = f"{value!r} does not evaluate to a real number"
+            raise SpecError(reason, field=f"problem.{field}") from None
 
     def vector(self, values: list[Value], field: str) -> np.ndarray:
         return np.array([self.scalar(v, f"{field}.{i}") for i, v in enumerate(values)])

@@ -19,6 +19,7 @@ from typing import Literal
 from pydantic import Field, field_validator, model_validator
 
 from gamespec.errors import ExpressionError, SpecError
+from gamespec.limits import MAX_INTERVALS
 from gamespec.specs.base import Number, ProblemParameters, SpecBase, StrictModel, Value
 from gamespec.specs.uncertainty import UncertainParameter
 from gamespec.symbolic.language import RESERVED, parse, parse_relation, symbol
@@ -446,7 +447,7 @@ class MethodSpec(StrictModel):
     """
 
     scheme: Literal["radau", "trapezoidal"] = "radau"
-    intervals: int = Field(40, ge=1, le=100_000)
+    intervals: int = Field(40, ge=1, le=MAX_INTERVALS)
     degree: int = Field(3, ge=1, le=12)
     grading: Number = Field(1.0, gt=0, le=1e4)
     mesh: list[Number] | None = Field(

@@ -11,8 +11,9 @@ from __future__ import annotations
 from pathlib import Path
 from typing import ClassVar, Literal
 
-from pydantic import Field, ValidationError, ValidationInfo, field_validator
+from pydantic import Field, ValidationError, ValidationInfo, field_validator, model_validator
 
+from gamespec.limits import MAX_STUDY_POINTS
 from gamespec.specs.base import Number, SpecBase, StrictModel
 from gamespec.specs.ocp import MethodSpec
 
@@ -54,6 +55,15 @@ class SuboptimalStudySpec(SpecBase):
     )
 
     default_backend: ClassVar[str] = "study"
+
+    @model_validator(mode="after")
+    def _grid_fits(self) -> SuboptimalStudySpec:
+        points = self.grid.angles * self.grid.fractions * len(self.speeds)
+        if points > MAX_STUDY_POINTS:
+            raise ValueError(
+                f"{points} grid points (angles × fractions × speeds) exceed the limit of {MAX_STUDY_POINTS}"
+            )
+        return self
 
     @field_validator("speeds")
     @classmethod

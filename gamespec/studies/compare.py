@@ -1,7 +1,8 @@
 """``gamespec compare``: one spec on several backends (and solvers), one row each.
 
 A backend that cannot take the problem (not installed, kind or feature missing) gets a row with
-its reason instead of stopping the study.
+its reason instead of stopping the study. With ``out``, each backend's Result is saved in its own
+folder and the rows go into the folder's study store (``gamespec results`` / ``plot`` read it).
 """
 
 from __future__ import annotations
@@ -18,6 +19,8 @@ from rich.table import Table
 
 from gamespec.errors import BackendError, GamespecError
 from gamespec.specs.base import SpecBase
+from gamespec.studies.runner import worker_versions
+from gamespec.studies.store import ResultStore
 
 
 def parse_backend_list(text: str) -> list[tuple[str, str | None]]:
@@ -67,7 +70,20 @@ def compare_backends(
         for r in rows:
             if r.get("objective") is not None:
                 r["relative_gap"] = abs(r["objective"] - ref) / max(abs(ref), 1e-12)
+    if out is not None:
+        _store_rows(spec, rows, Path(out))
     return rows
+
+
+def _store_rows(spec: SpecBase, rows: list[dict[str, Any]], out: Path) -> None:
+    """The comparison as a study store in ``out``: one record per backend label."""
+    from gamespec.loader import spec_hash
+
+    store = ResultStore(out)
+    labels = [row["backend"] for row in rows]
+    store.set_meta("study", {"type": "compare", "problem": spec.name, "backends": labels})
+    store.put_many((row["backend"], row, spec_hash(spec), worker_versions()) for row in rows)
+    store.close()
 
 
 FEASIBILITY_TOL = 1e-6

@@ -1,45 +1,153 @@
-"""A study's results on disk, one JSON file per finished point, written atomically.
+"""A study's results on disk: one SQLite database per study folder, in WAL mode.
 
-A crash loses at most the runs in flight; a rerun asks :meth:`ResultStore.done` and skips what is
-there. Keys are the points' own stable names (e.g. ``v=0.5,r2=1.4,psi=-0.5``), hashed into file
-names.
+Each finished point is one row ``(key, value JSON, digest, provenance)``; a batch of rows is one
+transaction, committed with ``synchronous=FULL`` (fsynced before :meth:`ResultStore.put_many`
+returns), so a crash or a power loss leaves every committed point intact and no half-written one.
+A record whose digest or JSON no longer checks out is reported (:attr:`ResultStore.damaged`) and
+left out, so the study computes it again; a database file that SQLite cannot read at all is moved
+aside (``store.sqlite.damaged-<time>``) and a fresh one started. 10⁵ points are 10⁵ rows of one
+file. ``meta`` holds what the study was (sweep or compare, its parameters) for ``gamespec results``
+and ``gamespec plot``.
 """
 
 from __future__ import annotations
 
+import datetime as _dt
 import hashlib
 import json
-import os
-from collections.abc import Iterator
+import sqlite3
+from collections.abc import Iterable, Mapping
 from pathlib import Path
 from typing import Any
 
+from gamespec.errors import GamespecError
+
+FILENAME = "store.sqlite"
+
+_SCHEMA = """
+CREATE TABLE IF NOT EXISTS points (
+    key TEXT PRIMARY KEY,
+    value TEXT NOT NULL,
+    digest TEXT NOT NULL,
+    spec_hash TEXT,
+    versions TEXT,
+    created TEXT NOT NULL
+);
+CREATE TABLE IF NOT EXISTS meta (name TEXT PRIMARY KEY, value TEXT NOT NULL);
+"""
+
+
+def _digest(text: str) -> str:
+    return hashlib.sha256(text.encode()).hexdigest()[:16]
+
+
+def is_store(folder: str | Path) -> bool:
+    """Whether ``folder`` holds a study store."""
+    return (Path(folder) / FILENAME).is_file()
+
 
 class ResultStore:
-    """A folder of ``<hash>.json`` records ``{"key": ..., "value": ...}``."""
+    """The points of one study folder (created if needed)."""
 
     def __init__(self, folder: str | Path) -> None:
         self.folder = Path(folder)
-        self.folder.mkdir(parents=True, exist_ok=True)
+        if self.folder.exists() and not self.folder.is_dir():
+            raise GamespecError(f"{self.folder}: is a file, not a folder for study results")
+        try:
+            self.folder.mkdir(parents=True, exist_ok=True)
+        except OSError as err:
+            raise GamespecError(f"{self.folder}: cannot write there ({err.strerror or err})") from None
+        self.path = self.folder / FILENAME
+        self._unreadable: list[str] = []
+        self._damaged_records: list[str] = []
+        self._db = self._open()
 
-    def _path(self, key: str) -> Path:
-        return self.folder / f"{hashlib.sha256(key.encode()).hexdigest()[:20]}.json"
+    @property
+    def damaged(self) -> list[str]:
+        """What was found damaged: the file on opening, records on the last read."""
+        return self._unreadable + self._damaged_records
 
-    def put(self, key: str, value: Any) -> None:
-        """Save one point's value (JSON-able), atomically."""
-        target = self._path(key)
-        tmp = target.with_suffix(".tmp")
-        tmp.write_text(json.dumps({"key": key, "value": value}))
-        os.replace(tmp, target)
+    def _connect(self) -> sqlite3.Connection:
+        db = sqlite3.connect(self.path, isolation_level=None, timeout=30)
+        db.execute("PRAGMA journal_mode=WAL")
+        db.execute("PRAGMA synchronous=FULL")
+        db.executescript(_SCHEMA)
+        (verdict,) = db.execute("PRAGMA quick_check").fetchone()
+        if verdict != "ok":
+            db.close()
+            raise sqlite3.DatabaseError(verdict)
+        return db
+
+    def _open(self) -> sqlite3.Connection:
+        try:
+            return self._connect()
+        except sqlite3.OperationalError as err:
+            raise GamespecError(f"{self.path}: cannot open the study store ({err})") from None
+        except sqlite3.DatabaseError as err:
+            stamp = _dt.datetime.now(_dt.UTC).strftime("%Y%m%dT%H%M%S")
+            aside = self.path.with_name(f"{FILENAME}.damaged-{stamp}")
+            self.path.rename(aside)
+            for suffix in ("-wal", "-shm"):
+                self.path.with_name(FILENAME + suffix).unlink(missing_ok=True)
+            self._unreadable.append(f"{self.path}: unreadable ({err}); moved to {aside.name}, starting anew")
+            return self._connect()
+
+    def close(self) -> None:
+        self._db.close()
+
+    def put(
+        self, key: str, value: Any, *, spec_hash: str | None = None, versions: Mapping | None = None
+    ) -> None:
+        """Save one point's value (JSON-able), durably."""
+        self.put_many([(key, value, spec_hash, versions)])
+
+    def put_many(self, records: Iterable[tuple[str, Any, str | None, Mapping | None]]) -> None:
+        """Save ``(key, value, spec_hash, versions)`` records in one fsynced transaction."""
+        now = _dt.datetime.now(_dt.UTC).isoformat(timespec="seconds")
+        rows = []
+        for key, value, spec_hash, versions in records:
+            text = json.dumps(value)
+            rows.append((key, text, _digest(text), spec_hash, json.dumps(versions or {}), now))
+        with self._db:
+            self._db.execute("BEGIN IMMEDIATE")
+            self._db.executemany("INSERT OR REPLACE INTO points VALUES (?, ?, ?, ?, ?, ?)", rows)
+
+    def _intact(self) -> dict[str, tuple[Any, dict[str, Any]]]:
+        found: dict[str, tuple[Any, dict[str, Any]]] = {}
+        self._damaged_records = []
+        rows = self._db.execute("SELECT key, value, digest, spec_hash, versions, created FROM points")
+        for key, text, digest, spec_hash, versions, created in rows:
+            try:
+                if _digest(text) != digest:
+                    raise ValueError("its digest does not match")
+                value = json.loads(text)
+                provenance = {"spec_hash": spec_hash, "versions": json.loads(versions), "created": created}
+            except (ValueError, TypeError) as err:
+                why = f"record {key!r} is damaged ({err}); computing it again"
+                self._damaged_records.append(f"{self.path}: {why}")
+                continue
+            found[key] = (value, provenance)
+        return found
 
     def done(self) -> set[str]:
-        """Keys already saved."""
-        return {record["key"] for record in self._records()}
+        """Keys saved intact."""
+        return set(self._intact())
 
     def items(self) -> dict[str, Any]:
-        """All saved ``key → value``."""
-        return {record["key"]: record["value"] for record in self._records()}
+        """All intact ``key → value``."""
+        return {key: value for key, (value, _) in self._intact().items()}
 
-    def _records(self) -> Iterator[dict[str, Any]]:
-        for path in sorted(self.folder.glob("*.json")):
-            yield json.loads(path.read_text())
+    def provenance(self) -> dict[str, dict[str, Any]]:
+        """Per intact key: the spec hash, the worker's package versions and the time it was saved."""
+        return {key: prov for key, (_, prov) in self._intact().items()}
+
+    def set_meta(self, name: str, value: Any) -> None:
+        """Record what the study is (kind, parameters, problem), durably."""
+        with self._db:
+            self._db.execute("BEGIN IMMEDIATE")
+            self._db.execute("INSERT OR REPLACE INTO meta VALUES (?, ?)", (name, json.dumps(value)))
+
+    def meta(self, name: str) -> Any:
+        """A recorded meta value, or None."""
+        row = self._db.execute("SELECT value FROM meta WHERE name = ?", (name,)).fetchone()
+        return None if row is None else json.loads(row[0])

@@ -10,12 +10,16 @@ expression and the column.
 from __future__ import annotations
 
 import ast
-from collections.abc import Mapping
+import math
+from collections.abc import Callable, Mapping
 from dataclasses import dataclass
+from functools import lru_cache
 
+import numpy as np
 import sympy as sp
 
 from gamespec.errors import ExpressionError
+from gamespec.limits import MAX_EXPRESSION_CHARS, MAX_EXPRESSION_NODES, MAX_MAGNITUDE
 
 FUNCTIONS: dict[str, tuple[int, object]] = {
     "sin": (1, sp.sin),
@@ -42,12 +46,59 @@ CONSTANTS: dict[str, sp.Expr] = {"pi": sp.pi}
 RESERVED = frozenset(FUNCTIONS) | frozenset(CONSTANTS) | {"t"}
 TIME = sp.Symbol("t", real=True)
 
-MAX_NODES = 2_000
+MAX_NODES = MAX_EXPRESSION_NODES
 """Largest number of syntax-tree nodes in one expression."""
 
 MAX_EXACT_EXPONENT = 1_024
 """Largest exponent magnitude for which a power of two exact numbers stays exact (``2**(1/3)``,
 ``pi**2``); larger ones are computed in floating point, not expanded."""
+
+_FLOAT_FUNCTIONS: dict[type, Callable[..., float]] = {
+    sp.sin: math.sin,
+    sp.cos: math.cos,
+    sp.tan: math.tan,
+    sp.asin: math.asin,
+    sp.acos: math.acos,
+    sp.atan: math.atan,
+    sp.atan2: math.atan2,
+    sp.exp: math.exp,
+    sp.log: math.log,
+    sp.Abs: abs,
+    sp.tanh: math.tanh,
+    sp.Min: min,
+    sp.Max: max,
+    sp.sign: lambda x: float(np.sign(x)),
+    sp.Heaviside: lambda x, *h: float(np.heaviside(x, 0.5)),
+}
+
+
+@lru_cache(maxsize=4096)
+def float_value(expr: sp.Basic) -> float:
+    """The value of a symbol-free expression computed in floating point, never by SymPy's exact
+    evaluation (which for ``exp(exp(exp(100)))`` works at astronomic precision for ever).
+
+    OverflowError when the value or an intermediate one exceeds
+    :data:`~gamespec.limits.MAX_MAGNITUDE` in size, ValueError when one is not a real number,
+    TypeError for an expression that is not a number (free symbols, unknown functions).
+    """
+    if expr.is_Number or expr.is_NumberSymbol:
+        value = float(expr)
+    elif expr.is_Add:
+        value = math.fsum(float_value(a) for a in expr.args)
+    elif expr.is_Mul:
+        value = math.prod(float_value(a) for a in expr.args)
+    elif expr.is_Pow:
+        value = math.pow(float_value(expr.base), float_value(expr.exp))
+    elif type(expr) in _FLOAT_FUNCTIONS:
+        value = _FLOAT_FUNCTIONS[type(expr)](*(float_value(a) for a in expr.args))
+    else:
+        raise TypeError(f"{expr} is not a number")
+    if math.isnan(value):
+        raise ValueError(f"{expr} is not a real number")
+    if not abs(value) <= MAX_MAGNITUDE:
+        raise OverflowError(f"{expr} exceeds {MAX_MAGNITUDE:g} in size")
+    return value
+
 
 _BINARY = {
     ast.Add: lambda a, b: a + b,
@@ -120,9 +171,21 @@ class _Translator:
         return self.finite(node, base**exponent)
 
     def finite(self, node: ast.AST, value: sp.Expr) -> sp.Expr:
-        """Refuse results SymPy already knows to be infinite, undefined or complex (``1/0``)."""
+        """Refuse results SymPy already knows to be infinite, undefined or complex (``1/0``), and
+        numbers (the value, or the numeric terms and factors SymPy folded into it) that are out of
+        range when computed in floating point (:func:`float_value`; ``exp(exp(exp(100)))``,
+        ``x*1e300*1e300``). A constant that is not real there (``asin(2)``) parses, as SymPy keeps it;
+        each kind's numeric evaluation refuses it where a real number is needed."""
         if value.has(sp.zoo, sp.oo, -sp.oo, sp.nan, sp.I):
             raise self.fail(node, "is infinite, undefined or not real")
+        numbers = [value] if value.is_number else [a for a in value.args if a.is_number]
+        for number in numbers:
+            try:
+                float_value(number)
+            except OverflowError:
+                raise self.fail(node, f"number out of range (beyond {MAX_MAGNITUDE:g})") from None
+            except (ValueError, TypeError, RecursionError):
+                pass
         return value
 
     def call(self, node: ast.Call) -> sp.Expr:
@@ -141,8 +204,8 @@ class _Translator:
 def _parse_tree(text: str) -> ast.expr:
     if not isinstance(text, str):
         return ast.Constant(value=text)
-    if len(text) > 10_000:
-        raise ExpressionError(text[:40] + "...", "expression longer than 10000 characters")
+    if len(text) > MAX_EXPRESSION_CHARS:
+        raise ExpressionError(text[:40] + "...", f"expression longer than {MAX_EXPRESSION_CHARS} characters")
     try:
         tree = ast.parse(text.strip(), mode="eval")
     except SyntaxError as err:

@@ -14,7 +14,7 @@ from hypothesis import HealthCheck, assume, given, settings
 from hypothesis import strategies as st
 
 from gamespec.errors import ExpressionError
-from gamespec.symbolic.language import parse, parse_relation, symbol
+from gamespec.symbolic.language import float_value, parse, parse_relation, symbol
 from gamespec.symbolic.printer import to_text
 from gamespec.symbolic.translate import NUMPY, translate
 
@@ -109,7 +109,8 @@ def trees(unary: list[Unary], binary: list[Binary]) -> st.SearchStrategy[sp.Expr
 
 def representable(expr: sp.Expr) -> bool:
     """Finite (no infinities, no bounds such as ``atan(zoo)``), real, no ``Piecewise``, every float
-    within double precision and every power of two numbers real: what the language can hold."""
+    within double precision, every power of two numbers real and every number-valued part within
+    double range (:func:`float_value`): what the language can hold."""
     if expr.has(sp.zoo, sp.oo, -sp.oo, sp.nan, sp.I, sp.AccumBounds, sp.Piecewise):
         return False
     if not all(math.isfinite(float(f)) and sp.Float(float(f)) == f for f in expr.atoms(sp.Float)):
@@ -124,6 +125,14 @@ def representable(expr: sp.Expr) -> bool:
                 return False
             if isinstance(value, complex):
                 return False
+    for part in sp.preorder_traversal(expr):
+        if part.is_number:
+            try:
+                float_value(part)
+            except OverflowError:
+                return False
+            except (ValueError, TypeError, RecursionError):
+                pass
     return True
 
 

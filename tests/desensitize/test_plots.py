@@ -22,11 +22,11 @@ def test_bundle_and_sensitivity_figures(tmp_path) -> None:
 
 def test_tradeoff_from_a_sweep_folder(tmp_path) -> None:
     solver = file_solver(FINAL, edit={"monte_carlo": {"samples": 0}})
-    store = ResultStore(tmp_path / "points")
+    store = ResultStore(tmp_path)
     for alpha in (0.0, 25.0, 75.0):
         result = solver.solve({"alpha": alpha})
         store.put(f"alpha={alpha}", {"alpha": alpha, **result.summary(), "metrics": result.metrics})
-    (path,) = plot_tradeoff(tmp_path, tmp_path / "figures")
+    (path,) = plot_tradeoff(store.items().values(), tmp_path / "figures")
     assert path.name == "tradeoff.png" and path.stat().st_size > 0
     with pytest.raises(GamespecError, match="no solved desensitized points"):
-        plot_tradeoff(tmp_path / "figures", tmp_path)
+        plot_tradeoff([{"alpha": 1.0, "metrics": {}}], tmp_path)

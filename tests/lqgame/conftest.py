@@ -5,8 +5,8 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from gamespec.lqgame.game import LQGame
 from gamespec.lqgame.solution import GameModel
+from gamespec.specs.lq_model import LQGame
 
 
 def random_game(seed: int, N: int = 4, n: int = 3, m: int = 2, ell: int = 1, r: int = 2) -> LQGame:

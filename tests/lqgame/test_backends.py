@@ -10,9 +10,9 @@ import yaml
 
 import gamespec
 from gamespec import spec_from_dict
-from gamespec.lqgame.game import LQGame
 from gamespec.lqgame.solution import GameModel
 from gamespec.result import Status
+from gamespec.specs.lq_model import LQGame
 from tests.conftest import PROBLEMS
 
 CH4 = PROBLEMS / "ch4"

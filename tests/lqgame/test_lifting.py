@@ -8,8 +8,8 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 from scipy.signal import cont2discrete
 
-from gamespec.lqgame.game import zero_order_hold
 from gamespec.lqgame.lifting import lift
+from gamespec.specs.lq_model import zero_order_hold
 from tests.lqgame.conftest import random_game
 
 

@@ -6,9 +6,9 @@ from __future__ import annotations
 import numpy as np
 
 from gamespec.lqgame.covariance import vector_to_gains
-from gamespec.lqgame.game import Strategies
 from gamespec.lqgame.montecarlo import agreement, simulate
 from gamespec.lqgame.solution import GameModel
+from gamespec.specs.lq_model import Strategies
 from tests.lqgame.conftest import random_game
 
 Z_BOUND = 5.0

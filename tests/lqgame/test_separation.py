@@ -14,8 +14,8 @@ import pytest
 
 import gamespec
 from gamespec.lqgame.covariance import vector_to_gains
-from gamespec.lqgame.game import LQGame
 from gamespec.lqgame.solution import GameModel
+from gamespec.specs.lq_model import LQGame
 from tests.conftest import PROBLEMS
 from tests.lqgame.conftest import random_game
 

@@ -8,7 +8,7 @@ import pytest
 import yaml
 
 from gamespec import SpecError, spec_from_dict
-from gamespec.lqgame.game import zero_order_hold
+from gamespec.specs.lq_model import zero_order_hold
 
 
 def _data(**problem_updates) -> dict:

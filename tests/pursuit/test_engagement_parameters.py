@@ -45,7 +45,8 @@ def test_sweep_over_evader_speed_matches_the_closed_form(tmp_path) -> None:
     """`gamespec sweep --param evader.speed=...` of the two-on-one constant-bearing engagement: at each
     speed the OCP's capture time is the analytic backend's (§2.4.1) at that speed."""
     speeds = [0.3, 0.4, 0.5]
-    rows = sweep(CB_TWO_ON_ONE, [("evader.speed", speeds)], out=tmp_path, show_progress=False)
+    run = sweep(CB_TWO_ON_ONE, [("evader.speed", speeds)], out=tmp_path, show_progress=False)
+    rows = list(run.values.values())
     assert [row["evader.speed"] for row in rows] == speeds
     for row, v in zip(rows, speeds, strict=True):
         analytic = gamespec.solve(gamespec.load(CB_TWO_ON_ONE, [f"evader.speed={v}"]), "analytic")

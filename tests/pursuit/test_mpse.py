@@ -5,8 +5,8 @@ from __future__ import annotations
 import pytest
 
 import gamespec
-from gamespec.pursuit.mpse import check_capturing_set, keep_pursuers
 from gamespec.pursuit.verification import RESIM_RTOL
+from gamespec.studies.capturing_set import check_capturing_set, keep_pursuers
 from tests.conftest import PROBLEMS
 
 MPSE_CB = PROBLEMS / "ch3" / "mpse_optimal_evasion_cb.yaml"

@@ -10,9 +10,9 @@ from hypothesis import strategies as st
 import gamespec
 from gamespec.pursuit import pure_pursuit as pp
 from gamespec.pursuit import regions, verification
-from gamespec.pursuit.mpse import path_difference
 from gamespec.pursuit.ocp_generation import to_ocp
 from gamespec.pursuit.simulation import Players, simulate_to_capture
+from gamespec.studies.capturing_set import path_difference
 from gamespec.symbolic.language import parse, symbol
 from gamespec.transforms import engagement as transforms_engagement
 from tests.conftest import PROBLEMS

@@ -12,6 +12,8 @@ import pytest
 import gamespec
 from gamespec.pursuit import regions, study
 from gamespec.pursuit.study import StudyPoint
+from gamespec.studies import suboptimal_study
+from gamespec.studies.store import ResultStore
 from tests.conftest import PROBLEMS
 
 STUDY = PROBLEMS / "ch2" / "pure_pursuit_suboptimal_study.yaml"
@@ -57,7 +59,7 @@ def test_solve_saves_points_resumes_and_plots(tmp_path, monkeypatch, cli) -> Non
     first = json.loads(out)
     assert first["status"] == "optimal"
     assert first["metrics"]["points"] == first["metrics"]["solved"] == first["metrics"]["computed"] == 4
-    assert len(list(store.glob("*.json"))) == 4
+    assert len(ResultStore(store).done()) == 4
     row = first["metrics"]["table"][0]
     assert row["points"] == row["solved"] == 4
     variation = np.array(first["arrays"]["variation_percent"])
@@ -67,7 +69,7 @@ def test_solve_saves_points_resumes_and_plots(tmp_path, monkeypatch, cli) -> Non
     def must_not_run(point: StudyPoint) -> dict[str, Any]:
         raise AssertionError("a saved point was solved again")
 
-    monkeypatch.setattr(study, "evaluate", must_not_run)
+    monkeypatch.setattr(suboptimal_study, "evaluate", must_not_run)
     code, out, err = cli(*args)
     assert code == 0, err
     again = json.loads(out)
@@ -84,7 +86,7 @@ def test_solve_saves_points_resumes_and_plots(tmp_path, monkeypatch, cli) -> Non
 
 
 def _solved_when_psi_positive(point: StudyPoint) -> dict[str, Any]:
-    """A stand-in for :func:`study.evaluate`: the points with ψ(0) > 0 get a (made-up) optimum."""
+    """A stand-in for :func:`suboptimal_study.evaluate`: the points with ψ(0) > 0 get a (made-up) optimum."""
     row = {"v": point.v, "r2": point.r2, "psi": point.psi, "t_suboptimal": 1.0, "max_defect": 0.0}
     if point.psi > 0:
         row |= {"t_optimal": 1.0, "variation_percent": 0.0}
@@ -93,7 +95,7 @@ def _solved_when_psi_positive(point: StudyPoint) -> dict[str, Any]:
 
 
 def test_points_left_out_make_the_result_feasible(tmp_path, monkeypatch, cli) -> None:
-    monkeypatch.setattr(study, "evaluate", _solved_when_psi_positive)
+    monkeypatch.setattr(suboptimal_study, "evaluate", _solved_when_psi_positive)
     code, out, err = cli("solve", STUDY, *TINY, "--set", f"store={tmp_path}", "--json")
     assert code == 0, err
     result = json.loads(out)
@@ -103,7 +105,7 @@ def test_points_left_out_make_the_result_feasible(tmp_path, monkeypatch, cli) ->
 
 
 def test_no_point_solved_is_an_error(tmp_path, monkeypatch, cli) -> None:
-    monkeypatch.setattr(study, "evaluate", _solved_when_psi_positive)
+    monkeypatch.setattr(suboptimal_study, "evaluate", _solved_when_psi_positive)
     code, _, err = cli("solve", STUDY, *TINY, "--set", "grid.angles=1", "--set", f"store={tmp_path}")
     assert code == 1
     assert "none of the 2 points solved" in err
@@ -122,7 +124,7 @@ def test_study_rows_compare_to_a_full_solve() -> None:
     """A study point's optimum (compiled once, re-solved with new parameters) equals a fresh solve
     of the same engagement, and its suboptimal time equals the analytic backend's."""
     point = next(iter(study.study_points(gamespec.load(STUDY)).values()))
-    row = study.evaluate(point)
+    row = suboptimal_study.evaluate(point)
     engagement = study.point_engagement(point)
     assert row["t_optimal"] == pytest.approx(gamespec.solve(engagement).t_final, rel=1e-6)
     assert row["t_suboptimal"] == pytest.approx(gamespec.solve(engagement, "analytic").t_final, rel=1e-9)

@@ -53,7 +53,7 @@ def test_no_executable_at_all_makes_the_backend_unavailable(monkeypatch) -> None
         ("optimal", "ripopt 0.8.2: Optimal Solution Found", Status.OPTIMAL),
         ("optimal", "Ipopt 3.14.16: Solved To Acceptable Level.", Status.FEASIBLE),
         ("maxIterations", "Maximum Number of Iterations Exceeded", Status.ITERATION_LIMIT),
-        ("infeasible", "Converged to a point of local infeasibility", Status.INFEASIBLE),
+        ("infeasible", "Converged to a point of local infeasibility", Status.LOCALLY_INFEASIBLE),
         ("internalSolverError", "Restoration Failed", Status.NUMERICAL_ERROR),
         ("somethingNew", "", Status.ERROR),
     ],

@@ -18,7 +18,8 @@ from gamespec.ocp.checks import Trajectory, relative_defects
 from gamespec.result import Result
 
 if TYPE_CHECKING:
-    from gamespec.ocp.transcription import CollocationModel, Transcription
+    from gamespec.backend.collocation import CollocationModel
+    from gamespec.ocp.transcription import Transcription
 
 
 def trajectory_of(tr: Transcription, result: Result) -> tuple[Trajectory, dict[str, float]]:

@@ -30,7 +30,14 @@ def study(
         Path | None,
         typer.Option(help="Save the Result and table_2_1.png here, and the points in OUT/points."),
     ] = None,
-    workers: Annotated[int | None, typer.Option(min=1, help="Local processes (default: the file's).")] = None,
+    workers: Annotated[int | None, typer.Option(min=1, help="Processes (default: the file's).")] = None,
+    executor: Annotated[
+        str | None, typer.Option(help="serial, process or dask (default: the file's, else by --workers).")
+    ] = None,
+    scheduler: Annotated[
+        str | None,
+        typer.Option(envvar="GAMESPEC_SCHEDULER", help="Address of a running Dask scheduler."),
+    ] = None,
     set_: Annotated[
         list[str] | None, typer.Option("--set", help="Override a value: dotted.path=value (repeatable).")
     ] = None,
@@ -48,13 +55,16 @@ def study(
     overrides = [*(set_ or []), *([f"store={out / 'points'}"] if out is not None else [])]
     spec = load(file, overrides)
     if spec.kind != "pursuit_suboptimal_study":
-        raise SpecError(f"expected kind 'pursuit_suboptimal_study', got {spec.kind!r}", field="kind")
-    options = {"progress": True} | ({"workers": workers} if workers is not None else {})
+        reason = f"expected kind 'pursuit_suboptimal_study', got {spec.kind!r}"
+        raise SpecError(reason, field="kind", source=str(file))
+    chosen = {"workers": workers, "executor": executor, "scheduler": scheduler}
+    options = {"progress": True} | {name: value for name, value in chosen.items() if value is not None}
     result = solve(spec, options=options)
     if out is not None:
         result.save(out)
         for path in plot_result(result, out):
-            Console(stderr=True).print(f"wrote {out / 'result.json'} and {path}", highlight=False)
+            if not json_:
+                Console().print(f"wrote {out / 'result.json'} and {path}", highlight=False)
     table = result.metrics.get("table", [])
     if json_:
         sys.stdout.write(json.dumps(table, indent=2) + "\n")
@@ -65,6 +75,11 @@ def study(
         for row in table:
             view.add_row(*(_cell(row[c]) for c in TABLE_COLUMNS))
         Console().print(view)
-    Console(stderr=True).print(f"{result.status.value}: {result.message}", highlight=False)
     if not result.ok:
+        print(
+            f"error: {spec.name}: study ended with status {result.status.value}: {result.message}",
+            file=sys.stderr,
+        )
         raise typer.Exit(1)
+    if not json_:
+        Console().print(f"{result.status.value}: {result.message}", highlight=False)

@@ -83,12 +83,20 @@ class Backend(ABC):
     def options(self, spec: SpecBase, overrides: dict[str, Any] | None = None) -> StrictModel:
         """This backend's options block from the spec's ``solver.options``, validated."""
         raw = {**self.shared_options(spec), **spec.solver.options.get(self.name, {}), **(overrides or {})}
+        return self.validate_options(raw, spec.source)
+
+    @classmethod
+    def validate_options(cls, raw: Mapping[str, Any], source: str = "<spec>") -> StrictModel:
+        """``raw`` validated into :attr:`options_model`; a SpecError naming the file, the field
+        ``solver.options.<backend>.<key>`` and the reason (the nearest valid key for a misspelled one)."""
+        from gamespec.loader import format_validation_error
+
         try:
-            return self.options_model.model_validate(raw)
+            return cls.options_model.model_validate(dict(raw))
         except ValidationError as err:
-            first = err.errors()[0]
-            loc = ".".join(str(p) for p in first["loc"])
-            raise SpecError(first["msg"], field=f"solver.options.{self.name}.{loc}") from None
+            found = format_validation_error(err, cls.options_model, source, raw)
+            field = ".".join(p for p in ("solver.options", cls.name, found.field) if p)
+            raise SpecError(found.reason, field=field, source=source) from None
 
     def shared_options(self, spec: SpecBase) -> dict[str, Any]:
         """Option values that blocks other than this backend's own give it (none by default; the

@@ -1,0 +1,212 @@
+"""Both players' steps of Algorithm 3 as CVXPY problems, built once on ``cp.Parameter``s.
+
+The pursuer minimizes the payoff ``J`` (convex in its gains): with the ``trace`` payoff (eq. 5.34) a
+sum of squares, with the ``frobenius`` payoff (eq. 5.17) ``min ‖S‖²_F`` s.t. ``[[S, G], [Gᵀ, I]] ⪰ 0``
+(``S ⪰ G Gᵀ = Σʳ``; ``‖·‖_F`` is monotone on the PSD cone), an SDP. The evader *maximizes* the convex
+``J``, which is not a convex program: it is solved by the convex–concave procedure — maximize the
+linearization of ``J`` at the current gains over the evader's (convex) constraint set, repeat; each
+step cannot lower ``J`` (``J`` lies above its tangent), and the procedure stops at a stationary
+point when ``J`` rises by less than the tolerance. Its history is reported.
+
+Both feasible sets are eqs. 5.35a–b and the chance constraint eq. 5.36, all second-order cones; in
+eq. 5.36 the matrix norm ``‖Σ^{y1/2} K_kⁱᵀ‖`` is bounded by its Frobenius norm (a conservative SOC
+form of Theorem 5's ``σ_max``). ``V`` does not enter ``J`` (eq. 5.34 depends on ``K`` only), so it
+is fixed by a small proximal term ``ρ ‖V − Û‖²`` that breaks ties toward the nominal control.
+Problems are scaled so that the open-loop payoff is 1.
+"""
+
+from __future__ import annotations
+
+import warnings
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+from gamespec_cvxpy.backend import STATUS_MAP
+
+from gamespec.best_response import StepReport
+from gamespec.flowfield.covariance_game import PLAYERS, CovarianceGame, Strategy
+from gamespec.result import Status
+
+PROXIMAL = 1e-6
+
+
+def _root(M: np.ndarray) -> np.ndarray:
+    w, v = np.linalg.eigh((M + M.T) / 2)
+    return (v * np.sqrt(np.clip(w, 0.0, None))) @ v.T
+
+
+class _PlayerProblem:
+    """Variables ``V`` (2N) and the gains of steps 1 … N−1 (8(N−1)) of one player, and its
+    constraints (eqs. 5.35–5.36)."""
+
+    def __init__(
+        self, game: CovarianceGame, player: int, solver: str, solver_options: dict[str, Any]
+    ) -> None:
+        import cvxpy as cp
+
+        self.game, self.player = game, player
+        self.solver, self.solver_options = solver, solver_options
+        N, b = game.N, game.bounds[player]
+        self.V = cp.Variable(2 * N)
+        self.kappa = cp.Variable(8 * (N - 1)) if N > 1 else None
+        self.U_hat = game.U_hat[:, 2 * player : 2 * player + 2].reshape(-1)
+        c, B = game.mean_map(player)
+        X_hat = game.X_hat[:, 2 * player : 2 * player + 2].reshape(-1)
+        V2 = cp.reshape(self.V, (N, 2), order="C")
+        mean = cp.reshape(c + B @ self.V - X_hat, (N, 2), order="C")
+        self.constraints = [
+            cp.norm(mean, 2, axis=1) <= b.delta_x,
+            cp.norm(V2 - self.U_hat.reshape(N, 2), 2, axis=1) <= b.delta_u,
+            cp.norm(V2[0]) <= b.max_speed,
+        ]
+        for k in range(1, N):
+            L = _root(game.noise_rows[k] @ game.noise_rows[k].T)
+            spread = cp.norm(np.kron(np.eye(2), L.T) @ self.kappa[8 * (k - 1) : 8 * k])
+            self.constraints.append(cp.norm(V2[k]) + b.chance_factor * spread <= b.max_speed)
+        self.proximal = (
+            PROXIMAL * cp.sum_squares(self.V - self.U_hat) / max(1.0, float(self.U_hat @ self.U_hat))
+        )
+
+    def strategy(self) -> Strategy:
+        kappa = np.zeros((self.game.N, 2, 4))
+        if self.kappa is not None:
+            kappa[1:] = np.asarray(self.kappa.value).reshape(-1, 2, 4)
+        return Strategy(np.asarray(self.V.value).reshape(-1, 2), kappa)
+
+    def gains_map(self) -> np.ndarray:
+        """``Tⁱ`` restricted to steps 1 … N−1."""
+        return self.game.gain_maps[self.player][:, 8:]
+
+    def run(self, problem: Any) -> Status:
+        import cvxpy as cp
+
+        try:
+            with warnings.catch_warnings():
+                warnings.filterwarnings("ignore", message="Solution may be inaccurate")
+                problem.solve(solver=self.solver, **self.solver_options)
+        except cp.SolverError:
+            return Status.NUMERICAL_ERROR
+        return STATUS_MAP.get(problem.status, Status.ERROR)
+
+
+class PursuerStep(_PlayerProblem):
+    """``argmin J`` over the pursuer's ``(V, K)`` with the evader's fixed (Algorithm 3, line 3)."""
+
+    def __init__(
+        self, game: CovarianceGame, solver: str, solver_options: dict[str, Any], scale: float
+    ) -> None:
+        import cvxpy as cp
+
+        super().__init__(game, 0, solver, solver_options)
+        self.scale = scale
+        T = self.gains_map()
+        if game.payoff == "trace":
+            # ‖c + Tκ‖² = ‖Rκ‖² + 2 (Tᵀc)ᵀκ + ‖c‖², R = (TᵀT)^{1/2}: the small form of the same QP
+            self.offset = cp.Parameter(T.shape[1])
+            objective = (cp.sum_squares(_root(T.T @ T) @ self.kappa) + 2 * self.offset @ self.kappa) / scale
+            constraints = self.constraints
+        else:
+            N = game.N
+            self.offset = cp.Parameter(game.g0.size)
+            G = cp.reshape(self.offset + T @ self.kappa, (2 * N, 4 * N), order="C") / np.sqrt(np.sqrt(scale))
+            S = cp.Variable((2 * N, 2 * N), symmetric=True)
+            objective = cp.sum_squares(S)
+            constraints = [*self.constraints, cp.bmat([[S, G], [G.T, np.eye(4 * N)]]) >> 0]
+        self.problem = cp.Problem(cp.Minimize(objective + self.proximal), constraints)
+
+    def respond(self, evader: Strategy) -> tuple[Strategy | None, StepReport]:
+        offset = self.game.g0 + self.game.gain_maps[1] @ evader.kappa.reshape(-1)
+        self.offset.value = self.gains_map().T @ offset if self.game.payoff == "trace" else offset
+        status = self.run(self.problem)
+        if not status.ok:
+            return None, StepReport(status, f"pursuer step: solver reported {self.problem.status}")
+        return self.strategy(), StepReport(status)
+
+
+@dataclass
+class ConvexConcaveLog:
+    """Payoffs ``J`` along each evader step's convex–concave iterations."""
+
+    steps: list[list[float]] = field(default_factory=list)
+    converged: list[bool] = field(default_factory=list)
+    responses: list[Strategy] = field(default_factory=list)
+
+    def alternation(self) -> dict[str, float] | None:
+        """How far the last response lies from the one before and from the one two before
+        (``max(‖ΔV‖, ‖ΔK‖)``): a period-two cycle of Gauss–Seidel shows as the second far smaller."""
+        if len(self.responses) < 3:
+            return None
+        last, previous, before = self.responses[-1], self.responses[-2], self.responses[-3]
+        return {"to_previous": _distance(last, previous), "to_one_before": _distance(last, before)}
+
+
+def _distance(a: Strategy, b: Strategy) -> float:
+    return float(max(np.linalg.norm(a.V - b.V), np.linalg.norm(a.kappa - b.kappa)))
+
+
+class EvaderStep(_PlayerProblem):
+    """``argmax J`` over the evader's ``(V, K)`` with the pursuer's fixed (Algorithm 3, line 5), by
+    the convex–concave procedure from the evader's current strategy."""
+
+    def __init__(
+        self,
+        game: CovarianceGame,
+        solver: str,
+        solver_options: dict[str, Any],
+        scale: float,
+        tolerance: float,
+        max_iterations: int,
+        start: Strategy,
+    ) -> None:
+        import cvxpy as cp
+
+        super().__init__(game, 1, solver, solver_options)
+        self.scale, self.tolerance, self.max_iterations = scale, tolerance, max_iterations
+        self.slope = cp.Parameter(8 * (game.N - 1)) if game.N > 1 else None
+        linear = self.slope @ self.kappa if self.kappa is not None else 0
+        self.problem = cp.Problem(cp.Maximize(linear - self.proximal), self.constraints)
+        self.current = start
+        self.log = ConvexConcaveLog()
+
+    def respond(self, pursuer: Strategy) -> tuple[Strategy | None, StepReport]:
+        current = self.current
+        values = [self.game.value((pursuer, current)) / self.scale]
+        converged = self.slope is None
+        for _ in range(0 if converged else self.max_iterations):
+            slope = self.game.gradient((pursuer, current), 1)[1:].reshape(-1)
+            self.slope.value = slope / max(np.linalg.norm(slope), 1e-300)  # the maximizer is scale-free
+            status = self.run(self.problem)
+            if not status.ok:
+                self.log.steps.append(values)
+                self.log.converged.append(False)
+                return None, StepReport(status, f"evader step: solver reported {self.problem.status}")
+            current = self.strategy()
+            values.append(self.game.value((pursuer, current)) / self.scale)
+            if values[-1] - values[-2] <= self.tolerance * max(abs(values[-2]), 1e-12):
+                converged = True
+                break
+        self.current = current
+        self.log.responses.append(current)
+        self.log.steps.append(values)
+        self.log.converged.append(converged)
+        if not converged:
+            message = f"evader step: convex-concave procedure stopped after {self.max_iterations} iterations"
+            return current, StepReport(Status.FEASIBLE, message)
+        return current, StepReport(Status.OPTIMAL)
+
+
+@dataclass(frozen=True)
+class GamePlayer:
+    """A player of :mod:`gamespec.best_response`: its strategy is a :class:`Strategy`,
+    distance ``max(‖ΔV‖, ‖ΔK‖)`` (the stopping rule of section 5.4)."""
+
+    name: str
+    step: PursuerStep | EvaderStep
+
+    def respond(self, others: dict[str, Strategy]) -> tuple[Strategy | None, StepReport]:
+        (other,) = (others[n] for n in PLAYERS if n != self.name)
+        return self.step.respond(other)
+
+    def distance(self, a: Strategy, b: Strategy) -> float:
+        return _distance(a, b)

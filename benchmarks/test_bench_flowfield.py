@@ -1,0 +1,106 @@
+"""Chapter 5 timings: the level-set solve of eq. 5.22 on the Hurricane Hugo field (eqs. 5.40–5.42)
+at two grid sizes, beside hj_reachability (JAX, CPU; WENO5 + TVD-RK3, the same scheme) where it is
+installed — the goal is "not slower" — with the largest difference of the two solutions on the
+front's band; one Gauss–Seidel iteration of the covariance game (Algorithm 3) on the linear-flow
+file; and the peak memory of the capture search on the finest grid (``extra_info``).
+
+Run: ``python -m pytest benchmarks/test_bench_flowfield.py --benchmark-enable``.
+hj_reachability is optional (``pip install hj-reachability jax``); its tests skip without it.
+"""
+
+from __future__ import annotations
+
+import tracemalloc
+
+import numpy as np
+import pytest
+
+import gamespec
+from gamespec.flowfield.grid import Grid
+from gamespec.flowfield.hamiltonian import FlowHamiltonian
+from gamespec.flowfield.levelset import LevelSetSolver, capture_by_level_sets, initial_cones
+from tests.conftest import PROBLEMS
+
+HUGO = PROBLEMS / "ch5" / "hurricane_hugo.yaml"
+LINEAR = PROBLEMS / "ch5" / "linear_flow.yaml"
+NODES = (101, 201)
+DURATION = 1.5
+
+
+def _hugo(n: int):
+    data = gamespec.load(HUGO).data()
+    grid = Grid(data.grid.lower, data.grid.upper, (n, n))
+    return data, grid
+
+
+def _ours(n: int) -> np.ndarray:
+    data, grid = _hugo(n)
+    solver = LevelSetSolver(
+        grid, FlowHamiltonian(data.nominal_speeds[:1], data.field.drift(grid.points)), "weno5"
+    )
+    return solver.propagate(initial_cones(grid, data.origins[:1]), DURATION)[0]
+
+
+@pytest.mark.parametrize("n", NODES)
+def test_levelset_hugo(benchmark, n: int) -> None:
+    benchmark.group = f"ch5 level set, Hugo field, {n}×{n}, t = {DURATION}"
+    phi = benchmark.pedantic(_ours, args=(n,), rounds=3, warmup_rounds=0)
+    assert np.isfinite(phi).all()
+
+
+def _hj_solver(n: int):
+    pytest.importorskip("hj_reachability")
+    import hj_reachability as hj
+    import jax.numpy as jnp
+    from gamespec_levelset.hj_solver import drift_dynamics, hj_grid
+
+    data, grid = _hugo(n)
+    dynamics = drift_dynamics(data.field, float(data.nominal_speeds[0]))
+    nodes = hj_grid(grid)
+    initial = jnp.linalg.norm(nodes.states - jnp.array(data.origins[0]), axis=-1)
+    settings = hj.SolverSettings.with_accuracy("very_high", CFL_number=0.5)
+
+    def run() -> np.ndarray:
+        values = hj.solve(settings, dynamics, nodes, jnp.array([0.0, DURATION]), initial, progress_bar=False)
+        return np.asarray(values[-1].block_until_ready())
+
+    return run
+
+
+@pytest.mark.parametrize("n", NODES)
+def test_hj_reachability_hugo(benchmark, n: int) -> None:
+    benchmark.group = f"ch5 level set, Hugo field, {n}×{n}, t = {DURATION}"
+    run = _hj_solver(n)
+    phi = benchmark.pedantic(run, rounds=3, warmup_rounds=1)
+    ours = _ours(n)
+    band = (ours > 0.3) & (ours < 1.5)
+    difference = float(np.abs(phi - ours)[band].max())
+    benchmark.extra_info["max_difference_on_band"] = difference
+    assert difference < 5 * (25 / (n - 1)) ** 2
+
+
+def test_gauss_seidel_iteration(benchmark) -> None:
+    """One Gauss–Seidel sweep (pursuer QP + evader convex–concave) with linearization and eq. 5.39;
+    the reachability stage is cached by the compiled model after the first solve."""
+    benchmark.group = "ch5 covariance game"
+    spec = gamespec.load(LINEAR, ["method.game.max_iterations=1", "method.monte_carlo.samples=0"])
+    solver = gamespec.compile_spec(spec, options={"cross_check": False})
+    solver.solve()
+    result = benchmark.pedantic(solver.solve, rounds=3, warmup_rounds=0)
+    assert result.metrics["best_response"]["iterations"] == 1
+
+
+def test_capture_search_memory_at_the_finest_grid(benchmark) -> None:
+    data, grid = _hugo(NODES[-1])
+    solver = LevelSetSolver(
+        grid, FlowHamiltonian(data.nominal_speeds, data.field.drift(grid.points)), "weno5"
+    )
+    tracemalloc.start()
+    reach = benchmark.pedantic(
+        capture_by_level_sets, args=(solver, data.origins, 10.0), rounds=1, warmup_rounds=0
+    )
+    peak = tracemalloc.get_traced_memory()[1]
+    tracemalloc.stop()
+    benchmark.extra_info["peak_memory_mib"] = peak / 2**20
+    benchmark.extra_info["snapshots"] = len(reach.snapshot_times)
+    assert reach.capture_time is not None

@@ -1,0 +1,1 @@
+"""Command groups that register in the ``gamespec.commands`` entry-point group."""

@@ -1,0 +1,70 @@
+"""The capture condition of Theorem 6 in its instantaneous form (section 5.2): the evader's reachable
+set lies inside the pursuer's, ``ℛᵉ(t) ⊆ ℛᵖ(t)``.
+
+On a grid the condition is measured by the *margin* ``m(t) = max over the evader's front of φᵖ``
+(the zero contour of φᵉ, interpolated): positive while part of the evader's set is uncovered, zero
+when the last uncovered point — the capture point ``x_f`` — is reached. ``m`` is continuous in ``t``,
+so the capture time is its first zero, interpolated between time steps. The margin can be read at a
+level ``c > 0`` (the sets reached from the disks of radius ``c`` about the starting points).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import contourpy
+import numpy as np
+
+from gamespec.flowfield.grid import Grid
+
+
+def contours(grid: Grid, phi: np.ndarray, level: float = 0.0) -> list[np.ndarray]:
+    """The ``level`` contours of node values ``phi`` (nx, ny), each an array (M, 2) of points."""
+    x, y = np.meshgrid(*grid.axes, indexing="ij")
+    generator = contourpy.contour_generator(x, y, phi, line_type=contourpy.LineType.Separate)
+    return [line for line in generator.lines(level) if len(line) > 1]
+
+
+def refined_peak(values: np.ndarray, points: np.ndarray, k: int) -> tuple[float, np.ndarray]:
+    """The parabola through samples k−1, k, k+1 of a front (by arc length): its peak value and point."""
+    if k == 0 or k == len(values) - 1:
+        return float(values[k]), points[k]
+    s = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(points[k - 1 : k + 2], axis=0), axis=1))])
+    c2, c1, c0 = np.polyfit(s, values[k - 1 : k + 2], 2)
+    if c2 >= 0:
+        return float(values[k]), points[k]
+    peak = float(np.clip(-c1 / (2 * c2), s[0], s[2]))
+    segment = 0 if peak <= s[1] else 1
+    w = (peak - s[segment]) / max(s[segment + 1] - s[segment], 1e-300)
+    point = (1 - w) * points[k - 1 + segment] + w * points[k + segment]
+    return float(np.polyval([c2, c1, c0], peak)), point
+
+
+@dataclass(frozen=True)
+class Margin:
+    """``m(t)``: the largest pursuer level on the evader's front, and where it is."""
+
+    value: float
+    point: np.ndarray
+
+
+def margin(grid: Grid, phi_pursuer: np.ndarray, phi_evader: np.ndarray, level: float = 0.0) -> Margin | None:
+    """``max (φᵖ − level)`` over the evader's ``level`` contour (None when it is not on the grid)."""
+    best: Margin | None = None
+    for line in contours(grid, phi_evader, level):
+        values = grid.interpolate(phi_pursuer, line) - level
+        k = int(np.argmax(values))
+        value, point = refined_peak(values, line, k)
+        if best is None or value > best.value:
+            best = Margin(value, point)
+    return best
+
+
+def first_zero(times: np.ndarray, margins: np.ndarray) -> tuple[int, float] | None:
+    """The index ``k`` with ``m_k > 0 ≥ m_{k+1}`` first, and the interpolated zero in between."""
+    crossed = np.flatnonzero((margins[:-1] > 0) & (margins[1:] <= 0))
+    if crossed.size == 0:
+        return None
+    k = int(crossed[0])
+    w = margins[k] / (margins[k] - margins[k + 1])
+    return k, float(times[k] + w * (times[k + 1] - times[k]))

@@ -1,0 +1,63 @@
+"""Limits on what a problem file may ask for, each checked where the input is read (README, "Limits").
+
+A file beyond one of these is bad input: exit 2 with one line naming the limit, never a hang, a
+traceback or an exhausted memory. The values are far beyond every problem of the thesis and small
+enough that the work or memory they allow takes seconds, not hours.
+"""
+
+from __future__ import annotations
+
+import sys
+
+MAX_FILE_BYTES = 4_000_000
+"""Largest problem file read (bytes): room for per-step matrices over a long horizon."""
+
+MAX_DEPTH = 64
+"""Deepest nesting of mappings and lists in a problem file."""
+
+MAX_VALUES = 1_000_000
+"""Most values (mappings, lists and scalars) in a problem file after its YAML aliases are expanded:
+a "billion laughs" file of nested aliases is refused at this count instead of being expanded."""
+
+MAX_INT_DIGITS = 4300
+"""Longest integer literal (decimal digits); Python's own limit on converting text to an integer."""
+
+MAX_EXPRESSION_CHARS = 10_000
+"""Longest expression string."""
+
+MAX_EXPRESSION_NODES = 2_000
+"""Most syntax-tree nodes in one expression."""
+
+MAX_MAGNITUDE = sys.float_info.max
+"""Largest absolute value of a constant (sub-)expression, the largest finite double: expressions are
+evaluated in floating point, and one whose value or an intermediate value overflows is refused as out
+of range instead of being computed exactly."""
+
+MAX_INTERVALS = 10_000
+"""Most intervals of a grid: collocation intervals of an ``optimal_control`` transcription (and of the
+OCP an ``engagement`` becomes), steps of an ``lq_stochastic_game`` horizon."""
+
+MAX_SIMULATION_VALUES = 2_000_000
+"""Most positions a ``pursuit_scenario`` simulation records: time steps (``horizon / time_step``)
+times players."""
+
+MAX_SAMPLES = 1_000_000
+"""Most Monte Carlo samples of an ``lq_stochastic_game``."""
+
+MAX_SAMPLE_VALUES = 20_000_000
+"""Most numbers the Monte Carlo samples of an ``lq_stochastic_game`` hold: samples times
+(horizon + 1) times states (160 MB of doubles)."""
+
+MAX_STUDY_POINTS = 10_000
+"""Most points of a ``pursuit_suboptimal_study`` grid (angles times fractions times speeds), each an
+OCP solve."""
+
+MAX_SWEEP_POINTS = 10_000
+"""Most points of a ``gamespec sweep`` grid (the product of the ``--param`` counts), each a solve."""
+
+MAX_COORDINATE = 1e9
+"""Largest absolute value of a position coordinate (``engagement``, ``pursuit_scenario``): beyond it
+squared distances lose the precision a capture radius needs, and far beyond it they overflow."""
+
+MAX_SPEED = 1e9
+"""Largest speed of a player (``engagement``, ``pursuit_scenario``)."""

@@ -1,0 +1,263 @@
+"""The ``flow_field_game`` kind: pursuit-evasion of two agents in a stochastic flow field (chapter 5).
+
+``problem`` gives the flow field of eq. 5.3 — the drift ``f(x)`` (two expressions of the position
+names, e.g. eq. 5.37 or eq. 5.40) and the diffusion ``g(x)`` (a 2 × 2 matrix of expressions, or
+``{identity: s}``) — both players' starts, speed limits and the bounds of eqs. 5.35–5.36
+(``delta_x``, ``delta_u``, ``beta``), the nominal speed fraction ``v̂/v_max``, the capture radius ε,
+the step ``T̂/N`` and the payoff (``trace``: eq. 5.34; ``frobenius``: eq. 5.17). Any number may be
+an expression over ``parameters``; the flow's expressions may use the position names as well.
+``method`` sets the reachability grid and scheme, the Gauss–Seidel stopping rule (Algorithm 3), the
+evader's convex–concave procedure and the Monte Carlo.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+from typing import Literal
+
+import numpy as np
+import sympy as sp
+from pydantic import Field, FiniteFloat, model_validator
+
+from gamespec.errors import ExpressionError, SpecError
+from gamespec.flowfield.covariance_game import PlayerBounds
+from gamespec.flowfield.field import FlowField
+from gamespec.flowfield.grid import Grid
+from gamespec.flowfield.problem import FlowGameData
+from gamespec.specs.base import SpecBase, StrictModel, Value
+from gamespec.symbolic.language import RESERVED, parse, symbol
+
+
+class Identity(StrictModel):
+    """``scale · I₂``."""
+
+    identity: Value = 1.0
+
+
+class FlowSpec(StrictModel):
+    """Drift ``f(x)`` (two expressions) and diffusion ``g(x)`` (2 × 2) of eq. 5.3."""
+
+    drift: tuple[Value, Value]
+    diffusion: tuple[tuple[Value, Value], tuple[Value, Value]] | Identity = Identity(identity=0.0)
+
+
+class PlayerSpec(StrictModel):
+    """One agent: start ``x₀ⁱ``, speed limit ``vⁱ_max`` (eq. 5.2) and the bounds of eqs. 5.35–5.36."""
+
+    initial: tuple[Value, Value]
+    max_speed: Value
+    delta_x: Value = Field(0.1, description="δ_x: distance of the mean from the nominal path (eq. 5.35a).")
+    delta_u: Value = Field(
+        description="δ_u: distance of the feedforward from the nominal control (eq. 5.35b)."
+    )
+    beta: Value = Field(0.01, description="β: the chance constraint's risk (eq. 5.36).")
+
+
+class FlowGameProblem(StrictModel):
+    """The mathematics of the game."""
+
+    parameters: dict[str, FiniteFloat] = Field(default_factory=dict)
+    position: tuple[str, str] = ("x1", "x2")
+    flow: FlowSpec
+    pursuer: PlayerSpec
+    evader: PlayerSpec
+    nominal_speed_fraction: Value = Field(0.8, description="v̂/v_max of eq. 5.24, 5.26.")
+    capture_radius: Value = Field(description="ε of eq. 5.4.")
+    step: Value = Field(description="T̂/N of eq. 5.7; N = round(T̂/step).")
+    payoff: Literal["trace", "frobenius"] = "trace"
+
+    @model_validator(mode="after")
+    def _names(self) -> FlowGameProblem:
+        names = [*self.position, *self.parameters]
+        for name in names:
+            if not name.isidentifier() or name in RESERVED:
+                raise ValueError(f"{name!r} cannot be a name (reserved or not an identifier)")
+        if len(set(names)) != len(names):
+            raise ValueError("the position names and parameter names must all differ")
+        return self
+
+
+class GridSpec(StrictModel):
+    """The reachability grid: the box and the number of nodes per axis."""
+
+    lower: tuple[FiniteFloat, FiniteFloat]
+    upper: tuple[FiniteFloat, FiniteFloat]
+    nodes: tuple[int, int] = Field((101, 101))
+
+    @model_validator(mode="after")
+    def _box(self) -> GridSpec:
+        if any(lo >= hi for lo, hi in zip(self.lower, self.upper, strict=True)):
+            raise ValueError("each lower bound must be below its upper bound")
+        if any(n < 11 or n > 2001 for n in self.nodes):
+            raise ValueError("nodes must lie in [11, 2001] per axis")
+        return self
+
+
+class GameMethod(StrictModel):
+    """Stopping rule of Gauss–Seidel (Algorithm 3): ``max(‖ΔV‖, ‖ΔK‖) ≤ tolerance`` (ε_v = ε_k)."""
+
+    tolerance: float = Field(5e-3, gt=0)
+    max_iterations: int = Field(30, ge=1, le=1000)
+
+
+class ConvexConcaveMethod(StrictModel):
+    """The evader's convex–concave procedure: stop when ``J`` rises by less than ``tolerance · J``."""
+
+    tolerance: float = Field(1e-6, gt=0)
+    max_iterations: int = Field(50, ge=1, le=1000)
+
+
+class MonteCarloMethod(StrictModel):
+    """Euler–Maruyama samples of the nonlinear SDE (0 to skip), ``substeps`` per control step."""
+
+    samples: int = Field(20_000, ge=0, le=1_000_000)
+    seed: int = 0
+    substeps: int = Field(5, ge=1, le=100)
+
+
+class ExtremalMethod(StrictModel):
+    """Extremal shooting: initial directions and the RK4 step."""
+
+    directions: int = Field(720, ge=16, le=20_000)
+    step: float = Field(2e-3, gt=0)
+
+
+class FlowGameMethod(StrictModel):
+    """Reachability (grid, scheme, CFL, levels), the game's iterations and the Monte Carlo."""
+
+    grid: GridSpec
+    scheme: Literal["weno5", "eno2", "first_order"] = "weno5"
+    cfl: float = Field(0.5, gt=0, le=1)
+    max_time: float = Field(20.0, gt=0)
+    level_cells: tuple[float, float] = Field(
+        (2.0, 4.0), description="The two positive levels read, in cells."
+    )
+    extremals: ExtremalMethod = Field(default_factory=ExtremalMethod)
+    game: GameMethod = Field(default_factory=GameMethod)
+    convex_concave: ConvexConcaveMethod = Field(default_factory=ConvexConcaveMethod)
+    monte_carlo: MonteCarloMethod = Field(default_factory=MonteCarloMethod)
+
+    @model_validator(mode="after")
+    def _levels(self) -> FlowGameMethod:
+        low, high = self.level_cells
+        if not 0 < low < high:
+            raise ValueError("level_cells must be two increasing positive numbers")
+        return self
+
+
+class FlowGameSpec(SpecBase):
+    """Two agents in a stochastic flow field: reachability, nominal paths, covariance game (ch. 5)."""
+
+    kind: Literal["flow_field_game"] = "flow_field_game"
+    problem: FlowGameProblem
+    method: FlowGameMethod
+
+    default_backend = "levelset"
+
+    @model_validator(mode="after")
+    def _evaluates(self) -> FlowGameSpec:
+        self.data()
+        return self
+
+    def data(self, parameters: Mapping[str, float] | None = None) -> FlowGameData:
+        """The evaluated game for the file's parameter values, updated by ``parameters``."""
+        unknown = set(parameters or {}) - set(self.problem.parameters)
+        if unknown:
+            raise SpecError(f"unknown parameter(s) {sorted(unknown)}", field="problem.parameters")
+        return _Evaluator(self, {**self.problem.parameters, **(parameters or {})}).data()
+
+
+class _Evaluator:
+    """Parses every entry and substitutes the parameter values (no eval)."""
+
+    def __init__(self, spec: FlowGameSpec, values: Mapping[str, float]) -> None:
+        self.spec = spec
+        self.position = tuple(symbol(n) for n in spec.problem.position)
+        self.symbols = {name: symbol(name) for name in values}
+        self.substitution = {symbol(name): sp.Float(v) for name, v in values.items()}
+
+    def expression(self, value: Value, field: str, position: bool) -> sp.Expr:
+        symbols = (
+            {**self.symbols, **dict(zip(self.spec.problem.position, self.position, strict=True))}
+            if position
+            else self.symbols
+        )
+        try:
+            return sp.sympify(parse(value, symbols)).xreplace(self.substitution)
+        except ExpressionError as err:
+            raise SpecError(str(err), field=f"problem.{field}") from None
+
+    def number(self, value: Value, field: str, positive: bool = False) -> float:
+        expr = self.expression(value, field, position=False)
+        try:
+            result = complex(expr)
+        except (TypeError, ValueError):
+            raise SpecError(f"{value!r} does not evaluate to a number", field=f"problem.{field}") from None
+        if result.imag != 0 or not np.isfinite(result.real) or (positive and result.real <= 0):
+            need = "a positive number" if positive else "a finite real number"
+            raise SpecError(f"{value!r} evaluates to {result.real:g}; need {need}", field=f"problem.{field}")
+        return result.real
+
+    def player(self, name: str) -> tuple[np.ndarray, PlayerBounds]:
+        p: PlayerSpec = getattr(self.spec.problem, name)
+        origin = np.array([self.number(v, f"{name}.initial.{i}") for i, v in enumerate(p.initial)])
+        beta = self.number(p.beta, f"{name}.beta", positive=True)
+        if beta >= 1:
+            raise SpecError("β must lie in (0, 1)", field=f"problem.{name}.beta")
+        bounds = PlayerBounds(
+            max_speed=self.number(p.max_speed, f"{name}.max_speed", positive=True),
+            delta_x=self.number(p.delta_x, f"{name}.delta_x", positive=True),
+            delta_u=self.number(p.delta_u, f"{name}.delta_u", positive=True),
+            beta=beta,
+        )
+        return origin, bounds
+
+    def field(self) -> FlowField:
+        flow = self.spec.problem.flow
+        drift = sp.Matrix([self.expression(v, f"flow.drift.{i}", True) for i, v in enumerate(flow.drift)])
+        if isinstance(flow.diffusion, Identity):
+            diffusion = sp.eye(2) * self.expression(flow.diffusion.identity, "flow.diffusion.identity", True)
+        else:
+            diffusion = sp.Matrix(
+                [
+                    [self.expression(v, f"flow.diffusion.{i}.{j}", True) for j, v in enumerate(row)]
+                    for i, row in enumerate(flow.diffusion)
+                ]
+            )
+        field = FlowField(self.position, drift, diffusion)
+        probe = np.zeros((1, 2))
+        for label, evaluate in (
+            ("drift", field.drift),
+            ("diffusion", field.diffusion),
+            ("drift", field.jacobian),
+        ):
+            try:
+                evaluate(probe)
+            except ExpressionError as err:
+                raise SpecError(str(err), field=f"problem.flow.{label}") from None
+        return field
+
+    def data(self) -> FlowGameData:
+        p, m = self.spec.problem, self.spec.method
+        (xp, bp), (xe, be) = self.player("pursuer"), self.player("evader")
+        fraction = self.number(p.nominal_speed_fraction, "nominal_speed_fraction", positive=True)
+        if fraction > 1:
+            raise SpecError("v̂/v_max must not exceed 1 (eq. 5.24)", field="problem.nominal_speed_fraction")
+        if bp.max_speed <= be.max_speed:
+            raise SpecError(
+                "the pursuer must be faster than the evader (section 5.1)", field="problem.pursuer.max_speed"
+            )
+        grid = Grid(m.grid.lower, m.grid.upper, m.grid.nodes)
+        origins = np.stack([xp, xe])
+        if not grid.contains(origins).all():
+            raise SpecError("both starting points must lie inside the grid", field="method.grid")
+        return FlowGameData(
+            field=self.field(),
+            origins=origins,
+            bounds=(bp, be),
+            speed_fraction=fraction,
+            capture_radius=self.number(p.capture_radius, "capture_radius", positive=True),
+            step=self.number(p.step, "step", positive=True),
+            payoff=p.payoff,
+            grid=grid,
+        )

@@ -1,0 +1,198 @@
+"""The ``study`` backend: runs a ``pursuit_suboptimal_study`` (Table 2.1, §2.4.4) point by point.
+
+Every point of :func:`gamespec.pursuit.study.study_points` is solved by :func:`evaluate` (the
+generated eq. 2.21 OCP compiled once per speed and process) and goes through
+:func:`gamespec.studies.runner.run_study` into a :class:`~gamespec.studies.store.ResultStore` at the
+spec's ``store`` folder, through an executor plugin (``serial``, ``process`` or ``dask``, see
+:mod:`gamespec.studies.executors`); points already stored are reused, so solving the file again
+resumes where it stopped.
+
+The Result: ``metrics["table"]`` holds one Table 2.1 row per speed, ``arrays`` the per-point
+values (NaN where a point has no accepted optimum), ``checks`` the worst simultaneous-capture gap,
+re-simulation error (eq. 2.1 integrated under the optimal heading) and defect over the solved
+points. Status ``optimal`` when every point solved, ``feasible`` when some were left out of the
+averages (no optimum passed the defect check), ``error`` when none solved.
+"""
+
+from __future__ import annotations
+
+import time
+from functools import cache
+from typing import Any, ClassVar
+
+import numpy as np
+from pydantic import Field
+
+from gamespec.backend import Backend, CompiledModel, Inputs, refuse_inputs
+from gamespec.errors import UnsupportedFeature
+from gamespec.loader import spec_hash
+from gamespec.pursuit import pure_pursuit, study
+from gamespec.pursuit.ocp_generation import to_ocp, trajectory_guess
+from gamespec.pursuit.ocp_report import heading_law
+from gamespec.pursuit.pursuit_curve import constant_heading_pursuit
+from gamespec.pursuit.reduced import reduce
+from gamespec.pursuit.report import capture_gap
+from gamespec.pursuit.simulation import Players, simulate_to_capture
+from gamespec.pursuit.study import DEFECT_TOL, StudyPoint, point_engagement
+from gamespec.result import Result, Status
+from gamespec.solving import get_backend
+from gamespec.specs.base import StrictModel
+from gamespec.specs.suboptimal_study import SuboptimalStudySpec
+from gamespec.studies.executors import SCHEDULER_ENV, executor
+from gamespec.studies.runner import run_study
+from gamespec.studies.store import ResultStore
+
+POINT_ARRAYS = ("v", "r2", "psi", "t_suboptimal", "t_optimal", "variation_percent")
+"""Per-point values copied into ``Result.arrays`` (the plot's scatter)."""
+
+SWEPT = ("v", "r2", "psi")
+"""The per-point fields that vary over the grid (what ``gamespec results`` and ``plot`` show)."""
+
+POINT_CHECKS = {
+    "max_simultaneous_capture_gap": "simultaneous_capture_gap",
+    "max_resimulated_capture_time_error": "resimulated_capture_time_error",
+    "max_defect": "max_defect",
+}
+"""``Result.checks`` entry → the per-point check whose maximum over the solved points it holds."""
+
+
+@cache
+def _model(v: float, r1: float, u: float, eps: float, method: str, backend: str):
+    """The eq. 2.21 OCP of one speed, compiled once per process (P2 far away only sets the bounds)."""
+    reference = StudyPoint(v, 10 * r1, 0.5 * np.pi, r1, u, eps, (method,), backend)
+    ocp, _ = to_ocp(point_engagement(reference))
+    solver = get_backend(backend)
+    return solver.compile(ocp)
+
+
+def _first_accepted(point: StudyPoint, parameters: dict[str, float], guess: Result) -> tuple[int, Result]:
+    """Solve with each of the point's methods in turn; the first that passes the defect check (or
+    the last one tried) and its index."""
+    for attempt, method in enumerate(point.methods):
+        model = _model(point.v, point.r1, point.u, point.eps, method, point.backend)
+        result = model.solve(parameters=parameters, guess=guess)
+        if result.ok and result.checks["max_defect"] < DEFECT_TOL:
+            return attempt, result
+    return len(point.methods) - 1, result
+
+
+def evaluate(point: StudyPoint) -> dict[str, Any]:
+    """Suboptimal and optimal capture times of one point (the row the store keeps)."""
+    spec = point_engagement(point)
+    players = Players.from_spec(spec)
+    red = reduce(spec)
+    choice = pure_pursuit.suboptimal_heading(players)
+    traj = constant_heading_pursuit(players, choice.heading)
+    guess = trajectory_guess(red, traj)
+    parameters = {k: red.parameters[k] for k in ("r2_init", "psi_init")}
+    attempt, result = _first_accepted(point, parameters, guess)
+    row: dict[str, Any] = {
+        "v": point.v,
+        "r2": point.r2,
+        "psi": point.psi,
+        "status": result.status.value,
+        "t_suboptimal": traj.capture_time,
+        "heading_suboptimal": choice.heading,
+        "solve_time_s": result.solve_time_s,
+        "attempt": attempt,
+        "max_defect": result.checks.get("max_defect"),
+    }
+    if not (result.ok and row["max_defect"] < DEFECT_TOL):
+        return row
+    terminal = np.array([result.states[red.distance[i]][-1] for i in (0, 1)])
+    check = simulate_to_capture(players, heading_law(red, result))
+    return row | {
+        "t_optimal": result.t_final,
+        "variation_percent": 100.0 * (result.t_final - traj.capture_time) / result.t_final,
+        "simultaneous_capture_gap": capture_gap(players, terminal),
+        "resimulated_capture_time_error": abs(check.capture_time - result.t_final),
+    }
+
+
+class StudyOptions(StrictModel):
+    """Options of the ``study`` backend (``solver.options.study``)."""
+
+    workers: int = Field(1, ge=1, description="Worker processes (1: everything in this process).")
+    executor: str | None = Field(
+        None,
+        description="Executor plugin: serial, process or dask (default: serial for one worker, "
+        "process for more, dask when a scheduler is given).",
+    )
+    scheduler: str | None = Field(
+        None, description=f"Address of a running Dask scheduler (default: ${SCHEDULER_ENV})."
+    )
+    progress: bool = Field(
+        False,
+        description="Show a progress bar on stderr (`gamespec pursuit study` does; `gamespec solve` "
+        "shows its own spinner instead).",
+    )
+
+
+class StudyModel(CompiledModel):
+    """A study ready to run (or resume) into its store."""
+
+    def __init__(self, spec: SuboptimalStudySpec, options: StudyOptions) -> None:
+        self.spec = spec
+        self.options = options
+
+    def solve(
+        self, parameters: dict[str, float] | None = None, guess: Result | None = None, inputs: Inputs = None
+    ) -> Result:
+        refuse_inputs(inputs, self.spec.kind)
+        if parameters:
+            raise UnsupportedFeature("a pursuit_suboptimal_study takes no parameters; edit the file")
+        tic = time.perf_counter()
+        points = study.study_points(self.spec)
+        store = ResultStore(self.spec.store)
+        store.set_meta("study", {"type": "sweep", "problem": self.spec.name, "parameters": list(SWEPT)})
+        run = run_study(
+            points,
+            evaluate,
+            store,
+            executor=executor(self.options.executor, self.options.workers, self.options.scheduler),
+            description=self.spec.name,
+            show_progress=self.options.progress,
+            spec_hash=spec_hash(self.spec),
+        )
+        rows = [run.values[key] for key in points]
+        solved = [r for r in rows if "variation_percent" in r]
+        status, message = _outcome(len(rows), len(solved))
+        computed = run.computed
+        return Result(
+            status=status,
+            message=f"{message} ({computed} computed now, {run.reused} read from {self.spec.store})",
+            solve_time_s=time.perf_counter() - tic,
+            arrays={name: np.array([r.get(name, np.nan) for r in rows]) for name in POINT_ARRAYS},
+            checks={name: max((r[key] for r in solved), default=None) for name, key in POINT_CHECKS.items()},
+            metrics={
+                "table": study.summarize(rows),
+                "points": len(rows),
+                "solved": len(solved),
+                "computed": computed,
+                "store": str(self.spec.store),
+            },
+        )
+
+
+def _outcome(points: int, solved: int) -> tuple[Status, str]:
+    if points and solved == points:
+        return Status.OPTIMAL, f"all {points} points solved"
+    if solved:
+        left_out = points - solved
+        return Status.FEASIBLE, (
+            f"{left_out} of {points} points left out of the averages "
+            f"(no optimum with a defect below {study.DEFECT_TOL:g})"
+        )
+    return Status.ERROR, f"none of the {points} points solved"
+
+
+class StudyBackend(Backend):
+    """Runs the Table 2.1 study (see module doc); each point's OCP is solved on ``ocp_backend``."""
+
+    name: ClassVar[str] = "study"
+    kinds: ClassVar[frozenset[str]] = frozenset({"pursuit_suboptimal_study"})
+    options_model: ClassVar[type[StrictModel]] = StudyOptions
+
+    def _compile(self, spec: SuboptimalStudySpec, options: StudyOptions) -> StudyModel:
+        get_backend(spec.ocp_backend)
+        return StudyModel(spec, options)

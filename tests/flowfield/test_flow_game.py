@@ -1,0 +1,122 @@
+"""The ``flow_field_game`` kind end to end on a uniform flow, where every stage has a closed form:
+the discs of the reachable sets, straight nominal paths, an exact linear model (so eq. 5.39 and the
+Monte Carlo of the SDE must agree within sampling error), and the bad-input contract."""
+
+from __future__ import annotations
+
+import copy
+from pathlib import Path
+
+import numpy as np
+import pytest
+import yaml
+
+from gamespec.errors import SpecError
+from gamespec.loader import load, spec_from_dict
+from gamespec.solving import solve
+
+SPEC = {
+    "kind": "flow_field_game",
+    "name": "uniform",
+    "problem": {
+        "parameters": {"noise": 0.05},
+        "flow": {"drift": [0.4, -0.3], "diffusion": {"identity": "noise"}},
+        "pursuer": {"initial": [0, 0], "max_speed": 2, "delta_u": 0.4},
+        "evader": {"initial": [1, 0.5], "max_speed": 0.75, "delta_u": 0.15},
+        "capture_radius": 0.09,
+        "step": 0.2,
+    },
+    "method": {
+        "grid": {"lower": [-2.5, -3.0], "upper": [4.0, 3.0], "nodes": [53, 49]},
+        "game": {"max_iterations": 3},
+        "monte_carlo": {"samples": 20000, "seed": 1},
+    },
+}
+T_EXACT = np.hypot(1, 0.5) / (1.6 - 0.6)
+
+
+@pytest.fixture(scope="module")
+def result():
+    return solve(spec_from_dict(SPEC))
+
+
+def test_capture_time_and_point(result) -> None:
+    gap = np.array([1.0, 0.5])
+    x_f = gap + np.array([0.4, -0.3]) * T_EXACT + 0.6 * T_EXACT * gap / np.linalg.norm(gap)
+    dx = 6.5 / 52
+    assert result.metrics["capture_time"] == pytest.approx(T_EXACT, abs=0.1 * dx / 1.6)
+    assert np.linalg.norm(np.array(result.metrics["capture_point"]) - x_f) < dx
+    assert result.checks["capture_time_difference"] < 0.1 * dx / 1.6
+    assert max(result.checks["closure_error_pursuer"], result.checks["closure_error_evader"]) < dx
+
+
+def test_monte_carlo_agrees_with_eq_5_39(result) -> None:
+    """For a uniform flow the linearized model is exact and Euler–Maruyama is exact, so the Monte
+    Carlo frequency of capture at T̂ has mean eq. 5.39 (both loops)."""
+    carlo = result.metrics["monte_carlo_capture_probability"]
+    for loop in ("open_loop", "closed_loop"):
+        p = result.metrics[f"capture_probability_{loop}"]
+        n = carlo[loop]["samples"]
+        assert n >= 20000
+        assert abs(carlo[loop]["estimate"] - p) < 4 * np.sqrt(p * (1 - p) / n) + 1e-3
+
+
+def test_result_reports_the_game_honestly(result) -> None:
+    assert isinstance(result.metrics["game_converged"], bool)
+    history = result.metrics["best_response"]["history"]
+    assert history and result.metrics["best_response"]["scheme"] == "gauss_seidel"
+    assert result.ok == result.metrics["game_converged"]
+    assert result.checks["max_constraint_violation"] <= 1e-6
+    for values in result.metrics["evader_convex_concave"]["payoffs"]:
+        assert np.all(np.diff(values) >= -1e-6 * np.abs(values[:-1]))
+
+
+def test_extremal_backend_agrees(result) -> None:
+    other = solve(spec_from_dict(SPEC), backend="extremals", options={"cross_check": False})
+    assert other.metrics["capture_time"] == pytest.approx(T_EXACT, abs=1e-3)
+    cell_time = 6.5 / 52 / 1.6
+    assert other.metrics["capture_time"] == pytest.approx(result.metrics["capture_time"], abs=0.1 * cell_time)
+
+
+@pytest.mark.parametrize(
+    ("path", "value", "field"),
+    [
+        (("problem", "flow", "drift"), ["x1 +", 0], "problem.flow.drift.0"),
+        (("problem", "flow", "drift"), ["y3", 0], "problem.flow.drift.0"),
+        (("problem", "pursuer", "max_speed"), 0.5, "problem.pursuer.max_speed"),
+        (("problem", "evader", "beta"), 1.5, "problem.evader.beta"),
+        (("problem", "nominal_speed_fraction"), 1.2, "problem.nominal_speed_fraction"),
+        (("problem", "evader", "initial"), [40, 0], "method.grid"),
+        (("method", "grid", "nodes"), [5, 5], "method.grid"),
+        (("problem", "payoff"), "max", "problem.payoff"),
+    ],
+)
+def test_bad_input_names_the_field(path: tuple[str, ...], value: object, field: str) -> None:
+    data = copy.deepcopy(SPEC)
+    node = data
+    for key in path[:-1]:
+        node = node[key]
+    node[path[-1]] = value
+    with pytest.raises(SpecError) as err:
+        spec_from_dict(data, source="bad.yaml")
+    assert err.value.field.startswith(field)
+
+
+def test_set_parameter_on_the_command_line(tmp_path: Path, cli) -> None:
+    path = tmp_path / "uniform.yaml"
+    path.write_text(yaml.safe_dump(SPEC))
+    spec = load(path, ["problem.parameters.noise=0.1"])
+    assert spec.problem.parameters["noise"] == 0.1
+    assert spec.data().field.diffusion(np.zeros((1, 2)))[0, 0, 0] == pytest.approx(0.1)
+    code, out, err = cli("validate", path, "--set", "problem.flow.drift=[1]")
+    assert code == 2 and "problem.flow.drift" in out + err
+    assert cli("validate", path, "--set", "problem.parameters.noise=0.1")[0] == 0
+
+
+def test_hj_reachability_backend_agrees(result) -> None:
+    """The optional JAX engine (same scheme, global Lax–Friedrichs) finds the same capture."""
+    pytest.importorskip("hj_reachability")
+    other = solve(spec_from_dict(SPEC), backend="hj_reachability", options={"cross_check": False})
+    assert other.metrics["reachability"]["engine"].startswith("hj_reachability")
+    cell_time = 6.5 / 52 / 1.6
+    assert other.metrics["capture_time"] == pytest.approx(result.metrics["capture_time"], abs=0.1 * cell_time)

@@ -253,21 +253,17 @@ class OcpProblem(StrictModel):
                         f"{value:g} lies outside [{lo:g}, {hi:g}]", field=f"problem.states.{name}.{key}"
                     )
             states.append((lo, hi, *ends))
-        controls = []
-        for name, c in self.controls.items():
-            lo, hi = (
-                number(c.lower, -INF, f"controls.{name}.lower"),
-                number(c.upper, INF, f"controls.{name}.upper"),
-            )
-            _ordered(lo, hi, f"controls.{name}")
-            controls.append((lo, hi))
+
+        def interval(group: str, name: str, spec: ControlSpec | DesignSpec) -> tuple[float, float]:
+            lo = number(spec.lower, -INF, f"{group}.{name}.lower")
+            hi = number(spec.upper, INF, f"{group}.{name}.upper")
+            _ordered(lo, hi, f"{group}.{name}")
+            return lo, hi
+
+        controls = [interval("controls", name, c) for name, c in self.controls.items()]
         design = []
         for name, d in self.design.items():
-            lo, hi = (
-                number(d.lower, -INF, f"design.{name}.lower"),
-                number(d.upper, INF, f"design.{name}.upper"),
-            )
-            _ordered(lo, hi, f"design.{name}")
+            lo, hi = interval("design", name, d)
             guess = d.guess if d.guess is not None else bounds_midpoint(lo, hi)
             if not lo <= guess <= hi:
                 raise SpecError(

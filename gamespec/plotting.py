@@ -66,6 +66,10 @@ def plot_trajectories(result: Result, output_dir: Path, *, animate: bool = False
         from gamespec.desensitize.plotting import plot_desensitized
 
         paths += plot_desensitized(result, output_dir)
+    if "rcs" in result.metrics:
+        from gamespec.rcs.plotting import plot_rcs
+
+        paths += plot_rcs(result, output_dir)
     return paths
 
 

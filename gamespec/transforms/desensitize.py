@@ -105,13 +105,26 @@ def desensitize(
             "final",
         ),
     )
+    fixed = {key: _parse(raw, params, spec, f"fixed.{key}") for key, raw in options.fixed.items()}
+    new = augmented_spec(spec, aug, penalty, fixed)
+    inverse = InverseData(aug, penalty, measure, options, len(spec.problem.states), len(new.problem.states))
+    return new, inverse
+
+
+def augmented_spec(
+    spec: OptimalControlSpec, aug: Augmentation, penalty: Penalty, fixed: dict[str, sp.Expr] | None = None
+) -> OptimalControlSpec:
+    """``spec`` with the augmentation's states and dynamics, the end values in ``fixed`` (entry name →
+    value, eq. 6.18) and the penalty added to the objective in the file's sense (pure)."""
+    ocp = SymbolicOcp(spec)
+    params = {n: symbol(n) for n in spec.problem.parameters}
     data = spec.model_dump(exclude={"transforms"} & set(type(spec).model_fields))
     problem = data["problem"]
     taken = set(problem["states"]) | set(problem["parameters"]) | set(problem["controls"])
     clash = sorted(taken & {s.name for s in aug.states})
     if clash:
         raise SpecError(
-            f"names needed by the {options.method} method are taken: {clash}", field=FIELD, source=spec.source
+            f"names needed by the {aug.method} method are taken: {clash}", field=FIELD, source=spec.source
         )
     for name, expr in aug.dynamics.items():
         problem["dynamics"][name] = to_text(expr)
@@ -132,8 +145,7 @@ def desensitize(
         for s in problem["states"]
         for e, key in (("0", "initial"), ("f", "final"))
     }
-    for key, raw in options.fixed.items():
-        value = _parse(raw, params, spec, f"fixed.{key}")
+    for key, value in (fixed or {}).items():
         end = aug.final[key]
         if end in end_of:
             state, which = end_of[end]
@@ -142,12 +154,11 @@ def desensitize(
             constraints.append(_equation(end - value))
     sign = ocp.sign
     user_lagrange, user_mayer = sign * ocp.lagrange, sign * ocp.mayer
-    problem["objective"]["lagrange"] = to_text(user_lagrange + sign * running)
-    problem["objective"]["mayer"] = to_text(user_mayer + sign * final)
+    problem["objective"]["lagrange"] = to_text(user_lagrange + sign * penalty.running)
+    problem["objective"]["mayer"] = to_text(user_mayer + sign * penalty.final)
     new = OptimalControlSpec.model_validate(data)
     new.with_source(spec.source, spec.file_hash)
-    inverse = InverseData(aug, penalty, measure, options, len(spec.problem.states), len(new.problem.states))
-    return new, inverse
+    return new
 
 
 def _equation(residual: sp.Expr) -> str:

@@ -36,7 +36,7 @@ class WeightedLagrange(Transform):
         self, spec: OptimalControlSpec, options: WeightedLagrangeOptions, upstream: Result | None = None
     ) -> tuple[OptimalControlSpec, Any]:
         p = spec.problem
-        names = [*p.parameters, *p.states, *p.controls, WEIGHT]
+        names = [*p.parameters, *p.states, *p.controls, *p.inputs, WEIGHT]
         symbols = {n: symbol(n) for n in names} | {"t": symbol("t")}
         lagrange = parse(str(p.objective.lagrange), symbols) + symbols[WEIGHT] * parse(options.term, symbols)
         problem = p.model_copy(

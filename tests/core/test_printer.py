@@ -14,7 +14,7 @@ from hypothesis import HealthCheck, assume, given, settings
 from hypothesis import strategies as st
 
 from gamespec.errors import ExpressionError
-from gamespec.symbolic.language import float_value, parse, parse_relation, symbol
+from gamespec.symbolic.language import FUNCTIONS, float_value, parse, parse_relation, symbol
 from gamespec.symbolic.printer import to_text
 from gamespec.symbolic.translate import NUMPY, translate
 
@@ -108,11 +108,15 @@ def trees(unary: list[Unary], binary: list[Binary]) -> st.SearchStrategy[sp.Expr
 
 
 def representable(expr: sp.Expr) -> bool:
-    """Finite (no infinities, no bounds such as ``atan(zoo)``), real, no ``Piecewise``, every float
+    """Finite (no infinities, no bounds such as ``atan(zoo)``), real, no ``Piecewise``, only the
+    language's functions, every float
     within double precision, every power of two numbers real and every number-valued part within
     double range (:func:`float_value`): what the language can hold."""
     if expr.has(sp.zoo, sp.oo, -sp.oo, sp.nan, sp.I, sp.AccumBounds, sp.Piecewise):
         return False
+    language = {func for _, func in FUNCTIONS.values()}
+    if any(part.func not in language for part in expr.atoms(sp.Function)):
+        return False  # e.g. cos(sqrt(-1)) evaluates to cosh(1), which the language has no name for
     if not all(math.isfinite(float(f)) and sp.Float(float(f)) == f for f in expr.atoms(sp.Float)):
         return False
     if any(max(abs(r.p), r.q).bit_length() > 1_000 for r in expr.atoms(sp.Rational)):

@@ -1,0 +1,117 @@
+"""The ``best_response`` backend: a ``differential_game`` solved by best responses on OCP backends.
+
+Compiling builds a :class:`~gamespec.games.equilibrium.GameModel` (each player's problem of each game
+compiled once on ``game.backend``); solving runs the receding horizon of Algorithm 4 when the file
+has a ``receding_horizon`` section (:mod:`gamespec.games.receding_horizon`), else the open-loop game
+over the whole horizon. Runtime parameters are the game's ``problem.parameters``.
+"""
+
+from __future__ import annotations
+
+from typing import ClassVar
+
+import numpy as np
+
+from gamespec.backend import Backend, CompiledModel, Inputs, refuse_inputs
+from gamespec.games.equilibrium import GameModel, GameSolution, status_of
+from gamespec.games.problems import initial_state
+from gamespec.games.simulate import TrueSystem, control_signal, grid_of
+from gamespec.result import Result
+from gamespec.specs.base import SpecBase, StrictModel
+from gamespec.specs.differential_game import DifferentialGameSpec
+
+
+def true_parameters(model: GameModel) -> dict[str, float]:
+    """The game's parameter values with every uncertain one at its true value."""
+    return dict(model.parameters) | {n: u.actual for n, u in model.game.problem.uncertain.items()}
+
+
+def open_loop(model: GameModel) -> Result:
+    """The open-loop game over the whole horizon from the initial state.
+
+    One game (no private beliefs or transforms): its trajectories. Several (``G^i`` per player):
+    each player applies the controls of its own game and the true system is integrated with them;
+    each game's own trajectories are in ``arrays["game/<player>/<state>"]``.
+    """
+    game = model.game
+    x0, t0 = initial_state(game), game.problem.time.initial
+    solutions = [model.solve(view, x0, t0) for view in model.views]
+    own = {name: _own(solutions, name) for name in game.problem.players}
+    first = solutions[0].states
+    tc = first.control_time + t0
+    controls = {
+        c: own[p].results[p].controls[c] for p, pl in game.problem.players.items() for c in pl.controls
+    }
+    arrays = {}
+    if len(solutions) == 1:
+        time, states = first.time + t0, dict(first.states)
+    else:
+        for s in solutions:
+            arrays |= {f"game/{s.view}/{k}": v for k, v in s.states.states.items()}
+        time, states = _simulated(model, first, controls, t0)
+    metrics = {"best_response": _runs(solutions), "builds": model.builds}
+    return Result(
+        status=status_of(solutions),
+        message="; ".join(s.run.message for s in solutions if s.run.message),
+        objective=first.objective,
+        t_final=float(time[-1]),
+        time=time,
+        control_time=tc,
+        states=states,
+        controls=controls,
+        arrays=arrays,
+        iterations=sum(s.run.iterations for s in solutions),
+        metrics=metrics,
+    )
+
+
+def _own(solutions: list[GameSolution], player: str) -> GameSolution:
+    """The game ``player`` solves (the only one when there is one)."""
+    return next((s for s in solutions if s.view == player), solutions[0])
+
+
+def _runs(solutions: list[GameSolution]) -> dict:
+    return {s.view: s.run.as_metrics() for s in solutions}
+
+
+def _simulated(
+    model: GameModel, reference: Result, controls: dict[str, np.ndarray], t0: float
+) -> tuple[np.ndarray, dict[str, np.ndarray]]:
+    game = model.game
+    grid = grid_of(game.method)
+    horizon = float(reference.time[-1] - reference.time[0])
+    signals = {c: control_signal(grid, v, t0, horizon) for c, v in controls.items()}
+    system = TrueSystem(game, true_parameters(model))
+    times, rows = system.advance(initial_state(game), signals, t0, horizon, t0 + horizon * grid.nodes)
+    return times, dict(zip(system.states, rows.T, strict=True))
+
+
+class GameCompiled(CompiledModel):
+    """A compiled game: re-solved with new values of the game's parameters without a rebuild."""
+
+    def __init__(self, game: DifferentialGameSpec) -> None:
+        self.game = game
+        self.model = GameModel(game)
+
+    def solve(
+        self, parameters: dict[str, float] | None = None, guess: Result | None = None, inputs: Inputs = None
+    ) -> Result:
+        refuse_inputs(inputs, self.game.kind)
+        if parameters:
+            self.model.parameters = {**self.model.parameters, **parameters}
+        if self.game.receding_horizon is not None:
+            from gamespec.games.receding_horizon import receding_horizon
+
+            return receding_horizon(self.model)
+        return open_loop(self.model)
+
+
+class BestResponseBackend(Backend):
+    """Best responses of the players of a ``differential_game``, each an ``optimal_control`` problem
+    compiled once on casadi or pyomo."""
+
+    name: ClassVar[str] = "best_response"
+    kinds: ClassVar[frozenset[str]] = frozenset({"differential_game"})
+
+    def _compile(self, spec: SpecBase, options: StrictModel) -> GameCompiled:
+        return GameCompiled(spec)

@@ -1,0 +1,150 @@
+"""Figures of ``differential_game`` Results (Figs. 7.1–7.2): the players' paths, the obstacle where it
+truly is (filled) and where the pursuer believes it is (dashed), its initial position (dotted), and
+each step's look-ahead trajectories (green); with ``animate`` a GIF of the run, step by step.
+
+A receding-horizon Result names its position states in ``metrics.figure``; any other Result (an
+open-loop game) gets the ``optimal_control`` plots of its trajectories.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+
+from gamespec.plotting import plot_trajectories
+from gamespec.result import Result
+
+COLORS = ("tab:blue", "tab:red", "tab:purple", "tab:orange")
+
+
+def _pyplot():
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    return plt
+
+
+def _obstacles(result: Result) -> dict[str, tuple[np.ndarray, np.ndarray]]:
+    """``true`` and each believing player's obstacle centre along the run."""
+    out = {}
+    for key in result.arrays:
+        parts = key.split("/")
+        if parts[0] == "obstacle" and parts[2] == "x":
+            out[parts[1]] = (result.arrays[key], result.arrays[f"obstacle/{parts[1]}/y"])
+    return out
+
+
+def _draw(ax, result: Result, upto: int, step: int | None) -> None:
+    """The run up to sample ``upto``; the look-ahead of ``step`` (every step's when None)."""
+    plt = _pyplot()
+    figure = result.metrics["figure"]
+    radius = figure["obstacle_radius"]
+    obstacles = _obstacles(result)
+    if radius is not None and "true" in obstacles:
+        ox, oy = obstacles["true"]
+        ax.add_patch(
+            plt.Circle((ox[0], oy[0]), radius, fill=False, ls=":", color="grey", label="obstacle at t = 0")
+        )
+        ax.add_patch(
+            plt.Circle((ox[upto], oy[upto]), radius, color="grey", alpha=0.5, label="obstacle (true)")
+        )
+        for name, (bx, by) in obstacles.items():
+            if name != "true":
+                ax.add_patch(
+                    plt.Circle(
+                        (bx[upto], by[upto]),
+                        radius,
+                        fill=False,
+                        ls="--",
+                        color="k",
+                        label=f"obstacle ({name}'s belief)",
+                    )
+                )
+    steps = range(len(result.control_time)) if step is None else [step]
+    for view in figure["lookahead_players"]:
+        px, py = figure["positions"].get(view, (None, None))
+        if px is None:
+            continue
+        xs, ys = result.arrays[f"lookahead/{view}/{px}"], result.arrays[f"lookahead/{view}/{py}"]
+        for k in steps:
+            ax.plot(xs[k], ys[k], "-", color="tab:green", lw=0.8, alpha=0.6 if step is None else 1.0)
+    for (player, (px, py)), color in zip(figure["positions"].items(), COLORS, strict=False):
+        x, y = result.states[px], result.states[py]
+        ax.plot(x[: upto + 1], y[: upto + 1], "-", color=color, label=player)
+        ax.plot(x[0], y[0], "o", color=color, mfc="none")
+        ax.plot(x[upto], y[upto], "o", color=color)
+    ax.plot([], [], "-", color="tab:green", label="look-ahead")
+    ax.set_xlabel("x")
+    ax.set_ylabel("y")
+    ax.set_aspect("equal", adjustable="datalim")
+    ax.grid(alpha=0.3)
+
+
+def _summary(result: Result) -> str:
+    m = result.metrics
+    end = f"captured at t = {m['capture_time']:.2f}" if m.get("captured") else f"stopped: {m.get('stop')}"
+    return f"{result.problem}: {end}"
+
+
+def plot_game(result: Result, output_dir: Path, *, animate: bool = False) -> list[Path]:
+    """The figures of the module doc; the paths of the files written."""
+    if "figure" not in result.metrics:
+        return plot_trajectories(result, output_dir, animate=animate)
+    plt = _pyplot()
+    output_dir.mkdir(parents=True, exist_ok=True)
+    fig, ax = plt.subplots(figsize=(7, 6))
+    _draw(ax, result, len(result.time) - 1, None)
+    ax.set_title(_summary(result))
+    ax.legend(loc="best", fontsize=8)
+    fig.tight_layout()
+    paths = [output_dir / f"{result.problem}_paths.png"]
+    fig.savefig(paths[0], dpi=120)
+    plt.close(fig)
+    if animate:
+        paths.append(_animation(result, output_dir))
+    return paths
+
+
+def _animation(result: Result, output_dir: Path) -> Path:
+    from matplotlib.animation import FuncAnimation, PillowWriter
+
+    plt = _pyplot()
+    fig, ax = plt.subplots(figsize=(7, 6))
+    steps = result.control_time
+    samples = np.searchsorted(result.time, steps)
+    limits = _limits(result)
+
+    def frame(k: int) -> None:
+        ax.clear()
+        _draw(ax, result, int(samples[k]), k)
+        ax.set_xlim(*limits[0])
+        ax.set_ylim(*limits[1])
+        ax.set_title(f"{result.problem} — t = {steps[k]:.2f}")
+        ax.legend(loc="upper left", fontsize=7)
+
+    anim = FuncAnimation(fig, frame, frames=len(steps))
+    path = output_dir / f"{result.problem}.gif"
+    anim.save(path, writer=PillowWriter(fps=8))
+    plt.close(fig)
+    return path
+
+
+def _limits(result: Result) -> tuple[tuple[float, float], tuple[float, float]]:
+    """Axis limits holding every path, look-ahead and obstacle position, with a margin."""
+    figure = result.metrics["figure"]
+    xs, ys = [], []
+    for px, py in figure["positions"].values():
+        xs.append(result.states[px])
+        ys.append(result.states[py])
+        for view in figure["lookahead_players"]:
+            xs.append(result.arrays[f"lookahead/{view}/{px}"].ravel())
+            ys.append(result.arrays[f"lookahead/{view}/{py}"].ravel())
+    for ox, oy in _obstacles(result).values():
+        xs.append(ox)
+        ys.append(oy)
+    margin = (figure["obstacle_radius"] or 0.0) + 0.2
+    x, y = np.concatenate(xs), np.concatenate(ys)
+    return (np.nanmin(x) - margin, np.nanmax(x) + margin), (np.nanmin(y) - margin, np.nanmax(y) + margin)

@@ -1,0 +1,181 @@
+"""Each player's best-response problem as an ``optimal_control`` spec, generated symbolically.
+
+In the game ``G^i`` that player ``i`` solves (section 7.2.2), player ``j``'s best response is the
+optimal-control problem of its own controls with the other players' controls as grid inputs
+(:mod:`gamespec.ocp.inputs`):
+
+- parameters: the game's, each uncertain one at the value ``i`` assigns to ``j`` (``j``'s belief
+  when ``j == i`` or ``i`` knows the others' beliefs, else ``i``'s own: the pursuer models the
+  evader with ρ̂ in ``G^u``; the evader knows the pursuer uses ρ̂ in ``G^v``), the initial state as
+  ``initial_<state>`` and the absolute start time as ``start_time`` — all runtime parameters, so a
+  receding-horizon step re-solves the compiled model;
+- the payoff (eq. 7.1) in ``j``'s sense, ``j``'s path constraints (eqs. 7.3–7.4), the terminal
+  constraints (eq. 7.5), with ``t`` read as ``t + start_time`` (absolute time);
+- ``j``'s requested ``transforms`` when ``j == i`` or ``i`` knows them (the evader does not know
+  the pursuer's regularizer), so the solving chain applies them.
+
+Every expression is parsed from the file and printed back from SymPy by
+:func:`~gamespec.symbolic.printer.to_text`.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import sympy as sp
+
+from gamespec.specs.differential_game import (
+    INITIAL_PREFIX,
+    NOMINAL_PREFIX,
+    START_TIME,
+    DifferentialGameSpec,
+    PayoffSpec,
+    sensitivity_name,
+)
+from gamespec.specs.ocp import OptimalControlSpec, StateSpec
+from gamespec.symbolic.language import parse, parse_relation, symbol
+from gamespec.symbolic.printer import to_text
+
+
+@dataclass(frozen=True)
+class Symbols:
+    """The symbol tables of a game's expressions."""
+
+    running: dict[str, sp.Symbol]
+    ends: dict[str, sp.Symbol]
+    shift: dict[sp.Symbol, sp.Expr]
+
+
+def symbols_of(game: DifferentialGameSpec) -> Symbols:
+    p = game.problem
+    params = {n: symbol(n) for n in [*p.parameters, *p.uncertain]}
+    controls = {c: symbol(c) for pl in p.players.values() for c in pl.controls}
+    running = params | controls | {n: symbol(n) for n in [*p.states, "t"]}
+    ends = params | {f"{s}_f": symbol(f"{s}_f") for s in p.states} | {"t_f": symbol("t_f")}
+    start = symbol(START_TIME)
+    return Symbols(running, ends, {symbol("t"): symbol("t") + start, symbol("t_f"): symbol("t_f") + start})
+
+
+def _expression(text: float | str, table: dict[str, sp.Symbol], shift: dict) -> str:
+    return to_text(sp.sympify(parse(text, table)).subs(shift))
+
+
+def _relations(text: str, table: dict[str, sp.Symbol], shift: dict) -> list[str]:
+    """A constraint of the file printed back (a two-sided one as two one-sided ones)."""
+    rel = parse_relation(text, table)
+    expr = sp.sympify(rel.expr).subs(shift)
+    if rel.lower == rel.upper:
+        return [to_text(sp.Eq(expr, sp.Float(rel.lower)))]
+    out = []
+    if math.isfinite(rel.lower):
+        out.append(to_text(sp.Ge(expr, sp.Float(rel.lower))))
+    if math.isfinite(rel.upper):
+        out.append(to_text(sp.Le(expr, sp.Float(rel.upper))))
+    return out
+
+
+def parameter_values(game: DifferentialGameSpec, player: str, view: str) -> dict[str, float]:
+    """The uncertain parameters' values in ``player``'s problem of the game ``view`` solves."""
+    owner = game.problem.players[view]
+    holder = player if player == view or owner.knows_beliefs else view
+    return {name: u.belief(holder) for name, u in game.problem.uncertain.items()}
+
+
+def applies_transforms(game: DifferentialGameSpec, player: str, view: str) -> bool:
+    return player == view or game.problem.players[view].knows_transforms
+
+
+def initial_state(game: DifferentialGameSpec) -> dict[str, float]:
+    """The game's initial state (eq. 7.2's x_0); a free initial value starts at 0."""
+    return {n: float(s.initial) if s.initial is not None else 0.0 for n, s in game.problem.states.items()}
+
+
+def predicted_states(game: DifferentialGameSpec, view: str) -> list[str]:
+    """The states the player ``view`` predicts, whose initial values in its game carry their
+    accumulated sensitivity (``receding_horizon.sensitivity_time: absolute``)."""
+    rh, observes = game.receding_horizon, game.problem.players[view].observes
+    if rh is None or rh.sensitivity_time == "relative" or observes is None or not game.problem.uncertain:
+        return []
+    return [s for s in game.problem.states if s not in observes]
+
+
+def _initial_value(name: str, predicted: bool, uncertain: list[str]) -> str:
+    """``initial_<x>``, or for a predicted state the first-order expansion of eq. 7.14,
+    ``initial_<x> + Σ_ρ initial_S_<x>_<ρ> (ρ − nominal_ρ)``, equal to ``initial_<x>`` at the problem's
+    parameter values and with ``∂x0/∂ρ`` the predicted sensitivity."""
+    value = symbol(f"{INITIAL_PREFIX}{name}")
+    if predicted:
+        value += sum(
+            symbol(sensitivity_name(name, u)) * (symbol(u) - symbol(f"{NOMINAL_PREFIX}{u}"))
+            for u in uncertain
+        )
+    return to_text(value)
+
+
+def player_problem(game: DifferentialGameSpec, player: str, view: str) -> OptimalControlSpec:
+    """``player``'s best-response problem in the game ``view`` solves (see module doc)."""
+    p = game.problem
+    me = p.players[player]
+    sym = symbols_of(game)
+    running, ends, shift = sym.running, sym.ends, sym.shift
+    x0 = initial_state(game)
+    beliefs = parameter_values(game, player, view)
+    predicted = predicted_states(game, view)
+    parameters = (
+        dict(p.parameters)
+        | beliefs
+        | {f"{INITIAL_PREFIX}{s}": v for s, v in x0.items()}
+        | {START_TIME: float(game.problem.time.initial)}
+        | {f"{NOMINAL_PREFIX}{u}": v for u, v in beliefs.items()}
+        | {sensitivity_name(s, u): 0.0 for s in predicted for u in p.uncertain}
+    )
+    states = {
+        name: StateSpec(
+            initial=_initial_value(name, name in predicted, list(p.uncertain)),
+            lower=s.lower,
+            upper=s.upper,
+            final=s.final,
+        )
+        for name, s in p.states.items()
+    }
+    others = {n: pl for n, pl in p.players.items() if n != player}
+    inputs = {c: {"default": o.start.get(c, 0.0)} for o in others.values() for c in o.controls}
+    payoff: PayoffSpec = me.payoff or p.payoff
+    path = [r for c in me.path_constraints for r in _relations(c, running, shift)]
+    terminal = [r for c in p.terminal_constraints for r in _relations(c, ends, shift)]
+    horizon = sp.sympify(parse(p.time.final, running)) - p.time.initial
+    problem = {
+        "parameters": parameters,
+        "states": {n: s.model_dump() for n, s in states.items()},
+        "controls": {n: c.model_dump() for n, c in me.controls.items()},
+        "inputs": inputs,
+        "dynamics": {n: _expression(e, running, shift) for n, e in p.dynamics.items()},
+        "objective": {
+            "sense": me.objective,
+            "mayer": _expression(payoff.mayer, ends, shift),
+            "lagrange": _expression(payoff.lagrange, running, shift),
+        },
+        "time": {"initial": 0.0, "final": to_text(horizon)},
+        "path_constraints": path,
+        "boundary_constraints": terminal,
+        "uncertain": {n: u.distribution.model_dump() for n, u in p.uncertain.items() if u.distribution},
+    }
+    return OptimalControlSpec.model_validate(
+        {
+            "name": f"{game.name}.{view}.{player}",
+            "problem": problem,
+            "method": game.method.model_dump(),
+            "solver": {"backend": game.game.backend, "options": game.solver.options},
+            "guess": {"controls": dict(me.start)},
+            "transforms": list(me.transforms) if applies_transforms(game, player, view) else [],
+        }
+    )
+
+
+def views(game: DifferentialGameSpec) -> list[str]:
+    """The games to solve: one per player (``G^i``), or one for all when every player's problems
+    are the same in every player's game (no private beliefs or transforms)."""
+    names = list(game.problem.players)
+    games = [[player_problem(game, j, i).model_dump(exclude={"name"}) for j in names] for i in names]
+    return names[:1] if all(g == games[0] for g in games) else names

@@ -1,0 +1,414 @@
+"""Algorithm 4: receding-horizon control of both players, the true system advancing between steps.
+
+At every step each player's game is solved from where the players are (``G^u`` under ρ̂ with the
+pursuer's transforms, ``G^v`` under ρ̄; one game when the views coincide), by best responses on the
+compiled models of :class:`~gamespec.games.equilibrium.GameModel`, warm-started from the previous
+step's strategies shifted by one step. Each player applies the first ``step`` of the controls of its
+own game (or, when that game did not converge and ``on_not_converged: previous_plan``, the next step
+of its last converged plan); the true system (true parameter values) is integrated over the step
+(:class:`~gamespec.games.simulate.TrueSystem`). A state a player does not observe (the pursuer's
+obstacle) it predicts with its own beliefs from the controls applied. The run stops at capture, at a
+collision with the obstacle (when ``stop_at_collision``) or at the time limit.
+
+The horizon is ``N Δt`` ahead at every step (``receding``), or reaches the game's final time
+(``shrinking``: each remaining length has its own compiled models); with a shrinking horizon and a
+time-consistent open-loop equilibrium the run reproduces the open-loop solution.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+from dataclasses import dataclass, field
+
+import numpy as np
+from rich.console import Console
+from rich.progress import BarColumn, Progress, TextColumn, TimeElapsedColumn
+
+from gamespec.errors import SpecError
+from gamespec.games.backend import true_parameters
+from gamespec.games.equilibrium import GameModel, GameSolution
+from gamespec.games.problems import initial_state, predicted_states
+from gamespec.games.simulate import TrueSystem, control_signal, grid_of
+from gamespec.result import Result, Status
+from gamespec.specs.differential_game import DifferentialGameSpec, sensitivity_name
+from gamespec.symbolic.calculus import numeric_function
+from gamespec.symbolic.language import parse, parse_relation, symbol
+from gamespec.symbolic.translate import numeric
+
+SAMPLES_PER_STEP = 10
+"""Points of the true trajectory per step at which capture and collisions are checked."""
+DIFFERENCE_STEP = 1e-4
+"""Relative step of the central differences of a prediction in an uncertain parameter (the
+integration's relative tolerance 1e-11 leaves an error near 1e-7 in the quotient)."""
+
+
+def believed_parameters(model: GameModel, player: str) -> dict[str, float]:
+    """The game's parameter values with every uncertain one at ``player``'s belief."""
+    return dict(model.parameters) | {n: u.belief(player) for n, u in model.game.problem.uncertain.items()}
+
+
+class StateFunction:
+    """An expression of the states and parameters, read from the file, evaluated along sampled
+    trajectories."""
+
+    def __init__(
+        self, game: DifferentialGameSpec, text: str | float, field: str, relation: bool = False
+    ) -> None:
+        p = game.problem
+        self.names = [*p.parameters, *p.uncertain, *p.states]
+        table = {n: symbol(n) for n in self.names}
+        try:
+            parsed = parse_relation(text, table) if relation else parse(text, table)
+        except SpecError as err:
+            raise SpecError(err.reason, field=field, source=game.source) from None
+        self.lower, self.upper = (parsed.lower, parsed.upper) if relation else (-np.inf, np.inf)
+        expr = parsed.expr if relation else parsed
+        self._f = numeric_function([expr], [table[n] for n in self.names])
+
+    def __call__(self, states: Mapping[str, np.ndarray], params: Mapping[str, float]) -> np.ndarray:
+        return self._f(*(states[n] if n in states else params[n] for n in self.names))[0]
+
+
+class Predictor:
+    """What a player that does not observe every state predicts of them: its model of the true
+    system at its beliefs, from the observed states reset at every step, and the sensitivity of its
+    predictions to each uncertain parameter by central differences of the same integration."""
+
+    def __init__(self, model: GameModel, player: str, x0: Mapping[str, float]) -> None:
+        game = model.game
+        self.player = player
+        self.observes = game.problem.players[player].observes
+        believed = believed_parameters(model, player)
+        self.system = TrueSystem(game, believed)
+        self.state = dict(x0)
+        self.predicted = predicted_states(game, player)
+        self.perturbed: dict[str, list[tuple[TrueSystem, dict[str, float], float]]] = {}
+        for u in game.problem.uncertain if self.predicted else ():
+            h = DIFFERENCE_STEP * max(1.0, abs(believed[u]))
+            self.perturbed[u] = [
+                (TrueSystem(game, believed | {u: believed[u] + sign * h}), dict(x0), sign * h)
+                for sign in (1, -1)
+            ]
+
+    def _merged(self, x: Mapping[str, float], own: Mapping[str, float]) -> dict[str, float]:
+        return {s: x[s] if s in self.observes else own[s] for s in x}
+
+    def start(self, x: Mapping[str, float]) -> dict[str, float]:
+        """The state the player's game starts from: observed from ``x``, the rest predicted."""
+        return self._merged(x, self.state)
+
+    def sensitivities(self) -> dict[str, float]:
+        """The predicted states' sensitivities, by their generated parameter names."""
+        out = {}
+        for u, ((_, plus, hp), (_, minus, hm)) in self.perturbed.items():
+            for s in self.predicted:
+                out[sensitivity_name(s, u)] = (plus[s] - minus[s]) / (hp - hm)
+        return out
+
+    def advance(
+        self, x: Mapping[str, float], signals: Mapping, t: float, step: float, times: np.ndarray
+    ) -> np.ndarray:
+        """Advance the predictions over the step; the nominal prediction's rows at ``times``."""
+        _, rows = self.system.advance(self.start(x), signals, t, step, times)
+        self.state = dict(zip(self.system.states, rows[-1], strict=True))
+        for u, runs in self.perturbed.items():
+            updated = []
+            for system, state, h in runs:
+                _, prow = system.advance(self._merged(x, state), signals, t, step, times)
+                updated.append((system, dict(zip(system.states, prow[-1], strict=True)), h))
+            self.perturbed[u] = updated
+        return rows
+
+
+def _horizon(game: DifferentialGameSpec, params: Mapping[str, float]) -> float:
+    p = game.problem
+    table = {n: symbol(n) for n in [*p.parameters, *p.uncertain]}
+    return float(numeric(parse(p.time.final, table), {table[k]: v for k, v in params.items() if k in table}))
+
+
+@dataclass
+class Record:
+    """What the run keeps: true samples, applied controls, look-ahead trajectories, per-step games."""
+
+    times: list[float] = field(default_factory=list)
+    states: list[np.ndarray] = field(default_factory=list)
+    control_time: list[float] = field(default_factory=list)
+    controls: dict[str, list[float]] = field(default_factory=dict)
+    lookahead: dict[str, list[dict[str, np.ndarray]]] = field(default_factory=dict)
+    predicted: dict[str, list[np.ndarray]] = field(default_factory=dict)
+    steps: list[dict] = field(default_factory=list)
+
+
+def _shifted(strategy: np.ndarray, points: int, keep_length: bool) -> np.ndarray:
+    tail = strategy[:, points:]
+    return (
+        np.concatenate([tail, np.repeat(strategy[:, -1:], points, axis=1)], axis=1) if keep_length else tail
+    )
+
+
+class RecedingHorizon:
+    """One run of Algorithm 4 (see module doc)."""
+
+    def __init__(self, model: GameModel) -> None:
+        self.model = model
+        self.game = game = model.game
+        self.rh = rh = game.receding_horizon
+        self.players = list(game.problem.players)
+        self.truth = TrueSystem(game, true_parameters(model))
+        self.predicting = [n for n, pl in game.problem.players.items() if pl.observes is not None]
+        self.horizon = _horizon(game, model.parameters)
+        intervals = game.method.intervals
+        self.interval = self.horizon / intervals
+        per_step = rh.step / self.interval
+        if abs(per_step - round(per_step)) > 1e-9 or round(per_step) < 1:
+            raise SpecError(
+                f"the step ({rh.step:g}) must be a whole number of collocation intervals "
+                f"(horizon / intervals = {self.interval:g})",
+                field="receding_horizon.step",
+                source=game.source,
+            )
+        self.intervals_per_step = round(per_step)
+        self.points_per_step = self.intervals_per_step * grid_of(game.method).points_per_interval
+        self.models: dict[int, GameModel] = {intervals: model}
+        self.capture = (
+            StateFunction(game, rh.capture.when, "receding_horizon.capture.when", True)
+            if rh.capture
+            else None
+        )
+        ob = rh.obstacle
+        self.obstacle = (
+            {
+                k: StateFunction(game, getattr(ob, k), f"receding_horizon.obstacle.{k}")
+                for k in ("x", "y", "radius")
+            }
+            if ob
+            else None
+        )
+
+    def _model(self, intervals: int, start: float) -> GameModel:
+        """The compiled game with ``intervals`` left (shrinking horizon), compiled on first use."""
+        if intervals not in self.models:
+            data = self.game.model_dump(mode="json")
+            data["method"]["intervals"] = intervals
+            data["problem"]["time"] = {"initial": start, "final": self.game.problem.time.final}
+            game = DifferentialGameSpec.model_validate(data)
+            self.models[intervals] = GameModel(game, parameters=dict(self.model.parameters))
+        return self.models[intervals]
+
+    def _observed(
+        self, view: str, x: Mapping[str, float], predicted: Mapping[str, float]
+    ) -> dict[str, float]:
+        observes = self.game.problem.players[view].observes
+        return {s: x[s] if observes is None or s in observes else predicted[s] for s in x}
+
+    def run(self, progress: bool = True) -> Result:
+        rh, game = self.rh, self.game
+        t = game.problem.time.initial
+        end = t + rh.time_limit
+        if rh.horizon == "shrinking":
+            end = min(end, t + self.horizon)
+        x = initial_state(game)
+        predictors = {n: Predictor(self.model, n, x) for n in self.predicting}
+        record = Record(times=[t], states=[np.array([x[s] for s in self.truth.states])])
+        record.predicted = {n: [record.states[0]] for n in self.predicting}
+        previous: dict[str, dict[str, np.ndarray]] = {}
+        plans: dict[str, np.ndarray] = {}
+        intervals = game.method.intervals
+        stop, captured_at = "time_limit", None
+        total = round((end - t) / rh.step)
+        with _progress(progress) as bar:
+            task = bar.add_task(game.name, total=total, info="")
+            for _ in range(total):
+                model = self._model(intervals, t) if rh.horizon == "shrinking" else self.model
+                solutions = {}
+                for view in model.views:
+                    predictor = predictors.get(view)
+                    state = predictor.start(x) if predictor else x
+                    sensitivities = predictor.sensitivities() if predictor else None
+                    solutions[view] = model.solve(view, state, t, previous.get(view), sensitivities)
+                keep = rh.horizon == "receding"
+                previous = {
+                    v: {n: _shifted(a, self.points_per_step, keep) for n, a in s.run.strategies.items()}
+                    for v, s in solutions.items()
+                }
+                applied = self._applied(solutions, plans, keep)
+                record.steps.append(self._step_record(t, solutions))
+                self._lookahead(record, solutions, t)
+                horizon = self.horizon if keep else intervals * self.interval
+                signals = {}
+                for player, strategy in applied.items():
+                    rows = list(game.problem.players[player].controls)
+                    for row, c in enumerate(rows):
+                        signals[c] = control_signal(grid_of(model.game.method), strategy[row], t, horizon)
+                        record.controls.setdefault(c, []).append(signals[c](t + 1e-9 * rh.step))
+                record.control_time.append(t)
+                times, rows = self.truth.advance(
+                    x, signals, t, rh.step, np.linspace(t, t + rh.step, SAMPLES_PER_STEP + 1)
+                )
+                for n, predictor in predictors.items():
+                    record.predicted[n].extend(predictor.advance(x, signals, t, rh.step, times)[1:])
+                record.times.extend(times[1:])
+                record.states.extend(rows[1:])
+                x = dict(zip(self.truth.states, rows[-1], strict=True))
+                t = float(times[-1])
+                if rh.horizon == "shrinking":
+                    intervals -= self.intervals_per_step
+                iterations = ", ".join(f"{v}: {s.run.iterations}" for v, s in solutions.items())
+                bar.update(task, advance=1, info=f"t = {t:.2f}  iterations {iterations}")
+                captured_at = self._captured(record)
+                if captured_at is not None:
+                    stop = "captured"
+                    break
+                if rh.stop_at_collision and self._collided(record):
+                    stop = "collision"
+                    break
+        return self._result(record, stop, captured_at)
+
+    def _applied(
+        self, solutions: dict[str, GameSolution], plans: dict[str, np.ndarray], keep: bool
+    ) -> dict[str, np.ndarray]:
+        """Each player's strategy to apply now (see module doc), and its plan kept for later."""
+        applied = {}
+        for player in self.players:
+            own = solutions.get(player) or next(iter(solutions.values()))
+            strategy = own.run.strategies[player]
+            if own.run.converged or self.rh.on_not_converged == "last_iterate" or player not in plans:
+                plans[player] = strategy
+            else:
+                strategy = plans[player] = _shifted(plans[player], self.points_per_step, keep)
+            applied[player] = strategy
+        return applied
+
+    @staticmethod
+    def _step_record(t: float, solutions: dict[str, GameSolution]) -> dict:
+        return {
+            "time": t,
+            "games": {
+                v: {
+                    "iterations": s.run.iterations,
+                    "converged": s.run.converged,
+                    "outcome": s.run.outcome.value,
+                }
+                for v, s in solutions.items()
+            },
+        }
+
+    def _lookahead(self, record: Record, solutions: dict[str, GameSolution], t: float) -> None:
+        """Each game's look-ahead trajectories (NaN when its last solve failed: no solution)."""
+        for view, s in solutions.items():
+            r = s.states
+            blank = {k: np.full_like(v, np.nan, dtype=float) for k, v in r.states.items()}
+            states = r.states if r.ok else blank
+            record.lookahead.setdefault(view, []).append({"time": r.time + t, **states})
+
+    def _samples(self, record: Record) -> dict[str, np.ndarray]:
+        rows = np.array(record.states)
+        return dict(zip(self.truth.states, rows.T, strict=True))
+
+    def _captured(self, record: Record) -> float | None:
+        """The first time the capture condition holds along the true trajectory (linear between
+        samples), None if it has not."""
+        if self.capture is None:
+            return None
+        g = self.capture(self._samples(record), true_parameters(self.model))
+        lo, hi = self.capture.lower, self.capture.upper
+        gap = np.maximum(lo - g, g - hi)
+        inside = np.flatnonzero(gap <= 0)
+        if inside.size == 0:
+            return None
+        k = int(inside[0])
+        if k == 0:
+            return record.times[0]
+        t0, t1 = record.times[k - 1], record.times[k]
+        return float(t0 + (t1 - t0) * gap[k - 1] / (gap[k - 1] - gap[k]))
+
+    def _distances(self, record: Record) -> dict[str, np.ndarray]:
+        """Each avoiding player's distance to the obstacle's edge along the true trajectory."""
+        if self.obstacle is None:
+            return {}
+        samples = self._samples(record)
+        params = true_parameters(self.model)
+        ox, oy, radius = (self.obstacle[k](samples, params) for k in ("x", "y", "radius"))
+        return {
+            player: np.hypot(samples[px] - ox, samples[py] - oy) - radius
+            for player, (px, py) in self.rh.obstacle.avoided_by.items()
+        }
+
+    def _collided(self, record: Record) -> bool:
+        return any(float(d.min()) < 0 for d in self._distances(record).values())
+
+    def _result(self, record: Record, stop: str, captured_at: float | None) -> Result:
+        samples = self._samples(record)
+        params = true_parameters(self.model)
+        arrays: dict[str, np.ndarray] = {}
+        if self.obstacle is not None:
+            arrays |= {f"obstacle/true/{k}": self.obstacle[k](samples, params) for k in ("x", "y")}
+            for n in self.predicting:
+                believed = dict(zip(self.truth.states, np.array(record.predicted[n]).T, strict=True))
+                bparams = believed_parameters(self.model, n)
+                arrays |= {f"obstacle/{n}/{k}": self.obstacle[k](believed, bparams) for k in ("x", "y")}
+        for view, steps in record.lookahead.items():
+            for name in steps[0]:
+                arrays[f"lookahead/{view}/{name}"] = _padded([s[name] for s in steps])
+        metrics: dict = {"captured": captured_at is not None, "capture_time": captured_at, "stop": stop}
+        for player, d in self._distances(record).items():
+            metrics[f"{player}_min_obstacle_distance"] = float(d.min())
+            metrics[f"{player}_collided"] = bool(d.min() < 0)
+        converged = all(g["converged"] for s in record.steps for g in s["games"].values())
+        models = list(self.models.values())
+        metrics |= {
+            "steps": len(record.steps),
+            "per_step": record.steps,
+            "all_converged": converged,
+            "builds": sum(m.builds for m in models),
+            "solves": sum(r.solves for m in models for r in m.responders.values()),
+            "figure": {
+                "positions": {p: list(v) for p, v in self.rh.positions.items()},
+                "obstacle_radius": float(self.obstacle["radius"](samples, params)[0])
+                if self.obstacle
+                else None,
+                "lookahead_players": {v: list(self.rh.positions) for v in record.lookahead},
+            },
+        }
+        failed = sum(not g["converged"] for s in record.steps for g in s["games"].values())
+        message = f"stopped: {stop}" + (f"; {failed} game(s) did not converge" if failed else "")
+        return Result(
+            status=Status.OPTIMAL if converged else Status.FEASIBLE,
+            message=message,
+            objective=captured_at,
+            t_final=record.times[-1],
+            time=np.array(record.times),
+            control_time=np.array(record.control_time),
+            states=samples,
+            controls={c: np.array(v) for c, v in record.controls.items()},
+            arrays=arrays,
+            iterations=sum(g["iterations"] for s in record.steps for g in s["games"].values()),
+            metrics=metrics,
+        )
+
+
+def _padded(rows: list[np.ndarray]) -> np.ndarray:
+    """Rows of different lengths (a shrinking horizon) as one array padded with NaN."""
+    width = max(len(r) for r in rows)
+    out = np.full((len(rows), width), np.nan)
+    for i, r in enumerate(rows):
+        out[i, : len(r)] = r
+    return out
+
+
+def _progress(enabled: bool) -> Progress:
+    return Progress(
+        TextColumn("[bold]{task.description}"),
+        BarColumn(),
+        TextColumn("{task.completed}/{task.total} steps"),
+        TimeElapsedColumn(),
+        TextColumn("{task.fields[info]}"),
+        console=Console(stderr=True),
+        transient=True,
+        disable=not enabled,
+    )
+
+
+def receding_horizon(model: GameModel, progress: bool = True) -> Result:
+    """Run Algorithm 4 on a compiled game (see module doc)."""
+    return RecedingHorizon(model).run(progress)

@@ -1,0 +1,74 @@
+"""Options of the ``rcs`` and ``moving_obstacles`` transforms (thesis §6.4), as a file requests them:
+
+```yaml
+transforms:
+  - moving_obstacles:                 # path constraints g <= 0 of eqs. 6.39 / 6.41 / 6.43-6.44
+      agent: [x, y]                   # the agent's position (expressions of states)
+      power: beta                     # β of eq. 6.41 (1: eq. 6.39)
+      obstacles:
+        o1: {center: [5, -1.25], velocity: [0, rho], radius: 2}
+        train: {center: [5, -2], velocity: [0, rho], radius: 1, track: {half_width: 0.5, gamma: 20}}
+  - rcs:                              # eqs. 6.31-6.36
+      weight: Q                       # Q = weight·I (a list: one weight per constraint)
+      relevance: logistic_derivative  # eq. 6.35 | gaussian | hat | logistic | inverse_quadratic
+                                      # | inverse_abs_square | any expression of w
+      relevant: true                  # false: the plain constraint-sensitivity penalty of eq. 6.32
+      monte_carlo: {samples: 1000, seed: 0, steps: 500}
+```
+
+Weights, radii, centres, velocities and β are numbers or expressions of the problem's parameters, so
+``--set problem.parameters.Q=2`` re-solves the compiled model.
+"""
+
+from __future__ import annotations
+
+from pydantic import Field, field_validator
+
+from gamespec.specs.base import StrictModel, Value
+from gamespec.specs.desensitize import MonteCarloOptions
+
+
+class RcsOptions(StrictModel):
+    """The relevant-constraint-sensitivity cost ∫‖vec S_r‖²_Q (eq. 6.36) or ∫‖vec S_g‖²_Q (eq. 6.32)."""
+
+    weight: Value | list[Value] = Field(
+        1.0, description="Q = weight·I over the constraints, or one weight per constraint (diagonal Q)."
+    )
+    constraints: list[int] | None = Field(
+        None, description="Indices of the inequality path constraints g <= 0 (default: all of them)."
+    )
+    relevance: str = Field("logistic_derivative", description="r̃ of eq. 6.33: a name or an expression of w.")
+    relevant: bool = Field(True, description="Weight S_g by r(g) (eq. 6.34); false: eq. 6.32.")
+    monte_carlo: MonteCarloOptions = Field(default_factory=MonteCarloOptions)
+
+
+class Track(StrictModel):
+    """The rail track of eq. 6.43: the obstacle runs along it; the super-Gaussian of eq. 6.44 (even
+    ``gamma``) switches the constraint on while the agent is within ``half_width`` (w_o) of it."""
+
+    half_width: Value
+    gamma: int = Field(20, ge=2, le=200)
+
+    @field_validator("gamma")
+    @classmethod
+    def _even(cls, v: int) -> int:
+        if v % 2:
+            raise ValueError("gamma must be even (eq. 6.44: γ ∈ 2Z+)")
+        return v
+
+
+class Obstacle(StrictModel):
+    """A circular obstacle at ``center + velocity·(t - t0)`` with safe distance ``radius`` (r_o)."""
+
+    center: tuple[Value, Value]
+    velocity: tuple[Value, Value] = (0.0, 0.0)
+    radius: Value
+    track: Track | None = Field(None, description="Car-vs-train form (eq. 6.43), moving along y.")
+
+
+class MovingObstaclesOptions(StrictModel):
+    """Obstacles whose closed-form positions enter avoidance path constraints g <= 0."""
+
+    agent: tuple[Value, Value] = ("x", "y")
+    power: Value = Field(1.0, description="β of eq. 6.41 (β = 1 is eq. 6.39); a number or parameter.")
+    obstacles: dict[str, Obstacle] = Field(min_length=1)

@@ -1,0 +1,57 @@
+"""The ``rcs_multi_obstacle_study`` kind: the trade-off study of thesis §6.4.4 (Fig. 6.11).
+
+An agent (heading and speed v ∈ [0, v_max] the controls, eq. 6.37) goes from (0, 0) to
+(``goal``, 0) in minimum time past N identical obstacles moving parallel to y at uncertain speeds
+ρ_i (nominal ``rho``), with the RCS cost ``Q = α I_N`` (eq. 6.36), for every N in ``obstacles`` and α
+in ``alphas``. Layout (not given in the thesis): obstacle i of N sits on x_i = goal·i/(N+1), moves
+up (i odd) or down (i even) and starts at y_i(0) = ∓ρ̂ x_i, so that it crosses y = 0 at t = x_i,
+just when a straight-line agent at full speed gets there: every obstacle blocks the straight path.
+
+The Monte Carlo draws ρ_i = ρ̂ + Δρ_i, Δρ_i ~ N(0, σ²). §6.4.4 writes "σ² = 0.1": ``sigma`` is σ
+when ``sigma_is: std`` (the default, so ``--set sigma=0.1`` means σ = 0.1) and σ² when
+``sigma_is: variance`` (``--set sigma_is=variance`` reads the thesis literally: σ ≈ 0.316).
+The ``rcs_study`` backend saves each (N, α) point under ``store`` as it finishes; solving the file
+again resumes.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import ClassVar, Literal
+
+from pydantic import Field
+
+from gamespec.specs.base import Number, SpecBase
+from gamespec.specs.ocp import MethodSpec
+
+
+class RcsStudySpec(SpecBase):
+    """Fig. 6.11: travel time against collision probability per number of obstacles and weight."""
+
+    kind: Literal["rcs_multi_obstacle_study"] = "rcs_multi_obstacle_study"
+    obstacles: list[int] = Field(default_factory=lambda: [2, 3, 5, 10], min_length=1)
+    alphas: list[Number] = Field(default_factory=lambda: [0.0, 0.1, 0.33, 1.0], min_length=1)
+    sigma: Number = Field(0.1, gt=0, description="σ (sigma_is: std) or σ² (sigma_is: variance) of Δρ.")
+    sigma_is: Literal["std", "variance"] = "std"
+    rho: Number = Field(0.25, gt=0, description="Nominal obstacle speed ρ̂.")
+    radius: Number = Field(1.0, gt=0, description="Safe distance r_o of every obstacle.")
+    goal: Number = Field(30.0, gt=0, description="The target (goal, 0).")
+    v_max: Number = Field(1.0, gt=0)
+    guesses: list[Number] = Field(
+        default_factory=lambda: [4.0, -4.0, 0.0],
+        min_length=1,
+        description="Initial guesses y = a·sin(πτ) (homotopy classes); the best solution is kept.",
+    )
+    samples: int = Field(1000, ge=2, le=100_000)
+    seed: int = Field(0, ge=0)
+    steps: int = Field(1000, ge=10, le=100_000, description="RK4 steps of the Monte Carlo re-simulation.")
+    method: MethodSpec = Field(default_factory=lambda: MethodSpec(intervals=40, degree=3))
+    ocp_backend: str = "casadi"
+    store: Path = Field(Path("runs/rcs_multi_obstacle/points"), description="Folder of per-point records.")
+
+    default_backend: ClassVar[str] = "rcs_study"
+
+    @property
+    def std(self) -> float:
+        """σ, whichever way ``sigma`` is given."""
+        return float(self.sigma if self.sigma_is == "std" else self.sigma**0.5)

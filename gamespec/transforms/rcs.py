@@ -1,0 +1,241 @@
+"""``moving_obstacles`` and ``rcs``: the requested ``optimal_control`` rewrites of thesis §6.4.
+
+``moving_obstacles`` appends one avoidance path constraint ``g <= 0`` per declared obstacle
+(:mod:`gamespec.rcs.obstacles`: eqs. 6.39, 6.41, 6.43-6.44) and, on the way back, puts the
+obstacles' positions along the solution in the Result (``obstacle_<name>_x``/``_y``) for plots.
+
+``rcs`` adds the state sensitivities the desensitize transform builds (eq. 6.12, the identically
+zero ones left out) and the cost ``∫‖vec S_r‖²_Q`` with ``S_r = R S_g`` (eqs. 6.31-6.36), or
+``∫‖vec S_g‖²_Q`` (eq. 6.32) with ``relevant: false``. On the way back it reports through the
+desensitize transform's report (``metrics.sensitivity_cost`` is the RCS cost,
+``metrics.nominal_objective`` the rest), adds ``S_g<i>_<ρ>`` and ``S_r<i>_<ρ>`` along the solution,
+and ``metrics.monte_carlo.collision_probability``: the share of sampled speeds for which the
+open-loop re-simulation (RK4, ``monte_carlo.steps`` steps, agent and obstacles together) breaks a
+path constraint somewhere on that fine grid, with its Wilson interval (``gamespec.montecarlo.proportion``).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Any, ClassVar
+
+import numpy as np
+import sympy as sp
+
+from gamespec.desensitize.augment import sensitivity_functions
+from gamespec.desensitize.simulate import evaluate, open_loop
+from gamespec.errors import ExpressionError, SpecError
+from gamespec.ocp.symbolic import SymbolicOcp
+from gamespec.rcs import obstacles as geometry
+from gamespec.rcs.sensitivity import (
+    constraint_sensitivity,
+    inequalities,
+    nonzero,
+    relevant,
+    state_sensitivity,
+    weighted_square,
+)
+from gamespec.result import Result
+from gamespec.specs.base import SpecBase
+from gamespec.specs.desensitize import DesensitizeOptions
+from gamespec.specs.ocp import OptimalControlSpec
+from gamespec.specs.rcs import MovingObstaclesOptions, RcsOptions
+from gamespec.symbolic.language import TIME, parse, symbol
+from gamespec.symbolic.printer import to_text
+from gamespec.transforms.base import Transform
+from gamespec.transforms.desensitize import InverseData, Penalty, augmented_spec, report
+
+
+def _parser(spec: OptimalControlSpec, field: str, running: bool = False):
+    names = [*spec.problem.parameters, *(spec.problem.states if running else ())]
+    symbols = {n: symbol(n) for n in names}
+
+    def read(raw: float | str) -> sp.Expr:
+        try:
+            return sp.sympify(parse(raw, symbols))
+        except ExpressionError as err:
+            raise SpecError(str(err), field=field, source=spec.source) from None
+
+    return read
+
+
+@dataclass(frozen=True)
+class ObstacleData:
+    """The obstacles' positions as expressions of the parameters and ``t``."""
+
+    positions: dict[str, tuple[sp.Expr, sp.Expr]]
+    radii: dict[str, sp.Expr]
+    power: sp.Expr
+
+
+class MovingObstacles(Transform):
+    """Avoidance constraints of declared moving obstacles (§6.4.1-6.4.3)."""
+
+    name: ClassVar[str] = "moving_obstacles"
+    source_kind: ClassVar[str] = "optimal_control"
+    target_kind: ClassVar[str] = "optimal_control"
+    requested: ClassVar[bool] = True
+    options_model: ClassVar[type[MovingObstaclesOptions]] = MovingObstaclesOptions
+
+    def apply(
+        self, spec: SpecBase, options: MovingObstaclesOptions, upstream: Result | None = None
+    ) -> tuple[OptimalControlSpec, ObstacleData]:
+        field = "transforms.moving_obstacles"
+        read = _parser(spec, field)
+        agent = tuple(_parser(spec, f"{field}.agent", running=True)(a) for a in options.agent)
+        t0 = float(spec.problem.time.initial)
+        power = read(options.power)
+        g = geometry.constraints(options.obstacles, agent, power, read, t0)
+        data = spec.model_dump(exclude={"transforms"} & set(type(spec).model_fields))
+        data["problem"]["path_constraints"] += [to_text(sp.Le(e, 0, evaluate=False)) for e in g.values()]
+        new = OptimalControlSpec.model_validate(data)
+        new.with_source(spec.source, spec.file_hash)
+        positions = {n: geometry.position(o, read, t0) for n, o in options.obstacles.items()}
+        radii = {n: read(o.radius) for n, o in options.obstacles.items()}
+        return new, ObstacleData(positions, radii, power)
+
+    def invert(self, result: Result, spec: SpecBase, inverse_data: ObstacleData) -> Result:
+        arrays, metrics = dict(result.arrays), dict(result.metrics)
+        if result.time is not None:
+            params = {symbol(k): v for k, v in result.parameters.items()}
+            t = np.asarray(result.time)
+            values = {**params, TIME: t}
+            for name, (px, py) in inverse_data.positions.items():
+                xy = evaluate([px, py], values, t.shape)
+                arrays[f"obstacle_{name}_x"], arrays[f"obstacle_{name}_y"] = xy[0], xy[1]
+            metrics["obstacle_power"] = float(evaluate([inverse_data.power], params, ())[0])
+            metrics["obstacles"] = {
+                n: float(evaluate([r], params, ())[0]) for n, r in inverse_data.radii.items()
+            }
+        return result.model_copy(
+            update={"arrays": arrays, "metrics": metrics, "kind": spec.kind, "problem": spec.name}
+        )
+
+
+@dataclass(frozen=True)
+class RcsData:
+    """The desensitize report's data, and S_g, S_r (k × ℓ) with their row labels."""
+
+    report: InverseData
+    labels: list[str]
+    uncertain: list[str]
+    S_g: sp.Matrix
+    S_r: sp.Matrix
+    options: RcsOptions
+
+
+class Rcs(Transform):
+    """Relevant constraint sensitivity (eqs. 6.31-6.36), or eq. 6.32 with ``relevant: false``."""
+
+    name: ClassVar[str] = "rcs"
+    source_kind: ClassVar[str] = "optimal_control"
+    target_kind: ClassVar[str] = "optimal_control"
+    requested: ClassVar[bool] = True
+    options_model: ClassVar[type[RcsOptions]] = RcsOptions
+
+    def apply(
+        self, spec: SpecBase, options: RcsOptions | None = None, upstream: Result | None = None
+    ) -> tuple[OptimalControlSpec, RcsData]:
+        return regularized(spec, options or RcsOptions())
+
+    def invert(self, result: Result, spec: SpecBase, inverse_data: RcsData) -> Result:
+        return rcs_report(result, spec, inverse_data)
+
+
+FIELD = "transforms.rcs"
+
+
+def regularized(spec: OptimalControlSpec, options: RcsOptions) -> tuple[OptimalControlSpec, RcsData]:
+    """The spec with the sensitivity states and the (relevant) constraint-sensitivity cost (pure)."""
+    uncertain = list(spec.problem.uncertain)
+    if not uncertain:
+        raise SpecError("rcs needs uncertain parameters (problem.uncertain)", field=FIELD, source=spec.source)
+    ocp = SymbolicOcp(spec)
+    chosen = _chosen(spec, ocp, options)
+    aug = nonzero(sensitivity_functions(ocp, uncertain))
+    g = [q.g for q in chosen]
+    S_g = constraint_sensitivity(ocp, g, uncertain, state_sensitivity(ocp, uncertain, aug))
+    try:
+        S_r = relevant(S_g, g, options.relevance)
+    except ExpressionError as err:
+        raise SpecError(str(err), field=f"{FIELD}.relevance", source=spec.source) from None
+    penalized = S_r if options.relevant else S_g
+    weights = _weights(spec, options, len(chosen))
+    penalty = Penalty(weighted_square(penalized, weights), sp.Integer(0))
+    measure = Penalty(weighted_square(penalized, [sp.Integer(1)] * len(chosen)), sp.Integer(0))
+    new = augmented_spec(spec, aug, penalty)
+    data = InverseData(
+        aug,
+        penalty,
+        measure,
+        DesensitizeOptions(monte_carlo=options.monte_carlo),
+        len(spec.problem.states),
+        len(new.problem.states),
+    )
+    return new, RcsData(data, [q.label for q in chosen], uncertain, S_g, S_r, options)
+
+
+def _chosen(spec: OptimalControlSpec, ocp: SymbolicOcp, options: RcsOptions) -> list:
+    found = inequalities(ocp)
+    if options.constraints is not None:
+        indices = {q.index for q in found}
+        unknown = sorted(set(options.constraints) - indices)
+        if unknown:
+            raise SpecError(
+                f"no inequality path constraint at {unknown} (there are: {sorted(indices)})",
+                field=f"{FIELD}.constraints",
+                source=spec.source,
+            )
+        found = [q for q in found if q.index in options.constraints]
+    if not found:
+        raise SpecError("rcs needs inequality path constraints g <= 0", field=FIELD, source=spec.source)
+    return found
+
+
+def _weights(spec: OptimalControlSpec, options: RcsOptions, k: int) -> list[sp.Expr]:
+    raw = options.weight if isinstance(options.weight, list) else [options.weight] * k
+    if len(raw) != k:
+        raise SpecError(
+            f"{len(raw)} weights for {k} constraints", field=f"{FIELD}.weight", source=spec.source
+        )
+    read = _parser(spec, f"{FIELD}.weight")
+    return [read(w) for w in raw]
+
+
+def rcs_report(result: Result, spec: OptimalControlSpec, data: RcsData) -> Result:
+    """The desensitize report, ``metrics.rcs``, S_g and S_r along the solution, and the collision
+    probability (see module doc)."""
+    result = report(result, spec, data.report)
+    metrics, arrays = dict(result.metrics), dict(result.arrays)
+    metrics["rcs"] = {
+        "constraints": data.labels,
+        "relevance": data.options.relevance,
+        "relevant": data.options.relevant,
+    }
+    if result.ok and result.time is not None:
+        arrays |= along(result, spec, data)
+        mc = metrics.get("monte_carlo")
+        if mc is not None and "violation_probability" in mc:
+            mc = dict(mc)
+            mc["collision_probability"] = mc["violation_probability"]
+            mc["collision_probability_ci"] = mc["violation_probability_ci"]
+            metrics["monte_carlo"] = mc
+    return result.model_copy(update={"metrics": metrics, "arrays": arrays})
+
+
+def along(result: Result, spec: OptimalControlSpec, data: RcsData) -> dict[str, Any]:
+    """``S_g<i>_<ρ>`` and ``S_r<i>_<ρ>`` at the Result's time points."""
+    ocp = SymbolicOcp(spec)
+    t = np.asarray(result.time)
+    values: dict[sp.Symbol, Any] = {symbol(k): v for k, v in result.parameters.items()}
+    values |= {symbol(k): np.asarray(v) for k, v in result.states.items()}
+    if ocp.controls:
+        values |= dict(zip(ocp.u, open_loop(result, ocp.controls)(t), strict=True))
+    values[TIME] = t
+    out = {}
+    for prefix, M in (("S_g", data.S_g), ("S_r", data.S_r)):
+        flat = [M[i, j] for i in range(M.rows) for j in range(M.cols)]
+        rows = evaluate(flat, values, t.shape)
+        for (i, j), row in zip(np.ndindex(M.rows, M.cols), rows, strict=True):
+            out[f"{prefix}{data.labels[i][1:]}_{data.uncertain[j]}"] = np.array(row)
+    return out

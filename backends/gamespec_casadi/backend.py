@@ -2,7 +2,8 @@
 
 The NLP is built once (on one flat SX graph, or with ``graph: mx`` an MX graph around the mapped
 per-point function) from the backend-neutral :class:`~gamespec.ocp.transcription.Transcription`:
-decision variables ``[vec(X); vec(U); d; T]`` (d: the design variables), defects ``D X - T W F``
+decision variables ``[vec(X / s_x); vec(U / s_u); d; T]`` (s: the scale factors, d: the design
+variables), defects ``D X - T W F``
 with ``F`` a mapped CasADi function over the evaluation points, and the problem's parameters, the
 grid inputs (one block of n_w × n_eval values) and a fixed horizon as NLP parameters ``p = [params;
 vec(Win); T]``, so a re-solve with new values reuses the solver and warm-starts from the last
@@ -106,8 +107,10 @@ class CasadiModel(CollocationModel):
         point = ca.Function("point", [x, u, w, t, p], [f, L, path, integrand]).map(k)
 
         outer = ca.MX if options.graph == "mx" else ca.SX
-        X = outer.sym("X", nx, grid.n_nodes)
-        U = outer.sym("U", nu, k)
+        self.sx, self.su = tr.scales(tr.ocp.parameter_values())
+        X_scaled, U_scaled = outer.sym("X", nx, grid.n_nodes), outer.sym("U", nu, k)
+        X = ca.diag(ca.DM(self.sx)) @ X_scaled
+        U = ca.diag(ca.DM(self.su)) @ U_scaled
         T = outer.sym("T") if tr.free_time else None
         design = outer.sym("d", tr.n_d)
         p_all = outer.sym("p_all", npar + nw * k + (0 if tr.free_time else 1))
@@ -131,7 +134,7 @@ class CasadiModel(CollocationModel):
         self.n_defects = defects.numel()
         integrals = horizon * (Iv @ ca.DM(q))
         g = ca.vertcat(ca.vec(defects), ca.vec(G.T), *boundary, integrals)
-        w = ca.vertcat(ca.vec(X), ca.vec(U), design, *([T] if tr.free_time else []))
+        w = ca.vertcat(ca.vec(X_scaled), ca.vec(U_scaled), design, *([T] if tr.free_time else []))
         lower = [np.zeros(self.n_defects)]
         upper = [np.zeros(self.n_defects)]
         for r in ocp.path:
@@ -152,13 +155,14 @@ class CasadiModel(CollocationModel):
         self._last: np.ndarray | None = None
 
     def _pack(self, X: np.ndarray, U: np.ndarray, d: np.ndarray, T: float) -> np.ndarray:
-        parts = [X.ravel(order="F"), U.ravel(order="F"), d]
+        """The NLP's variables: X and U divided by their scale factors."""
+        parts = [(X / self.sx[:, None]).ravel(order="F"), (U / self.su[:, None]).ravel(order="F"), d]
         return np.concatenate([*parts, [T]] if self.tr.free_time else parts)
 
     def _unpack(self, w: np.ndarray, params_T: float) -> tuple[np.ndarray, np.ndarray, np.ndarray, float]:
         nx, n, nu, k = self.shape
-        X = w[: nx * n].reshape((nx, n), order="F")
-        U = w[nx * n : nx * n + nu * k].reshape((nu, k), order="F")
+        X = w[: nx * n].reshape((nx, n), order="F") * self.sx[:, None]
+        U = w[nx * n : nx * n + nu * k].reshape((nu, k), order="F") * self.su[:, None]
         d = w[nx * n + nu * k : nx * n + nu * k + self.tr.n_d]
         T = float(w[-1]) if self.tr.free_time else params_T
         return X, U, d, T

@@ -6,8 +6,10 @@ Variables ``X[i, node]``, ``U[j, point]``, the design variables ``d[name]`` and 
 Var when the final time is free (time scaling ``t = t0 + tau * T``) and a mutable Param otherwise.
 The problem's parameters are mutable Params indexed by name, and the grid inputs mutable Params
 ``w[input, point]`` indexed by evaluation point, so a re-solve changes values, not the model.
-Constraints: the defects ``D X - T W F(X, U, t) = 0``, path constraints at every evaluation point
-and boundary constraints over the end values; objective ``Phi + T q^T L`` in minimization form.
+Constraints: the defects ``D X - T W F(X, U, t) = 0``, path constraints at every evaluation point,
+boundary constraints over the end values and integral constraints ``T q^T g``; objective ``Phi + T
+q^T L`` in minimization form. The ``scaling_factor`` Suffix (``1/scale``, applied by Pyomo's NL
+writer) gives the solver the scaled variables the casadi backend gives IPOPT.
 """
 
 from __future__ import annotations
@@ -131,6 +133,12 @@ def build_model(tr: Transcription, params: Mapping[str, float]) -> Any:
     running = sum(float(w) * term for w, term in zip(q, L, strict=True))
     m.objective = pyo.Objective(expr=translate(ocp.mayer, ends, lib) + m.T * running + tr.rate_penalty(m.U))
     m.dual = pyo.Suffix(direction=pyo.Suffix.IMPORT)
+    m.scaling_factor = pyo.Suffix(direction=pyo.Suffix.EXPORT)
+    sx, su = tr.scales(params)
+    for (i, _), var in m.X.items():
+        m.scaling_factor[var] = 1.0 / sx[i]
+    for (j, _), var in m.U.items():
+        m.scaling_factor[var] = 1.0 / su[j]
     return m
 
 

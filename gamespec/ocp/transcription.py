@@ -222,6 +222,28 @@ class Transcription:
         last = [U[j, last_point] for j in range(self.n_u)]
         return first, last
 
+    def scales(self, params: Mapping[str, float]) -> tuple[np.ndarray, np.ndarray]:
+        """Per state and per control, the factor the NLP divides the variable by (``scale:``; 1 when
+        unset). ``auto`` takes the largest finite bound magnitude, else the largest magnitude of the
+        guess, else 1; the same factors on every backend."""
+        start = self.guess(params)
+        found = []
+        for group, values, limits in (
+            (self.spec.problem.states, start.X, self.ocp.state_bounds(params)),
+            (self.spec.problem.controls, start.U, self.ocp.control_bounds(params)),
+        ):
+            row = []
+            for spec, guess, (lo, hi, *_) in zip(group.values(), values, limits, strict=True):
+                if spec.scale is None:
+                    row.append(1.0)
+                elif spec.scale != "auto":
+                    row.append(abs(float(spec.scale)) or 1.0)
+                else:
+                    finite = [abs(b) for b in (lo, hi) if np.isfinite(b) and b != 0]
+                    row.append(max(finite) if finite else float(np.max(np.abs(guess), initial=0.0)) or 1.0)
+            found.append(np.array(row, dtype=float))
+        return found[0], found[1]
+
     def rate_penalty(self, U: Any) -> Any:
         """``w * sum_j sum_k (U[j, k+1] - U[j, k])**2 / (tau_{k+1} - tau_k)`` over consecutive
         evaluation points (``method.control_rate_penalty``; 0 when w is 0), a discrete

@@ -37,6 +37,9 @@ class StateSpec(StrictModel):
     final: Value | None = None
     lower: Value | None = None
     upper: Value | None = None
+    scale: Number | Literal["auto"] | None = Field(
+        None, description="The NLP sees this variable divided by scale; auto: from the bounds or the guess."
+    )
 
 
 class ControlSpec(StrictModel):
@@ -44,6 +47,9 @@ class ControlSpec(StrictModel):
 
     lower: Value | None = None
     upper: Value | None = None
+    scale: Number | Literal["auto"] | None = Field(
+        None, description="The NLP sees this variable divided by scale; auto: from the bounds or the guess."
+    )
 
 
 class InputSpec(StrictModel):
@@ -308,7 +314,7 @@ class OcpProblem(StrictModel):
         timed = params | {"t": symbol("t")}
         for group, items in (("states", self.states), ("controls", self.controls), ("design", self.design)):
             for name, spec in items.items():
-                for key, value in spec.model_dump().items():
+                for key, value in spec.model_dump(exclude={"scale"}).items():
                     if isinstance(value, str):
                         along = group != "design" and key in ("lower", "upper")
                         if along:

@@ -268,3 +268,24 @@ def test_each_check_has_a_verdict_against_its_tolerance() -> None:
     assert passed["max_constraint_violation"] is (coarse.checks["max_constraint_violation"] <= 1e-6)
     assert passed["max_defect_relative"] is False  # 10 intervals: a relative defect of order 1e-1
     assert coarse.checks["max_defect_relative"] <= coarse.checks["max_defect"]  # scales are >= 1
+
+
+def test_scale_factors_from_the_file_the_bounds_and_the_guess() -> None:
+    tr = Transcription(gamespec.load(HANG_GLIDER))
+    sx, su = tr.scales(tr.ocp.parameter_values())
+    assert list(sx) == [1000.0, 1000.0, 1.0, 1.0]  # given; auto from the guess (1000 -> 900); unset
+    assert list(su) == [1.4]  # auto from the bounds [0, 1.4]
+
+
+@pytest.mark.parametrize("backend", ["casadi", "pyomo"])
+def test_scaling_leaves_the_optimum_where_it_is(backend: str) -> None:
+    unscaled = [
+        "problem.states.x.scale=null",
+        "problem.states.y.scale=null",
+        "problem.controls.cL.scale=null",
+    ]
+    scaled = gamespec.solve(gamespec.load(HANG_GLIDER, SMALL), backend)
+    plain = gamespec.solve(gamespec.load(HANG_GLIDER, [*SMALL, *unscaled]), backend)
+    assert scaled.status == plain.status == gamespec.Status.OPTIMAL
+    assert scaled.objective == pytest.approx(plain.objective, rel=1e-8)
+    assert np.allclose(scaled.states["x"], plain.states["x"], rtol=1e-6, atol=1e-6)

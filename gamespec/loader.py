@@ -15,7 +15,6 @@ from collections.abc import Iterable, Mapping
 from pathlib import Path
 from typing import Any
 
-import yaml
 from pydantic import BaseModel, ValidationError
 
 from gamespec import registry
@@ -37,11 +36,7 @@ def parse_override(assignment: str) -> tuple[list[str], Any]:
     key, sep, value = assignment.partition("=")
     if not sep or not key.strip():
         raise SpecError(f"--set expects dotted.path=value, got {assignment!r}", source="--set")
-    try:
-        parsed = yaml.safe_load(value) if value.strip() else ""
-    except yaml.YAMLError:
-        parsed = value
-    return override_path(key), parsed
+    return override_path(key), read_value(value) if value.strip() else ""
 
 
 def set_path(data: dict[str, Any], path: list[str], value: Any, *, create: bool, source: str) -> None:

@@ -15,13 +15,12 @@ from collections.abc import Iterable, Mapping
 from pathlib import Path
 from typing import Any
 
-import yaml
 from pydantic import BaseModel, ValidationError
 
 from gamespec import registry
 from gamespec.errors import SpecError
 from gamespec.reading import read_file, read_value
-from gamespec.specs.base import SpecBase
+from gamespec.specs.base import NLP_OPTIONS, SpecBase
 
 
 def override_path(key: str, source: str = "--set") -> list[str]:
@@ -37,11 +36,7 @@ def parse_override(assignment: str) -> tuple[list[str], Any]:
     key, sep, value = assignment.partition("=")
     if not sep or not key.strip():
         raise SpecError(f"--set expects dotted.path=value, got {assignment!r}", source="--set")
-    try:
-        parsed = yaml.safe_load(value) if value.strip() else ""
-    except yaml.YAMLError:
-        parsed = value
-    return override_path(key), parsed
+    return override_path(key), read_value(value) if value.strip() else ""
 
 
 def set_path(data: dict[str, Any], path: list[str], value: Any, *, create: bool, source: str) -> None:
@@ -199,6 +194,8 @@ def check_backend_options(spec: SpecBase, source: str) -> None:
     when the file has a block for it), so a misspelled backend or option fails at load, not at solve.
     A backend whose module cannot be imported here is left to the solve, which says why."""
     for name, block in spec.solver.options.items():
+        if name == NLP_OPTIONS:
+            continue
         known = registry.names("gamespec.backends")
         if name not in known:
             near = difflib.get_close_matches(name, known, n=1)

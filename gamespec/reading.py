@@ -33,6 +33,8 @@ _MAX_INT_BITS = int(MAX_INT_DIGITS * math.log2(10))
 _LONG_INTEGER = re.compile(rf"[0-9][0-9_]{{{MAX_INT_DIGITS},}}")
 _TIMESTAMP = "tag:yaml.org,2002:timestamp"
 _MERGE = "tag:yaml.org,2002:merge"
+_FLOAT = "tag:yaml.org,2002:float"
+_EXPONENT_FLOAT = re.compile(r"^[-+]?[0-9][0-9_]*[eE][-+]?[0-9]+$")
 
 
 class RefusedYAML(ComposerError):
@@ -52,6 +54,10 @@ class SafeProblemLoader(yaml.SafeLoader):
         first: [(tag, regexp) for tag, regexp in resolvers if tag != _TIMESTAMP]
         for first, resolvers in yaml.SafeLoader.yaml_implicit_resolvers.items()
     }
+    for _first in "-+0123456789":
+        # YAML 1.2's floats without a dot (``1e-8``), which YAML 1.1 reads as text
+        yaml_implicit_resolvers.setdefault(_first, []).insert(0, (_FLOAT, _EXPONENT_FLOAT))
+    del _first
 
     def __init__(self, stream: str) -> None:
         super().__init__(stream)

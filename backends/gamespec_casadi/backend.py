@@ -2,10 +2,12 @@
 
 The NLP is built once (on one flat SX graph, or with ``graph: mx`` an MX graph around the mapped
 per-point function) from the backend-neutral :class:`~gamespec.ocp.transcription.Transcription`:
-decision variables ``[vec(X); vec(U); T]``, defects ``D X - T W F`` with ``F`` a mapped CasADi
-function over the evaluation points, and the problem's parameters, the grid inputs (one block of
-n_w × n_eval values) and a fixed horizon as NLP parameters ``p = [params; vec(Win); T]``, so a re-solve
-with new values reuses the solver and warm-starts from the last solution.
+decision variables ``[vec(X / s_x); vec(U / s_u); d; T]`` (s: the scale factors, d: the design
+variables), defects ``D X - T W F``
+with ``F`` a mapped CasADi function over the evaluation points, and the problem's parameters, the
+grid inputs (one block of n_w × n_eval values) and a fixed horizon as NLP parameters ``p = [params;
+vec(Win); T]``, so a re-solve with new values reuses the solver and warm-starts from the last
+solution.
 """
 
 from __future__ import annotations
@@ -48,6 +50,7 @@ class CasadiOptions(StrictModel):
     solver: str = Field("ipopt", description="NLP solver plugin of CasADi's nlpsol.")
     tol: float = Field(1e-8, gt=0, description="IPOPT's tol.")
     max_iter: int = Field(3000, ge=1)
+    max_wall_time: float = Field(300.0, gt=0, description="IPOPT's wall-time limit in seconds.")
     ipopt: dict[str, Any] = Field(default_factory=dict, description="Further IPOPT options.")
     warm_start: bool = Field(True, description="Re-solves start from the previous solution.")
     graph: Literal["sx", "mx"] = Field(
@@ -92,39 +95,46 @@ class CasadiModel(CollocationModel):
         lib = casadi_library(ca)
         nx, nu, nw, npar = tr.n_x, tr.n_u, tr.n_w, len(ocp.p)
         x, u, w = ca.SX.sym("x", nx), ca.SX.sym("u", nu), ca.SX.sym("w", nw)
-        p, t = ca.SX.sym("p", npar), ca.SX.sym("t")
+        p, t = ca.SX.sym("p", npar + tr.n_d), ca.SX.sym("t")
         values = {ocp.t: t}
-        for symbols, var in ((ocp.x, x), (ocp.u, u), (ocp.w, w), (ocp.p, p)):
+        for symbols, var in ((ocp.x, x), (ocp.u, u), (ocp.w, w), (ocp.p + ocp.d, p)):
             values |= dict(zip(symbols, ca.vertsplit(var), strict=True))
         f = ca.vertcat(*(translate(e, values, lib) for e in ocp.dynamics))
         L = translate(ocp.lagrange, values, lib)
         path = ca.vertcat(*(translate(r.expr, values, lib) for r in ocp.path))
+        integrand = ca.vertcat(*(translate(r.expr, values, lib) for r in ocp.integrals))
         k = len(grid.eval_index)
-        point = ca.Function("point", [x, u, w, t, p], [f, L, path]).map(k)
+        point = ca.Function("point", [x, u, w, t, p], [f, L, path, integrand]).map(k)
 
         outer = ca.MX if options.graph == "mx" else ca.SX
-        X = outer.sym("X", nx, grid.n_nodes)
-        U = outer.sym("U", nu, k)
+        self.sx, self.su = tr.scales(tr.ocp.parameter_values())
+        X_scaled, U_scaled = outer.sym("X", nx, grid.n_nodes), outer.sym("U", nu, k)
+        X = ca.diag(ca.DM(self.sx)) @ X_scaled
+        U = ca.diag(ca.DM(self.su)) @ U_scaled
         T = outer.sym("T") if tr.free_time else None
+        design = outer.sym("d", tr.n_d)
         p_all = outer.sym("p_all", npar + nw * k + (0 if tr.free_time else 1))
-        params = p_all[:npar, :]
+        params = ca.vertcat(p_all[:npar, :], design)
         Win = ca.reshape(p_all[npar : npar + nw * k], nw, k)
         horizon = T if tr.free_time else p_all[npar + nw * k]
         t_eval = tr.t0 + horizon * ca.DM(grid.eval_tau).T
-        F, Lv, G = point(X[:, grid.eval_index.tolist()], U, Win, t_eval, params)
+        F, Lv, G, Iv = point(X[:, grid.eval_index.tolist()], U, Win, t_eval, params)
         D, W, q = grid.matrices
         defects = X @ ca.DM(D.T) - horizon * (F @ ca.DM(W.T))
 
         ends = dict(zip(ocp.x0, ca.vertsplit(X[:, 0]), strict=True))
         ends |= dict(zip(ocp.xf, ca.vertsplit(X[:, -1]), strict=True)) | {ocp.tf: tr.t0 + horizon}
-        ends |= dict(zip(ocp.p, ca.vertsplit(params), strict=True))
+        ends |= dict(zip(ocp.p + ocp.d, ca.vertsplit(params), strict=True))
+        first, last = tr.end_controls(U)
+        ends |= dict(zip(ocp.u0, first, strict=True)) | dict(zip(ocp.uf, last, strict=True))
         mayer = translate(ocp.mayer, ends, lib)
         boundary = [translate(r.expr, ends, lib) for r in ocp.boundary]
-        objective = mayer + horizon * (Lv @ ca.DM(q))
+        objective = mayer + horizon * (Lv @ ca.DM(q)) + tr.rate_penalty(U)
 
         self.n_defects = defects.numel()
-        g = ca.vertcat(ca.vec(defects), ca.vec(G.T), *boundary)
-        w = ca.vertcat(ca.vec(X), ca.vec(U), *([T] if tr.free_time else []))
+        integrals = horizon * (Iv @ ca.DM(q))
+        g = ca.vertcat(ca.vec(defects), ca.vec(G.T), *boundary, integrals)
+        w = ca.vertcat(ca.vec(X_scaled), ca.vec(U_scaled), design, *([T] if tr.free_time else []))
         lower = [np.zeros(self.n_defects)]
         upper = [np.zeros(self.n_defects)]
         for r in ocp.path:
@@ -132,8 +142,11 @@ class CasadiModel(CollocationModel):
             upper.append(np.full(k, r.upper))
         lower += [np.array([r.lower for r in ocp.boundary])]
         upper += [np.array([r.upper for r in ocp.boundary])]
+        lower += [np.array([r.lower for r in ocp.integrals])]
+        upper += [np.array([r.upper for r in ocp.integrals])]
         self.lbg, self.ubg = np.concatenate(lower), np.concatenate(upper)
         ipopt = {"print_level": 0, "sb": "yes", "tol": options.tol, "max_iter": options.max_iter}
+        ipopt["max_wall_time"] = options.max_wall_time
         nlp_opts = {"ipopt": ipopt | options.ipopt, "print_time": False}
         self.solver = ca.nlpsol(
             "gamespec", options.solver, {"x": w, "p": p_all, "f": objective, "g": g}, nlp_opts
@@ -141,18 +154,20 @@ class CasadiModel(CollocationModel):
         self.shape = (nx, grid.n_nodes, nu, k)
         self._last: np.ndarray | None = None
 
-    def _pack(self, X: np.ndarray, U: np.ndarray, T: float) -> np.ndarray:
-        parts = [X.ravel(order="F"), U.ravel(order="F")]
+    def _pack(self, X: np.ndarray, U: np.ndarray, d: np.ndarray, T: float) -> np.ndarray:
+        """The NLP's variables: X and U divided by their scale factors."""
+        parts = [(X / self.sx[:, None]).ravel(order="F"), (U / self.su[:, None]).ravel(order="F"), d]
         return np.concatenate([*parts, [T]] if self.tr.free_time else parts)
 
-    def _unpack(self, w: np.ndarray, params_T: float) -> tuple[np.ndarray, np.ndarray, float]:
+    def _unpack(self, w: np.ndarray, params_T: float) -> tuple[np.ndarray, np.ndarray, np.ndarray, float]:
         nx, n, nu, k = self.shape
-        X = w[: nx * n].reshape((nx, n), order="F")
-        U = w[nx * n : nx * n + nu * k].reshape((nu, k), order="F")
+        X = w[: nx * n].reshape((nx, n), order="F") * self.sx[:, None]
+        U = w[nx * n : nx * n + nu * k].reshape((nu, k), order="F") * self.su[:, None]
+        d = w[nx * n + nu * k : nx * n + nu * k + self.tr.n_d]
         T = float(w[-1]) if self.tr.free_time else params_T
-        return X, U, T
+        return X, U, d, T
 
-    def solve(
+    def solve_once(
         self, parameters: dict[str, float] | None = None, guess: Result | None = None, inputs: Inputs = None
     ) -> Result:
         tr = self.tr
@@ -163,9 +178,9 @@ class CasadiModel(CollocationModel):
             w0 = self._last
         else:
             start: Guess = tr.guess(params, guess)
-            w0 = self._pack(start.X, start.U, start.T)
-        lbx = self._pack(b.x_lower, b.u_lower, b.t_lower)
-        ubx = self._pack(b.x_upper, b.u_upper, b.t_upper)
+            w0 = self._pack(start.X, start.U, start.d, start.T)
+        lbx = self._pack(b.x_lower, b.u_lower, b.d_lower, b.t_lower)
+        ubx = self._pack(b.x_upper, b.u_upper, b.d_upper, b.t_upper)
         horizon = [] if tr.free_time else [b.t_lower]
         p_val = np.concatenate([[params[n] for n in tr.ocp.parameters], Win.ravel(order="F"), horizon])
         tic = time.perf_counter()
@@ -177,7 +192,7 @@ class CasadiModel(CollocationModel):
         w = np.asarray(sol["x"]).ravel()
         if status.ok:
             self._last = w
-        X, U, T = self._unpack(w, b.t_lower)
+        X, U, d, T = self._unpack(w, b.t_lower)
         nx = self.shape[0]
         nu_def = np.asarray(sol["lam_g"]).ravel()[: self.n_defects].reshape((nx, -1), order="F")
         return tr.result(
@@ -187,6 +202,7 @@ class CasadiModel(CollocationModel):
             objective=float(sol["f"]) * tr.ocp.sign if status.ok else None,
             params=params,
             inputs=Win,
+            design=d,
             status=status,
             message=native,
             solve_time_s=elapsed,
@@ -201,6 +217,7 @@ class CasadiBackend(CollocationBackend):
 
     name: ClassVar[str] = "casadi"
     options_model = CasadiOptions
+    nlp_field: ClassVar[str] = "ipopt"
 
     @classmethod
     def available(cls) -> Availability:

@@ -47,6 +47,7 @@ class PyomoOptions(StrictModel):
     )
     tol: float = Field(1e-8, gt=0, description="The solver's tol.")
     max_iter: int = Field(3000, ge=1)
+    max_wall_time: float = Field(300.0, gt=0, description="The solver's wall-time limit in seconds.")
     options: dict[str, Any] = Field(
         default_factory=dict, description="Further solver options (key=value on its command line)."
     )
@@ -87,14 +88,19 @@ class PyomoModel(CollocationModel):
         for (j, c), var in m.U.items():
             var.setlb(_bound(b.u_lower[j, c]))
             var.setub(_bound(b.u_upper[j, c]))
+        for name, lo, hi in zip(self.tr.ocp.design, b.d_lower, b.d_upper, strict=True):
+            m.d[name].setlb(_bound(lo))
+            m.d[name].setub(_bound(hi))
         if self.tr.free_time:
             m.T.setlb(b.t_lower)
             m.T.setub(b.t_upper)
         else:
             m.T.set_value(b.t_lower)
 
-    def _set_start(self, X: np.ndarray, U: np.ndarray, T: float, b: Bounds) -> None:
+    def _set_start(self, X: np.ndarray, U: np.ndarray, d: np.ndarray, T: float, b: Bounds) -> None:
         m = self.model
+        for name, value in zip(self.tr.ocp.design, np.clip(d, b.d_lower, b.d_upper), strict=True):
+            m.d[name].set_value(float(value))
         X = np.clip(X, b.x_lower, b.x_upper)
         U = np.clip(U, b.u_lower, b.u_upper)
         for (i, n), var in m.X.items():
@@ -124,6 +130,7 @@ class PyomoModel(CollocationModel):
 
         name = self.executable.name
         opts = {"tol": self.options.tol, "max_iter": self.options.max_iter, "print_level": PRINT_LEVEL[name]}
+        opts["max_wall_time"] = self.options.max_wall_time
         with tempfile.TemporaryDirectory(prefix="gamespec-pyomo-") as tmp:
             log = Path(tmp) / "solver.log"
             try:
@@ -145,7 +152,7 @@ class PyomoModel(CollocationModel):
             self.model.solutions.load_from(results)
         return True
 
-    def solve(
+    def solve_once(
         self, parameters: dict[str, float] | None = None, guess: Result | None = None, inputs: Inputs = None
     ) -> Result:
         tr, m = self.tr, self.model
@@ -159,7 +166,7 @@ class PyomoModel(CollocationModel):
         self._set_bounds(b)
         if guess is not None or not (self._solved and self.options.warm_start):
             start = tr.guess(params, guess)
-            self._set_start(start.X, start.U, start.T, b)
+            self._set_start(start.X, start.U, start.d, start.T, b)
         m.dual.clear()
         tic = time.perf_counter()
         results, log = self._run()
@@ -177,6 +184,7 @@ class PyomoModel(CollocationModel):
             objective=float(self.pyo.value(m.objective)) * tr.ocp.sign if loaded else None,
             params=params,
             inputs=Win,
+            design=np.array([m.d[n].value for n in tr.ocp.design], dtype=float),
             status=status_of(termination, message),
             message=message,
             solve_time_s=elapsed,
@@ -197,6 +205,7 @@ class PyomoBackend(CollocationBackend):
 
     name: ClassVar[str] = "pyomo"
     options_model = PyomoOptions
+    nlp_field: ClassVar[str] = "options"
 
     @classmethod
     def available(cls) -> Availability:

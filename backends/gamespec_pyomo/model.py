@@ -1,13 +1,15 @@
-"""A :class:`~gamespec.ocp.transcription.Transcription` as a Pyomo model: the explicit collocation
-of :mod:`gamespec.ocp.collocation`, row for row the NLP the CasADi backend builds, so both backends
+"""A :class:`~gamespec.ocp.transcription.Transcription` as a Pyomo model: the explicit collocation of
+:mod:`gamespec.ocp.collocation`, row for row the NLP the CasADi backend builds, so both backends
 solve the identical discretization.
 
-Variables ``X[i, node]``, ``U[j, point]`` and the horizon ``T``, a Var when the final time is free
-(time scaling ``t = t0 + tau * T``) and a mutable Param otherwise. The problem's parameters are
-mutable Params indexed by name, and the grid inputs mutable Params ``w[input, point]`` indexed by
-evaluation point, so a re-solve changes values, not the model. Constraints: the
-defects ``D X - T W F(X, U, t) = 0``, path constraints at every evaluation point and boundary
-constraints over the end values; objective ``Phi + T q^T L`` in minimization form.
+Variables ``X[i, node]``, ``U[j, point]``, the design variables ``d[name]`` and the horizon ``T``, a
+Var when the final time is free (time scaling ``t = t0 + tau * T``) and a mutable Param otherwise.
+The problem's parameters are mutable Params indexed by name, and the grid inputs mutable Params
+``w[input, point]`` indexed by evaluation point, so a re-solve changes values, not the model.
+Constraints: the defects ``D X - T W F(X, U, t) = 0``, path constraints at every evaluation point,
+boundary constraints over the end values and integral constraints ``T q^T g``; objective ``Phi + T
+q^T L`` in minimization form. The ``scaling_factor`` Suffix (``1/scale``, applied by Pyomo's NL
+writer) gives the solver the scaled variables the casadi backend gives IPOPT.
 """
 
 from __future__ import annotations
@@ -85,15 +87,18 @@ def build_model(tr: Transcription, params: Mapping[str, float]) -> Any:
     m.w = pyo.Param(range(tr.n_w), range(k), mutable=True, initialize=0.0)
     m.X = pyo.Var(range(tr.n_x), range(grid.n_nodes), initialize=0.0)
     m.U = pyo.Var(range(tr.n_u), range(k), initialize=0.0)
+    m.d = pyo.Var(ocp.design, initialize=0.0)
     if tr.free_time:
         m.T = pyo.Var(initialize=1.0)
     else:
         m.T = pyo.Param(mutable=True, initialize=1.0)
     symbols = {s: m.p[name] for s, name in zip(ocp.p, ocp.parameters, strict=True)}
+    symbols |= {s: m.d[name] for s, name in zip(ocp.d, ocp.design, strict=True)}
 
     F = np.empty((tr.n_x, k), dtype=object)
     L = []
     path = []
+    integrands = []
     for col, (node, tau) in enumerate(zip(grid.eval_index, grid.eval_tau, strict=True)):
         values = symbols | {ocp.t: tr.t0 + tau * m.T}
         values |= {s: m.X[i, int(node)] for i, s in enumerate(ocp.x)}
@@ -102,6 +107,7 @@ def build_model(tr: Transcription, params: Mapping[str, float]) -> Any:
         F[:, col] = [translate(f, values, lib) for f in ocp.dynamics]
         L.append(translate(ocp.lagrange, values, lib))
         path.append([_relation(r, translate(r.expr, values, lib)) for r in ocp.path])
+        integrands.append([translate(r.expr, values, lib) for r in ocp.integrals])
 
     def defect(_m: Any, i: int, row: int) -> Any:
         dx = sum(v * m.X[i, int(c)] for c, v in _row(D, row))
@@ -113,11 +119,26 @@ def build_model(tr: Transcription, params: Mapping[str, float]) -> Any:
     ends = symbols | {ocp.tf: tr.t0 + m.T}
     ends |= {s: m.X[i, 0] for i, s in enumerate(ocp.x0)}
     ends |= {s: m.X[i, grid.n_nodes - 1] for i, s in enumerate(ocp.xf)}
+    first, last = tr.end_controls(m.U)
+    ends |= dict(zip(ocp.u0, first, strict=True)) | dict(zip(ocp.uf, last, strict=True))
     boundary = [_relation(r, translate(r.expr, ends, lib)) for r in ocp.boundary]
     m.boundary = pyo.Constraint(range(len(boundary)), rule=lambda _m, r: boundary[r])
+    integral = [
+        m.T * sum(float(w) * terms[r] for w, terms in zip(q, integrands, strict=True))
+        for r in range(len(ocp.integrals))
+    ]
+    m.integral = pyo.Constraint(
+        range(len(ocp.integrals)), rule=lambda _m, r: _relation(ocp.integrals[r], integral[r])
+    )
     running = sum(float(w) * term for w, term in zip(q, L, strict=True))
-    m.objective = pyo.Objective(expr=translate(ocp.mayer, ends, lib) + m.T * running)
+    m.objective = pyo.Objective(expr=translate(ocp.mayer, ends, lib) + m.T * running + tr.rate_penalty(m.U))
     m.dual = pyo.Suffix(direction=pyo.Suffix.IMPORT)
+    m.scaling_factor = pyo.Suffix(direction=pyo.Suffix.EXPORT)
+    sx, su = tr.scales(params)
+    for (i, _), var in m.X.items():
+        m.scaling_factor[var] = 1.0 / sx[i]
+    for (j, _), var in m.U.items():
+        m.scaling_factor[var] = 1.0 / su[j]
     return m
 
 

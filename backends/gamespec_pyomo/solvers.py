@@ -146,8 +146,11 @@ def pyomo_solver(exe: Executable) -> Any:
 
 def status_of(termination: str, message: str) -> Status:
     """gamespec's Status for a Pyomo termination condition; Ipopt's (and ripopt's) 'Solved To
-    Acceptable Level' has an optimal solve code but is only feasible to the acceptable tolerances."""
+    Acceptable Level' has an optimal solve code but is only feasible to the acceptable tolerances, and
+    ripopt reports its wall-time limit ('Maximum CPU Time Exceeded') with the iteration-limit code."""
     status = STATUS_MAP.get(termination, Status.ERROR)
+    if "time exceeded" in message.lower():
+        return Status.TIME_LIMIT
     if status is Status.OPTIMAL and "acceptable level" in message.lower():
         return Status.FEASIBLE
     return status

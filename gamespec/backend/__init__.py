@@ -82,7 +82,7 @@ class Backend(ABC):
 
     def options(self, spec: SpecBase, overrides: dict[str, Any] | None = None) -> StrictModel:
         """This backend's options block from the spec's ``solver.options``, validated."""
-        raw = {**spec.solver.options.get(self.name, {}), **(overrides or {})}
+        raw = {**self.shared_options(spec), **spec.solver.options.get(self.name, {}), **(overrides or {})}
         return self.validate_options(raw, spec.source)
 
     @classmethod
@@ -97,6 +97,11 @@ class Backend(ABC):
             found = format_validation_error(err, cls.options_model, source, raw)
             field = ".".join(p for p in ("solver.options", cls.name, found.field) if p)
             raise SpecError(found.reason, field=field, source=source) from None
+
+    def shared_options(self, spec: SpecBase) -> dict[str, Any]:
+        """Option values that blocks other than this backend's own give it (none by default; the
+        collocation backends take ``solver.options.nlp``); the backend's own block wins."""
+        return {}
 
     def compile(self, spec: SpecBase, options: StrictModel | None = None) -> CompiledModel:
         """Check support, then build the backend model once."""

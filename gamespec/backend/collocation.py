@@ -1,32 +1,76 @@
 """What the backends that solve ``optimal_control`` specs by direct collocation share: the kinds and
-features they declare, and a compiled model that says where its grid inputs go. Their numerics (the
-backend-neutral :class:`~gamespec.ocp.transcription.Transcription`) live in :mod:`gamespec.ocp`."""
+features they declare, the one spelling of NLP options (``solver.options.nlp``), and a compiled
+model that says where its grid inputs go and refines its mesh when the file asks. Their numerics
+(the backend-neutral :class:`~gamespec.ocp.transcription.Transcription`) live in :mod:`gamespec.ocp`."""
 
 from __future__ import annotations
 
+from abc import abstractmethod
 from collections.abc import Mapping
-from typing import ClassVar
+from typing import Any, ClassVar
 
-from gamespec.backend import Backend, CompiledModel
+from gamespec.backend import Backend, CompiledModel, Inputs
 from gamespec.ocp.inputs import InputGrid
 from gamespec.ocp.transcription import Transcription
+from gamespec.result import Result
+from gamespec.specs.base import NLP_OPTIONS, SpecBase
 
 
 class CollocationBackend(Backend):
     """Base of the backends that solve ``optimal_control`` specs by direct collocation of a
-    :class:`Transcription` (the same kinds and features for each of them)."""
+    :class:`Transcription` (the same kinds and features for each of them). ``solver.options.nlp``
+    holds IPOPT options for all of them: those the backend's options block names (``tol``,
+    ``max_iter``, ``max_wall_time``) set that field, the rest go to its pass-through block
+    (``nlp_field``); the backend's own block overrides either."""
 
+    nlp_field: ClassVar[str] = ""
     kinds: ClassVar[frozenset[str]] = frozenset({"optimal_control"})
     features: ClassVar[frozenset[str]] = frozenset(
-        {"ode", "free_final_time", "path_constraints", "boundary_constraints", "grid_inputs"}
+        {
+            "ode",
+            "free_final_time",
+            "path_constraints",
+            "boundary_constraints",
+            "grid_inputs",
+            "design_parameters",
+            "integral_constraints",
+        }
     )
+
+    def shared_options(self, spec: SpecBase) -> dict[str, Any]:
+        nlp = dict(spec.solver.options.get(NLP_OPTIONS, {}))
+        own = spec.solver.options.get(self.name, {})
+        fields = set(self.options_model.model_fields) - {self.nlp_field}
+        named = {k: nlp.pop(k) for k in list(nlp) if k in fields}
+        if nlp:
+            named[self.nlp_field] = {**nlp, **own.get(self.nlp_field, {})}
+        return named
 
 
 class CollocationModel(CompiledModel):
     """A compiled model of a :class:`Transcription` (``tr``), re-solvable with new grid inputs."""
 
     tr: Transcription
+    options: Any
 
     def input_grid(self, parameters: Mapping[str, float] | None = None) -> InputGrid:
         """Where ``solve(inputs=...)`` expects its values (see :meth:`Transcription.input_grid`)."""
         return self.tr.input_grid(parameters)
+
+    def solve(
+        self, parameters: dict[str, float] | None = None, guess: Result | None = None, inputs: Inputs = None
+    ) -> Result:
+        """One solve on this mesh, then adaptive refinement when ``method.refine`` asks for it
+        (:mod:`gamespec.backend.refinement`)."""
+        result = self.solve_once(parameters, guess, inputs)
+        if self.tr.spec.method.refine is None:
+            return result
+        from gamespec.backend.refinement import refined
+
+        return refined(self, result, parameters, inputs)
+
+    @abstractmethod
+    def solve_once(
+        self, parameters: dict[str, float] | None = None, guess: Result | None = None, inputs: Inputs = None
+    ) -> Result:
+        """Solve on this model's mesh."""

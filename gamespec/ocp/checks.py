@@ -5,7 +5,12 @@
   Inputs are interpolated as the controls are and as the transcription sees them: through the
   interval's collocation points (the degree d-1 polynomial, Radau) or linearly between nodes
   (trapezoidal), so the check measures the discretization, not how a signal was tabulated.
-- ``max_constraint_violation``: bounds, fixed end values, path and boundary constraints.
+- ``max_defect_relative``: the same gap divided by the state's scale ``max(1, max |x|)`` (what
+  ``method.refine.tolerance`` is compared with).
+- ``max_constraint_violation``: bounds, fixed end values, path, boundary and integral constraints.
+- ``control_swings/<control>``: total variation of the control over the range it spans; ``chattering``
+  is 1 when one sweeps its range more than ``CHATTERING_SWINGS`` times (regularize it with
+  ``method.control_rate_penalty``), else 0.
 - ``hamiltonian_variation``: ``max |H - mean H|`` along the solution for autonomous problems, with
   ``H = sign*L + lambda^T f`` from the costate estimates (constant on an optimal arc). A grid input
   that enters f or L and varies along the grid makes the problem non-autonomous
@@ -29,6 +34,9 @@ if TYPE_CHECKING:
     from gamespec.ocp.transcription import Transcription
 
 RK4_STEPS = 16
+CHATTERING_SWINGS = 10.0
+"""A control that sweeps its range more often than this (total variation over the range it spans)
+chatters: a bang-bang or bang-singular profile sweeps it a few times, on every mesh."""
 
 
 @dataclass(frozen=True)
@@ -43,8 +51,9 @@ class Trajectory:
 
 
 def _running(tr: Transcription, x, u, w, t: np.ndarray, params: Mapping[str, float]) -> np.ndarray:
-    """The dynamics (first ``n_x`` rows) and the Lagrange integrand (last row) along ``t``."""
-    p = [params[n] for n in tr.ocp.parameters]
+    """The dynamics (first ``n_x`` rows) and the Lagrange integrand (last row) along ``t``
+    (``params`` holds the design variables' values too)."""
+    p = [params[n] for n in [*tr.ocp.parameters, *tr.ocp.design]]
     return tr.ocp.running_function(*x, *u, *w, *p, t)
 
 
@@ -55,7 +64,7 @@ def _values(tr: Transcription, x, u, w, t, params) -> dict:
     return values | {symbol(k): v for k, v in params.items()} | {ocp.t: t}
 
 
-def _control_basis(tr: Transcription, s: np.ndarray) -> np.ndarray:
+def control_basis(tr: Transcription, s: np.ndarray) -> np.ndarray:
     """Weights (len(s) × points) interpolating an interval's controls at local times ``s``."""
     grid = tr.grid
     if grid.scheme == "trapezoidal":
@@ -77,8 +86,9 @@ def _per_interval(tr: Transcription, V: np.ndarray) -> np.ndarray:
     return np.stack([V[:, :-1], V[:, 1:]], axis=2)
 
 
-def max_defect(tr: Transcription, sol: Trajectory, params: Mapping[str, float]) -> float:
-    """Largest gap between an RK4 re-integration of each interval and the collocated state."""
+def interval_defects(tr: Transcription, sol: Trajectory, params: Mapping[str, float]) -> np.ndarray:
+    """Per state and interval (n_x × intervals), the gap between an RK4 re-integration of the
+    interval from its first node and the collocated state at its end."""
     X, T = sol.X, sol.T
     grid = tr.grid
     starts = grid.interval_start_index
@@ -89,7 +99,7 @@ def max_defect(tr: Transcription, sol: Trajectory, params: Mapping[str, float]) 
     ds = 1.0 / RK4_STEPS
 
     def f(x: np.ndarray, s: float) -> np.ndarray:
-        basis = _control_basis(tr, np.array([s]))[0]
+        basis = control_basis(tr, np.array([s]))[0]
         return _running(tr, x, Ui @ basis, Wi @ basis, t0 + s * h, params)[:-1]
 
     for step in range(RK4_STEPS):
@@ -99,7 +109,46 @@ def max_defect(tr: Transcription, sol: Trajectory, params: Mapping[str, float]) 
         k3 = f(x + 0.5 * ds * h * k2, s + ds / 2)
         k4 = f(x + ds * h * k3, s + ds)
         x = x + ds * h / 6.0 * (k1 + 2 * k2 + 2 * k3 + k4)
-    return float(np.max(np.abs(x - X[:, starts[1:]]))) if x.size else 0.0
+    return np.abs(x - X[:, starts[1:]])
+
+
+def state_scale(X: np.ndarray) -> np.ndarray:
+    """Per state, ``max(1, max |x|)`` along the solution: what a defect is relative to."""
+    return np.maximum(1.0, np.max(np.abs(X), axis=1, initial=0.0))
+
+
+def relative_defects(tr: Transcription, sol: Trajectory, params: Mapping[str, float]) -> np.ndarray:
+    """Per interval, the largest defect over the states relative to each state's scale."""
+    gaps = interval_defects(tr, sol, params) / state_scale(sol.X)[:, None]
+    return np.max(gaps, axis=0, initial=0.0)
+
+
+DEFAULT_TOLERANCES = {"max_constraint_violation": 1e-6, "max_defect_relative": 1e-6, "chattering": 0.0}
+"""What each check is held to when the file sets nothing: a constraint violation and a relative
+defect at the level of IPOPT's default tolerance, and no chattering control."""
+
+
+def verdicts(checks: Mapping[str, float | None], defect_tolerance: float | None) -> dict[str, bool]:
+    """Pass (True) or fail per check that has a tolerance (``method.refine.tolerance`` for the
+    relative defect when the file sets one); a check that could not be computed fails."""
+    tolerances = DEFAULT_TOLERANCES | (
+        {"max_defect_relative": defect_tolerance} if defect_tolerance is not None else {}
+    )
+    return {
+        name: checks[name] is not None and bool(checks[name] <= tol)
+        for name, tol in tolerances.items()
+        if name in checks
+    }
+
+
+def control_swings(U: np.ndarray) -> np.ndarray:
+    """Per control, its total variation ``sum_k |u_{k+1} - u_k|`` over the evaluation points divided
+    by the range it spans (0 for a constant control): how many times it sweeps that range."""
+    if U.shape[1] < 2:
+        return np.zeros(U.shape[0])
+    variation = np.sum(np.abs(np.diff(U, axis=1)), axis=1)
+    span = np.ptp(U, axis=1)
+    return np.where(span > 0, variation / np.where(span > 0, span, 1.0), 0.0)
 
 
 def _violation(values: np.ndarray, lower: np.ndarray | float, upper: np.ndarray | float) -> float:
@@ -114,22 +163,32 @@ def _relation_violation(rel: Relation, values: dict, shape: tuple[int, ...]) -> 
 
 
 def max_constraint_violation(tr: Transcription, sol: Trajectory, params: Mapping[str, float]) -> float:
-    """Largest violation of bounds, fixed end values, path and boundary constraints."""
+    """Largest violation of bounds (the design variables' too), fixed end values, path, boundary
+    and integral constraints (by the transcription's quadrature)."""
     X, U, T = sol.X, sol.U, sol.T
     b = tr.bounds(params)
     worst = [_violation(X, b.x_lower, b.x_upper), _violation(U, b.u_lower, b.u_upper)]
     worst.append(_violation(np.array([T]), b.t_lower, b.t_upper))
+    worst.append(_violation(np.array([params[n] for n in tr.ocp.design]), b.d_lower, b.d_upper))
     t_eval = tr.t0 + T * tr.grid.eval_tau
     running = _values(tr, X[:, tr.grid.eval_index], U, sol.Win, t_eval, params)
     worst += [_relation_violation(r, running, t_eval.shape) for r in tr.ocp.path]
-    ends = _end_values(tr, X, T, params)
+    ends = _end_values(tr, X, U, T, params)
     worst += [_relation_violation(r, ends, ()) for r in tr.ocp.boundary]
+    q = tr.grid.matrices[2]
+    for r in tr.ocp.integrals:
+        g = np.broadcast_to(np.asarray(translate(r.expr, running, NUMPY), dtype=float), t_eval.shape)
+        worst.append(_violation(np.array([T * q @ g]), r.lower, r.upper))
     return float(np.max(worst))
 
 
-def _end_values(tr: Transcription, X: np.ndarray, T: float, params: Mapping[str, float]) -> dict:
+def _end_values(
+    tr: Transcription, X: np.ndarray, U: np.ndarray, T: float, params: Mapping[str, float]
+) -> dict:
     ocp = tr.ocp
     values = {s: X[i, 0] for i, s in enumerate(ocp.x0)} | {s: X[i, -1] for i, s in enumerate(ocp.xf)}
+    first, last = tr.end_controls(U)
+    values |= dict(zip(ocp.u0, first, strict=True)) | dict(zip(ocp.uf, last, strict=True))
     return values | {ocp.tf: tr.t0 + T} | {symbol(k): v for k, v in params.items()}
 
 
@@ -157,12 +216,18 @@ def solution_checks(
     e.g. a diverging re-integration of a failed solve)."""
     checks: dict[str, float | None] = {
         "max_constraint_violation": max_constraint_violation(tr, sol, params),
-        "max_defect": max_defect(tr, sol, params),
     }
+    gaps = interval_defects(tr, sol, params)
+    checks["max_defect"] = float(np.max(gaps, initial=0.0))
+    checks["max_defect_relative"] = float(np.max(gaps / state_scale(sol.X)[:, None], initial=0.0))
+    if tr.n_u:
+        swings = control_swings(sol.U)
+        checks |= {f"control_swings/{n}": float(v) for n, v in zip(tr.ocp.controls, swings, strict=True)}
+        checks["chattering"] = float(np.max(swings) > CHATTERING_SWINGS)
     if lam is not None and _time_invariant(tr, sol.Win):
         H = hamiltonian(tr, sol, params, lam)
         checks["hamiltonian_variation"] = float(np.max(np.abs(H - H.mean())))
         if tr.free_time:
-            end = translate(tr.ocp.hamiltonian_end_value, _end_values(tr, sol.X, sol.T, params), NUMPY)
+            end = translate(tr.ocp.hamiltonian_end_value, _end_values(tr, sol.X, sol.U, sol.T, params), NUMPY)
             checks["hamiltonian_end_error"] = float(np.max(np.abs(H - float(end))))
     return checks

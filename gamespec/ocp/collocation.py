@@ -56,11 +56,15 @@ class Grid:
     intervals: int
     degree: int
     grading: float = 1.0
+    mesh: tuple[float, ...] | None = None
 
     @cached_property
     def breaks(self) -> np.ndarray:
-        """Interval boundaries in tau; geometric lengths when ``grading`` != 1."""
+        """Interval boundaries in tau: the given ``mesh`` (``intervals + 1`` points from 0 to 1, e.g.
+        from mesh refinement), else geometric lengths when ``grading`` != 1, else uniform."""
         n = self.intervals
+        if self.mesh is not None:
+            return np.asarray(self.mesh, dtype=float)
         if self.grading == 1.0:
             return np.linspace(0.0, 1.0, n + 1)
         ratio = (1.0 / self.grading) ** (1.0 / max(n - 1, 1))

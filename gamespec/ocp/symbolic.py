@@ -39,6 +39,11 @@ class SymbolicOcp:
         return list(self.spec.problem.parameters)
 
     @property
+    def design(self) -> list[str]:
+        """Names of the free static parameters (decision variables of the NLP)."""
+        return list(self.spec.problem.design)
+
+    @property
     def inputs(self) -> list[str]:
         """Names of the grid inputs (signals tabulated at the evaluation points)."""
         return list(self.spec.problem.inputs)
@@ -54,6 +59,10 @@ class SymbolicOcp:
     @cached_property
     def p(self) -> list[sp.Symbol]:
         return [symbol(n) for n in self.parameters]
+
+    @cached_property
+    def d(self) -> list[sp.Symbol]:
+        return [symbol(n) for n in self.design]
 
     @cached_property
     def w(self) -> list[sp.Symbol]:
@@ -72,18 +81,36 @@ class SymbolicOcp:
         return [symbol(f"{n}_f") for n in self.states]
 
     @cached_property
+    def u0(self) -> list[sp.Symbol]:
+        """The controls at the initial time (``<control>_0``, in Mayer and boundary terms)."""
+        return [symbol(f"{n}_0") for n in self.controls]
+
+    @cached_property
+    def uf(self) -> list[sp.Symbol]:
+        return [symbol(f"{n}_f") for n in self.controls]
+
+    @cached_property
     def tf(self) -> sp.Symbol:
         return symbol("t_f")
 
     @cached_property
     def _running(self) -> dict[str, sp.Expr]:
-        names = [*self.parameters, *self.inputs, *self.states, *self.controls]
-        return {n: symbol(n) for n in names} | {"t": TIME}
+        """Running symbols, and each definition by its expanded expression (substituted where named)."""
+        names = [*self.parameters, *self.design, *self.inputs, *self.states, *self.controls]
+        symbols = {n: symbol(n) for n in names} | {"t": TIME}
+        for name, raw in self.spec.problem.definitions.items():
+            symbols[name] = parse(raw, symbols)
+        return symbols
+
+    @cached_property
+    def definitions(self) -> dict[str, sp.Expr]:
+        """Each named expression with the earlier ones substituted (over running symbols only)."""
+        return {n: self._running[n] for n in self.spec.problem.definitions}
 
     @cached_property
     def _ends(self) -> dict[str, sp.Expr]:
-        ends = {str(s): s for s in [*self.x0, *self.xf, self.tf]}
-        return {n: symbol(n) for n in self.parameters} | ends
+        ends = {str(s): s for s in [*self.x0, *self.xf, *self.u0, *self.uf, self.tf]}
+        return {n: symbol(n) for n in [*self.parameters, *self.design]} | ends
 
     @cached_property
     def _params(self) -> dict[str, sp.Expr]:
@@ -110,7 +137,28 @@ class SymbolicOcp:
 
     @cached_property
     def path(self) -> list[Relation]:
-        return [parse_relation(c, self._running) for c in self.spec.problem.path_constraints]
+        """The path constraints, then each bound that uses ``t`` as ``x - bound(t) >= 0`` (lower)
+        or ``<= 0`` (upper)."""
+        problem = self.spec.problem
+        relations = [parse_relation(c, self._running) for c in problem.path_constraints]
+        for name, key, raw in problem.time_varying_bounds():
+            gap = symbol(name) - parse(raw, self._running)
+            relations.append(
+                Relation(gap, 0.0, math.inf) if key == "lower" else Relation(gap, -math.inf, 0.0)
+            )
+        return relations
+
+    @cached_property
+    def integrals(self) -> list[Relation]:
+        """Integral constraints: ``lower <= integral of expr dt <= upper`` (integrands not signed)."""
+        return [
+            Relation(
+                parse(c.integrand, self._running),
+                -math.inf if c.lower is None else c.lower,
+                math.inf if c.upper is None else c.upper,
+            )
+            for c in self.spec.problem.integral_constraints
+        ]
 
     @cached_property
     def boundary(self) -> list[Relation]:
@@ -132,7 +180,7 @@ class SymbolicOcp:
     @cached_property
     def running_arguments(self) -> list[sp.Symbol]:
         """The symbols a running expression may use, in the order of :attr:`running_function`."""
-        return [*self.x, *self.u, *self.w, *self.p, self.t]
+        return [*self.x, *self.u, *self.w, *self.p, *self.d, self.t]
 
     @cached_property
     def running_function(self) -> Callable[..., np.ndarray]:
@@ -148,9 +196,18 @@ class SymbolicOcp:
         return [i for i, s in enumerate(self.w) if s in used]
 
     def parameter_values(self, overrides: Mapping[str, float] | None = None) -> dict[str, float]:
-        """The file's parameter values with ``overrides`` applied (unknown names are an error)."""
-        values = dict(self.spec.problem.parameters)
+        """The file's parameter values with ``overrides`` applied, derived parameters recomputed
+        from them (unknown names, and a derived parameter set on its own, are an error)."""
+        problem = self.spec.problem
+        values = {n: v for n, v in problem.parameters.items() if not isinstance(v, str)}
         for name, value in (overrides or {}).items():
+            if name in problem.derived_parameters:
+                raise SpecError(
+                    f"parameter {name!r} is derived ({name}: {problem.parameters[name]}); set the "
+                    "parameters it is computed from, or replace it by a number with --set at load",
+                    field=f"problem.parameters.{name}",
+                    source=self.spec.source,
+                )
             if name not in values:
                 raise SpecError(
                     f"unknown parameter {name!r} (declared: {', '.join(values) or 'none'})",
@@ -160,7 +217,10 @@ class SymbolicOcp:
             if not math.isfinite(float(value)):
                 raise SpecError(f"parameter {name!r} must be finite, got {value}", source=self.spec.source)
             values[name] = float(value)
-        return values
+        try:
+            return problem.parameter_values(values)
+        except SpecError as err:
+            raise SpecError(err.reason, field=err.field, source=self.spec.source) from None
 
     def state_bounds(
         self, params: Mapping[str, float]
@@ -170,6 +230,10 @@ class SymbolicOcp:
 
     def control_bounds(self, params: Mapping[str, float]) -> list[tuple[float, float]]:
         return self._evaluated(params).controls
+
+    def design_bounds(self, params: Mapping[str, float]) -> list[tuple[float, float, float]]:
+        """Per design variable: ``(lower, upper, guess)``."""
+        return self._evaluated(params).design
 
     def _evaluated(self, params: Mapping[str, float]) -> EvaluatedValues:
         try:

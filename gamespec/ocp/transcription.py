@@ -11,16 +11,17 @@ from __future__ import annotations
 from collections.abc import Mapping
 from dataclasses import dataclass
 from functools import cached_property
+from typing import Any
 
 import numpy as np
 
 from gamespec.errors import SpecError
-from gamespec.ocp.checks import Trajectory, solution_checks
+from gamespec.ocp.checks import Trajectory, control_basis, solution_checks, verdicts
 from gamespec.ocp.collocation import Grid
 from gamespec.ocp.inputs import InputGrid, InputValue, on_grid
 from gamespec.ocp.symbolic import SymbolicOcp
 from gamespec.result import Result, Status
-from gamespec.specs.ocp import NORMALIZED_TIME, OptimalControlSpec
+from gamespec.specs.ocp import NORMALIZED_TIME, OptimalControlSpec, bounds_midpoint
 from gamespec.symbolic.language import ExpressionError, parse, symbol
 from gamespec.symbolic.translate import NUMPY, translate
 
@@ -35,15 +36,18 @@ class Bounds:
     u_upper: np.ndarray
     t_lower: float
     t_upper: float
+    d_lower: np.ndarray
+    d_upper: np.ndarray
 
 
 @dataclass(frozen=True)
 class Guess:
-    """A starting point: X, U and the horizon T."""
+    """A starting point: X, U, the horizon T and the design variables d."""
 
     X: np.ndarray
     U: np.ndarray
     T: float
+    d: np.ndarray
 
 
 class Transcription:
@@ -53,7 +57,8 @@ class Transcription:
         self.spec = spec
         self.ocp = SymbolicOcp(spec)
         m = spec.method
-        self.grid = Grid(m.scheme, m.intervals, m.degree if m.scheme == "radau" else 1, m.grading)
+        mesh = None if m.mesh is None else tuple(m.mesh)
+        self.grid = Grid(m.scheme, m.intervals, m.degree if m.scheme == "radau" else 1, m.grading, mesh)
         self.t0 = spec.problem.time.initial
 
     @property
@@ -67,6 +72,10 @@ class Transcription:
     @property
     def n_w(self) -> int:
         return len(self.ocp.inputs)
+
+    @property
+    def n_d(self) -> int:
+        return len(self.ocp.design)
 
     @property
     def free_time(self) -> bool:
@@ -121,7 +130,8 @@ class Transcription:
         ul = np.repeat(cb[:, :1], k, axis=1)
         uu = np.repeat(cb[:, 1:], k, axis=1)
         tf_lo, tf_hi, _ = self.ocp.final_time(params)
-        return Bounds(xl, xu, ul, uu, tf_lo - self.t0, tf_hi - self.t0)
+        db = np.array(self.ocp.design_bounds(params)).reshape(self.n_d, 3)
+        return Bounds(xl, xu, ul, uu, tf_lo - self.t0, tf_hi - self.t0, db[:, 0], db[:, 1])
 
     def guess(self, params: Mapping[str, float], previous: Result | None = None) -> Guess:
         """The starting point: from ``previous`` (or the spec's ``guess.result`` file), else from the
@@ -150,7 +160,8 @@ class Transcription:
             U[j] = self._profile(
                 raw, self.grid.eval_tau, params, f"guess.controls.{name}", None, None, lo, hi
             )
-        return Guess(X, U, tf_guess - self.t0)
+        d = np.array([g for *_, g in self.ocp.design_bounds(params)], dtype=float)
+        return Guess(X, U, tf_guess - self.t0, d)
 
     def _profile(
         self,
@@ -166,9 +177,7 @@ class Transcription:
         if isinstance(raw, int | float):
             return np.full_like(tau, float(raw))
         if raw == "linear":
-            mid = _midpoint(lo, hi)
-            a = start if start is not None else (end if end is not None else mid)
-            b = end if end is not None else a
+            a, b = _linear_ends(start, end, lo, hi)
             return a + (b - a) * tau
         symbols = {n: symbol(n) for n in params} | {NORMALIZED_TIME: symbol(NORMALIZED_TIME)}
         try:
@@ -192,7 +201,60 @@ class Transcription:
         tc = np.asarray(previous.control_time if previous.control_time is not None else t)
         tau_c = (tc - t[0]) / span
         U = np.array([np.interp(self.grid.eval_tau, tau_c, previous.controls[n]) for n in self.ocp.controls])
-        return Guess(X.reshape(self.n_x, -1), U.reshape(self.n_u, -1), float(span))
+        design = previous.metrics.get("design", {})
+        defaults = [g for *_, g in self.ocp.design_bounds(previous.parameters or self.ocp.parameter_values())]
+        d = np.array([design.get(n, g) for n, g in zip(self.ocp.design, defaults, strict=True)], dtype=float)
+        return Guess(X.reshape(self.n_x, -1), U.reshape(self.n_u, -1), float(span), d)
+
+    @cached_property
+    def start_weights(self) -> np.ndarray:
+        """Weights on the first interval's controls giving the control at the initial time (the
+        interval's interpolating polynomial extrapolated to its start, Radau; the first node's value,
+        trapezoidal)."""
+        return control_basis(self, np.array([0.0]))[0]
+
+    def end_controls(self, U: Any) -> tuple[list[Any], list[Any]]:
+        """The controls at the initial and the final time (``<control>_0``, ``<control>_f``) as linear
+        functions of ``U``, anything indexed ``U[j, point]`` (a NumPy array, a CasADi matrix, a Pyomo
+        Var)."""
+        last_point = len(self.grid.eval_index) - 1
+        first = [sum(float(w) * U[j, c] for c, w in enumerate(self.start_weights)) for j in range(self.n_u)]
+        last = [U[j, last_point] for j in range(self.n_u)]
+        return first, last
+
+    def scales(self, params: Mapping[str, float]) -> tuple[np.ndarray, np.ndarray]:
+        """Per state and per control, the factor the NLP divides the variable by (``scale:``; 1 when
+        unset). ``auto`` takes the largest finite bound magnitude, else the largest magnitude of the
+        guess, else 1; the same factors on every backend."""
+        start = self.guess(params)
+        found = []
+        for group, values, limits in (
+            (self.spec.problem.states, start.X, self.ocp.state_bounds(params)),
+            (self.spec.problem.controls, start.U, self.ocp.control_bounds(params)),
+        ):
+            row = []
+            for spec, guess, (lo, hi, *_) in zip(group.values(), values, limits, strict=True):
+                if spec.scale is None:
+                    row.append(1.0)
+                elif spec.scale != "auto":
+                    row.append(abs(float(spec.scale)) or 1.0)
+                else:
+                    finite = [abs(b) for b in (lo, hi) if np.isfinite(b) and b != 0]
+                    row.append(max(finite) if finite else float(np.max(np.abs(guess), initial=0.0)) or 1.0)
+            found.append(np.array(row, dtype=float))
+        return found[0], found[1]
+
+    def rate_penalty(self, U: Any) -> Any:
+        """``w * sum_j sum_k (U[j, k+1] - U[j, k])**2 / (tau_{k+1} - tau_k)`` over consecutive
+        evaluation points (``method.control_rate_penalty``; 0 when w is 0), a discrete
+        ``w * integral of |du/dtau|**2``, for NumPy, CasADi or Pyomo ``U`` alike."""
+        weight = self.spec.method.control_rate_penalty
+        if weight == 0.0:
+            return 0.0
+        inverse = 1.0 / np.diff(self.grid.eval_tau)
+        return weight * sum(
+            float(c) * (U[j, k + 1] - U[j, k]) ** 2 for j in range(self.n_u) for k, c in enumerate(inverse)
+        )
 
     @cached_property
     def costate_rows(self) -> np.ndarray:
@@ -211,11 +273,18 @@ class Transcription:
         solve_time_s: float,
         iterations: int | None,
         inputs: np.ndarray,
+        design: np.ndarray | None = None,
         defect_multipliers: np.ndarray | None = None,
         solver_stats: dict | None = None,
     ) -> Result:
-        """A Result from a solution, with costates from the defect multipliers, the checks, and the
-        grid inputs used (``arrays["input/<name>"]``, on ``control_time``)."""
+        """A Result from a solution, with costates from the defect multipliers, the checks, the
+        grid inputs used (``arrays["input/<name>"]``, on ``control_time``), the optimized design
+        variables (``metrics["design"]``) and a pass/fail verdict per check against its tolerance
+        (``metrics["checks_passed"]``, see :func:`~gamespec.ocp.checks.verdicts`)."""
+        if objective is not None:
+            objective -= self.ocp.sign * float(self.rate_penalty(U))
+        values = np.zeros(self.n_d) if design is None else np.asarray(design, dtype=float)
+        optimized = {n: float(v) for n, v in zip(self.ocp.design, values, strict=True)}
         t_nodes = self.t0 + T * self.grid.nodes
         t_eval = self.t0 + T * self.grid.eval_tau
         costates: dict[str, np.ndarray] = {}
@@ -224,7 +293,8 @@ class Transcription:
         if defect_multipliers is not None and self.grid.scheme == "radau":
             lam = defect_multipliers * self.costate_rows[None, :]
             costates = {f"lambda_{n}": lam[i] for i, n in enumerate(self.ocp.states)}
-        checks = solution_checks(self, Trajectory(X, U, inputs, T), params, lam)
+        checks = solution_checks(self, Trajectory(X, U, inputs, T), {**params, **optimized}, lam)
+        refine = self.spec.method.refine
         if lam is not None:
             arrays["costate_time"] = t_eval
         return Result(
@@ -242,7 +312,9 @@ class Transcription:
             arrays=arrays,
             parameters=dict(params),
             checks=checks,
-            metrics={
+            metrics=({"design": optimized} if optimized else {})
+            | {"checks_passed": verdicts(checks, refine.tolerance if refine else None)}
+            | {
                 "plot": {
                     **self.spec.plot.as_metrics(),
                     "path_constraints": list(self.spec.problem.path_constraints),
@@ -252,11 +324,16 @@ class Transcription:
         )
 
 
-def _midpoint(lo: float, hi: float) -> float:
-    if np.isfinite(lo) and np.isfinite(hi):
-        return 0.5 * (lo + hi)
-    if np.isfinite(lo):
-        return max(lo, 0.0)
-    if np.isfinite(hi):
-        return min(hi, 0.0)
-    return 0.0
+def _linear_ends(start: float | None, end: float | None, lo: float, hi: float) -> tuple[float, float]:
+    """The end values of the ``linear`` guess: the fixed end values; from a fixed end toward the
+    middle of the bounds when the other end is free and both bounds are finite (held at the fixed
+    end when a bound is infinite); the middle of the bounds when both ends are free."""
+    mid = bounds_midpoint(lo, hi)
+    bounded = bool(np.isfinite(lo) and np.isfinite(hi))
+    if start is not None and end is not None:
+        return start, end
+    if start is not None:
+        return start, mid if bounded else start
+    if end is not None:
+        return mid if bounded else end, end
+    return mid, mid

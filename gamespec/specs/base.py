@@ -32,11 +32,17 @@ class StrictModel(BaseModel):
     model_config = ConfigDict(extra="forbid", frozen=True, populate_by_name=True)
 
 
+NLP_OPTIONS = "nlp"
+"""The ``solver.options`` block that is not one backend's: IPOPT options by IPOPT's names (``tol``,
+``max_iter``, ``max_wall_time``, ``mu_strategy`` ...), given once for every collocation backend."""
+
+
 class SolverSection(StrictModel):
     """Which backend solves the problem, and the knobs of each backend (validated by the backend).
 
     ``options`` maps a backend name to that backend's own options block, so the same file can be
-    solved on several backends without re-typing anything.
+    solved on several backends without re-typing anything; ``options.nlp`` gives NLP (IPOPT) options
+    once to every collocation backend.
     """
 
     backend: str | None = Field(None, description="Backend name; the kind's default when omitted.")

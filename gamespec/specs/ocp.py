@@ -8,6 +8,9 @@ symbols it may use, so a typo stops at load time with the field that holds it.
 
 from __future__ import annotations
 
+import ast
+import dataclasses
+import itertools
 import math
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass
@@ -35,6 +38,9 @@ class StateSpec(StrictModel):
     final: Value | None = None
     lower: Value | None = None
     upper: Value | None = None
+    scale: Number | Literal["auto"] | None = Field(
+        None, description="The NLP sees this variable divided by scale; auto: from the bounds or the guess."
+    )
 
 
 class ControlSpec(StrictModel):
@@ -42,6 +48,9 @@ class ControlSpec(StrictModel):
 
     lower: Value | None = None
     upper: Value | None = None
+    scale: Number | Literal["auto"] | None = Field(
+        None, description="The NLP sees this variable divided by scale; auto: from the bounds or the guess."
+    )
 
 
 class InputSpec(StrictModel):
@@ -53,8 +62,36 @@ class InputSpec(StrictModel):
     default: Value = 0.0
 
 
+class DesignSpec(StrictModel):
+    """A free static parameter (design variable): one number optimized with the trajectory, used
+    wherever a parameter may be used in dynamics, costs and constraints; bounds are numbers or
+    expressions of the parameters, the guess defaults to the middle of finite bounds."""
+
+    lower: Value | None = None
+    upper: Value | None = None
+    guess: Number | None = None
+
+
+class IntegralConstraintSpec(StrictModel):
+    """An isoperimetric constraint ``lower <= integral of integrand dt <= upper`` over the horizon
+    (the integrand is a running expression; an omitted bound is infinite)."""
+
+    integrand: Value
+    lower: Number | None = None
+    upper: Number | None = None
+
+    @model_validator(mode="after")
+    def _some_bound(self) -> IntegralConstraintSpec:
+        if self.lower is None and self.upper is None:
+            raise ValueError("an integral constraint needs lower, upper or both")
+        if self.lower is not None and self.upper is not None and self.lower > self.upper:
+            raise ValueError(f"lower {self.lower:g} exceeds upper {self.upper:g}")
+        return self
+
+
 class ObjectiveSpec(StrictModel):
-    """Mayer term (over ``<state>_0``, ``<state>_f``, ``t_f``, parameters) plus Lagrange integrand."""
+    """Mayer term (over ``<state>_0``, ``<state>_f``, ``<control>_0``, ``<control>_f``, ``t_f``,
+    parameters and design variables) plus Lagrange integrand."""
 
     sense: Literal["minimize", "maximize"] = "minimize"
     mayer: Value = 0.0
@@ -85,17 +122,36 @@ class TimeSpec(StrictModel):
 
 
 class OcpProblem(StrictModel):
-    """The mathematics of an optimal-control problem."""
+    """The mathematics of an optimal-control problem.
 
-    parameters: dict[str, Number] = Field(default_factory=dict)
+    ``parameters`` are numbers, or expressions of the parameters declared before them (*derived*
+    parameters such as ``Dc: 0.5*620``, recomputed whenever a parameter they use changes; the
+    runtime parameters of a compiled model are the numeric ones). ``definitions`` are named
+    expressions, in order, over the parameters, states, controls, inputs, ``t`` and the earlier
+    definitions, substituted symbolically wherever a running expression (dynamics, the Lagrange
+    integrand, path constraints) names them.
+    """
+
+    parameters: dict[str, Value] = Field(
+        default_factory=dict,
+        description="Numbers, or expressions of earlier parameters (derived, recomputed from them).",
+    )
+    definitions: dict[str, Value] = Field(
+        default_factory=dict,
+        description="Named expressions used in dynamics, the Lagrange integrand and path constraints.",
+    )
     states: dict[str, StateSpec]
     controls: dict[str, ControlSpec] = Field(default_factory=dict)
     inputs: dict[str, InputSpec] = Field(default_factory=dict)
+    design: dict[str, DesignSpec] = Field(
+        default_factory=dict, description="Free static parameters optimized with the trajectory."
+    )
     dynamics: dict[str, Value]
     objective: ObjectiveSpec = Field(default_factory=ObjectiveSpec)
     time: TimeSpec = Field(default_factory=TimeSpec)
     path_constraints: list[str] = Field(default_factory=list)
     boundary_constraints: list[str] = Field(default_factory=list)
+    integral_constraints: list[IntegralConstraintSpec] = Field(default_factory=list)
     uncertain: dict[str, UncertainParameter] = Field(
         default_factory=dict, description="Uncertain parameters (chapter 6) and their distributions."
     )
@@ -109,8 +165,15 @@ class OcpProblem(StrictModel):
 
     @model_validator(mode="after")
     def _consistent(self) -> OcpProblem:
-        names = [*self.parameters, *self.states, *self.controls, *self.inputs]
-        boundary = [f"{s}_0" for s in self.states] + [f"{s}_f" for s in self.states] + ["t_f"]
+        names = [
+            *self.parameters,
+            *self.states,
+            *self.controls,
+            *self.inputs,
+            *self.definitions,
+            *self.design,
+        ]
+        boundary = [f"{s}_{e}" for s in [*self.states, *self.controls] for e in "0f"] + ["t_f"]
         for name in names:
             if not name.isidentifier() or name in RESERVED or name == NORMALIZED_TIME:
                 raise ValueError(f"{name!r} cannot be a symbol name (reserved or not an identifier)")
@@ -127,9 +190,44 @@ class OcpProblem(StrictModel):
         unknown = set(self.uncertain) - set(self.parameters)
         if unknown:
             raise ValueError(f"uncertain names undeclared parameters: {sorted(unknown)}")
+        derived = set(self.uncertain) & self.derived_parameters
+        if derived:
+            raise ValueError(f"uncertain names derived parameters (give a number instead): {sorted(derived)}")
         self._check_expressions()
-        self.evaluate(self.parameters)
+        self.evaluate(self.parameter_values())
         return self
+
+    def time_varying_bounds(self) -> list[tuple[str, str, str]]:
+        """``(name, "lower" | "upper", expression)`` of each state or control bound that uses ``t``."""
+        found = []
+        for items in (self.states, self.controls):
+            for name, spec in items.items():
+                for key in ("lower", "upper"):
+                    raw = getattr(spec, key)
+                    if is_time_varying(raw):
+                        found.append((name, key, raw))
+        return found
+
+    @property
+    def derived_parameters(self) -> set[str]:
+        """The parameters given as expressions of earlier ones."""
+        return {n for n, v in self.parameters.items() if isinstance(v, str)}
+
+    def parameter_values(self, base: Mapping[str, float] | None = None) -> dict[str, float]:
+        """Every parameter's value, in declaration order: the numeric ones from ``base`` (else the
+        file), each derived one evaluated over the values before it."""
+        base = base or {}
+        values: dict[str, float] = {}
+        for name, raw in self.parameters.items():
+            if isinstance(raw, str):
+                expr = parse(raw, {n: symbol(n) for n in values})
+                value = numeric(expr, {symbol(k): v for k, v in values.items()})
+                if not math.isfinite(value):
+                    raise SpecError(f"evaluates to {value}", field=f"problem.parameters.{name}")
+                values[name] = value
+            else:
+                values[name] = float(base.get(name, raw))
+        return values
 
     def evaluate(self, params: Mapping[str, float]) -> EvaluatedValues:
         """Bounds, fixed end values and a fixed final time as floats for these parameter values;
@@ -139,7 +237,7 @@ class OcpProblem(StrictModel):
         values = {symbol(k): float(v) for k, v in params.items()}
 
         def number(raw: float | str | None, default: float, field: str) -> float:
-            if raw is None:
+            if raw is None or (default in (-INF, INF) and is_time_varying(raw)):
                 return default
             if isinstance(raw, str):
                 raw = numeric(parse(raw, symbols), values)
@@ -162,14 +260,23 @@ class OcpProblem(StrictModel):
                         f"{value:g} lies outside [{lo:g}, {hi:g}]", field=f"problem.states.{name}.{key}"
                     )
             states.append((lo, hi, *ends))
-        controls = []
-        for name, c in self.controls.items():
-            lo, hi = (
-                number(c.lower, -INF, f"controls.{name}.lower"),
-                number(c.upper, INF, f"controls.{name}.upper"),
-            )
-            _ordered(lo, hi, f"controls.{name}")
-            controls.append((lo, hi))
+
+        def interval(group: str, name: str, spec: ControlSpec | DesignSpec) -> tuple[float, float]:
+            lo = number(spec.lower, -INF, f"{group}.{name}.lower")
+            hi = number(spec.upper, INF, f"{group}.{name}.upper")
+            _ordered(lo, hi, f"{group}.{name}")
+            return lo, hi
+
+        controls = [interval("controls", name, c) for name, c in self.controls.items()]
+        design = []
+        for name, d in self.design.items():
+            lo, hi = interval("design", name, d)
+            guess = d.guess if d.guess is not None else bounds_midpoint(lo, hi)
+            if not lo <= guess <= hi:
+                raise SpecError(
+                    f"{guess:g} lies outside [{lo:g}, {hi:g}]", field=f"problem.design.{name}.guess"
+                )
+            design.append((lo, hi, guess))
         t_final = t_bounds = None
         if self.time.free:
             lo, hi = (number(b, 0.0, f"time.bounds.{i}") for i, b in enumerate(self.time.bounds))
@@ -180,25 +287,45 @@ class OcpProblem(StrictModel):
             t_final = number(self.time.final, 1.0, "time.final")
             if t_final <= self.time.initial:
                 raise SpecError("final time must be after the initial time", field="problem.time.final")
-        return EvaluatedValues(states, controls, t_final, t_bounds)
+        return EvaluatedValues(states, controls, t_final, t_bounds, design)
 
     def _check_expressions(self) -> None:
         """Parse every expression over the symbols its field may use; an input where it may not
         appear (bounds, end values, Mayer and boundary terms, the final time) is named as such."""
         params = {n: symbol(n) for n in self.parameters}
         inputs = {n: symbol(n) for n in self.inputs}
-        running = {**params, **inputs, **{n: symbol(n) for n in [*self.states, *self.controls, "t"]}}
+        design = {n: symbol(n) for n in self.design}
+        running = {**params, **design, **inputs}
+        running |= {n: symbol(n) for n in [*self.states, *self.controls, "t"]}
+        checks: list[tuple[str, object, dict, bool]] = []
+        earlier: dict = {}
+        for name, raw in self.parameters.items():
+            if isinstance(raw, str):
+                checks.append((f"parameters.{name}", raw, dict(earlier), False))
+            earlier[name] = params[name]
+        for name, raw in self.definitions.items():
+            checks.append((f"definitions.{name}", raw, dict(running), False))
+            running[name] = symbol(name)
         ends = {
             **params,
-            **{f"{s}_{e}": symbol(f"{s}_{e}") for s in self.states for e in "0f"},
+            **design,
+            **{f"{s}_{e}": symbol(f"{s}_{e}") for s in [*self.states, *self.controls] for e in "0f"},
             "t_f": symbol("t_f"),
         }
-        checks: list[tuple[str, object, dict, bool]] = []
-        for group, items in (("states", self.states), ("controls", self.controls)):
+        timed = params | {"t": symbol("t")}
+        for group, items in (("states", self.states), ("controls", self.controls), ("design", self.design)):
             for name, spec in items.items():
-                for key, value in spec.model_dump().items():
+                for key, value in spec.model_dump(exclude={"scale"}).items():
                     if isinstance(value, str):
-                        checks.append((f"{group}.{name}.{key}", value, params, False))
+                        along = group != "design" and key in ("lower", "upper")
+                        if along:
+                            _bound_over_time(
+                                value,
+                                timed,
+                                {k: v for k, v in running.items() if k not in inputs},
+                                f"problem.{group}.{name}.{key}",
+                            )
+                        checks.append((f"{group}.{name}.{key}", value, timed if along else params, False))
         checks += [
             (f"inputs.{n}.default", i.default, params | {NORMALIZED_TIME: symbol(NORMALIZED_TIME)}, False)
             for n, i in self.inputs.items()
@@ -215,6 +342,10 @@ class OcpProblem(StrictModel):
             if isinstance(bound, str):
                 checks.append((f"time.bounds.{i}", bound, params, False))
         checks += [(f"path_constraints.{i}", c, running, True) for i, c in enumerate(self.path_constraints)]
+        checks += [
+            (f"integral_constraints.{i}.integrand", c.integrand, running, False)
+            for i, c in enumerate(self.integral_constraints)
+        ]
         checks += [
             (f"boundary_constraints.{i}", c, ends, True) for i, c in enumerate(self.boundary_constraints)
         ]
@@ -233,6 +364,34 @@ class OcpProblem(StrictModel):
                 raise SpecError(reason, field=f"problem.{field}") from None
 
 
+def is_time_varying(raw: float | str | None) -> bool:
+    """Whether a bound uses ``t`` (it is then imposed as a path constraint, not a variable bound)."""
+    if not isinstance(raw, str):
+        return False
+    try:
+        tree = ast.parse(raw.strip(), mode="eval")
+    except SyntaxError:
+        return False
+    return any(isinstance(n, ast.Name) and n.id == "t" for n in ast.walk(tree))
+
+
+def _bound_over_time(text: str, timed: dict, running: dict, field: str) -> None:
+    """A bound may use the parameters and ``t``; one over states or controls is refused with a
+    pointer to ``path_constraints``."""
+    try:
+        parse(text, timed)
+    except ExpressionError:
+        try:
+            parse(text, running)
+        except ExpressionError:
+            return
+        raise SpecError(
+            f"bound {text!r} uses states or controls: a bound may use the parameters and t; write it "
+            "as a path constraint (path_constraints: [...])",
+            field=field,
+        ) from None
+
+
 def _inputs_in(read: Callable, text: str, symbols: dict, inputs: dict) -> list[str]:
     """The grid inputs that ``text`` uses, when it parses once they are allowed (else none)."""
     if not inputs or set(inputs) <= set(symbols):
@@ -248,17 +407,39 @@ def _inputs_in(read: Callable, text: str, symbols: dict, inputs: dict) -> list[s
 @dataclass(frozen=True)
 class EvaluatedValues:
     """Per state ``(lower, upper, initial, final)`` (initial/final None when free), per control
-    ``(lower, upper)``, the fixed final time (None when free) and the bounds of a free one."""
+    ``(lower, upper)``, the fixed final time (None when free), the bounds of a free one, and per
+    design variable ``(lower, upper, guess)``."""
 
     states: list[tuple[float, float, float | None, float | None]]
     controls: list[tuple[float, float]]
     t_final: float | None
     t_bounds: tuple[float, float] | None = None
+    design: list[tuple[float, float, float]] = dataclasses.field(default_factory=list)
+
+
+def bounds_midpoint(lo: float, hi: float) -> float:
+    """The middle of finite bounds, the finite one (or 0 when inside) of half-bounded ones, else 0."""
+    if math.isfinite(lo) and math.isfinite(hi):
+        return 0.5 * (lo + hi)
+    if math.isfinite(lo):
+        return max(lo, 0.0)
+    if math.isfinite(hi):
+        return min(hi, 0.0)
+    return 0.0
 
 
 def _ordered(lower: float, upper: float, field: str) -> None:
     if lower > upper:
         raise SpecError(f"lower bound {lower:g} exceeds upper bound {upper:g}", field=f"problem.{field}")
+
+
+class RefineSpec(StrictModel):
+    """Adaptive h-refinement: solve, split every interval whose defect relative to the state scale
+    (``max_defect_relative``) exceeds ``tolerance`` into two, re-solve from the last solution, until
+    none does or ``max_iterations`` refinements were made."""
+
+    tolerance: Number = Field(1e-6, gt=0)
+    max_iterations: int = Field(8, ge=1, le=30)
 
 
 class MethodSpec(StrictModel):
@@ -272,6 +453,36 @@ class MethodSpec(StrictModel):
     intervals: int = Field(40, ge=1, le=MAX_INTERVALS)
     degree: int = Field(3, ge=1, le=12)
     grading: Number = Field(1.0, gt=0, le=1e4)
+    mesh: list[Number] | None = Field(
+        None, description="Interval boundaries in normalized time, 0 to 1 increasing (sets intervals)."
+    )
+    refine: RefineSpec | None = Field(None, description="Adaptive h-refinement on the defect estimate.")
+
+    @model_validator(mode="before")
+    @classmethod
+    def _intervals_of_mesh(cls, data: object) -> object:
+        if isinstance(data, dict) and isinstance(data.get("mesh"), list):
+            return {**data, "intervals": max(len(data["mesh"]) - 1, 1)}
+        return data
+
+    @field_validator("mesh")
+    @classmethod
+    def _increasing(cls, mesh: list[float] | None) -> list[float] | None:
+        if mesh is not None and (
+            len(mesh) < 2
+            or mesh[0] != 0.0
+            or mesh[-1] != 1.0
+            or any(b <= a for a, b in itertools.pairwise(mesh))
+        ):
+            raise ValueError("mesh must increase strictly from 0 to 1")
+        return mesh
+
+    control_rate_penalty: Number = Field(
+        0.0,
+        ge=0,
+        description="Weight w of the regularization w * sum_k |u_{k+1} - u_k|**2 / (tau_{k+1} - tau_k) "
+        "added to the objective (smooths singular and chattering arcs; not in the Result's objective).",
+    )
 
 
 class GuessSpec(StrictModel):
@@ -323,15 +534,23 @@ class OptimalControlSpec(ProblemParameters, SpecBase):
     def objective_sense(self) -> str:
         return self.problem.objective.sense
 
+    def runtime_parameters(self) -> dict[str, float]:
+        """The numeric parameters (derived ones follow them and are not set on their own)."""
+        return {n: float(v) for n, v in self.problem.parameters.items() if not isinstance(v, str)}
+
     def required_features(self) -> frozenset[str]:
         p = self.problem
         needed = {"ode"}
         if p.time.free:
             needed.add("free_final_time")
-        if p.path_constraints:
+        if p.path_constraints or p.time_varying_bounds():
             needed.add("path_constraints")
+        if p.integral_constraints:
+            needed.add("integral_constraints")
         if p.boundary_constraints:
             needed.add("boundary_constraints")
         if p.inputs:
             needed.add("grid_inputs")
+        if p.design:
+            needed.add("design_parameters")
         return frozenset(needed)

@@ -10,20 +10,19 @@ Status ``optimal`` when every point solved, ``feasible`` when some did not, ``er
 from __future__ import annotations
 
 import time
+from collections.abc import Callable
 from typing import Any, ClassVar
 
-from gamespec.backend import Backend, CompiledModel, Inputs, refuse_inputs
-from gamespec.errors import UnsupportedFeature
-from gamespec.loader import spec_from_dict, spec_hash
+from gamespec.backend import Backend
+from gamespec.loader import spec_from_dict
 from gamespec.rcs import study
 from gamespec.rcs.study import StudyPoint, point_problem
 from gamespec.result import Result, Status
 from gamespec.solving import solve
 from gamespec.specs.base import StrictModel
 from gamespec.specs.rcs_study import RcsStudySpec
-from gamespec.studies.executors import executor
-from gamespec.studies.runner import run_study
-from gamespec.studies.store import ResultStore
+from gamespec.studies.point_study import PointStudyModel
+from gamespec.studies.runner import StudyRun
 from gamespec.studies.suboptimal_study import StudyOptions
 
 
@@ -62,31 +61,16 @@ def evaluate(point: StudyPoint) -> dict[str, Any]:
     }
 
 
-class RcsStudyModel(CompiledModel):
-    """A study ready to run (or resume) into its store."""
+class RcsStudyModel(PointStudyModel):
+    """The §6.4.4 study ready to run (or resume) into its store."""
 
-    def __init__(self, spec: RcsStudySpec, options: StudyOptions) -> None:
-        self.spec = spec
-        self.options = options
+    def points(self) -> dict[str, Any]:
+        return study.study_points(self.spec)
 
-    def solve(
-        self, parameters: dict[str, float] | None = None, guess: Result | None = None, inputs: Inputs = None
-    ) -> Result:
-        refuse_inputs(inputs, self.spec.kind)
-        if parameters:
-            raise UnsupportedFeature("an rcs_multi_obstacle_study takes no parameters: --set its fields")
-        tic = time.perf_counter()
-        points = study.study_points(self.spec)
-        run = run_study(
-            points,
-            evaluate,
-            ResultStore(self.spec.store),
-            executor=executor(self.options.executor, self.options.workers, self.options.scheduler),
-            description=self.spec.name,
-            show_progress=self.options.progress,
-            spec_hash=spec_hash(self.spec),
-        )
-        rows, computed = [run.values[key] for key in points], run.computed
+    def point_function(self) -> Callable[[Any], dict[str, Any]]:
+        return evaluate
+
+    def result(self, rows: list[dict[str, Any]], run: StudyRun) -> Result:
         solved = sum(r["status"] != "error" for r in rows)
         if solved == len(rows):
             status, message = Status.OPTIMAL, f"all {len(rows)} points solved"
@@ -95,8 +79,7 @@ class RcsStudyModel(CompiledModel):
             message = f"{len(rows) - solved} of {len(rows)} points failed from every guess"
         return Result(
             status=status,
-            message=f"{message} ({computed} computed now, {len(rows) - computed} from {self.spec.store})",
-            solve_time_s=time.perf_counter() - tic,
+            message=message,
             arrays=study.arrays(rows),
             metrics={
                 "table": study.summarize(rows),
@@ -105,7 +88,7 @@ class RcsStudyModel(CompiledModel):
                 "radius": self.spec.radius,
                 "layout": {str(n): study.layout(self.spec, n) for n in self.spec.obstacles},
                 "seconds": {f"N={r['obstacles']},alpha={r['alpha']:g}": r["seconds"] for r in rows},
-                "computed": computed,
+                "computed": run.computed,
                 "store": str(self.spec.store),
             },
         )

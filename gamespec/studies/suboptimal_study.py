@@ -16,16 +16,14 @@ averages (no optimum passed the defect check), ``error`` when none solved.
 
 from __future__ import annotations
 
-import time
+from collections.abc import Callable
 from functools import cache
 from typing import Any, ClassVar
 
 import numpy as np
 from pydantic import Field
 
-from gamespec.backend import Backend, CompiledModel, Inputs, refuse_inputs
-from gamespec.errors import UnsupportedFeature
-from gamespec.loader import spec_hash
+from gamespec.backend import Backend
 from gamespec.pursuit import pure_pursuit, study
 from gamespec.pursuit.ocp_generation import to_ocp, trajectory_guess
 from gamespec.pursuit.ocp_report import heading_law
@@ -38,8 +36,9 @@ from gamespec.result import Result, Status
 from gamespec.solving import get_backend
 from gamespec.specs.base import StrictModel
 from gamespec.specs.suboptimal_study import SuboptimalStudySpec
-from gamespec.studies.executors import SCHEDULER_ENV, executor
-from gamespec.studies.runner import run_study
+from gamespec.studies.executors import SCHEDULER_ENV
+from gamespec.studies.point_study import PointStudyModel
+from gamespec.studies.runner import StudyRun
 from gamespec.studies.store import ResultStore
 
 POINT_ARRAYS = ("v", "r2", "psi", "t_suboptimal", "t_optimal", "variation_percent")
@@ -128,47 +127,31 @@ class StudyOptions(StrictModel):
     )
 
 
-class StudyModel(CompiledModel):
-    """A study ready to run (or resume) into its store."""
+class StudyModel(PointStudyModel):
+    """The Table 2.1 study ready to run (or resume) into its store."""
 
-    def __init__(self, spec: SuboptimalStudySpec, options: StudyOptions) -> None:
-        self.spec = spec
-        self.options = options
+    def points(self) -> dict[str, Any]:
+        return study.study_points(self.spec)
 
-    def solve(
-        self, parameters: dict[str, float] | None = None, guess: Result | None = None, inputs: Inputs = None
-    ) -> Result:
-        refuse_inputs(inputs, self.spec.kind)
-        if parameters:
-            raise UnsupportedFeature("a pursuit_suboptimal_study takes no parameters; edit the file")
-        tic = time.perf_counter()
-        points = study.study_points(self.spec)
-        store = ResultStore(self.spec.store)
+    def point_function(self) -> Callable[[Any], dict[str, Any]]:
+        return evaluate
+
+    def prepare(self, store: ResultStore) -> None:
         store.set_meta("study", {"type": "sweep", "problem": self.spec.name, "parameters": list(SWEPT)})
-        run = run_study(
-            points,
-            evaluate,
-            store,
-            executor=executor(self.options.executor, self.options.workers, self.options.scheduler),
-            description=self.spec.name,
-            show_progress=self.options.progress,
-            spec_hash=spec_hash(self.spec),
-        )
-        rows = [run.values[key] for key in points]
+
+    def result(self, rows: list[dict[str, Any]], run: StudyRun) -> Result:
         solved = [r for r in rows if "variation_percent" in r]
         status, message = _outcome(len(rows), len(solved))
-        computed = run.computed
         return Result(
             status=status,
-            message=f"{message} ({computed} computed now, {run.reused} read from {self.spec.store})",
-            solve_time_s=time.perf_counter() - tic,
+            message=message,
             arrays={name: np.array([r.get(name, np.nan) for r in rows]) for name in POINT_ARRAYS},
             checks={name: max((r[key] for r in solved), default=None) for name, key in POINT_CHECKS.items()},
             metrics={
                 "table": study.summarize(rows),
                 "points": len(rows),
                 "solved": len(solved),
-                "computed": computed,
+                "computed": run.computed,
                 "store": str(self.spec.store),
             },
         )

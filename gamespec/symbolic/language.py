@@ -137,6 +137,9 @@ class _Translator:
             raise self.fail(node, f"undefined symbol {node.id!r} (declared: {known})")
         if isinstance(node, ast.BinOp) and isinstance(node.op, ast.Pow):
             return self.power(node)
+        if isinstance(node, ast.BinOp) and isinstance(node.op, ast.BitXor):
+            column = self.text.find("^", getattr(node.left, "end_col_offset", 0) or 0)
+            raise ExpressionError(self.text, "'^' is not a power: use ** for powers", column)
         if isinstance(node, ast.BinOp) and type(node.op) in _BINARY:
             return self.finite(node, _BINARY[type(node.op)](self(node.left), self(node.right)))
         if isinstance(node, ast.UnaryOp) and isinstance(node.op, ast.USub | ast.UAdd):

@@ -126,3 +126,12 @@ def lowering_path(spec: SpecBase, kinds: frozenset[str]) -> list[Transform] | No
             seen.add(t.target_kind)
             queue.append((t.target_kind, [*path, t]))
     return None
+
+
+class OcpRewrite(Transform, ABC):
+    """A requested ``optimal_control`` → ``optimal_control`` rewrite (chapter 6's desensitization
+    and regularizers): applied only when a file's ``transforms:`` list names it."""
+
+    source_kind: ClassVar[str] = "optimal_control"
+    target_kind: ClassVar[str] = "optimal_control"
+    requested: ClassVar[bool] = True

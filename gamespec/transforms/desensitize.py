@@ -33,7 +33,7 @@ from gamespec.specs.desensitize import DesensitizeOptions, Weights
 from gamespec.specs.ocp import OptimalControlSpec
 from gamespec.symbolic.language import TIME, parse, symbol
 from gamespec.symbolic.printer import to_text
-from gamespec.transforms.base import Transform
+from gamespec.transforms.base import OcpRewrite
 
 FIELD = "transforms.desensitize"
 
@@ -60,13 +60,10 @@ class InverseData:
     augmented_states: int
 
 
-class Desensitize(Transform):
+class Desensitize(OcpRewrite):
     """Desensitized optimal control (chapter 6) by sensitivity functions, Seywald's method or C-DOC."""
 
     name: ClassVar[str] = "desensitize"
-    source_kind: ClassVar[str] = "optimal_control"
-    target_kind: ClassVar[str] = "optimal_control"
-    requested: ClassVar[bool] = True
     options_model: ClassVar[type[DesensitizeOptions]] = DesensitizeOptions
 
     def apply(

@@ -42,7 +42,7 @@ from gamespec.specs.ocp import OptimalControlSpec
 from gamespec.specs.rcs import MovingObstaclesOptions, RcsOptions
 from gamespec.symbolic.language import TIME, parse, symbol
 from gamespec.symbolic.printer import to_text
-from gamespec.transforms.base import Transform
+from gamespec.transforms.base import OcpRewrite
 from gamespec.transforms.desensitize import InverseData, Penalty, augmented_spec, report
 
 
@@ -68,13 +68,10 @@ class ObstacleData:
     power: sp.Expr
 
 
-class MovingObstacles(Transform):
+class MovingObstacles(OcpRewrite):
     """Avoidance constraints of declared moving obstacles (§6.4.1-6.4.3)."""
 
     name: ClassVar[str] = "moving_obstacles"
-    source_kind: ClassVar[str] = "optimal_control"
-    target_kind: ClassVar[str] = "optimal_control"
-    requested: ClassVar[bool] = True
     options_model: ClassVar[type[MovingObstaclesOptions]] = MovingObstaclesOptions
 
     def apply(
@@ -124,13 +121,10 @@ class RcsData:
     options: RcsOptions
 
 
-class Rcs(Transform):
+class Rcs(OcpRewrite):
     """Relevant constraint sensitivity (eqs. 6.31-6.36), or eq. 6.32 with ``relevant: false``."""
 
     name: ClassVar[str] = "rcs"
-    source_kind: ClassVar[str] = "optimal_control"
-    target_kind: ClassVar[str] = "optimal_control"
-    requested: ClassVar[bool] = True
     options_model: ClassVar[type[RcsOptions]] = RcsOptions
 
     def apply(

@@ -9,16 +9,38 @@ from __future__ import annotations
 import time
 from abc import abstractmethod
 from collections.abc import Callable
-from typing import Any
+from typing import Any, ClassVar
 
-from gamespec.backend import CompiledModel, Inputs, refuse_inputs
+from pydantic import Field
+
+from gamespec.backend import Backend, CompiledModel, Inputs, refuse_inputs
 from gamespec.errors import UnsupportedFeature
 from gamespec.loader import spec_hash
 from gamespec.result import Result
+from gamespec.solving import get_backend
 from gamespec.specs.base import SpecBase, StrictModel
-from gamespec.studies.executors import executor
+from gamespec.studies.executors import SCHEDULER_ENV, executor
 from gamespec.studies.runner import StudyRun, run_study
 from gamespec.studies.store import ResultStore
+
+
+class StudyOptions(StrictModel):
+    """Options of the point-study backends (``solver.options.study``, ``solver.options.rcs_study``)."""
+
+    workers: int = Field(1, ge=1, description="Worker processes (1: everything in this process).")
+    executor: str | None = Field(
+        None,
+        description="Executor plugin: serial, process or dask (default: serial for one worker, "
+        "process for more, dask when a scheduler is given).",
+    )
+    scheduler: str | None = Field(
+        None, description=f"Address of a running Dask scheduler (default: ${SCHEDULER_ENV})."
+    )
+    progress: bool = Field(
+        False,
+        description="Show a progress bar on stderr (`gamespec pursuit study` does; `gamespec solve` "
+        "shows its own spinner instead).",
+    )
 
 
 class PointStudyModel(CompiledModel):
@@ -67,3 +89,15 @@ class PointStudyModel(CompiledModel):
         result = self.result([run.values[key] for key in points], run)
         message = f"{result.message} ({run.computed} computed now, {run.reused} read from {self.spec.store})"
         return result.model_copy(update={"message": message, "solve_time_s": time.perf_counter() - tic})
+
+
+class PointStudyBackend(Backend):
+    """A backend that runs a point study: checks that its ``ocp_backend`` is there, then builds
+    :attr:`model`."""
+
+    options_model: ClassVar[type[StrictModel]] = StudyOptions
+    model: ClassVar[type[PointStudyModel]]
+
+    def _compile(self, spec: SpecBase, options: StudyOptions) -> PointStudyModel:
+        get_backend(spec.ocp_backend)
+        return self.model(spec, options)

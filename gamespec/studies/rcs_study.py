@@ -13,17 +13,14 @@ import time
 from collections.abc import Callable
 from typing import Any, ClassVar
 
-from gamespec.backend import Backend
 from gamespec.loader import spec_from_dict
 from gamespec.rcs import study
 from gamespec.rcs.study import StudyPoint, point_problem
 from gamespec.result import Result, Status
 from gamespec.solving import solve
-from gamespec.specs.base import StrictModel
 from gamespec.specs.rcs_study import RcsStudySpec
-from gamespec.studies.point_study import PointStudyModel
+from gamespec.studies.point_study import PointStudyBackend, PointStudyModel
 from gamespec.studies.runner import StudyRun
-from gamespec.studies.suboptimal_study import StudyOptions
 
 
 def evaluate(point: StudyPoint) -> dict[str, Any]:
@@ -94,15 +91,9 @@ class RcsStudyModel(PointStudyModel):
         )
 
 
-class RcsStudyBackend(Backend):
+class RcsStudyBackend(PointStudyBackend):
     """Runs the §6.4.4 study (see module doc); each point's OCP is solved on ``ocp_backend``."""
 
     name: ClassVar[str] = "rcs_study"
     kinds: ClassVar[frozenset[str]] = frozenset({"rcs_multi_obstacle_study"})
-    options_model: ClassVar[type[StrictModel]] = StudyOptions
-
-    def _compile(self, spec: RcsStudySpec, options: StudyOptions) -> RcsStudyModel:
-        from gamespec.solving import get_backend
-
-        get_backend(spec.ocp_backend)
-        return RcsStudyModel(spec, options)
+    model: ClassVar[type[PointStudyModel]] = RcsStudyModel

@@ -21,9 +21,7 @@ from functools import cache
 from typing import Any, ClassVar
 
 import numpy as np
-from pydantic import Field
 
-from gamespec.backend import Backend
 from gamespec.pursuit import pure_pursuit, study
 from gamespec.pursuit.ocp_generation import to_ocp, trajectory_guess
 from gamespec.pursuit.ocp_report import heading_law
@@ -34,10 +32,7 @@ from gamespec.pursuit.simulation import Players, simulate_to_capture
 from gamespec.pursuit.study import DEFECT_TOL, StudyPoint, point_engagement
 from gamespec.result import Result, Status
 from gamespec.solving import get_backend
-from gamespec.specs.base import StrictModel
-from gamespec.specs.suboptimal_study import SuboptimalStudySpec
-from gamespec.studies.executors import SCHEDULER_ENV
-from gamespec.studies.point_study import PointStudyModel
+from gamespec.studies.point_study import PointStudyBackend, PointStudyModel
 from gamespec.studies.runner import StudyRun
 from gamespec.studies.store import ResultStore
 
@@ -108,25 +103,6 @@ def evaluate(point: StudyPoint) -> dict[str, Any]:
     }
 
 
-class StudyOptions(StrictModel):
-    """Options of the ``study`` backend (``solver.options.study``)."""
-
-    workers: int = Field(1, ge=1, description="Worker processes (1: everything in this process).")
-    executor: str | None = Field(
-        None,
-        description="Executor plugin: serial, process or dask (default: serial for one worker, "
-        "process for more, dask when a scheduler is given).",
-    )
-    scheduler: str | None = Field(
-        None, description=f"Address of a running Dask scheduler (default: ${SCHEDULER_ENV})."
-    )
-    progress: bool = Field(
-        False,
-        description="Show a progress bar on stderr (`gamespec pursuit study` does; `gamespec solve` "
-        "shows its own spinner instead).",
-    )
-
-
 class StudyModel(PointStudyModel):
     """The Table 2.1 study ready to run (or resume) into its store."""
 
@@ -169,13 +145,9 @@ def _outcome(points: int, solved: int) -> tuple[Status, str]:
     return Status.ERROR, f"none of the {points} points solved"
 
 
-class StudyBackend(Backend):
+class StudyBackend(PointStudyBackend):
     """Runs the Table 2.1 study (see module doc); each point's OCP is solved on ``ocp_backend``."""
 
     name: ClassVar[str] = "study"
     kinds: ClassVar[frozenset[str]] = frozenset({"pursuit_suboptimal_study"})
-    options_model: ClassVar[type[StrictModel]] = StudyOptions
-
-    def _compile(self, spec: SuboptimalStudySpec, options: StudyOptions) -> StudyModel:
-        get_backend(spec.ocp_backend)
-        return StudyModel(spec, options)
+    model: ClassVar[type[PointStudyModel]] = StudyModel

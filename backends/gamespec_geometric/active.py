@@ -168,7 +168,7 @@ def _envelope_edges(dual: np.ndarray) -> _Edges:
             try:
                 return _farthest_power_edges(ConvexHull(dual), dual[:, :2] / 2)
             except QhullError:
-                pass
+                pass  # numerically flat after all: the 2-D envelope below is exact for it
     return _flat_envelope_edges(dual)
 
 

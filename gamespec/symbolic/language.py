@@ -185,7 +185,7 @@ class _Translator:
             except OverflowError:
                 raise self.fail(node, f"number out of range (beyond {MAX_MAGNITUDE:g})") from None
             except (ValueError, TypeError, RecursionError):
-                pass
+                pass  # not real (asin(2)): each kind refuses it where it evaluates the value
         return value
 
     def call(self, node: ast.Call) -> sp.Expr:

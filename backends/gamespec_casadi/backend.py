@@ -25,7 +25,7 @@ from gamespec.ocp.transcription import Guess, Transcription
 from gamespec.result import Result, Status
 from gamespec.specs.base import StrictModel
 from gamespec.specs.ocp import OptimalControlSpec
-from gamespec.symbolic.translate import Library, translate
+from gamespec.symbolic.translate import Library
 
 STATUS_MAP = {
     "Solve_Succeeded": Status.OPTIMAL,
@@ -53,12 +53,13 @@ class CasadiOptions(StrictModel):
     max_wall_time: float = Field(300.0, gt=0, description="IPOPT's wall-time limit in seconds.")
     ipopt: dict[str, Any] = Field(default_factory=dict, description="Further IPOPT options.")
     warm_start: bool = Field(True, description="Re-solves start from the previous solution.")
-    graph: Literal["sx", "mx"] = Field(
-        "sx",
-        description="Outer NLP graph: 'sx' flattens every interval into one SX graph (slow nlpsol build"
-        " at large N, fastest IPOPT iterations and re-solves); 'mx' keeps the per-point function as one"
-        " mapped node (a 3-8x faster build at N = 1000, 1.2-2x slower iterations): for one-shot solves"
-        " of large grids.",
+    graph: Literal["assembled", "sx", "mx"] = Field(
+        "assembled",
+        description="How the NLP and its derivatives are built. 'assembled': an MX graph around the"
+        " mapped per-point function, with the Jacobian and Hessian assembled from the per-point"
+        " derivatives (fast build and fast iterations; NLP solvers without custom-derivative options"
+        " get 'mx'); 'sx': one flat SX graph differentiated whole (slow nlpsol build at large N);"
+        " 'mx': the MX graph differentiated whole by CasADi (fast build, slower iterations).",
     )
 
     @field_validator("ipopt")
@@ -86,72 +87,28 @@ class CasadiModel(CollocationModel):
     def __init__(self, spec: OptimalControlSpec, options: CasadiOptions) -> None:
         import casadi as ca
 
+        from gamespec_casadi.assembly import assembled_nlp
+        from gamespec_casadi.nlp import collocation_nlp
+
         if not ca.has_nlpsol(options.solver):
             raise BackendError(f"casadi has no NLP solver plugin {options.solver!r}")
         self.ca = ca
         self.tr = tr = Transcription(spec)
         self.options = options
-        ocp, grid = tr.ocp, tr.grid
-        lib = casadi_library(ca)
-        nx, nu, nw, npar = tr.n_x, tr.n_u, tr.n_w, len(ocp.p)
-        x, u, w = ca.SX.sym("x", nx), ca.SX.sym("u", nu), ca.SX.sym("w", nw)
-        p, t = ca.SX.sym("p", npar + tr.n_d), ca.SX.sym("t")
-        values = {ocp.t: t}
-        for symbols, var in ((ocp.x, x), (ocp.u, u), (ocp.w, w), (ocp.p + ocp.d, p)):
-            values |= dict(zip(symbols, ca.vertsplit(var), strict=True))
-        f = ca.vertcat(*(translate(e, values, lib) for e in ocp.dynamics))
-        L = translate(ocp.lagrange, values, lib)
-        path = ca.vertcat(*(translate(r.expr, values, lib) for r in ocp.path))
-        integrand = ca.vertcat(*(translate(r.expr, values, lib) for r in ocp.integrals))
-        k = len(grid.eval_index)
-        point = ca.Function("point", [x, u, w, t, p], [f, L, path, integrand]).map(k)
-
-        outer = ca.MX if options.graph == "mx" else ca.SX
         self.sx, self.su = tr.scales(tr.ocp.parameter_values())
-        X_scaled, U_scaled = outer.sym("X", nx, grid.n_nodes), outer.sym("U", nu, k)
-        X = ca.diag(ca.DM(self.sx)) @ X_scaled
-        U = ca.diag(ca.DM(self.su)) @ U_scaled
-        T = outer.sym("T") if tr.free_time else None
-        design = outer.sym("d", tr.n_d)
-        p_all = outer.sym("p_all", npar + nw * k + (0 if tr.free_time else 1))
-        params = ca.vertcat(p_all[:npar, :], design)
-        Win = ca.reshape(p_all[npar : npar + nw * k], nw, k)
-        horizon = T if tr.free_time else p_all[npar + nw * k]
-        t_eval = tr.t0 + horizon * ca.DM(grid.eval_tau).T
-        F, Lv, G, Iv = point(X[:, grid.eval_index.tolist()], U, Win, t_eval, params)
-        D, W, q = grid.matrices
-        defects = X @ ca.DM(D.T) - horizon * (F @ ca.DM(W.T))
-
-        ends = dict(zip(ocp.x0, ca.vertsplit(X[:, 0]), strict=True))
-        ends |= dict(zip(ocp.xf, ca.vertsplit(X[:, -1]), strict=True)) | {ocp.tf: tr.t0 + horizon}
-        ends |= dict(zip(ocp.p + ocp.d, ca.vertsplit(params), strict=True))
-        first, last = tr.end_controls(U)
-        ends |= dict(zip(ocp.u0, first, strict=True)) | dict(zip(ocp.uf, last, strict=True))
-        mayer = translate(ocp.mayer, ends, lib)
-        boundary = [translate(r.expr, ends, lib) for r in ocp.boundary]
-        objective = mayer + horizon * (Lv @ ca.DM(q)) + tr.rate_penalty(U)
-
-        self.n_defects = defects.numel()
-        integrals = horizon * (Iv @ ca.DM(q))
-        g = ca.vertcat(ca.vec(defects), ca.vec(G.T), *boundary, integrals)
-        w = ca.vertcat(ca.vec(X_scaled), ca.vec(U_scaled), design, *([T] if tr.free_time else []))
-        lower = [np.zeros(self.n_defects)]
-        upper = [np.zeros(self.n_defects)]
-        for r in ocp.path:
-            lower.append(np.full(k, r.lower))
-            upper.append(np.full(k, r.upper))
-        lower += [np.array([r.lower for r in ocp.boundary])]
-        upper += [np.array([r.upper for r in ocp.boundary])]
-        lower += [np.array([r.lower for r in ocp.integrals])]
-        upper += [np.array([r.upper for r in ocp.integrals])]
-        self.lbg, self.ubg = np.concatenate(lower), np.concatenate(upper)
+        outer = ca.SX if options.graph == "sx" else ca.MX
+        nlp = collocation_nlp(tr, casadi_library(ca), outer, self.sx, self.su)
+        self.n_defects, self.lbg, self.ubg = nlp.n_defects, nlp.lbg, nlp.ubg
         ipopt = {"print_level": 0, "sb": "yes", "tol": options.tol, "max_iter": options.max_iter}
         ipopt["max_wall_time"] = options.max_wall_time
         nlp_opts = {"ipopt": ipopt | options.ipopt, "print_time": False}
-        self.solver = ca.nlpsol(
-            "gamespec", options.solver, {"x": w, "p": p_all, "f": objective, "g": g}, nlp_opts
-        )
-        self.shape = (nx, grid.n_nodes, nu, k)
+        if options.graph == "assembled":
+            assembled = assembled_nlp(nlp)
+            problem, nlp_opts = assembled.nlp, nlp_opts | assembled.derivatives
+        else:
+            problem = nlp.closed()
+        self.solver = ca.nlpsol("gamespec", options.solver, problem, nlp_opts)
+        self.shape = (tr.n_x, tr.grid.n_nodes, tr.n_u, len(tr.grid.eval_index))
         self._last: np.ndarray | None = None
 
     def _pack(self, X: np.ndarray, U: np.ndarray, d: np.ndarray, T: float) -> np.ndarray:

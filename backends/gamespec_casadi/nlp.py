@@ -1,0 +1,215 @@
+"""A :class:`~gamespec.ocp.transcription.Transcription` as CasADi expressions: the decision variables,
+the NLP parameters, and the objective and constraints as functions of the variables and of the
+outputs of one *point function* evaluated at every evaluation point.
+
+Decision variables ``w = [vec(X / s_x); vec(U / s_u); d; T]`` (s: the scale factors, d: the design
+variables), NLP parameters ``p = [params; vec(Win); T]`` (the grid inputs, one block of n_w × n_eval
+values, and a fixed horizon). At evaluation point i the point function maps its variables
+``v_i = [x_i; u_i; d]`` (and T when free; linear in w) and its data (inputs, normalized time, parameters) to
+
+    o_i = [T f_i; T L_i; path_i; T integrand_i],
+
+and the NLP is linear in the outputs ``O = [o_1 ... o_k]`` (constant coefficients):
+
+    g = [vec(X D^T - O_f W^T); vec(O_path^T); boundary(ends); O_integrand q],
+    J = mayer(ends) + O_L q + rate penalty(U),
+
+the defects ``D X - T W F`` and the Lagrange quadrature of :mod:`gamespec.ocp.collocation`, with the
+constant matrices built here once. That split is what :mod:`gamespec_casadi.assembly`
+differentiates; :meth:`CollocationNlp.closed` puts the mapped point function in place of ``O`` for
+the flat SX graph and the MX graph.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Any
+
+import casadi as ca
+import numpy as np
+import scipy.sparse as sps
+
+from gamespec.ocp.transcription import Transcription
+from gamespec.symbolic.translate import Library, translate
+
+
+@dataclass(frozen=True)
+class CollocationNlp:
+    """The collocation NLP with the point outputs as a free symbol ``outputs`` (n_o × k):
+    ``vec(points) = selection w``, ``g = linear w + weights vec(outputs) + boundary rows`` and
+    ``f = cost + cost_weights^T vec(outputs)`` (constant sparse matrices; ``boundary`` and ``cost``
+    hold the end-point terms and the rate penalty)."""
+
+    w: Any
+    p: Any
+    point: Any
+    point_data: list[Any]
+    outputs: Any
+    selection: Any
+    linear: Any
+    weights: Any
+    cost_weights: Any
+    boundary: Any
+    boundary_rows: list[int]
+    cost: Any
+    lbg: np.ndarray
+    ubg: np.ndarray
+    n_defects: int
+
+    @property
+    def points(self) -> Any:
+        """The point variables ``[v_1 ... v_k]`` (n_v × k)."""
+        return ca.reshape(self.selection @ self.w, -1, self.outputs.size2())
+
+    def objective(self, outputs: Any) -> Any:
+        return self.cost + self.cost_weights.T @ ca.vec(outputs)
+
+    def constraints(self, outputs: Any) -> Any:
+        """``g`` for given point outputs (the symbol, or the mapped point function)."""
+        return self.rest_constraints() + self.weights @ ca.vec(outputs)
+
+    def rest_constraints(self) -> Any:
+        """``g`` at zero point outputs: the defects' ``X D^T`` and the boundary rows."""
+        rows = self.boundary_embedding()
+        return self.linear @ self.w + (rows @ self.boundary if self.boundary_rows else 0)
+
+    def boundary_embedding(self) -> Any:
+        """The columns of the identity that put the boundary rows in place in g."""
+        return ca.DM.eye(self.linear.size1())[:, self.boundary_rows]
+
+    def mapped_outputs(self) -> Any:
+        """The point function mapped over the points."""
+        return self.point.map(self.outputs.size2())(self.points, *self.point_data)
+
+    def closed(self) -> dict[str, Any]:
+        """The NLP (``x, p, f, g``) with the mapped point function in place of ``outputs``."""
+        values = self.mapped_outputs()
+        return {"x": self.w, "p": self.p, "f": self.objective(values), "g": self.constraints(values)}
+
+
+def sparse_dm(matrix: sps.spmatrix) -> Any:
+    """A SciPy sparse matrix as a CasADi DM, by its compressed columns (several times faster than
+    ``ca.DM(matrix)``)."""
+    csc = sps.csc_matrix(matrix)
+    pattern = ca.Sparsity(*csc.shape, csc.indptr.tolist(), csc.indices.tolist())
+    return ca.DM(pattern, csc.data)
+
+
+def point_function(tr: Transcription, lib: Library) -> Any:
+    """The SX function ``o(v, w, tau, p[, T])`` of one evaluation point: variables ``v = [x; u; d]``
+    (and the horizon ``T`` when it is free), grid inputs ``w``, normalized time ``tau``
+    (``t = t0 + T tau``), parameters ``p`` (and a fixed horizon ``T``), to ``[T f; T L; path;
+    T integrand]`` (the terms of the defects and quadratures of :mod:`gamespec.ocp.collocation`)."""
+    ocp = tr.ocp
+    x, u, d = ca.SX.sym("x", tr.n_x), ca.SX.sym("u", tr.n_u), ca.SX.sym("d", tr.n_d)
+    horizon, tau = ca.SX.sym("T"), ca.SX.sym("tau")
+    w, p = ca.SX.sym("w", tr.n_w), ca.SX.sym("p", len(ocp.p))
+    values = {ocp.t: tr.t0 + horizon * tau}
+    for symbols, var in ((ocp.x, x), (ocp.u, u), (ocp.w, w), (ocp.p, p), (ocp.d, d)):
+        values |= dict(zip(symbols, ca.vertsplit(var), strict=True))
+    f = ca.vertcat(*(translate(e, values, lib) for e in ocp.dynamics))
+    L = translate(ocp.lagrange, values, lib)
+    path = ca.vertcat(*(translate(r.expr, values, lib) for r in ocp.path))
+    integrand = ca.vertcat(*(translate(r.expr, values, lib) for r in ocp.integrals))
+    o = ca.vertcat(horizon * f, horizon * L, path, horizon * integrand)
+    if tr.free_time:
+        return ca.Function("point", [ca.vertcat(x, u, d, horizon), w, tau, p], [o])
+    return ca.Function("point", [ca.vertcat(x, u, d), w, tau, p, horizon], [o])
+
+
+def _point_selection(tr: Transcription, sx: np.ndarray, su: np.ndarray, n_var: int) -> sps.csr_matrix:
+    """S with ``vec([v_1 ... v_k]) = S w``: point i's ``x`` is state node ``eval_index[i]`` times the
+    state scales, its ``u`` the i-th control column times the control scales, then d (and T)."""
+    nx, nu, nd, n = tr.n_x, tr.n_u, tr.n_d, tr.grid.n_nodes
+    e = tr.grid.eval_index
+    k = len(e)
+    n_v = nx + nu + nd + int(tr.free_time)
+    point = np.arange(k)[:, None]
+    rows, cols, vals = [], [], []
+    for offset, width, col, val in (
+        (0, nx, e[:, None] * nx + np.arange(nx), np.broadcast_to(sx, (k, nx))),
+        (nx, nu, nx * n + point * nu + np.arange(nu), np.broadcast_to(su, (k, nu))),
+        (nx + nu, nd, nx * n + nu * k + np.broadcast_to(np.arange(nd), (k, nd)), np.ones((k, nd))),
+        (n_v - 1, int(tr.free_time), np.full((k, int(tr.free_time)), n_var - 1), np.ones((k, 1))),
+    ):
+        if width:
+            rows.append((point * n_v + offset + np.arange(width)).ravel())
+            cols.append(np.broadcast_to(col, (k, width)).ravel())
+            vals.append(np.broadcast_to(val, (k, width)).ravel())
+    return sps.csr_matrix((np.concatenate(vals), (np.concatenate(rows), np.concatenate(cols))), (n_v * k, n_var))
+
+
+def _output_weights(tr: Transcription, n_o: int, n_boundary: int) -> tuple[sps.csr_matrix, np.ndarray]:
+    """C and c with ``g = ... + C vec(O)`` (the defects' ``- vec(O_f W^T)``, the path rows
+    ``vec(O_path^T)``, the integrals ``O_integrand q``) and ``f = ... + c^T vec(O)`` (``O_L q``)."""
+    nx, n_path, n_int = tr.n_x, len(tr.ocp.path), len(tr.ocp.integrals)
+    _, W, q = tr.grid.matrices
+    k = len(q)
+    defects = -sps.kron(W, sps.eye(nx, n_o))
+    r, i = np.meshgrid(np.arange(n_path), np.arange(k), indexing="ij")
+    path = sps.csr_matrix(
+        (np.ones(r.size), ((i + k * r).ravel(), (nx + 1 + r + n_o * i).ravel())), (k * n_path, k * n_o)
+    )
+    boundary = sps.csr_matrix((n_boundary, k * n_o))
+    integrals = sps.kron(q[None, :], sps.eye(n_int, n_o, nx + 1 + n_path))
+    cost = np.kron(q, np.eye(n_o)[nx])
+    return sps.vstack([defects, path, boundary, integrals]).tocsr(), cost
+
+
+def collocation_nlp(
+    tr: Transcription, lib: Library, outer: Any, sx: np.ndarray, su: np.ndarray
+) -> CollocationNlp:
+    """The NLP of ``tr`` on symbols of type ``outer`` (``ca.SX`` or ``ca.MX``), the variables scaled
+    by ``sx`` (states) and ``su`` (controls)."""
+    ocp, grid = tr.ocp, tr.grid
+    nx, nu, nw, npar, k = tr.n_x, tr.n_u, tr.n_w, len(ocp.p), len(grid.eval_index)
+    X_scaled, U_scaled = outer.sym("X", nx, grid.n_nodes), outer.sym("U", nu, k)
+    U = ca.diag(ca.DM(su)) @ U_scaled
+    T = outer.sym("T") if tr.free_time else None
+    design = outer.sym("d", tr.n_d)
+    p_all = outer.sym("p_all", npar + nw * k + (0 if tr.free_time else 1))
+    params = p_all[:npar, :]
+    Win = ca.reshape(p_all[npar : npar + nw * k], nw, k)
+    horizon = T if tr.free_time else p_all[npar + nw * k]
+    w = ca.vertcat(ca.vec(X_scaled), ca.vec(U_scaled), design, *([T] if tr.free_time else []))
+    n_o = nx + 1 + len(ocp.path) + len(ocp.integrals)
+
+    x_ends = ca.DM(sx) * X_scaled[:, [0, grid.n_nodes - 1]]
+    ends = dict(zip(ocp.x0, ca.vertsplit(x_ends[:, 0]), strict=True))
+    ends |= dict(zip(ocp.xf, ca.vertsplit(x_ends[:, 1]), strict=True)) | {ocp.tf: tr.t0 + horizon}
+    ends |= dict(zip(ocp.p + ocp.d, ca.vertsplit(ca.vertcat(params, design)), strict=True))
+    first, last = tr.end_controls(U)
+    ends |= dict(zip(ocp.u0, first, strict=True)) | dict(zip(ocp.uf, last, strict=True))
+    boundary = ca.vertcat(*(translate(r.expr, ends, lib) for r in ocp.boundary))
+    cost = translate(ocp.mayer, ends, lib) + tr.rate_penalty(U)
+
+    D = grid.matrices[0]
+    n_defects = D.shape[0] * nx
+    weights, cost_weights = _output_weights(tr, n_o, len(ocp.boundary))
+    linear = sps.hstack([sps.kron(D, sps.diags(sx)), sps.csr_matrix((n_defects, w.numel() - D.shape[1] * nx))])
+    linear = sps.vstack([linear, sps.csr_matrix((weights.shape[0] - n_defects, w.numel()))])
+    lower, upper = [np.zeros(n_defects)], [np.zeros(n_defects)]
+    for r in ocp.path:
+        lower.append(np.full(k, r.lower))
+        upper.append(np.full(k, r.upper))
+    for group in (ocp.boundary, ocp.integrals):
+        lower.append(np.array([r.lower for r in group]))
+        upper.append(np.array([r.upper for r in group]))
+    first_boundary = n_defects + k * len(ocp.path)
+    return CollocationNlp(
+        w=w,
+        p=p_all,
+        point=point_function(tr, lib),
+        point_data=[Win, ca.DM(grid.eval_tau).T, params, *([] if tr.free_time else [horizon])],
+        outputs=outer.sym("o", n_o, k),
+        selection=sparse_dm(_point_selection(tr, sx, su, w.numel())),
+        linear=sparse_dm(linear),
+        weights=sparse_dm(weights),
+        cost_weights=ca.DM(cost_weights),
+        boundary=boundary,
+        boundary_rows=list(range(first_boundary, first_boundary + len(ocp.boundary))),
+        cost=cost,
+        lbg=np.concatenate(lower),
+        ubg=np.concatenate(upper),
+        n_defects=n_defects,
+    )

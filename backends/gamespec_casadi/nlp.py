@@ -43,7 +43,7 @@ class CollocationNlp:
     w: Any
     p: Any
     point: Any
-    point_data: list[Any]
+    point_data: Any
     outputs: Any
     selection: Any
     linear: Any
@@ -79,7 +79,7 @@ class CollocationNlp:
 
     def mapped_outputs(self) -> Any:
         """The point function mapped over the points."""
-        return self.point.map(self.outputs.size2())(self.points, *self.point_data)
+        return self.point.map(self.outputs.size2())(self.points, self.point_data)
 
     def closed(self) -> dict[str, Any]:
         """The NLP (``x, p, f, g``) with the mapped point function in place of ``outputs``."""
@@ -96,10 +96,11 @@ def sparse_dm(matrix: sps.spmatrix) -> Any:
 
 
 def point_function(tr: Transcription, lib: Library) -> Any:
-    """The SX function ``o(v, w, tau, p[, T])`` of one evaluation point: variables ``v = [x; u; d]``
-    (and the horizon ``T`` when it is free), grid inputs ``w``, normalized time ``tau``
-    (``t = t0 + T tau``), parameters ``p`` (and a fixed horizon ``T``), to ``[T f; T L; path;
-    T integrand]`` (the terms of the defects and quadratures of :mod:`gamespec.ocp.collocation`)."""
+    """The SX function ``o(v, data)`` of one evaluation point: variables ``v = [x; u; d]`` (and the
+    horizon ``T`` when it is free), ``data = [w; tau; p]`` (grid inputs, normalized time with
+    ``t = t0 + T tau``, parameters; and a fixed horizon ``T``), to ``[T f; T L; path; T integrand]``
+    (the terms of the defects and quadratures of :mod:`gamespec.ocp.collocation`). Two arguments,
+    since a mapped call costs per argument and point."""
     ocp = tr.ocp
     x, u, d = ca.SX.sym("x", tr.n_x), ca.SX.sym("u", tr.n_u), ca.SX.sym("d", tr.n_d)
     horizon, tau = ca.SX.sym("T"), ca.SX.sym("tau")
@@ -113,8 +114,8 @@ def point_function(tr: Transcription, lib: Library) -> Any:
     integrand = ca.vertcat(*(translate(r.expr, values, lib) for r in ocp.integrals))
     o = ca.vertcat(horizon * f, horizon * L, path, horizon * integrand)
     if tr.free_time:
-        return ca.Function("point", [ca.vertcat(x, u, d, horizon), w, tau, p], [o])
-    return ca.Function("point", [ca.vertcat(x, u, d), w, tau, p, horizon], [o])
+        return ca.Function("point", [ca.vertcat(x, u, d, horizon), ca.vertcat(w, tau, p)], [o])
+    return ca.Function("point", [ca.vertcat(x, u, d), ca.vertcat(w, tau, p, horizon)], [o])
 
 
 def _point_selection(tr: Transcription, sx: np.ndarray, su: np.ndarray, n_var: int) -> sps.csr_matrix:
@@ -200,7 +201,9 @@ def collocation_nlp(
         w=w,
         p=p_all,
         point=point_function(tr, lib),
-        point_data=[Win, ca.DM(grid.eval_tau).T, params, *([] if tr.free_time else [horizon])],
+        point_data=ca.vertcat(
+            Win, ca.DM(grid.eval_tau).T, ca.repmat(params, 1, k), *([] if tr.free_time else [ca.repmat(horizon, 1, k)])
+        ),
         outputs=outer.sym("o", n_o, k),
         selection=sparse_dm(_point_selection(tr, sx, su, w.numel())),
         linear=sparse_dm(linear),

@@ -23,6 +23,7 @@ the flat SX graph and the MX graph.
 from __future__ import annotations
 
 from dataclasses import dataclass
+from functools import cached_property
 from typing import Any
 
 import casadi as ca
@@ -37,18 +38,18 @@ from gamespec.symbolic.translate import Library, translate
 class CollocationNlp:
     """The collocation NLP with the point outputs as a free symbol ``outputs`` (n_o × k):
     ``vec(points) = selection w``, ``g = linear w + weights vec(outputs) + boundary rows`` and
-    ``f = cost + cost_weights^T vec(outputs)`` (constant sparse matrices; ``boundary`` and ``cost``
-    hold the end-point terms and the rate penalty)."""
+    ``f = cost + cost_weights^T vec(outputs)`` (constant SciPy sparse matrices and a NumPy vector;
+    ``boundary`` and ``cost`` hold the end-point terms and the rate penalty)."""
 
     w: Any
     p: Any
     point: Any
     point_data: Any
     outputs: Any
-    selection: Any
-    linear: Any
-    weights: Any
-    cost_weights: Any
+    selection: sps.csr_matrix
+    linear: sps.csr_matrix
+    weights: sps.csr_matrix
+    cost_weights: np.ndarray
     boundary: Any
     boundary_rows: list[int]
     cost: Any
@@ -56,26 +57,38 @@ class CollocationNlp:
     ubg: np.ndarray
     n_defects: int
 
+    @cached_property
+    def selection_dm(self) -> Any:
+        return sparse_dm(self.selection)
+
+    @cached_property
+    def weights_dm(self) -> Any:
+        return sparse_dm(self.weights)
+
+    @cached_property
+    def linear_dm(self) -> Any:
+        return sparse_dm(self.linear)
+
     @property
     def points(self) -> Any:
         """The point variables ``[v_1 ... v_k]`` (n_v × k)."""
-        return ca.reshape(self.selection @ self.w, -1, self.outputs.size2())
+        return ca.reshape(self.selection_dm @ self.w, -1, self.outputs.size2())
 
     def objective(self, outputs: Any) -> Any:
-        return self.cost + self.cost_weights.T @ ca.vec(outputs)
+        return self.cost + ca.DM(self.cost_weights).T @ ca.vec(outputs)
 
     def constraints(self, outputs: Any) -> Any:
         """``g`` for given point outputs (the symbol, or the mapped point function)."""
-        return self.rest_constraints() + self.weights @ ca.vec(outputs)
+        return self.rest_constraints() + self.weights_dm @ ca.vec(outputs)
 
     def rest_constraints(self) -> Any:
         """``g`` at zero point outputs: the defects' ``X D^T`` and the boundary rows."""
         rows = self.boundary_embedding()
-        return self.linear @ self.w + (rows @ self.boundary if self.boundary_rows else 0)
+        return self.linear_dm @ self.w + (rows @ self.boundary if self.boundary_rows else 0)
 
     def boundary_embedding(self) -> Any:
         """The columns of the identity that put the boundary rows in place in g."""
-        return ca.DM.eye(self.linear.size1())[:, self.boundary_rows]
+        return ca.DM.eye(self.linear.shape[0])[:, self.boundary_rows]
 
     def mapped_outputs(self) -> Any:
         """The point function mapped over the points."""
@@ -205,10 +218,10 @@ def collocation_nlp(
             Win, ca.DM(grid.eval_tau).T, ca.repmat(params, 1, k), *([] if tr.free_time else [ca.repmat(horizon, 1, k)])
         ),
         outputs=outer.sym("o", n_o, k),
-        selection=sparse_dm(_point_selection(tr, sx, su, w.numel())),
-        linear=sparse_dm(linear),
-        weights=sparse_dm(weights),
-        cost_weights=ca.DM(cost_weights),
+        selection=_point_selection(tr, sx, su, w.numel()),
+        linear=linear.tocsr(),
+        weights=weights,
+        cost_weights=cost_weights,
         boundary=boundary,
         boundary_rows=list(range(first_boundary, first_boundary + len(ocp.boundary))),
         cost=cost,

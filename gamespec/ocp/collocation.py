@@ -124,13 +124,9 @@ class Grid:
             deriv, _ = lagrange_matrices(self.local_points)
             weights = self.radau_weights
             block = deriv[:, 1:].T
-            rows, cols, vals = [], [], []
-            for k in range(self.intervals):
-                for j in range(d):
-                    for r in range(d + 1):
-                        rows.append(k * d + j)
-                        cols.append(k * d + r)
-                        vals.append(block[j, r])
+            k, j, r = np.meshgrid(np.arange(self.intervals), np.arange(d), np.arange(d + 1), indexing="ij")
+            vals = np.broadcast_to(block, k.shape).ravel()
+            rows, cols = (k * d + j).ravel(), (k * d + r).ravel()
             dmat = sps.csr_matrix((vals, (rows, cols)), shape=(self.intervals * d, self.n_nodes))
             scale = np.repeat(h, d)
             wmat = sps.diags(scale).tocsr()

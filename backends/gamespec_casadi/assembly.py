@@ -109,18 +109,17 @@ class _Part:
 
 
 def _assemble(shape: tuple[int, int], parts: list[_Part]) -> Any:
-    """The sum of the parts as one sparse MX matrix: per part one constant sparse matrix times its
-    vector, giving the nonzeros (column-major, as CasADi stores them) of the sum."""
-    keys = [part.cols * shape[0] + part.rows for part in parts]
-    ordered = np.sort(np.concatenate(keys))
+    """The sum of the parts as one sparse MX matrix: one constant sparse matrix times the parts'
+    vectors stacked gives the nonzeros of the sum (column-major, as CasADi stores them)."""
+    keys = np.concatenate([part.cols * shape[0] + part.rows for part in parts])
+    ordered = np.sort(keys)
     unique = ordered[np.r_[True, ordered[1:] != ordered[:-1]]]
     pattern = ca.Sparsity.triplet(*shape, (unique % shape[0]).tolist(), (unique // shape[0]).tolist())
-    total = ca.MX.zeros(unique.size)
-    for part, key in zip(parts, keys, strict=True):
-        where = (np.searchsorted(unique, key), part.source)
-        gather = sps.csr_matrix((part.weights, where), shape=(unique.size, part.vector.numel()))
-        total = total + sparse_dm(gather) @ part.vector
-    return ca.sparsity_cast(total, pattern)
+    offsets = np.cumsum([0] + [part.vector.numel() for part in parts])
+    source = np.concatenate([part.source + offset for part, offset in zip(parts, offsets, strict=False)])
+    weights = np.concatenate([part.weights for part in parts])
+    gather = sps.csr_matrix((weights, (np.searchsorted(unique, keys), source)), shape=(unique.size, offsets[-1]))
+    return ca.sparsity_cast(sparse_dm(gather) @ ca.vertcat(*(part.vector for part in parts)), pattern)
 
 
 def _point_part(mapped: Any, block: Any, k: int, left: sps.csc_matrix | None, S: sps.csr_matrix) -> _Part:

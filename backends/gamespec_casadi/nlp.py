@@ -105,7 +105,7 @@ def sparse_dm(matrix: sps.spmatrix) -> Any:
     ``ca.DM(matrix)``)."""
     csc = sps.csc_matrix(matrix)
     pattern = ca.Sparsity(*csc.shape, csc.indptr.tolist(), csc.indices.tolist())
-    return ca.DM(pattern, csc.data)
+    return ca.DM(pattern, csc.data.tolist())
 
 
 def point_function(tr: Transcription, lib: Library) -> Any:

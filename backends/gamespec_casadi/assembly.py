@@ -41,10 +41,12 @@ class AssembledNlp:
 @dataclass(frozen=True)
 class _PointDerivatives:
     """The point function's outputs with their Jacobian ``[o, do/dv]``, its weighted objective rows
-    with their gradient ``[c^T o_rows, (do_rows/dv)^T c]`` and the Hessian ``d^2 (mu^T o)/dv^2``."""
+    ``c^T o_rows`` alone and with their gradient ``(do_rows/dv)^T c``, and the Hessian
+    ``d^2 (mu^T o)/dv^2`` (an SX function computes all its outputs, so one function a use)."""
 
     jacobian: Any
-    objective: Any
+    cost: Any
+    cost_gradient: Any
     hessian: Any
 
 
@@ -61,7 +63,8 @@ def _point_derivatives(point: Any, c: np.ndarray) -> tuple[_PointDerivatives, li
     hessian = ca.triu(ca.hessian(ca.dot(mu, o), v)[0])
     derivatives = _PointDerivatives(
         jacobian=ca.Function("point_jac", [v, data], [o, ca.jacobian(o, v)]),
-        objective=ca.Function("point_cost", [v, ca.vertcat(data, weights)], [cost, ca.gradient(cost, v)]),
+        cost=ca.Function("point_cost", [v, ca.vertcat(data, weights)], [cost]),
+        cost_gradient=ca.Function("point_cost_grad", [v, ca.vertcat(data, weights)], [cost, ca.gradient(cost, v)]),
         hessian=ca.Function("point_hess", [v, ca.vertcat(data, mu)], [hessian]),
     )
     return derivatives, objective_rows
@@ -153,10 +156,12 @@ def assembled_nlp(nlp: CollocationNlp) -> AssembledNlp:
     point, objective_rows = _point_derivatives(nlp.point, c)
     V, data = nlp.points, nlp.point_data
 
-    cost, cost_grad = nlp.cost, ca.gradient(nlp.cost, w)
+    cost, cost_again, cost_grad = nlp.cost, nlp.cost, ca.gradient(nlp.cost, w)
     if objective_rows:
-        total, grads = _over_points(point.objective, k, [0])(V, ca.vertcat(data, ca.DM(c[objective_rows, :])))
-        cost, cost_grad = cost + total, cost_grad + S.T @ ca.vec(grads)
+        weighted = ca.vertcat(data, ca.DM(c[objective_rows, :]))
+        cost += _over_points(point.cost, k, [0])(V, weighted)
+        total, grads = _over_points(point.cost_gradient, k, [0])(V, weighted)
+        cost_again, cost_grad = cost_again + total, cost_grad + S.T @ ca.vec(grads)
     g = nlp.constraints(_over_points(nlp.point, k)(V, data))
 
     S_np, C_np = nlp.selection, nlp.weights.tocsc()
@@ -178,7 +183,7 @@ def assembled_nlp(nlp: CollocationNlp) -> AssembledNlp:
     return AssembledNlp(
         nlp={"x": w, "p": p, "f": cost, "g": g},
         derivatives={
-            "grad_f": ca.Function("nlp_grad_f", [w, p], [cost, cost_grad]),
+            "grad_f": ca.Function("nlp_grad_f", [w, p], [cost_again, cost_grad]),
             "jac_g": ca.Function("nlp_jac_g", [w, p], [nlp.constraints(values), jac_g]),
             "hess_lag": ca.Function("nlp_hess_l", [w, p, sigma, lam], [hess_l]),
         },

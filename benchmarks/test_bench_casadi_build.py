@@ -69,8 +69,10 @@ def test_build_within_the_solve_and_resolves_as_fast(benchmark, case: str) -> No
     }
     benchmark.extra_info.update({f"{g} {k}": v for g, run in runs.items() for k, v in run.items()} | ratios)
     for graph, run in runs.items():
-        print(f"\n{case} {graph}: build {run['build']:.3f} s, solve {run['solve']:.3f} s, "
-              f"re-solve {run['resolve']:.3f} s")
+        print(
+            f"\n{case} {graph}: build {run['build']:.3f} s, solve {run['solve']:.3f} s, "
+            f"re-solve {run['resolve']:.3f} s"
+        )
     print(", ".join(f"{k} {v:.2f}" for k, v in ratios.items()))
     assert new["objective"] == pytest.approx(old["objective"], rel=1e-8)
     assert new["objective_again"] == pytest.approx(old["objective_again"], rel=1e-8)

@@ -2,19 +2,23 @@
 derivatives of its one point function instead of differentiating the whole NLP graph (issue 16).
 
 With the point variables ``V = [v_1 ... v_k]`` linear in the decision variables w (``vec V = S w``,
-S constant) and the NLP linear in the point outputs ``O = [o(v_1) ... o(v_k)]`` with constant
-coefficients, ``g = g_0(w) + C vec O`` and ``f = f_0(w) + c^T vec O`` (g_0, f_0: the NLP at O = 0,
-i.e. the defects' ``X D^T``, the end-point terms, the rate penalty), the chain rule gives
+S a scaled selection) and the NLP linear in the point outputs ``O = [o(v_1) ... o(v_k)]`` with
+constant coefficients, ``g = g_0(w) + C vec O`` and ``f = f_0(w) + c^T vec O`` (g_0: the defects'
+``X D^T``, a constant matrix times w, and the boundary rows; f_0: the Mayer term and the rate
+penalty), the chain rule gives
 
     jac g       = jac g_0 + C blkdiag(do_i/dv_i) S,
     grad f      = grad f_0 + S^T vec((do_i/dv_i)^T c_i),
     hess Lagr.  = hess (sigma f_0 + lambda^T g_0) + S^T blkdiag(d^2 (mu_i^T o_i)/dv_i^2) S,
-    mu          = C^T lambda + sigma c,
+    mu          = C^T lambda + sigma c.
 
-with the per-point derivatives (small SX functions) mapped over the points and the sums sparse
-products with constant matrices. The rows of g_0 affine in (w, p) have a constant Jacobian, taken
-once; CasADi differentiates only the rest (the end-point terms). Building costs a few dozen CasADi
-nodes whatever the grid, and each evaluation does the per-point work once.
+The per-point derivatives are small SX functions evaluated over the points in blocks (one mapped
+call per block of inlined points); each sum is one constant sparse matrix, computed here once from
+the sparsity patterns, times the stacked nonzeros of its parts. CasADi differentiates only the
+end-point terms. Building costs a few dozen MX nodes and a few sparse matrices whatever the grid (no
+AD of a graph that grows with N, which is what makes ``nlpsol`` slow on the flat SX graph); each
+evaluation does the per-point work once (no colored directions through the map, which is what makes
+CasADi's own derivatives of the MX graph slow to evaluate).
 """
 
 from __future__ import annotations
@@ -64,7 +68,9 @@ def _point_derivatives(point: Any, c: np.ndarray) -> tuple[_PointDerivatives, li
     derivatives = _PointDerivatives(
         jacobian=ca.Function("point_jac", [v, data], [o, ca.jacobian(o, v)]),
         cost=ca.Function("point_cost", [v, ca.vertcat(data, weights)], [cost]),
-        cost_gradient=ca.Function("point_cost_grad", [v, ca.vertcat(data, weights)], [cost, ca.gradient(cost, v)]),
+        cost_gradient=ca.Function(
+            "point_cost_grad", [v, ca.vertcat(data, weights)], [cost, ca.gradient(cost, v)]
+        ),
         hessian=ca.Function("point_hess", [v, ca.vertcat(data, mu)], [hessian]),
     )
     return derivatives, objective_rows
@@ -121,7 +127,9 @@ def _assemble(shape: tuple[int, int], parts: list[_Part]) -> Any:
     offsets = np.cumsum([0] + [part.vector.numel() for part in parts])
     source = np.concatenate([part.source + offset for part, offset in zip(parts, offsets, strict=False)])
     weights = np.concatenate([part.weights for part in parts])
-    gather = sps.csr_matrix((weights, (np.searchsorted(unique, keys), source)), shape=(unique.size, offsets[-1]))
+    gather = sps.csr_matrix(
+        (weights, (np.searchsorted(unique, keys), source)), shape=(unique.size, offsets[-1])
+    )
     return ca.sparsity_cast(sparse_dm(gather) @ ca.vertcat(*(part.vector for part in parts)), pattern)
 
 

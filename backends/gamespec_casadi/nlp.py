@@ -5,7 +5,8 @@ outputs of one *point function* evaluated at every evaluation point.
 Decision variables ``w = [vec(X / s_x); vec(U / s_u); d; T]`` (s: the scale factors, d: the design
 variables), NLP parameters ``p = [params; vec(Win); T]`` (the grid inputs, one block of n_w × n_eval
 values, and a fixed horizon). At evaluation point i the point function maps its variables
-``v_i = [x_i; u_i; d]`` (and T when free; linear in w) and its data (inputs, normalized time, parameters) to
+``v_i = [x_i; u_i; d]`` (and T when free; linear in w) and its data (inputs, normalized time,
+parameters) to
 
     o_i = [T f_i; T L_i; path_i; T integrand_i],
 
@@ -150,7 +151,9 @@ def _point_selection(tr: Transcription, sx: np.ndarray, su: np.ndarray, n_var: i
             rows.append((point * n_v + offset + np.arange(width)).ravel())
             cols.append(np.broadcast_to(col, (k, width)).ravel())
             vals.append(np.broadcast_to(val, (k, width)).ravel())
-    return sps.csr_matrix((np.concatenate(vals), (np.concatenate(rows), np.concatenate(cols))), (n_v * k, n_var))
+    return sps.csr_matrix(
+        (np.concatenate(vals), (np.concatenate(rows), np.concatenate(cols))), (n_v * k, n_var)
+    )
 
 
 def _output_weights(tr: Transcription, n_o: int, n_boundary: int) -> tuple[sps.csr_matrix, np.ndarray]:
@@ -200,7 +203,9 @@ def collocation_nlp(
     D = grid.matrices[0]
     n_defects = D.shape[0] * nx
     weights, cost_weights = _output_weights(tr, n_o, len(ocp.boundary))
-    linear = sps.hstack([sps.kron(D, sps.diags(sx)), sps.csr_matrix((n_defects, w.numel() - D.shape[1] * nx))])
+    linear = sps.hstack(
+        [sps.kron(D, sps.diags(sx)), sps.csr_matrix((n_defects, w.numel() - D.shape[1] * nx))]
+    )
     linear = sps.vstack([linear, sps.csr_matrix((weights.shape[0] - n_defects, w.numel()))])
     lower, upper = [np.zeros(n_defects)], [np.zeros(n_defects)]
     for r in ocp.path:
@@ -215,7 +220,10 @@ def collocation_nlp(
         p=p_all,
         point=point_function(tr, lib),
         point_data=ca.vertcat(
-            Win, ca.DM(grid.eval_tau).T, ca.repmat(params, 1, k), *([] if tr.free_time else [ca.repmat(horizon, 1, k)])
+            Win,
+            ca.DM(grid.eval_tau).T,
+            ca.repmat(params, 1, k),
+            *([] if tr.free_time else [ca.repmat(horizon, 1, k)]),
         ),
         outputs=outer.sym("o", n_o, k),
         selection=_point_selection(tr, sx, su, w.numel()),

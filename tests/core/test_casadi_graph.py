@@ -9,14 +9,14 @@ from __future__ import annotations
 import casadi as ca
 import numpy as np
 import pytest
+from gamespec_casadi.assembly import assembled_nlp
+from gamespec_casadi.backend import casadi_library
+from gamespec_casadi.nlp import collocation_nlp
 
 import gamespec
 from gamespec.loader import spec_from_dict
 from gamespec.ocp.transcription import Transcription
 from gamespec.solving import get_backend
-from gamespec_casadi.assembly import assembled_nlp
-from gamespec_casadi.backend import casadi_library
-from gamespec_casadi.nlp import collocation_nlp
 from tests.conftest import PROBLEMS
 from tests.core.test_ocp_modelling import _design_problem, _double_integrator, _isoperimetric
 from tests.core.test_ocp_theory import _zermelo_closed_form
@@ -71,12 +71,23 @@ def test_assembled_derivatives_are_the_derivatives_of_the_nlp(case: str) -> None
         [f, ca.gradient(f, x), g, ca.jacobian(g, x), ca.triu(ca.hessian(sigma * f + ca.dot(lam, g), x)[0])],
     )
     rng = np.random.default_rng(7)
-    point = [rng.uniform(0.5, 1.5, x.numel()), rng.uniform(0.5, 1.5, p.numel()), 0.7, rng.normal(size=g.numel())]
+    point = [
+        rng.uniform(0.5, 1.5, x.numel()),
+        rng.uniform(0.5, 1.5, p.numel()),
+        0.7,
+        rng.normal(size=g.numel()),
+    ]
     f_ref, grad_ref, g_ref, jac_ref, hess_ref = (_dense(v) for v in reference(*point))
     f_val, grad_val = (_dense(v) for v in assembled["grad_f"](*point[:2]))
     g_val, jac_val = (_dense(v) for v in assembled["jac_g"](*point[:2]))
     hess_val = _dense(assembled["hess_lag"](*point))
-    for value, ref in ((f_val, f_ref), (grad_val, grad_ref), (g_val, g_ref), (jac_val, jac_ref), (hess_val, hess_ref)):
+    for value, ref in (
+        (f_val, f_ref),
+        (grad_val, grad_ref),
+        (g_val, g_ref),
+        (jac_val, jac_ref),
+        (hess_val, hess_ref),
+    ):
         assert value.shape == ref.shape
         assert np.max(np.abs(value - ref)) <= 1e-11 * max(1.0, np.max(np.abs(ref)))
 

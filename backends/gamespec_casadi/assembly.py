@@ -120,9 +120,9 @@ class _Part:
 def _assemble(shape: tuple[int, int], parts: list[_Part]) -> Any:
     """The sum of the parts as one sparse MX matrix: one constant sparse matrix times the parts'
     vectors stacked gives the nonzeros of the sum (column-major, as CasADi stores them)."""
-    keys = np.concatenate([part.cols * shape[0] + part.rows for part in parts])
+    keys = np.concatenate([part.cols.astype(np.int64) * shape[0] + part.rows for part in parts])
     ordered = np.sort(keys)
-    unique = ordered[np.r_[True, ordered[1:] != ordered[:-1]]]
+    unique = ordered[np.diff(ordered, prepend=-1) != 0]
     pattern = ca.Sparsity.triplet(*shape, (unique % shape[0]).tolist(), (unique // shape[0]).tolist())
     offsets = np.cumsum([0] + [part.vector.numel() for part in parts])
     source = np.concatenate([part.source + offset for part, offset in zip(parts, offsets, strict=False)])

@@ -18,7 +18,12 @@ from gamespec.loader import spec_from_dict
 from gamespec.ocp.transcription import Transcription
 from gamespec.solving import get_backend
 from tests.conftest import PROBLEMS
-from tests.core.test_ocp_modelling import _design_problem, _double_integrator, _isoperimetric
+from tests.core.test_ocp_modelling import (
+    _bounded_in_time,
+    _design_problem,
+    _double_integrator,
+    _isoperimetric,
+)
 from tests.core.test_ocp_theory import _zermelo_closed_form
 
 GRAPHS = ("assembled", "sx", "mx")
@@ -45,6 +50,7 @@ CASES = {
     "zermelo_trapezoidal": lambda: gamespec.load(ZERMELO_RANGE, ["method.scheme=trapezoidal"]),
     "design_variable": lambda: spec_from_dict(_design_problem(False, "casadi")),
     "integral_constraint": lambda: spec_from_dict(_isoperimetric(False, "casadi")),
+    "linear_with_path_constraint": lambda: spec_from_dict(_bounded_in_time(False)),
     "path_and_penalty": lambda: spec_from_dict(_with_path_and_penalty()),
 }
 

@@ -25,10 +25,11 @@ def _teams(seed: int, n: int, m: int, heterogeneous: bool):
 def test_lemmas_5_and_7_shortest_pair_is_allocated(seed: int, n: int, m: int, hetero: bool) -> None:
     """The pair with the shortest time |p_i - e_j| / (u_i + v_j) is in F (A2; AVAA when homogeneous).
 
-    Constant bearing only: the lemmas' proofs rest on the CB Apollonius circle, on which that time is
-    the capture time. Under pure pursuit the allocation does not always assign that pair (seed 1,
-    n = 16, m = 2, heterogeneous speeds: it goes to the other evader); whether that is the lemmas'
-    scope or a defect of the PP allocation is open."""
+    Constant bearing only, as the thesis states it: §3.4 assumes the pursuers follow CB, and the
+    proofs rest on the CB Apollonius circle, on which that time is the capture time. Under pure
+    pursuit the capture region is the refined Apollonius curve of §3.3, whose nearest point is not
+    at ``|p - e| / (u + v)``, so the lemma does not apply and the allocation need not assign that
+    pair (seed 1, n = 16, m = 2, heterogeneous speeds: it goes to the other evader)."""
     pursuers, evaders, u, v = _teams(seed, n, m, hetero)
     result = allocate(pursuers, evaders, u, v, algorithm="a2", strategy="cb")
     times = np.linalg.norm(pursuers[:, None] - evaders[None], axis=2) / (u[:, None] + v[None, :])

@@ -13,6 +13,8 @@ from __future__ import annotations
 import json
 import sys
 import warnings
+from collections.abc import Iterator
+from contextlib import contextmanager, nullcontext
 from functools import cache
 from pathlib import Path
 from typing import TYPE_CHECKING, Annotated
@@ -430,17 +432,25 @@ _ClickException = next(c for c in typer.BadParameter.__mro__ if c.__name__ == "C
 """Click's root exception (vendored by recent typer, a separate package before): usage errors."""
 
 
+@contextmanager
+def _quiet() -> Iterator[None]:
+    """No warning is shown, and NumPy's floating-point errors are ignored where NumPy is imported
+    already; where a command imports it later, they reach the same filter as warnings. NumPy is
+    not imported for it: ``--help`` and ``validate`` of most files never need it."""
+    numpy = sys.modules.get("numpy")
+    with warnings.catch_warnings(), numpy.errstate(all="ignore") if numpy else nullcontext():
+        warnings.simplefilter("ignore")
+        yield
+
+
 def run(argv: list[str] | None = None) -> int:
     """Run the CLI on ``argv`` and return the exit code: user errors and usage errors → 2 with one
     line on stderr. Warnings (numpy's, a solver's) are not printed: what a solve found is in its
     Result's status, message and checks."""
-    import numpy as np
-
     mount_commands()
     command = typer.main.get_command(app)
     try:
-        with warnings.catch_warnings(), np.errstate(all="ignore"):
-            warnings.simplefilter("ignore")
+        with _quiet():
             code = command.main(args=argv, prog_name="gamespec", standalone_mode=False)
     except SystemExit as exit_:
         return exit_.code if isinstance(exit_.code, int) else (0 if exit_.code is None else 1)

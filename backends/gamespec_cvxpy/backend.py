@@ -174,9 +174,29 @@ class CovariancePlayers:
         self.offset = cp.Parameter(self.w0.size)
         W = cp.reshape(self.offset + self.gains.map(T_WK) @ self.zeta, (n, p), order="F")
         payoff = cp.sum_squares(self.zeta) + 2 * self.c @ self.zeta
-        self.controller = _Problem(cp.Problem(cp.Minimize(payoff), [cp.sigma_max(W) <= 1]), options)
-        self.scaling = _Problem(cp.Problem(cp.Minimize(cp.sigma_max(W))), options)
+        self.controller = _Problem(cp.Problem(cp.Minimize(payoff), self.terminal_cone(W, 1.0)), options)
+        gamma = cp.Variable()
+        self.scaling = _Problem(cp.Problem(cp.Minimize(gamma), self.terminal_cone(W, gamma)), options)
         self.steps = 0
+
+    @staticmethod
+    def terminal_cone(W: Any, bound: Any) -> list[Any]:
+        """``W Wᵀ ⪯ bound · I`` for the n × p expression ``W``: eq. 4.61 normalized by ``Σ_N^{-1/2}``
+        (with ``bound = 1`` the constraint eq. 4.62, ``‖W‖₂ ≤ 1``, squared), as
+        ``Σ_j Z_j ⪯ bound · I`` and ``[[Z_j, w_j], [w_jᵀ, 1]] ⪰ 0`` (``Z_j ⪰ w_j w_jᵀ``) for each
+        column ``w_j``. ``W Wᵀ = Σ_j w_j w_jᵀ``, so the two are equivalent; this is the chordal
+        decomposition of the arrow-shaped ``[[bound · I, W], [Wᵀ, I]] ⪰ 0``: p cones of size n + 1
+        instead of one of size n + p, which a conic solver factors in time linear in p and, having
+        no decomposition of its own to do, re-solves on new parameter values without a new setup."""
+        import cvxpy as cp
+
+        n, p = W.shape
+        Y = [cp.Variable((n + 1, n + 1), PSD=True) for _ in range(p)]
+        return [
+            cp.vstack([Yj[:n, n] for Yj in Y]).T == W,
+            cp.hstack([Yj[n, n] for Yj in Y]) == 1,
+            bound * np.eye(n) - sum(Yj[:n, :n] for Yj in Y) >> 0,
+        ]
 
     def stopper_step(self, kappa: np.ndarray) -> tuple[np.ndarray, StepReport]:
         """eq. 4.59b: ``ℓ = −H_LL⁻¹(g_L + H_LK κ)``."""
@@ -198,7 +218,7 @@ class CovariancePlayers:
         """``min_K ‖W‖₂²`` for the current parameters: the least ``γ`` with ``Σ_N(K) ⪯ γ Σ_N``."""
         status = self.scaling.solve()
         value = self.scaling.problem.value
-        return float(value) ** 2 if status.ok and value is not None else None
+        return float(value) if status.ok and value is not None else None
 
     @property
     def seconds(self) -> float:
@@ -216,11 +236,12 @@ class CovariancePlayers:
         else:
             kappa0, ell0 = (gains_to_vector(G) for G in start_gains)
         run = algorithm_2(self.stopper_step, self.controller_step, kappa0, ell0, settings)
+        accelerated = " + anderson" if settings.acceleration == "anderson" else ""
         outcome = CovarianceOutcome(
             run.strategies[CONTROLLER],
             run.strategies[STOPPER],
             run.status,
-            f"{settings.scheme} (Algorithm 2, eq. 4.62)",
+            f"{settings.scheme}{accelerated} (Algorithm 2, eq. 4.62)",
             message=run.message,
             iterations=run.iterations,
             history=list(zip(run.changes(CONTROLLER), run.changes(STOPPER), strict=True)),
@@ -275,6 +296,8 @@ class CvxpyModel(LQCompiledModel):
             tolerance=method.tolerance,
             max_iterations=method.max_iterations,
             damping=method.damping,
+            acceleration=method.acceleration,
+            memory=method.memory,
         )
         return self.players.solve(settings, self._start_gains(guess))
 

@@ -163,7 +163,7 @@ class MonteCarloSpec(StrictModel):
 
 class LQMethodSpec(StrictModel):
     """The best-response iteration of the covariance game (Algorithm 2: scheme, stopping rule,
-    damping; :mod:`gamespec.best_response`) and the Monte Carlo check."""
+    damping, acceleration; :mod:`gamespec.best_response`) and the Monte Carlo check."""
 
     tolerance: Number = Field(1e-5, gt=0, description="Bound on ε_k and ε_ℓ (section 4.5).")
     max_iterations: int = Field(100, ge=1)
@@ -173,6 +173,12 @@ class LQMethodSpec(StrictModel):
     damping: float = Field(
         1.0, gt=0, le=1, description="Weight w of a new response: K_{i+1} = (1 − w) K_i + w BR (1: none)."
     )
+    acceleration: Literal["none", "anderson"] = Field(
+        "none",
+        description="anderson: each sweep answers Anderson's extrapolation from the last `memory` sweeps "
+        "(same best responses, same stopping rule; converges where the plain scheme spirals outwards).",
+    )
+    memory: int = Field(5, ge=1, description="Sweeps Anderson's extrapolation uses.")
     monte_carlo: MonteCarloSpec = Field(default_factory=MonteCarloSpec)
 
 

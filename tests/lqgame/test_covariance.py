@@ -142,9 +142,9 @@ def test_smallest_scaling_is_tight():
         assert report.status.ok is feasible
 
 
-HORIZON_25 = ["problem.horizon=25", "method.monte_carlo.samples=0"]
-"""§4.5.1 at N = 25, where Jacobi's iterates spiral outwards: ε_k and ε_ℓ alternate and each grows
-by about 1.4 every two iterations."""
+HORIZON_25 = ["problem.horizon=25", "method.monte_carlo.samples=0", "method.acceleration=none"]
+"""§4.5.1 at N = 25 with the plain iteration, where Jacobi's iterates spiral outwards: ε_k and ε_ℓ
+alternate and each grows by about 1.4 every two iterations."""
 
 
 def test_jacobi_that_diverges_says_so():
@@ -172,33 +172,75 @@ def test_a_covariance_game_past_its_iteration_limit_is_not_ok():
     assert len(result.metrics["convergence_history"]) == 6
 
 
+def _contraction_rate(result: gamespec.Result) -> float:
+    """The rate ρ per sweep a converged plain run contracted at, from its own history."""
+    largest = [max(h) for h in result.metrics["convergence_history"]]
+    return (largest[-1] / largest[0]) ** (1 / (len(largest) - 1))
+
+
 @pytest.mark.slow
 def test_damping_makes_the_horizon_25_game_converge():
-    """With w = 1/2 the relaxed Jacobi map's spectrum is pulled towards 1 − w: the N = 25 game
-    converges, to a point where the stopper's gains answer the controller's (eq. 4.59b) and
-    Σ_N(K, L) ⪯ Σ_N."""
+    """With w = 1/2 the relaxed Jacobi map ``G_w = (1 − w) x + w G(x)`` is pulled towards 1 − w: the
+    N = 25 game converges, to a point where the stopper's gains answer the controller's (eq. 4.59b)
+    and Σ_N(K, L) ⪯ Σ_N. The file's accelerated run stops at ``‖G(x) − x‖ ≤ tol`` per player, so
+    ``‖G_w(x) − x‖ ≤ w·tol`` and, ``G_w`` contracting at ρ, its responses lie within
+    ``tol + w·tol/(1 − ρ)`` of the damped run's fixed point (which lies within ``tol·ρ/(1 − ρ)``
+    of the damped run's answer)."""
     result = gamespec.solve(gamespec.load(EXAMPLE, [*HORIZON_25, "method.damping=0.5"]))
     assert result.status is Status.OPTIMAL, result.message
     assert result.checks["terminal_covariance_violation"] < 1e-6
     assert result.checks["stopper_response_gap"] < 1e-4
+    accelerated = gamespec.solve(gamespec.load(EXAMPLE, HORIZON_25[:2]))
+    tol, rate, w = gamespec.load(EXAMPLE).method.tolerance, _contraction_rate(result), 0.5
+    bound = np.sqrt(2) * (tol + w * tol / (1 - rate)) + tol * rate / (1 - rate)
+    for gains in ("K", "L"):
+        assert np.abs(accelerated.arrays[gains] - result.arrays[gains]).max() <= bound
+
+
+def test_the_accelerated_file_converges_at_horizon_25():
+    """§4.5.1 at N = 25 as the file stands (Anderson-accelerated Jacobi): converged, Σ_N(K, L) ⪯ Σ_N,
+    and the stopper's gains answer the controller's (eq. 4.59b) up to what a stop at a change ≤ tol
+    leaves: ``ℓ = BR_L(κ_x)`` for the point ``κ_x`` it answered, ``‖κ − κ_x‖ ≤ tol``, and
+    ``BR_L`` is affine with the slope ``Γ = −H_LL⁻¹H_LK``, so the gap is at most ``‖Γ‖₂ tol``."""
+    spec = gamespec.load(EXAMPLE, ["problem.horizon=25", "method.monte_carlo.samples=0"])
+    result = gamespec.solve(spec)
+    assert result.status is Status.OPTIMAL, result.message
+    assert result.metrics["best_response"]["acceleration"] == "anderson"
+    assert result.checks["terminal_covariance_violation"] < 1e-6
+    cov = GameModel.build(spec.game()).covariance
+    slope = np.linalg.norm(np.linalg.solve(cov.H_LL, cov.H_KL.T), 2)
+    assert result.checks["stopper_response_gap"] <= slope * spec.method.tolerance
+
+
+def test_accelerated_jacobi_finds_the_plain_fixed_point():
+    """§4.5.1 at N = 20, where plain Jacobi contracts slowly (ρ from its history, about 0.5 per
+    sweep): the accelerated run answers the same best responses and stops on the same rule, a
+    change ≤ tol per player, so with ``G`` contracting at ρ its responses ``g = G(x)`` are within
+    ``√2·tol·ρ/(1 − ρ)`` of the fixed point as well (``‖x − x*‖ ≤ ‖x − g‖ + ρ‖x − x*‖``), the plain
+    run's within ``tol·ρ/(1 − ρ)``; the payoffs agree to the same order."""
+    common = ["problem.horizon=20", "method.monte_carlo.samples=0"]
+    plain = gamespec.solve(gamespec.load(EXAMPLE, [*common, "method.acceleration=none"]))
+    accelerated = gamespec.solve(gamespec.load(EXAMPLE, common))
+    assert plain.status is Status.OPTIMAL and accelerated.status is Status.OPTIMAL
+    assert accelerated.iterations < plain.iterations
+    tol, rate = gamespec.load(EXAMPLE).method.tolerance, _contraction_rate(plain)
+    bound = (1 + np.sqrt(2)) * tol * rate / (1 - rate)
+    for gains in ("K", "L"):
+        assert np.abs(accelerated.arrays[gains] - plain.arrays[gains]).max() <= bound
 
 
 def test_gauss_seidel_finds_the_jacobi_fixed_point():
     """Both schemes stop near a fixed point of the same best responses (§4.5.1, N = 10): a run
     stopped at a change ≤ tol is within ``tol·ρ/(1 − ρ)`` of it, ``ρ`` the contraction rate
     estimated from the run's own history."""
-    settings = ["method.monte_carlo.samples=0"]
+    settings = ["method.monte_carlo.samples=0", "method.acceleration=none"]
     runs = {
         s: gamespec.solve(gamespec.load(EXAMPLE, [*settings, f"method.scheme={s}"]))
         for s in ("jacobi", "gauss_seidel")
     }
     assert all(r.status is Status.OPTIMAL for r in runs.values())
     tol = gamespec.load(EXAMPLE).method.tolerance
-    bound = 0.0
-    for run in runs.values():
-        largest = [max(h) for h in run.metrics["convergence_history"]]
-        rate = (largest[-1] / largest[0]) ** (1 / (len(largest) - 1))
-        bound += tol * rate / (1 - rate)
+    bound = sum(tol * _contraction_rate(run) / (1 - _contraction_rate(run)) for run in runs.values())
     for gains in ("K", "L"):
         gap = np.abs(runs["gauss_seidel"].arrays[gains] - runs["jacobi"].arrays[gains]).max()
         assert gap <= bound + 1e-7

@@ -95,6 +95,25 @@ def test_whitened_controller_step_is_the_unscaled_problems_minimizer(model: Game
     np.testing.assert_allclose(kappa, x.value, atol=1e-5 * max(1.0, np.abs(x.value).max()))
 
 
+@pytest.mark.parametrize("shape", [(4, 9), (3, 1), (1, 5)])
+def test_terminal_cone_is_the_squared_spectral_norm(shape: tuple[int, int]):
+    """The column form of eq. 4.61, ``Σ_j Z_j ⪯ t I`` with ``Z_j ⪰ w_j w_jᵀ``: its least ``t`` is
+    ``σ_max(W)²`` (``W Wᵀ = Σ_j w_j w_jᵀ``), and with ``t = 1`` it admits ``W`` exactly when
+    ``‖W‖₂ ≤ 1`` (eq. 4.62), here on either side of the boundary."""
+    import cvxpy as cp
+
+    W = np.random.default_rng(sum(shape)).standard_normal(shape)
+    sigma = np.linalg.norm(W, 2)
+    t = cp.Variable()
+    problem = cp.Problem(cp.Minimize(t), CovariancePlayers.terminal_cone(W, t))
+    problem.solve(solver="CLARABEL")
+    assert t.value == pytest.approx(sigma**2, rel=1e-6)
+    for factor, feasible in ((1 - 1e-3, True), (1 + 1e-3, False)):
+        problem = cp.Problem(cp.Minimize(0), CovariancePlayers.terminal_cone(factor * W / sigma, 1.0))
+        problem.solve(solver="CLARABEL")
+        assert (problem.status == "optimal") is feasible
+
+
 @pytest.mark.parametrize("seed", [0, 1])
 def test_jacobi_meets_the_terminal_constraint(seed: int):
     """Algorithm 2 with a target tighter than the UCSG reaches (halfway to the least scaling the

@@ -11,7 +11,7 @@ from scipy.linalg import sqrtm
 
 import gamespec
 from gamespec.best_response import Settings
-from gamespec.lqgame.covariance import lift_gains, vector_to_gains
+from gamespec.lqgame.covariance import gains_to_vector, lift_gains, vector_to_gains
 from gamespec.lqgame.solution import GameModel
 from gamespec.result import Status
 from tests.conftest import PROBLEMS
@@ -229,6 +229,31 @@ def test_the_accelerated_file_converges_at_horizon_25():
     cov = GameModel.build(spec.game()).covariance
     slope = np.linalg.norm(np.linalg.solve(cov.H_LL, cov.H_KL.T), 2)
     assert result.checks["stopper_response_gap"] <= slope * spec.method.tolerance
+
+
+TIGHT = {"tol_gap_abs": 1e-11, "tol_gap_rel": 1e-11, "tol_feas": 1e-11, "tol_ktratio": 1e-9}
+"""Clarabel's tolerances for checks of a best response at the level of the game's own tolerance
+(its defaults, 1e-8 on the duality gap, leave gains about 1e-4 apart between solver paths)."""
+
+
+def test_the_accelerated_answer_is_a_mutual_best_response():
+    """§4.5.1 at N = 20 (the file's accelerated Jacobi, Clarabel at :data:`TIGHT`): the returned
+    gains are the responses ``κ = BR_K(ℓ_x)``, ``ℓ = BR_L(κ_x)`` to a point within the last changes
+    ``ε_k = ‖κ − κ_x‖``, ``ε_ℓ = ‖ℓ − ℓ_x‖`` (≤ tol). So the stopper's best response to κ, affine
+    with the slope ``Γ = −H_LL⁻¹H_LK``, is ℓ within ``‖Γ‖₂ ε_k``, and the controller's, re-solved
+    from scratch on ℓ, is κ within the tolerance."""
+    spec = gamespec.load(EXAMPLE, ["problem.horizon=20", "method.monte_carlo.samples=0"])
+    result = gamespec.solve(spec, options={"solver_options": TIGHT})
+    assert result.status is Status.OPTIMAL, result.message
+    model = GameModel.build(spec.game())
+    cov = model.covariance
+    kappa, ell = gains_to_vector(result.arrays["K"]), gains_to_vector(result.arrays["L"])
+    eps_k, _ = result.metrics["convergence_history"][-1]
+    slope = np.linalg.norm(np.linalg.solve(cov.H_LL, cov.H_KL.T), 2)
+    assert np.linalg.norm(cov.stopper_response(kappa) - ell) <= slope * eps_k * (1 + 1e-6)
+    response, report = CovariancePlayers(model, CvxpyOptions(solver_options=TIGHT)).controller_step(ell)
+    assert report.status is Status.OPTIMAL
+    assert np.linalg.norm(response - kappa) <= spec.method.tolerance
 
 
 def test_accelerated_jacobi_finds_the_plain_fixed_point():

@@ -25,7 +25,6 @@ import qpsolvers
 from gamespec_cvxpy.backend import CovariancePlayers, CvxpyOptions
 
 import gamespec
-from gamespec.best_response import Settings
 from gamespec.lqgame.lifting import lift
 from gamespec.lqgame.mean_steering import MeanGame
 from gamespec.lqgame.solution import GameModel
@@ -85,18 +84,8 @@ def _covariance_game(players: type[CovariancePlayers], N: int, *settings: str) -
     """CPU seconds of building the players and running Algorithm 2 with the file's method."""
     spec = _horizon(N, *settings)
     model = GameModel.build(spec.game())
-    method = spec.method
     start = time.process_time()
-    outcome = players(model, CvxpyOptions()).solve(
-        Settings(
-            scheme=method.scheme,
-            tolerance=method.tolerance,
-            max_iterations=method.max_iterations,
-            damping=method.damping,
-            acceleration=method.acceleration,
-            memory=method.memory,
-        )
-    )
+    outcome = players(model, CvxpyOptions()).solve(spec.method.settings())
     return time.process_time() - start, (model, outcome)
 
 

@@ -294,16 +294,7 @@ class CvxpyModel(LQCompiledModel):
         """Algorithm 2 (warm-started from ``guess``'s gains) or, without Σ_N, the UCSG closed form."""
         if self.players is None:
             return super()._solve_covariance(guess)
-        method = self.spec.method
-        settings = Settings(
-            scheme=method.scheme,
-            tolerance=method.tolerance,
-            max_iterations=method.max_iterations,
-            damping=method.damping,
-            acceleration=method.acceleration,
-            memory=method.memory,
-        )
-        return self.players.solve(settings, self._start_gains(guess))
+        return self.players.solve(self.spec.method.settings(), self._start_gains(guess))
 
 
 class CvxpyBackend(LQBackend):

@@ -22,6 +22,7 @@ import numpy as np
 import sympy as sp
 from pydantic import Discriminator, Field, Tag, field_validator, model_validator
 
+from gamespec.best_response import Settings
 from gamespec.errors import ExpressionError, SpecError
 from gamespec.limits import MAX_INTERVALS, MAX_MAGNITUDE, MAX_SAMPLE_VALUES, MAX_SAMPLES
 from gamespec.specs.base import Number, ProblemParameters, SpecBase, StrictModel, Value
@@ -180,6 +181,17 @@ class LQMethodSpec(StrictModel):
     )
     memory: int = Field(5, ge=1, description="Sweeps Anderson's extrapolation uses.")
     monte_carlo: MonteCarloSpec = Field(default_factory=MonteCarloSpec)
+
+    def settings(self) -> Settings:
+        """The best-response engine's settings of this method."""
+        return Settings(
+            scheme=self.scheme,
+            tolerance=self.tolerance,
+            max_iterations=self.max_iterations,
+            damping=self.damping,
+            acceleration=self.acceleration,
+            memory=self.memory,
+        )
 
 
 class LQGameSpec(ProblemParameters, SpecBase):

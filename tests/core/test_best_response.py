@@ -126,18 +126,23 @@ def test_slow_convergence_reaches_the_iteration_limit():
     assert run.iterations == 30 and not run.converged
 
 
+def _failing_once(player: VectorPlayer, call: int) -> VectorPlayer:
+    """``player``, except that its ``call``-th response fails (infeasible, "empty set")."""
+    calls = []
+
+    def respond(others):
+        calls.append(1)
+        if len(calls) == call:
+            return None, StepReport(Status.INFEASIBLE, "empty set")
+        return player.respond(others)
+
+    return VectorPlayer(player.name, respond)
+
+
 def test_a_failed_player_stops_the_run_with_its_status():
     game = QuadraticGame(sigma=0.6)
     u_player, v_player = game.players()
-    calls = []
-
-    def failing(others):
-        calls.append(1)
-        if len(calls) == 3:
-            return None, StepReport(Status.INFEASIBLE, "empty set")
-        return v_player.respond(others)
-
-    run = iterate([u_player, VectorPlayer("v", failing)], game.start(), Settings(scheme="gauss_seidel"))
+    run = iterate([u_player, _failing_once(v_player, 3)], game.start(), Settings(scheme="gauss_seidel"))
     assert run.outcome is Outcome.PLAYER_FAILED and run.status is Status.INFEASIBLE
     assert run.failed_player == "v" and "empty set" in run.message
     assert run.iterations == 2
@@ -238,16 +243,8 @@ def test_a_failure_at_an_extrapolated_point_is_retried_at_the_responses():
     saddle; v answered once more than there were sweeps."""
     game = QuadraticGame(sigma=2.0, seed=1)
     u_player, v_player = game.players()
-    calls = []
-
-    def fails_once(others):
-        calls.append(1)
-        if len(calls) == 3:
-            return None, StepReport(Status.INFEASIBLE, "empty set")
-        return v_player.respond(others)
-
     settings = Settings(tolerance=1e-10, acceleration="anderson", memory=5)
-    run = iterate([u_player, VectorPlayer("v", fails_once)], game.start(), settings)
+    run = iterate([u_player, _failing_once(v_player, 3)], game.start(), settings)
     assert run.converged and run.status is Status.OPTIMAL
     assert run.players["v"].responses == run.iterations + 1
     np.testing.assert_allclose(run.strategies["u"], game.saddle()[0], atol=1e-9)

@@ -28,9 +28,9 @@ from typing import Any
 
 import casadi as ca
 import numpy as np
-import scipy.sparse as sps
 
-from gamespec_casadi.nlp import CollocationNlp, sparse_dm
+from gamespec_casadi.nlp import CollocationNlp
+from gamespec_casadi.sparse import Coo
 
 
 @dataclass(frozen=True)
@@ -105,9 +105,9 @@ class _Part:
     vector: Any
 
     @classmethod
-    def constant(cls, matrix: sps.spmatrix) -> _Part:
-        coo = sps.coo_matrix(matrix)
-        return cls(coo.row, coo.col, np.zeros(coo.nnz, dtype=int), coo.data, ca.DM.ones(1))
+    def constant(cls, matrix: Coo) -> _Part:
+        zeros = np.zeros(matrix.rows.size, dtype=np.int64)
+        return cls(matrix.rows, matrix.cols, zeros, matrix.values, ca.DM.ones(1))
 
     @classmethod
     def symbolic(cls, matrix: Any, row_offset: int = 0) -> _Part:
@@ -127,13 +127,11 @@ def _assemble(shape: tuple[int, int], parts: list[_Part]) -> Any:
     offsets = np.cumsum([0] + [part.vector.numel() for part in parts])
     source = np.concatenate([part.source + offset for part, offset in zip(parts, offsets, strict=False)])
     weights = np.concatenate([part.weights for part in parts])
-    gather = sps.csr_matrix(
-        (weights, (np.searchsorted(unique, keys), source)), shape=(unique.size, offsets[-1])
-    )
-    return ca.sparsity_cast(sparse_dm(gather) @ ca.vertcat(*(part.vector for part in parts)), pattern)
+    gather = Coo.of(np.searchsorted(unique, keys), source, weights, (unique.size, int(offsets[-1]))).dm()
+    return ca.sparsity_cast(gather @ ca.vertcat(*(part.vector for part in parts)), pattern)
 
 
-def _point_part(mapped: Any, block: Any, k: int, left: sps.csc_matrix | None, S: sps.csr_matrix) -> _Part:
+def _point_part(mapped: Any, block: Any, k: int, left: Coo | None, S: Coo) -> _Part:
     """The part ``L blkdiag(B_1, ..., B_k) S`` of a sum: the blocks the k side by side outputs of a
     mapped function (``block``: the sparsity of one), L the constraint weights C (a Jacobian) or
     ``S^T`` when ``left`` is None (a Hessian); S has one nonzero a row (a scaled selection)."""
@@ -141,18 +139,20 @@ def _point_part(mapped: Any, block: Any, k: int, left: sps.csc_matrix | None, S:
     n_v = block.size2()
     point = np.repeat(np.arange(k), rows_b.size)
     column = point * n_v + np.tile(cols_b, k)
-    assert np.all(np.diff(S.indptr) == 1), "each point variable is one decision variable"
-    var, scale = S.indices, S.data
+    order = np.argsort(S.rows, kind="stable")
+    assert np.array_equal(S.rows[order], np.arange(S.shape[0])), "each point variable is one variable"
+    var, scale = S.cols[order], S.values[order]
     cols = var[column]
     row = point * block.size1() + np.tile(rows_b, k)
     nz = ca.sparsity_cast(mapped, ca.Sparsity.dense(mapped.nnz(), 1))
     if left is None:
         return _Part(var[row], cols, np.arange(row.size), scale[row] * scale[column], nz)
-    counts = np.diff(left.indptr)[row]
+    colind, left_rows, left_values = left.compressed_columns()
+    counts = np.diff(colind)[row]
     entry = np.repeat(np.arange(row.size), counts)
     offsets = np.arange(counts.sum()) - np.repeat(np.cumsum(counts) - counts, counts)
-    at = np.repeat(left.indptr[row], counts) + offsets
-    return _Part(left.indices[at], cols[entry], entry, left.data[at] * scale[column][entry], nz)
+    at = np.repeat(colind[row], counts) + offsets
+    return _Part(left_rows[at], cols[entry], entry, left_values[at] * scale[column][entry], nz)
 
 
 def assembled_nlp(nlp: CollocationNlp) -> AssembledNlp:
@@ -172,11 +172,10 @@ def assembled_nlp(nlp: CollocationNlp) -> AssembledNlp:
         cost_again, cost_grad = cost_again + total, cost_grad + S.T @ ca.vec(grads)
     g = nlp.constraints(_over_points(nlp.point, k)(V, data))
 
-    S_np, C_np = nlp.selection, nlp.weights.tocsc()
     shape_j = (C.size1(), w.numel())
     values, point_jac = _over_points(point.jacobian, k)(V, data)
     parts = [_Part.constant(nlp.linear)]
-    parts.append(_point_part(point_jac, point.jacobian.sparsity_out(1), k, C_np, S_np))
+    parts.append(_point_part(point_jac, point.jacobian.sparsity_out(1), k, nlp.weights, nlp.selection))
     boundary = nlp.boundary
     if nlp.boundary_rows:
         parts.append(_Part.symbolic(ca.jacobian(boundary, w), nlp.boundary_rows[0]))
@@ -186,7 +185,7 @@ def assembled_nlp(nlp: CollocationNlp) -> AssembledNlp:
     mu = ca.reshape(C.T @ lam, n_o, k) + sigma * ca.DM(c)
     point_hess = _over_points(point.hessian, k)(V, ca.vertcat(data, mu))
     hess0 = ca.triu(ca.hessian(sigma * nlp.cost + ca.dot(lam[nlp.boundary_rows], boundary), w)[0])
-    parts = [_point_part(point_hess, point.hessian.sparsity_out(0), k, None, S_np)]
+    parts = [_point_part(point_hess, point.hessian.sparsity_out(0), k, None, nlp.selection)]
     hess_l = _assemble((w.numel(), w.numel()), [*parts, _Part.symbolic(hess0)])
     return AssembledNlp(
         nlp={"x": w, "p": p, "f": cost, "g": g},

@@ -29,17 +29,17 @@ from typing import Any
 
 import casadi as ca
 import numpy as np
-import scipy.sparse as sps
 
 from gamespec.ocp.transcription import Transcription
 from gamespec.symbolic.translate import Library, translate
+from gamespec_casadi.sparse import Coo
 
 
 @dataclass(frozen=True)
 class CollocationNlp:
     """The collocation NLP with the point outputs as a free symbol ``outputs`` (n_o × k):
     ``vec(points) = selection w``, ``g = linear w + weights vec(outputs) + boundary rows`` and
-    ``f = cost + cost_weights^T vec(outputs)`` (constant SciPy sparse matrices and a NumPy vector;
+    ``f = cost + cost_weights^T vec(outputs)`` (constant sparse matrices and a NumPy vector;
     ``boundary`` and ``cost`` hold the end-point terms and the rate penalty)."""
 
     w: Any
@@ -47,9 +47,9 @@ class CollocationNlp:
     point: Any
     point_data: Any
     outputs: Any
-    selection: sps.csr_matrix
-    linear: sps.csr_matrix
-    weights: sps.csr_matrix
+    selection: Coo
+    linear: Coo
+    weights: Coo
     cost_weights: np.ndarray
     boundary: Any
     boundary_rows: list[int]
@@ -60,15 +60,15 @@ class CollocationNlp:
 
     @cached_property
     def selection_dm(self) -> Any:
-        return sparse_dm(self.selection)
+        return self.selection.dm()
 
     @cached_property
     def weights_dm(self) -> Any:
-        return sparse_dm(self.weights)
+        return self.weights.dm()
 
     @cached_property
     def linear_dm(self) -> Any:
-        return sparse_dm(self.linear)
+        return self.linear.dm()
 
     @property
     def points(self) -> Any:
@@ -101,14 +101,6 @@ class CollocationNlp:
         return {"x": self.w, "p": self.p, "f": self.objective(values), "g": self.constraints(values)}
 
 
-def sparse_dm(matrix: sps.spmatrix) -> Any:
-    """A SciPy sparse matrix as a CasADi DM, by its compressed columns (several times faster than
-    ``ca.DM(matrix)``)."""
-    csc = sps.csc_matrix(matrix)
-    pattern = ca.Sparsity(*csc.shape, csc.indptr.tolist(), csc.indices.tolist())
-    return ca.DM(pattern, csc.data.tolist())
-
-
 def point_function(tr: Transcription, lib: Library) -> Any:
     """The SX function ``o(v, data)`` of one evaluation point: variables ``v = [x; u; d]`` (and the
     horizon ``T`` when it is free), ``data = [w; tau; p]`` (grid inputs, normalized time with
@@ -132,7 +124,7 @@ def point_function(tr: Transcription, lib: Library) -> Any:
     return ca.Function("point", [ca.vertcat(x, u, d), ca.vertcat(w, tau, p, horizon)], [o])
 
 
-def _point_selection(tr: Transcription, sx: np.ndarray, su: np.ndarray, n_var: int) -> sps.csr_matrix:
+def _point_selection(tr: Transcription, sx: np.ndarray, su: np.ndarray, n_var: int) -> Coo:
     """S with ``vec([v_1 ... v_k]) = S w``: point i's ``x`` is state node ``eval_index[i]`` times the
     state scales, its ``u`` the i-th control column times the control scales, then d (and T)."""
     nx, nu, nd, n = tr.n_x, tr.n_u, tr.n_d, tr.grid.n_nodes
@@ -151,26 +143,24 @@ def _point_selection(tr: Transcription, sx: np.ndarray, su: np.ndarray, n_var: i
             rows.append((point * n_v + offset + np.arange(width)).ravel())
             cols.append(np.broadcast_to(col, (k, width)).ravel())
             vals.append(np.broadcast_to(val, (k, width)).ravel())
-    return sps.csr_matrix(
-        (np.concatenate(vals), (np.concatenate(rows), np.concatenate(cols))), (n_v * k, n_var)
-    )
+    return Coo.of(np.concatenate(rows), np.concatenate(cols), np.concatenate(vals), (n_v * k, n_var))
 
 
-def _output_weights(tr: Transcription, n_o: int, n_boundary: int) -> tuple[sps.csr_matrix, np.ndarray]:
+def _output_weights(tr: Transcription, n_o: int, n_boundary: int) -> tuple[Coo, np.ndarray]:
     """C and c with ``g = ... + C vec(O)`` (the defects' ``- vec(O_f W^T)``, the path rows
     ``vec(O_path^T)``, the integrals ``O_integrand q``) and ``f = ... + c^T vec(O)`` (``O_L q``)."""
     nx, n_path, n_int = tr.n_x, len(tr.ocp.path), len(tr.ocp.integrals)
-    _, W, q = tr.grid.matrices
+    _, W, q = tr.grid.triplets
     k = len(q)
-    defects = -sps.kron(W, sps.eye(nx, n_o))
+    rows, cols, values, shape = W
+    defects = Coo.of(rows, cols, -values, shape).kron(Coo.eye(nx, n_o))
     r, i = np.meshgrid(np.arange(n_path), np.arange(k), indexing="ij")
-    path = sps.csr_matrix(
-        (np.ones(r.size), ((i + k * r).ravel(), (nx + 1 + r + n_o * i).ravel())), (k * n_path, k * n_o)
-    )
-    boundary = sps.csr_matrix((n_boundary, k * n_o))
-    integrals = sps.kron(q[None, :], sps.eye(n_int, n_o, nx + 1 + n_path))
+    path = Coo.of(i + k * r, nx + 1 + r + n_o * i, 1.0, (k * n_path, k * n_o))
+    boundary = Coo.of([], [], [], (n_boundary, k * n_o))
+    quadrature = Coo.of(np.zeros(k), np.arange(k), q, (1, k))
+    integrals = quadrature.kron(Coo.eye(n_int, n_o, nx + 1 + n_path))
     cost = np.kron(q, np.eye(n_o)[nx])
-    return sps.vstack([defects, path, boundary, integrals]).tocsr(), cost
+    return Coo.vstack([defects, path, boundary, integrals]), cost
 
 
 def collocation_nlp(
@@ -200,13 +190,11 @@ def collocation_nlp(
     boundary = ca.vertcat(*(translate(r.expr, ends, lib) for r in ocp.boundary))
     cost = translate(ocp.mayer, ends, lib) + tr.rate_penalty(U)
 
-    D = grid.matrices[0]
+    D = Coo.of(*grid.triplets[0])
     n_defects = D.shape[0] * nx
     weights, cost_weights = _output_weights(tr, n_o, len(ocp.boundary))
-    linear = sps.hstack(
-        [sps.kron(D, sps.diags(sx)), sps.csr_matrix((n_defects, w.numel() - D.shape[1] * nx))]
-    )
-    linear = sps.vstack([linear, sps.csr_matrix((weights.shape[0] - n_defects, w.numel()))])
+    scales = Coo.of(np.arange(nx), np.arange(nx), sx, (nx, nx))
+    linear = D.kron(scales).resized((weights.shape[0], w.numel()))
     lower, upper = [np.zeros(n_defects)], [np.zeros(n_defects)]
     for r in ocp.path:
         lower.append(np.full(k, r.lower))
@@ -227,7 +215,7 @@ def collocation_nlp(
         ),
         outputs=outer.sym("o", n_o, k),
         selection=_point_selection(tr, sx, su, w.numel()),
-        linear=linear.tocsr(),
+        linear=linear,
         weights=weights,
         cost_weights=cost_weights,
         boundary=boundary,

@@ -20,8 +20,8 @@ from gamespec.flowfield.grid import Grid
 
 def contours(grid: Grid, phi: np.ndarray, level: float = 0.0) -> list[np.ndarray]:
     """The ``level`` contours of node values ``phi`` (nx, ny), each an array (M, 2) of points."""
-    x, y = np.meshgrid(*grid.axes, indexing="ij")
-    generator = contourpy.contour_generator(x, y, phi, line_type=contourpy.LineType.Separate)
+    x, y = grid.axes
+    generator = contourpy.contour_generator(x, y, phi.T, line_type=contourpy.LineType.Separate)
     return [line for line in generator.lines(level) if len(line) > 1]
 
 

@@ -1,0 +1,32 @@
+"""The rectangle of nodes a local level-set update keeps exact (the "tube" of a narrow-band method,
+Peng, Merriman, Osher, Zhao & Kang 1999, as one box per agent).
+
+Each level of φ moves with the characteristics of eq. 5.22 and never takes values from a higher
+level (a viscosity solution of a control problem: φ(x, t) is the least initial value over the points
+that reach x in time t), so the levels read by the capture search depend only on the nodes at or below
+them. The box holds every node at or below the band level, grown by a margin of nodes: a front
+moves less than one node per CFL-limited step, and the stencils of the nodes near the box's edge
+read the frozen values beyond it, which stay above the band.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+Window = tuple[slice, slice]
+
+
+def band_window(values: np.ndarray, level: float, margin: int) -> Window | None:
+    """The smallest rectangle of nodes of ``values`` (nx, ny) holding every node with a value
+    below ``level``, grown by ``margin`` nodes on each side and clipped to the grid; None when no
+    node is that low."""
+    below = values < level
+    rows = np.flatnonzero(below.any(axis=1))
+    if rows.size == 0:
+        return None
+    cols = np.flatnonzero(below.any(axis=0))
+    nx, ny = values.shape
+    return (
+        slice(max(int(rows[0]) - margin, 0), min(int(rows[-1]) + margin + 1, nx)),
+        slice(max(int(cols[0]) - margin, 0), min(int(cols[-1]) + margin + 1, ny)),
+    )

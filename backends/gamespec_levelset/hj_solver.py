@@ -83,10 +83,36 @@ def tvd_rk3(settings: Any, dynamics: Any, grid: Any, values: Any, dt: Any) -> An
     return values / 3 + 2 / 3 * euler(second)
 
 
+_COMPILED: dict[tuple, Any] = {}
+"""The compiled step of each (grid, drift, speeds, CFL number) met in this process."""
+
+
+def compiled_step(grid: Grid, flow: FlowField, speeds: tuple[float, ...], cfl: float) -> Any:
+    """``(φ (agents, nx, ny), dt) → φ`` after one step of every agent, traced and compiled by XLA
+    on the first call for these values and reused by every later solver for them."""
+    key = (grid, tuple(map(str, flow.position)), str(flow.drift_exprs), speeds, cfl)
+    if key not in _COMPILED:
+        import hj_reachability as hj
+        import jax
+        import jax.numpy as jnp
+
+        nodes = hj_grid(grid)
+        settings = hj.SolverSettings.with_accuracy("very_high", CFL_number=cfl)
+        dynamics = [drift_dynamics(flow, s) for s in speeds]
+
+        def advance(values: Any, dt: Any) -> Any:
+            return jnp.stack(
+                [tvd_rk3(settings, d, nodes, v, dt) for d, v in zip(dynamics, values, strict=True)]
+            )
+
+        _COMPILED[key] = jax.jit(advance)
+    return _COMPILED[key]
+
+
 @dataclass
 class HJSolver:
     """Both agents' level sets advanced together by one compiled (XLA) TVD-RK3 step of
-    hj_reachability's WENO5 / Lax–Friedrichs operator."""
+    hj_reachability's WENO5 / Lax–Friedrichs operator, in JAX's default single precision."""
 
     grid: Grid
     flow: FlowField
@@ -95,21 +121,9 @@ class HJSolver:
     _advance: Any = field(init=False, repr=False)
 
     def __post_init__(self) -> None:
-        import hj_reachability as hj
-        import jax
-        import jax.numpy as jnp
-
         self.hamiltonian = FlowHamiltonian(np.asarray(self.speeds, float), self.flow.drift(self.grid.points))
-        grid = hj_grid(self.grid)
-        settings = hj.SolverSettings.with_accuracy("very_high", CFL_number=self.cfl)
-        dynamics = [drift_dynamics(self.flow, float(s)) for s in self.speeds]
-
-        def advance(values: Any, dt: Any) -> Any:
-            return jnp.stack(
-                [tvd_rk3(settings, d, grid, v, dt) for d, v in zip(dynamics, values, strict=True)]
-            )
-
-        self._advance = jax.jit(advance)
+        speeds = tuple(float(s) for s in self.speeds)
+        self._advance = compiled_step(self.grid, self.flow, speeds, float(self.cfl))
 
     @property
     def max_step(self) -> float:
@@ -118,7 +132,7 @@ class HJSolver:
     def step(self, phi: np.ndarray, dt: float, band: float | None = None) -> np.ndarray:
         """One step ``dt`` of every agent on the whole grid (``band`` is not needed: φ is kept exact
         everywhere)."""
-        return np.asarray(self._advance(phi, dt), dtype=float)
+        return np.asarray(self._advance(np.asarray(phi, dtype=np.float32), dt))
 
     def propagate(self, phi: np.ndarray, duration: float, band: float | None = None) -> np.ndarray:
         """φ after ``duration``, in equal CFL-limited steps."""

@@ -4,9 +4,11 @@ Peng, Merriman, Osher, Zhao & Kang 1999, as one box per agent).
 Each level of φ moves with the characteristics of eq. 5.22 and never takes values from a higher
 level (a viscosity solution of a control problem: φ(x, t) is the least initial value over the points
 that reach x in time t), so the levels read by the capture search depend only on the nodes at or below
-them. The box holds every node at or below the band level, grown by a margin of nodes: a front
-moves less than one node per CFL-limited step, and the stencils of the nodes near the box's edge
-read the frozen values beyond it, which stay above the band.
+them. The box holds every node below the band level, grown by a margin of nodes (a front moves less
+than one node per CFL-limited step); it is solved as a grid of its own, with ghost nodes
+extrapolated linearly from it as at the grid's edges, and the nodes beyond keep values above the
+band. What remains is the numerical coupling across levels (the stencils, Lax–Friedrichs
+dissipation), which decays with the distance in cells from the box's edge to the levels read.
 """
 
 from __future__ import annotations

@@ -20,6 +20,7 @@ class Scratch:
         self.capacity = capacity
         self._buffers: dict[str, np.ndarray] = {}
         self._views: dict[tuple[str, int, int, bool], np.ndarray] = {}
+        self._sets: dict[tuple[str, int, int, bool], dict[str, np.ndarray]] = {}
 
     def take(self, name: str, length: int, width: int, transposed: bool = False) -> np.ndarray:
         """A (length, width) array: C-ordered, or the transpose of a C-ordered (width, length) one.
@@ -38,3 +39,19 @@ class Scratch:
                 flat.reshape(width, length).T if transposed else flat.reshape(length, width)
             )
         return view
+
+    def arrays(
+        self, tag: str, extra_rows: dict[str, int], length: int, width: int, transposed: bool = False
+    ) -> dict[str, np.ndarray]:
+        """One array per name of ``extra_rows``, of ``length + extra`` rows (as :meth:`take`), found
+        by one look-up once this set of shapes has been asked for."""
+        key = (tag, length, width, transposed)
+        found = self._sets.get(key)
+        if found is None:
+            if len(self._sets) >= MAX_VIEWS:
+                self._sets.clear()
+            found = self._sets[key] = {
+                name: self.take(f"{tag}{name}", length + extra, width, transposed)
+                for name, extra in extra_rows.items()
+            }
+        return found

@@ -24,11 +24,12 @@ WENO_EPSILON = 1e-6
 
 
 def extrapolate_ghosts(padded: np.ndarray) -> None:
-    """Fill the :data:`GHOSTS`-wide border of ``padded`` (nx + 6, ny + 6) by linear extrapolation of
-    its inner nodes along each axis, in place (the corners are never read)."""
+    """Fill the :data:`GHOSTS`-wide border of ``padded`` (m + 6, k + 6) by linear extrapolation of
+    its inner nodes, in place: along the columns first, then along the rows over the whole width
+    (so the corners too)."""
     g = GHOSTS
     steps = np.arange(1, g + 1, dtype=float)[:, None]
-    for v in (padded[:, g:-g], padded[g:-g].T):  # the stencil axis first, the inner nodes across it
+    for v in (padded[g:-g].T, padded):  # the stencil axis first
         v[g - 1 :: -1] = v[g] - steps * (v[g + 1] - v[g])
         v[-g:] = v[-g - 1] + steps * (v[-g - 1] - v[-g - 2])
 
@@ -56,6 +57,17 @@ def _eno2(v: np.ndarray, dx: float, scratch: Scratch, tag: str, transposed: bool
     return left, right
 
 
+_WENO_ROWS = {
+    **dict.fromkeys(("d", "square"), 5),
+    **dict.fromkeys(("s", "pairs"), 4),
+    **dict.fromkeys(("jump", "common", "rising", "middle", "falling"), 3),
+    **dict.fromkeys(("third", "fours"), 2),
+    "eps": 1,
+    **dict.fromkeys(("central", "a0", "a1", "a2", "total", "left", "right"), 0),
+}
+"""The scratch arrays of :func:`_weno5` and their rows beyond the block's inner nodes."""
+
+
 def _weno5(v: np.ndarray, dx: float, scratch: Scratch, tag: str, transposed: bool) -> Pair:
     """Jiang–Peng WENO5 for both sides at once, in place.
 
@@ -69,43 +81,41 @@ def _weno5(v: np.ndarray, dx: float, scratch: Scratch, tag: str, transposed: boo
     is computed once per pair and read by both sides; they are kept divided by 3 (the weights are
     unchanged with ε scaled alike).
     """
-    n, width = v.shape[0] - 2 * GHOSTS, v.shape[1]
+    n = v.shape[0] - 2 * GHOSTS
+    w = scratch.arrays(tag, _WENO_ROWS, n, v.shape[1], transposed)
 
-    def take(name: str, length: int) -> np.ndarray:
-        return scratch.take(f"{tag}{name}", length, width, transposed)
-
-    d = np.subtract(v[1:], v[:-1], out=take("d", n + 5))
-    s = np.subtract(d[1:], d[:-1], out=take("s", n + 4))
-    jump = np.subtract(s[1:], s[:-1], out=take("jump", n + 3))  # s_{k+1} − s_k, one per pair
-    third = np.subtract(jump[1:], jump[:-1], out=take("third", n + 2))  # s_k − 2s_{k+1} + s_{k+2}
+    d = np.subtract(v[1:], v[:-1], out=w["d"])
+    s = np.subtract(d[1:], d[:-1], out=w["s"])
+    jump = np.subtract(s[1:], s[:-1], out=w["jump"])  # s_{k+1} − s_k, one per pair
+    third = np.subtract(jump[1:], jump[:-1], out=w["third"])  # s_k − 2s_{k+1} + s_{k+2}
     x, y = s[:-1], s[1:]
-    common = np.multiply(jump, jump, out=take("common", n + 3))
+    common = np.multiply(jump, jump, out=w["common"])
     common *= 13 / 3
-    rising = np.multiply(y, 2.0, out=take("rising", n + 3))  # (x − 3y)² = (jump + 2y)²
+    rising = np.multiply(y, 2.0, out=w["rising"])  # (x − 3y)² = (jump + 2y)²
     rising += jump
     np.square(rising, out=rising)
     rising += common
-    middle = np.add(x, y, out=take("middle", n + 3))
+    middle = np.add(x, y, out=w["middle"])
     np.square(middle, out=middle)
     middle += common
-    falling = np.multiply(x, 2.0, out=take("falling", n + 3))  # (3x − y)² = (2x − jump)²
+    falling = np.multiply(x, 2.0, out=w["falling"])  # (3x − y)² = (2x − jump)²
     falling -= jump
     np.square(falling, out=falling)
     falling += common
-    square = np.multiply(d, d, out=take("square", n + 5))
-    pairs = np.maximum(square[:-1], square[1:], out=take("pairs", n + 4))
-    fours = np.maximum(pairs[:-2], pairs[2:], out=take("fours", n + 2))
-    eps = np.maximum(fours[:-1], square[4:], out=take("eps", n + 1))
+    square = np.multiply(d, d, out=w["square"])
+    pairs = np.maximum(square[:-1], square[1:], out=w["pairs"])
+    fours = np.maximum(pairs[:-2], pairs[2:], out=w["fours"])
+    eps = np.maximum(fours[:-1], square[4:], out=w["eps"])
     eps *= WENO_EPSILON
     eps += 1e-99 * dx * dx  # O&F's ε in units of the undivided differences …
     eps *= 4  # … and scaled like the indicators (IS/3 = 12 S/3 in O&F's S)
     scale = 1 / (12 * dx)
-    central = np.add(d[2 : n + 2], d[3 : n + 3], out=take("central", n))
+    central = np.add(d[2 : n + 2], d[3 : n + 3], out=w["central"])
     central *= 7
     central -= d[1 : n + 1]
     central -= d[4 : n + 4]
     central *= scale
-    a0, a1, a2, total = (take(name, n) for name in ("a0", "a1", "a2", "total"))
+    a0, a1, a2, total = w["a0"], w["a1"], w["a2"], w["total"]
 
     def side(*args: np.ndarray) -> np.ndarray:
         """``Φ/dx`` from the indicators, ε and the two third differences, into the last argument:
@@ -134,7 +144,7 @@ def _weno5(v: np.ndarray, dx: float, scratch: Scratch, tag: str, transposed: boo
         eps[:n],
         third[:n],
         third[1 : n + 1],
-        take("left", n),
+        w["left"],
     )
     np.subtract(central, left, out=left)
     right = side(
@@ -144,7 +154,7 @@ def _weno5(v: np.ndarray, dx: float, scratch: Scratch, tag: str, transposed: boo
         eps[1:],
         third[2 : n + 2],
         third[1 : n + 1],
-        take("right", n),
+        w["right"],
     )
     right += central
     return left, right

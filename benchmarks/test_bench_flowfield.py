@@ -14,13 +14,12 @@ installed — the goal is "not slower"; one Gauss–Seidel iteration of the cova
 
 Run: ``python -m pytest benchmarks/test_bench_flowfield.py --benchmark-enable -s``.
 hj_reachability is optional (``pip install hj-reachability jax``); its tests skip without it.
-``python -m benchmarks.flowfield_levelset_speed`` prints the table with the accuracy of each engine
+``python benchmarks/flowfield_levelset_speed.py`` prints the table with the accuracy of each engine
 against a converged extremal-shooting reference.
 """
 
 from __future__ import annotations
 
-import time
 import tracemalloc
 from collections.abc import Callable
 
@@ -28,6 +27,7 @@ import numpy as np
 import pytest
 
 import gamespec
+from benchmarks.flowfield_levelset_speed import capture, timed
 from gamespec.flowfield.grid import Grid
 from gamespec.flowfield.hamiltonian import FlowHamiltonian
 from gamespec.flowfield.levelset import LevelSetReach, LevelSetSolver, capture_by_level_sets, initial_cones
@@ -43,28 +43,6 @@ def _hugo(n: int):
     data = gamespec.load(HUGO).data()
     grid = Grid(data.grid.lower, data.grid.upper, (n, n))
     return data, grid
-
-
-def capture(n: int, engine: str = "numpy") -> LevelSetReach:
-    """The capture search on the Hugo file at n × n nodes, the file's scheme and CFL number."""
-    spec = gamespec.load(HUGO)
-    data, grid = _hugo(n)
-    m = spec.method
-    if engine == "jax":
-        from gamespec_levelset.hj_solver import HJSolver
-
-        solver = HJSolver(grid, data.field, data.nominal_speeds, m.cfl)
-    else:
-        hamiltonian = FlowHamiltonian(data.nominal_speeds, data.field.drift(grid.points))
-        solver = LevelSetSolver(grid, hamiltonian, m.scheme, m.cfl)
-    return capture_by_level_sets(solver, data.origins, m.max_time, level_cells=m.level_cells)
-
-
-def timed(run: Callable[[], LevelSetReach]) -> tuple[LevelSetReach, float, float]:
-    """``run()`` and its CPU (all threads) and wall seconds."""
-    cpu, wall = time.process_time(), time.perf_counter()
-    out = run()
-    return out, time.process_time() - cpu, time.perf_counter() - wall
 
 
 def _best(run: Callable[[], LevelSetReach], rounds: int = 2) -> tuple[LevelSetReach, float, float]:

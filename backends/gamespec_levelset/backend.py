@@ -83,6 +83,7 @@ def _level_set_reach(
         "scheme": "weno5" if engine == "jax" else m.scheme,
         "nodes": list(data.grid.shape),
         "time_steps": reach.steps,
+        "band_level": reach.band,
     }
     arrays = {"reach_margin_time": reach.times, "reach_margin": reach.margins}
     if reach.capture_time is None:
@@ -296,7 +297,10 @@ class _FlowGameBackend(Backend):
 
 
 class LevelSetBackend(_FlowGameBackend):
-    """Reachability by the level-set equation 5.22 on the file's grid."""
+    """Reachability by the level-set equation 5.22 on the file's grid, in NumPy: each step updates
+    only the box around the levels the capture search reads (:mod:`gamespec.flowfield.band`).
+    Nothing to compile, so the fastest for one solve; see ``hj_reachability`` for repeated solves on
+    one grid in one process."""
 
     name = "levelset"
     method = "levelset"
@@ -311,7 +315,11 @@ class ExtremalBackend(_FlowGameBackend):
 
 class HJReachabilityBackend(_FlowGameBackend):
     """Reachability by hj_reachability (JAX) on the file's grid (WENO5, TVD-RK3; the scheme of
-    ``method.scheme`` is not used). Optional: needs ``pip install hj-reachability jax``."""
+    ``method.scheme`` is not used), single precision, the whole grid each step, one XLA program for
+    both agents' step compiled on the first solve for a grid, field and speeds (seconds) and reused
+    by later solves in the process. The fast option for many solves on one grid in one process
+    (per step about twice as fast as NumPy on the whole grid); for one solve, ``levelset`` is
+    faster. Optional: needs ``pip install hj-reachability jax``."""
 
     name = "hj_reachability"
     method = "hj_reachability"

@@ -2,8 +2,9 @@
 
 ``φ_t + v̂|∇φ| + ∇φ·f = 0`` from ``φ(x, 0) = |x − x₀|`` (eq. 5.22), upwind in space
 (:mod:`~gamespec.flowfield.upwind`), local Lax–Friedrichs (:mod:`~gamespec.flowfield.hamiltonian`),
-TVD-RK3 in time with CFL-limited steps (:mod:`~gamespec.flowfield.tvd_rk`); both agents are advanced
-together as one array (2, nx, ny).
+TVD-RK3 in time with CFL-limited steps (:mod:`~gamespec.flowfield.tvd_rk`); φ of both agents is one
+array (2, nx, ny), each advanced in place on its own rectangle of nodes (the whole grid, or in the
+capture search the box of :mod:`~gamespec.flowfield.band` around the levels read).
 
 The initial zero level set is a single point, and the viscosity solution from the cone is flat
 inside the set: in still air ``φ(x, t) = max(|x − x₀| − v̂t, 0)`` (Hopf–Lax), so the zero level set

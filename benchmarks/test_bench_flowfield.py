@@ -19,6 +19,7 @@ import gamespec
 from gamespec.flowfield.grid import Grid
 from gamespec.flowfield.hamiltonian import FlowHamiltonian
 from gamespec.flowfield.levelset import LevelSetSolver, capture_by_level_sets, initial_cones
+from gamespec.flowfield.problem import evaluate
 from tests.conftest import PROBLEMS
 
 HUGO = PROBLEMS / "ch5" / "hurricane_hugo.yaml"
@@ -28,7 +29,7 @@ DURATION = 1.5
 
 
 def _hugo(n: int):
-    data = gamespec.load(HUGO).data()
+    data = evaluate(gamespec.load(HUGO))
     grid = Grid(data.grid.lower, data.grid.upper, (n, n))
     return data, grid
 

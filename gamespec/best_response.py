@@ -273,9 +273,7 @@ class _Iterator:
         if changes[-1] < (1 - ratio) * changes[-1 - period]:
             return False
         bound = ratio * min(changes)
-        return all(
-            self._distance(recent[-1 - j], recent[-1 - j - period]) <= bound for j in range(period)
-        )
+        return all(self._distance(recent[-1 - j], recent[-1 - j - period]) <= bound for j in range(period))
 
     def _trend(self) -> Outcome | None:
         """Cycling or divergence from the largest changes of the last two windows."""

@@ -29,7 +29,7 @@ from gamespec.flowfield.hamiltonian import FlowHamiltonian
 from gamespec.flowfield.levelset import LevelSetSolver, capture_by_level_sets
 from gamespec.flowfield.linearize import lifted, zero_order_hold
 from gamespec.flowfield.nominal import NominalPaths, from_extremals, from_level_sets
-from gamespec.flowfield.problem import FlowGameData
+from gamespec.flowfield.problem import FlowGameData, evaluate
 from gamespec.flowfield.simulation import simulate
 from gamespec.montecarlo import proportion
 from gamespec.result import Result, Status
@@ -167,7 +167,7 @@ class FlowGameModel(CompiledModel):
         refuse_inputs(inputs, self.spec.kind)
         start = time.perf_counter()
         values = {**self.spec.problem.parameters, **(parameters or {})}
-        data = self.spec.data(values)
+        data = evaluate(self.spec, values)
         reach = self.reachability(data)
         if reach.capture_time is None:
             return Result(
@@ -199,7 +199,9 @@ def _game(spec: FlowGameSpec, options: FlowGameOptions, data: FlowGameData, reac
     model = zero_order_hold(data.field, reach.paths, N)
     lift = lifted(model, data.origins.reshape(-1))
     tau, x_hat, u_hat = reach.paths.sampled(N)
-    game = CovarianceGame(lift, _stack(x_hat[:, 1:]), _stack(u_hat), data.bounds, data.payoff)
+    game = CovarianceGame(
+        lift, _stack(x_hat[:, 1:]), _stack(u_hat), data.bounds, data.payoff, data.feedforward
+    )
     open_loop = game.nominal()
     scale = max(game.value(open_loop), 1e-300)
     m = spec.method

@@ -60,6 +60,8 @@ class _PlayerProblem:
             cp.norm(V2 - self.U_hat.reshape(N, 2), 2, axis=1) <= b.delta_u,
             cp.norm(V2[0]) <= b.max_speed,
         ]
+        if game.feedforward == "nominal":
+            self.constraints.append(self.V - self.U_hat == 0)
         for k in range(1, N):
             L = _root(game.noise_rows[k] @ game.noise_rows[k].T)
             spread = cp.norm(np.kron(np.eye(2), L.T) @ self.kappa[8 * (k - 1) : 8 * k])

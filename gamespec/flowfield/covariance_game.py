@@ -16,6 +16,13 @@ Payoffs (another ambiguity): eq. 5.17 is ``‖Σʳ‖²_F = ‖G Gᵀ‖²_F`` (
 which claims to rewrite it, is ``tr(Δᵀ Δ Σˣ) = tr Σʳ = ‖G‖²_F`` (``"trace"``); the two are not
 equal. Both are offered; both are convex in the gains, so the pursuer's step is convex and the
 evader's maximizes a convex function.
+
+Feedforward: ``J`` does not depend on ``V``, but the capture probability (eq. 5.39) does, through the
+mean. With ``"free"`` each player's ``V`` ranges over eq. 5.35; nothing in ``J`` keeps it on ``Û``,
+and a player moves it to free speed for its gains (eq. 5.36), shifting the mean relative position
+by up to ``δ_xᵖ + δ_xᵉ``. With ``"nominal"``, ``V = Û`` (section 5.3: "the mean trajectory is
+assumed to be essentially driven by … the nominal control inputs"): the means stay on the nominal
+paths, open and closed loop share them, and the feedback alone is compared.
 """
 
 from __future__ import annotations
@@ -29,6 +36,7 @@ import numpy as np
 from gamespec.flowfield.linearize import LiftedModel
 
 Payoff = Literal["trace", "frobenius"]
+Feedforward = Literal["free", "nominal"]
 PLAYERS = ("pursuer", "evader")
 
 
@@ -64,6 +72,7 @@ class CovarianceGame:
     U_hat: np.ndarray
     bounds: tuple[PlayerBounds, PlayerBounds]
     payoff: Payoff = "trace"
+    feedforward: Feedforward = "free"
 
     @property
     def N(self) -> int:

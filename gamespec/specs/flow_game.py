@@ -13,6 +13,7 @@ evader's convex–concave procedure and the Monte Carlo.
 from __future__ import annotations
 
 from collections.abc import Mapping
+from dataclasses import dataclass
 from typing import Literal
 
 import numpy as np
@@ -20,11 +21,8 @@ import sympy as sp
 from pydantic import Field, FiniteFloat, model_validator
 
 from gamespec.errors import ExpressionError, SpecError
-from gamespec.flowfield.covariance_game import PlayerBounds
-from gamespec.flowfield.field import FlowField
-from gamespec.flowfield.grid import Grid
-from gamespec.flowfield.problem import FlowGameData
 from gamespec.specs.base import SpecBase, StrictModel, Value
+from gamespec.symbolic.calculus import jacobian, numeric_function
 from gamespec.symbolic.language import RESERVED, parse, symbol
 
 
@@ -65,6 +63,11 @@ class FlowGameProblem(StrictModel):
     capture_radius: Value = Field(description="ε of eq. 5.4.")
     step: Value = Field(description="T̂/N of eq. 5.7; N = round(T̂/step).")
     payoff: Literal["trace", "frobenius"] = "trace"
+    feedforward: Literal["nominal", "free"] = Field(
+        "free",
+        description="free: each player's V moves within eq. 5.35; nominal: V = Û, the means stay on the "
+        "nominal paths (section 5.3: the mean is driven by the nominal controls).",
+    )
 
     @model_validator(mode="after")
     def _names(self) -> FlowGameProblem:
@@ -156,15 +159,46 @@ class FlowGameSpec(SpecBase):
 
     @model_validator(mode="after")
     def _evaluates(self) -> FlowGameSpec:
-        self.data()
+        self.values()
         return self
 
-    def data(self, parameters: Mapping[str, float] | None = None) -> FlowGameData:
-        """The evaluated game for the file's parameter values, updated by ``parameters``."""
+    def values(self, parameters: Mapping[str, float] | None = None) -> FlowGameValues:
+        """The evaluated game for the file's parameter values, updated by ``parameters``; the
+        numerics build their objects from it (:func:`gamespec.flowfield.problem.evaluate`)."""
         unknown = set(parameters or {}) - set(self.problem.parameters)
         if unknown:
             raise SpecError(f"unknown parameter(s) {sorted(unknown)}", field="problem.parameters")
-        return _Evaluator(self, {**self.problem.parameters, **(parameters or {})}).data()
+        return _Evaluator(self, {**self.problem.parameters, **(parameters or {})}).values()
+
+
+@dataclass(frozen=True)
+class PlayerValues:
+    """One agent's evaluated start, speed limit and bounds (eqs. 5.2, 5.35–5.36)."""
+
+    initial: tuple[float, float]
+    max_speed: float
+    delta_x: float
+    delta_u: float
+    beta: float
+
+
+@dataclass(frozen=True)
+class FlowGameValues:
+    """Every entry of a flow-field game evaluated: the drift (2 × 1) and diffusion (2 × 2) as SymPy
+    matrices of the ``position`` symbols only, numbers for the rest, and the grid's box."""
+
+    position: tuple[sp.Symbol, sp.Symbol]
+    drift: sp.Matrix
+    diffusion: sp.Matrix
+    players: tuple[PlayerValues, PlayerValues]
+    speed_fraction: float
+    capture_radius: float
+    step: float
+    payoff: str
+    feedforward: str
+    grid_lower: tuple[float, float]
+    grid_upper: tuple[float, float]
+    grid_nodes: tuple[int, int]
 
 
 class _Evaluator:
@@ -198,21 +232,21 @@ class _Evaluator:
             raise SpecError(f"{value!r} evaluates to {result.real:g}; need {need}", field=f"problem.{field}")
         return result.real
 
-    def player(self, name: str) -> tuple[np.ndarray, PlayerBounds]:
+    def player(self, name: str) -> PlayerValues:
         p: PlayerSpec = getattr(self.spec.problem, name)
-        origin = np.array([self.number(v, f"{name}.initial.{i}") for i, v in enumerate(p.initial)])
         beta = self.number(p.beta, f"{name}.beta", positive=True)
         if beta >= 1:
             raise SpecError("β must lie in (0, 1)", field=f"problem.{name}.beta")
-        bounds = PlayerBounds(
+        return PlayerValues(
+            initial=tuple(self.number(v, f"{name}.initial.{i}") for i, v in enumerate(p.initial)),
             max_speed=self.number(p.max_speed, f"{name}.max_speed", positive=True),
             delta_x=self.number(p.delta_x, f"{name}.delta_x", positive=True),
             delta_u=self.number(p.delta_u, f"{name}.delta_u", positive=True),
             beta=beta,
         )
-        return origin, bounds
 
-    def field(self) -> FlowField:
+    def flow(self) -> tuple[sp.Matrix, sp.Matrix]:
+        """Drift and diffusion, checked to evaluate (with the drift's Jacobian) at a probe point."""
         flow = self.spec.problem.flow
         drift = sp.Matrix([self.expression(v, f"flow.drift.{i}", True) for i, v in enumerate(flow.drift)])
         if isinstance(flow.diffusion, Identity):
@@ -224,40 +258,42 @@ class _Evaluator:
                     for i, row in enumerate(flow.diffusion)
                 ]
             )
-        field = FlowField(self.position, drift, diffusion)
-        probe = np.zeros((1, 2))
-        for label, evaluate in (
-            ("drift", field.drift),
-            ("diffusion", field.diffusion),
-            ("drift", field.jacobian),
+        for label, exprs in (
+            ("drift", list(drift)),
+            ("diffusion", list(diffusion)),
+            ("drift", list(jacobian(drift, self.position))),
         ):
             try:
-                evaluate(probe)
+                numeric_function(exprs, self.position)(np.zeros(1), np.zeros(1))
             except ExpressionError as err:
                 raise SpecError(str(err), field=f"problem.flow.{label}") from None
-        return field
+        return drift, diffusion
 
-    def data(self) -> FlowGameData:
+    def values(self) -> FlowGameValues:
         p, m = self.spec.problem, self.spec.method
-        (xp, bp), (xe, be) = self.player("pursuer"), self.player("evader")
+        pursuer, evader = self.player("pursuer"), self.player("evader")
         fraction = self.number(p.nominal_speed_fraction, "nominal_speed_fraction", positive=True)
         if fraction > 1:
             raise SpecError("v̂/v_max must not exceed 1 (eq. 5.24)", field="problem.nominal_speed_fraction")
-        if bp.max_speed <= be.max_speed:
+        if pursuer.max_speed <= evader.max_speed:
             raise SpecError(
                 "the pursuer must be faster than the evader (section 5.1)", field="problem.pursuer.max_speed"
             )
-        grid = Grid(m.grid.lower, m.grid.upper, m.grid.nodes)
-        origins = np.stack([xp, xe])
-        if not grid.contains(origins).all():
+        origins = np.array([pursuer.initial, evader.initial])
+        if not np.all((origins >= m.grid.lower) & (origins <= m.grid.upper)):
             raise SpecError("both starting points must lie inside the grid", field="method.grid")
-        return FlowGameData(
-            field=self.field(),
-            origins=origins,
-            bounds=(bp, be),
+        drift, diffusion = self.flow()
+        return FlowGameValues(
+            position=self.position,
+            drift=drift,
+            diffusion=diffusion,
+            players=(pursuer, evader),
             speed_fraction=fraction,
             capture_radius=self.number(p.capture_radius, "capture_radius", positive=True),
             step=self.number(p.step, "step", positive=True),
             payoff=p.payoff,
-            grid=grid,
+            feedforward=p.feedforward,
+            grid_lower=m.grid.lower,
+            grid_upper=m.grid.upper,
+            grid_nodes=m.grid.nodes,
         )

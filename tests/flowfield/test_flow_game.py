@@ -12,6 +12,7 @@ import pytest
 import yaml
 
 from gamespec.errors import SpecError
+from gamespec.flowfield.problem import evaluate
 from gamespec.loader import load, spec_from_dict
 from gamespec.solving import solve
 
@@ -107,7 +108,7 @@ def test_set_parameter_on_the_command_line(tmp_path: Path, cli) -> None:
     path.write_text(yaml.safe_dump(SPEC))
     spec = load(path, ["problem.parameters.noise=0.1"])
     assert spec.problem.parameters["noise"] == 0.1
-    assert spec.data().field.diffusion(np.zeros((1, 2)))[0, 0, 0] == pytest.approx(0.1)
+    assert evaluate(spec).field.diffusion(np.zeros((1, 2)))[0, 0, 0] == pytest.approx(0.1)
     code, out, err = cli("validate", path, "--set", "problem.flow.drift=[1]")
     assert code == 2 and "problem.flow.drift" in out + err
     assert cli("validate", path, "--set", "problem.parameters.noise=0.1")[0] == 0

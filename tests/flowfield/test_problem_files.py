@@ -6,6 +6,7 @@ import numpy as np
 import pytest
 
 import gamespec
+from gamespec.flowfield.problem import evaluate
 from tests.conftest import PROBLEMS
 
 FILES = sorted((PROBLEMS / "ch5").glob("*.yaml"))
@@ -18,7 +19,7 @@ def test_files_validate(path, cli) -> None:
 
 def test_alpha_is_a_parameter(cli) -> None:
     spec = gamespec.load(PROBLEMS / "ch5" / "linear_flow.yaml", ["problem.parameters.alpha=0.2"])
-    g = spec.data().field.diffusion(np.zeros((1, 2)))[0]
+    g = evaluate(spec).field.diffusion(np.zeros((1, 2)))[0]
     np.testing.assert_allclose(g, 0.05 * np.eye(2))
 
 
@@ -31,9 +32,9 @@ def test_files_solve(path) -> None:
     result = gamespec.solve(gamespec.load(path))
     m = result.metrics
     spec = gamespec.load(path)
-    dx = spec.data().grid.spacing.max()
+    dx = evaluate(spec).grid.spacing.max()
     assert m["capture_time"] > 0
-    assert result.checks["capture_time_difference"] < 0.25 * dx / spec.data().nominal_speeds[0]
+    assert result.checks["capture_time_difference"] < 0.25 * dx / evaluate(spec).nominal_speeds[0]
     assert isinstance(m["game_converged"], bool)
     carlo = m["monte_carlo_capture_probability"]["open_loop"]
     assert carlo["low"] - 0.01 <= m["capture_probability_open_loop"] <= carlo["high"] + 0.01

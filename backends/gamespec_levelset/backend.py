@@ -35,7 +35,7 @@ from gamespec.montecarlo import proportion
 from gamespec.result import Result, Status
 from gamespec.specs.base import SpecBase, StrictModel
 from gamespec.specs.flow_game import FlowGameSpec
-from gamespec_levelset.players import EvaderStep, GamePlayer, PursuerStep
+from gamespec_levelset.players import EvaderStep, GamePlayer, MinimaxPursuerStep, PursuerStep
 
 DISPERSION_PATHS = 200
 """Sample paths kept in the Result for the dispersion figures (Figs. 5.3, 5.4b)."""
@@ -205,7 +205,10 @@ def _game(spec: FlowGameSpec, options: FlowGameOptions, data: FlowGameData, reac
     open_loop = game.nominal()
     scale = max(game.value(open_loop), 1e-300)
     m = spec.method
-    pursuer = PursuerStep(game, options.solver, options.solver_options, scale)
+    if m.game.scheme == "minimax":
+        pursuer = MinimaxPursuerStep(game, options.solver, options.solver_options, scale, m.game.tolerance)
+    else:
+        pursuer = PursuerStep(game, options.solver, options.solver_options, scale)
     evader = EvaderStep(
         game,
         options.solver,
@@ -224,46 +227,64 @@ def _game(spec: FlowGameSpec, options: FlowGameOptions, data: FlowGameData, reac
         return game.value((strategies["pursuer"], strategies["evader"]))
 
     run = iterate(players, dict(zip(PLAYERS, open_loop, strict=True)), settings, payoff)
-    closed = (run.strategies["pursuer"], run.strategies["evader"])
+    p_star = run.strategies["pursuer"]
+    mixture = _evader_mixture(pursuer, run.strategies["evader"])
     eps = data.capture_radius
     prob = {
-        name: capture_probabilities(*game.relative(s), eps)
-        for name, s in (("open", open_loop), ("closed", closed))
+        "open_loop": capture_probabilities(*game.relative(open_loop), eps),
+        "closed_loop": sum(w * capture_probabilities(*game.relative((p_star, e)), eps) for w, e in mixture),
+        "pursuer_feedback": capture_probabilities(*game.relative((p_star, open_loop[1])), eps),
     }
+    closed = (p_star, max(mixture, key=lambda we: we[0])[1])
     metrics: dict[str, Any] = {
         "capture_time": T,
         "capture_point": [float(v) for v in reach.capture_point],
-        "capture_probability_open_loop": float(prob["open"][-1]),
-        "capture_probability_closed_loop": float(prob["closed"][-1]),
+        **{f"capture_probability_{k}": float(v[-1]) for k, v in prob.items()},
         "game_converged": run.converged,
+        "game_scheme": m.game.scheme,
         "best_response": run.as_metrics(),
         "evader_convex_concave": {"payoffs": evader.log.steps, "converged": evader.log.converged},
         "evader_alternation": evader.log.alternation(),
+        "evader_mixture": {
+            "weights": [w for w, _ in mixture],
+            "payoffs": [game.value((p_star, e)) / scale for _, e in mixture],
+        },
         "payoff": data.payoff,
+        "feedforward": data.feedforward,
         "payoff_open_loop": scale,
+        "payoff_closed_loop": sum(w * game.value((p_star, e)) for w, e in mixture),
+        "payoff_pursuer_feedback": game.value((p_star, open_loop[1])),
         "steps": N,
         "step": model.step,
         "reachability": reach.metrics,
     }
+    if m.game.scheme == "minimax":
+        metrics["minimax_lower_bound"] = pursuer.bound * scale
     arrays = {
         **reach.arrays,
         "nominal_time": reach.paths.times,
         "nominal_positions": reach.paths.positions,
-        "capture_probability_open_loop": prob["open"],
-        "capture_probability_closed_loop": prob["closed"],
+        **{f"capture_probability_{k}": v for k, v in prob.items()},
         "gains": game.controls(closed)[1],
+        "evader_support_gains": np.stack([e.kappa for _, e in mixture]),
     }
     carlo = m.monte_carlo
     if carlo.samples:
+        draws = np.random.default_rng(carlo.seed).multinomial(carlo.samples, [w for w, _ in mixture])
         estimates = {}
-        for name, strategies in (("open_loop", open_loop), ("closed_loop", closed)):
-            V, K = game.controls(strategies)
-            paths = simulate(
-                data.field, model, data.origins.reshape(-1), V, K, carlo.samples, carlo.seed, carlo.substeps
-            )
-            hit = proportion(paths.separation()[:, -1] <= eps)
+        for name, plays in (
+            ("open_loop", [(carlo.samples, open_loop)]),
+            ("closed_loop", [(n, (p_star, e)) for n, (_, e) in zip(draws, mixture, strict=True) if n]),
+        ):
+            x0 = data.origins.reshape(-1)
+            ensembles = [
+                simulate(data.field, model, x0, *game.controls(s), n, carlo.seed + j, carlo.substeps)
+                for j, (n, s) in enumerate(plays)
+            ]
+            hit = proportion(np.concatenate([e.separation()[:, -1] <= eps for e in ensembles]))
             estimates[name] = {"estimate": hit.estimate, "low": hit.low, "high": hit.high, "samples": hit.n}
-            arrays[f"monte_carlo_{name}"] = paths.positions[:DISPERSION_PATHS]
+            paths = np.concatenate([e.positions[:DISPERSION_PATHS] for e in ensembles])
+            arrays[f"monte_carlo_{name}"] = paths[:DISPERSION_PATHS]
         metrics["monte_carlo_capture_probability"] = estimates
     X_bar = np.vstack([data.origins.reshape(1, 4), game.mean(closed)])
     V, _ = game.controls(closed)
@@ -274,7 +295,7 @@ def _game(spec: FlowGameSpec, options: FlowGameOptions, data: FlowGameData, reac
     return Result(
         status=run.status,
         message=run.message,
-        objective=game.value(closed),
+        objective=metrics["payoff_closed_loop"],
         t_final=T,
         iterations=run.iterations,
         time=tau,
@@ -285,6 +306,16 @@ def _game(spec: FlowGameSpec, options: FlowGameOptions, data: FlowGameData, reac
         metrics=metrics,
         checks={"max_constraint_violation": max(0.0, *violations.values())},
     )
+
+
+def _evader_mixture(
+    pursuer: PursuerStep | MinimaxPursuerStep, last: Strategy
+) -> list[tuple[float, Strategy]]:
+    """The evader's play against the pursuer's last strategy: its last response (Gauss–Seidel), or
+    the mixed strategy over the support that the minimax pursuer's multipliers give."""
+    if isinstance(pursuer, MinimaxPursuerStep) and pursuer.support:
+        return [(float(w), e) for w, e in zip(pursuer.weights, pursuer.support, strict=True) if w > 1e-9]
+    return [(1.0, last)]
 
 
 class _FlowGameBackend(Backend):

@@ -126,6 +126,70 @@ class PursuerStep(_PlayerProblem):
         return self.strategy(), StepReport(status)
 
 
+class MinimaxPursuerStep(_PlayerProblem):
+    """The pursuer's security strategy ``min_p max_e J`` by outer approximation: it keeps every
+    evader strategy it has been shown (the support ``𝒮``) and answers ``argmin_p max_{e ∈ 𝒮} J(p, e)``,
+    a convex program (``min t`` s.t. ``J(p, e_j) ≤ t``). Why: ``J`` is convex in the evader's gains
+    too, so a pure saddle point need not exist (then Gauss–Seidel cannot converge); since ``J`` is
+    convex in the pursuer's gains, the pursuer has a pure optimal strategy in the mixed extension
+    and the game's value is ``min_p max_e J`` (Bohnenblust, Karlin and Shapley 1950, games with
+    convex payoff). The restricted value ``t`` is a lower bound of that value; the multipliers of
+    the constraints ``J(p, e_j) ≤ t`` sum to one and are the evader's mixed strategy over ``𝒮``
+    (``weights``). When the evader's best response to the answer is already in ``𝒮``, no response
+    it finds raises ``J`` above ``t``: the iteration has stopped at the value, up to the evader's
+    search being local (the convex–concave procedure)."""
+
+    def __init__(
+        self,
+        game: CovarianceGame,
+        solver: str,
+        solver_options: dict[str, Any],
+        scale: float,
+        tolerance: float,
+    ) -> None:
+        super().__init__(game, 0, solver, solver_options)
+        self.scale, self.tolerance = scale, tolerance
+        self.support: list[Strategy] = []
+        self.weights = np.zeros(0)
+        self.bound = float("nan")
+        T = self.gains_map()
+        self.root = _root(T.T @ T)
+
+    def _payoff_constraints(self, t: Any) -> list[Any]:
+        """``J(p, e_j)/scale ≤ t`` for every ``e_j`` of the support, in the forms of :class:`PursuerStep`."""
+        import cvxpy as cp
+
+        T, N = self.gains_map(), self.game.N
+        out = []
+        for e in self.support:
+            c = self.game.g0 + self.game.gain_maps[1] @ e.kappa.reshape(-1)
+            if self.game.payoff == "trace":
+                value = cp.sum_squares(self.root @ self.kappa) + 2 * (T.T @ c) @ self.kappa + float(c @ c)
+                out.append(value / self.scale <= t)
+            else:
+                G = cp.reshape(c + T @ self.kappa, (2 * N, 4 * N), order="C") / np.sqrt(np.sqrt(self.scale))
+                S = cp.Variable((2 * N, 2 * N), symmetric=True)
+                out += [cp.sum_squares(S) <= t, cp.bmat([[S, G], [G.T, np.eye(4 * N)]]) >> 0]
+        return out
+
+    def respond(self, evader: Strategy) -> tuple[Strategy | None, StepReport]:
+        import cvxpy as cp
+
+        if all(_distance(evader, e) > self.tolerance for e in self.support):
+            self.support.append(evader)
+        t = cp.Variable()
+        bounds = self._payoff_constraints(t)
+        problem = cp.Problem(cp.Minimize(t + self.proximal), [*self.constraints, *bounds])
+        status = self.run(problem)
+        if not status.ok:
+            return None, StepReport(status, f"pursuer step: solver reported {problem.status}")
+        step = 1 if self.game.payoff == "trace" else 2
+        duals = np.array([float(np.sum(c.dual_value)) for c in bounds[::step]])
+        self.weights = np.clip(duals, 0.0, None) / max(float(np.clip(duals, 0.0, None).sum()), 1e-300)
+        self.bound = float(t.value)
+        return self.strategy(), StepReport(status)
+
+
 @dataclass
 class ConvexConcaveLog:
     """Payoffs ``J`` along each evader step's convex–concave iterations."""
@@ -172,7 +236,30 @@ class EvaderStep(_PlayerProblem):
         self.log = ConvexConcaveLog()
 
     def respond(self, pursuer: Strategy) -> tuple[Strategy | None, StepReport]:
-        current = self.current
+        """The better of the procedure from the current strategy and from its mirror ``(V, −K)``
+        (the evader's set is symmetric in its gains and, for the trace payoff,
+        ``J(p, e) + J(p, ẽ) = 2‖c‖² + 2‖Tᵉκᵉ‖²`` for the mirror ``ẽ``: the mirror may lie on the side
+        where ``J`` grows). Ties keep the current strategy, so an evader indifferent between two
+        responses does not alternate."""
+        start = self.current
+        best = self._climb(pursuer, start)
+        if best[0] is not None and np.any(start.kappa):
+            mirror = self._climb(pursuer, Strategy(start.V, -start.kappa))
+            if mirror[0] is not None and mirror[2][-1] - best[2][-1] > self.tolerance * abs(best[2][-1]):
+                best = mirror
+        strategy, report, values, converged = best
+        if strategy is None:
+            return None, report
+        self.current = strategy
+        self.log.responses.append(strategy)
+        self.log.steps.append(values)
+        self.log.converged.append(converged)
+        return strategy, report
+
+    def _climb(
+        self, pursuer: Strategy, current: Strategy
+    ) -> tuple[Strategy | None, StepReport, list[float], bool]:
+        """The convex–concave procedure from ``current``: the strategy, report, payoffs, converged."""
         values = [self.game.value((pursuer, current)) / self.scale]
         converged = self.slope is None
         for _ in range(0 if converged else self.max_iterations):
@@ -180,22 +267,17 @@ class EvaderStep(_PlayerProblem):
             self.slope.value = slope / max(np.linalg.norm(slope), 1e-300)  # the maximizer is scale-free
             status = self.run(self.problem)
             if not status.ok:
-                self.log.steps.append(values)
-                self.log.converged.append(False)
-                return None, StepReport(status, f"evader step: solver reported {self.problem.status}")
+                message = f"evader step: solver reported {self.problem.status}"
+                return None, StepReport(status, message), values, False
             current = self.strategy()
             values.append(self.game.value((pursuer, current)) / self.scale)
             if values[-1] - values[-2] <= self.tolerance * max(abs(values[-2]), 1e-12):
                 converged = True
                 break
-        self.current = current
-        self.log.responses.append(current)
-        self.log.steps.append(values)
-        self.log.converged.append(converged)
         if not converged:
             message = f"evader step: convex-concave procedure stopped after {self.max_iterations} iterations"
-            return current, StepReport(Status.FEASIBLE, message)
-        return current, StepReport(Status.OPTIMAL)
+            return current, StepReport(Status.FEASIBLE, message), values, False
+        return current, StepReport(Status.OPTIMAL), values, True
 
 
 @dataclass(frozen=True)
@@ -204,7 +286,7 @@ class GamePlayer:
     distance ``max(‖ΔV‖, ‖ΔK‖)`` (the stopping rule of section 5.4)."""
 
     name: str
-    step: PursuerStep | EvaderStep
+    step: PursuerStep | MinimaxPursuerStep | EvaderStep
 
     def respond(self, others: dict[str, Strategy]) -> tuple[Strategy | None, StepReport]:
         (other,) = (others[n] for n in PLAYERS if n != self.name)

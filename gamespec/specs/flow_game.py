@@ -97,8 +97,12 @@ class GridSpec(StrictModel):
 
 
 class GameMethod(StrictModel):
-    """Stopping rule of Gauss–Seidel (Algorithm 3): ``max(‖ΔV‖, ‖ΔK‖) ≤ tolerance`` (ε_v = ε_k)."""
+    """The iteration and its stopping rule ``max(‖ΔV‖, ‖ΔK‖) ≤ tolerance`` (ε_v = ε_k): ``gauss_seidel``
+    is Algorithm 3 (it converges only to a pure saddle point, which this game need not have);
+    ``minimax`` keeps Gauss–Seidel's evader step and lets the pursuer answer every evader strategy
+    seen so far (its security strategy, the evader's answer a mixed strategy)."""
 
+    scheme: Literal["gauss_seidel", "minimax"] = "gauss_seidel"
     tolerance: float = Field(5e-3, gt=0)
     max_iterations: int = Field(30, ge=1, le=1000)
 

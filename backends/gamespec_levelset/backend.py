@@ -35,7 +35,13 @@ from gamespec.montecarlo import proportion
 from gamespec.result import Result, Status
 from gamespec.specs.base import SpecBase, StrictModel
 from gamespec.specs.flow_game import FlowGameSpec
-from gamespec_levelset.players import EvaderStep, GamePlayer, MinimaxPursuerStep, PursuerStep
+from gamespec_levelset.players import (
+    EvaderStep,
+    GamePlayer,
+    MinimaxEvader,
+    MinimaxPursuerStep,
+    PursuerStep,
+)
 
 DISPERSION_PATHS = 200
 """Sample paths kept in the Result for the dispersion figures (Figs. 5.3, 5.4b)."""
@@ -218,7 +224,10 @@ def _game(spec: FlowGameSpec, options: FlowGameOptions, data: FlowGameData, reac
         m.convex_concave.max_iterations,
         open_loop[1],
     )
-    players = [GamePlayer("pursuer", pursuer), GamePlayer("evader", evader)]
+    answer = (
+        MinimaxEvader(evader, pursuer, m.game.gap, open_loop[1]) if m.game.scheme == "minimax" else evader
+    )
+    players = [GamePlayer("pursuer", pursuer), GamePlayer("evader", answer)]
     settings = Settings(
         scheme="gauss_seidel", tolerance=m.game.tolerance, max_iterations=m.game.max_iterations
     )

@@ -280,13 +280,37 @@ class EvaderStep(_PlayerProblem):
         return current, StepReport(Status.OPTIMAL), values, True
 
 
+@dataclass
+class MinimaxEvader:
+    """The evader of the ``minimax`` scheme: its step's answer to the pursuer's security strategy
+    when that answer raises ``J`` above the restricted value ``t`` by more than ``gap · t`` (a new
+    strategy the pursuer has not guarded against), else its previous answer. At a mixed
+    equilibrium the evader is indifferent among its support, so its plain best response may jump
+    between support points without any gain; keeping the previous answer then lets the iteration
+    stop, and the stop certifies ``t ≤ J(p, BR_e(p)) ≤ (1 + gap) t``."""
+
+    step: EvaderStep
+    pursuer: MinimaxPursuerStep
+    gap: float
+    previous: Strategy
+
+    def respond(self, pursuer: Strategy) -> tuple[Strategy | None, StepReport]:
+        answer, report = self.step.respond(pursuer)
+        if answer is None:
+            return None, report
+        value = self.step.game.value((pursuer, answer)) / self.step.scale
+        if value > (1 + self.gap) * self.pursuer.bound:
+            self.previous = answer
+        return self.previous, report
+
+
 @dataclass(frozen=True)
 class GamePlayer:
     """A player of :mod:`gamespec.best_response`: its strategy is a :class:`Strategy`,
     distance ``max(‖ΔV‖, ‖ΔK‖)`` (the stopping rule of section 5.4)."""
 
     name: str
-    step: PursuerStep | MinimaxPursuerStep | EvaderStep
+    step: PursuerStep | MinimaxPursuerStep | EvaderStep | MinimaxEvader
 
     def respond(self, others: dict[str, Strategy]) -> tuple[Strategy | None, StepReport]:
         (other,) = (others[n] for n in PLAYERS if n != self.name)

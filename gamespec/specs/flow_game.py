@@ -103,6 +103,12 @@ class GameMethod(StrictModel):
     seen so far (its security strategy, the evader's answer a mixed strategy)."""
 
     scheme: Literal["gauss_seidel", "minimax"] = "gauss_seidel"
+    gap: float = Field(
+        1e-3,
+        gt=0,
+        description="minimax: an evader answer counts as new when it raises J above the pursuer's "
+        "restricted value t by more than gap·t; the stop certifies J(p, BR_e(p)) ≤ (1 + gap) t.",
+    )
     tolerance: float = Field(5e-3, gt=0)
     max_iterations: int = Field(30, ge=1, le=1000)
 

@@ -7,39 +7,13 @@ import numpy as np
 import pytest
 from gamespec_levelset.players import EvaderStep, PursuerStep
 
-from gamespec.flowfield.covariance_game import CovarianceGame, PlayerBounds, Strategy
-from gamespec.flowfield.linearize import lifted, zero_order_hold
-from gamespec.flowfield.nominal import NominalPaths
-from tests.flowfield.conftest import vortex_field
-
-N = 6
-
-
-def _paths() -> NominalPaths:
-    """Trajectories of the vortex field under turning unit headings at speeds 2.4 and 0.8, so the
-    nominal controls do drive the nominal paths (eqs. 5.23–5.26)."""
-    field, speeds = vortex_field(), np.array([2.4, 0.8])
-    t = np.linspace(0.0, 0.6, 601)
-    heading = np.stack([0.3 + 0.5 * t, 2.0 - 0.4 * t])
-    directions = np.stack([np.cos(heading), np.sin(heading)], axis=-1)
-    x = np.zeros((2, t.size, 2))
-    x[:, 0] = [[1.0, 0.5], [2.0, 1.0]]
-    for j in range(t.size - 1):  # Heun on a fine grid: second order, h = 1e-3
-        h = t[j + 1] - t[j]
-        a = field.drift(x[:, j]) + speeds[:, None] * directions[:, j]
-        b = field.drift(x[:, j] + h * a) + speeds[:, None] * directions[:, j + 1]
-        x[:, j + 1] = x[:, j] + h * (a + b) / 2
-    return NominalPaths(t, x, directions, speeds, np.zeros(2))
+from gamespec.flowfield.covariance_game import CovarianceGame, Strategy
+from tests.flowfield.conftest import SMALL_STEPS as N
+from tests.flowfield.conftest import small_game, vortex_field
 
 
 def _game(payoff: str = "trace") -> tuple[CovarianceGame, object]:
-    paths = _paths()
-    model = zero_order_hold(vortex_field(), paths, N)
-    _, x_hat, u_hat = paths.sampled(N)
-    stack = lambda a: np.concatenate([a[0], a[1]], axis=1)  # noqa: E731
-    bounds = (PlayerBounds(3.0, 0.1, 0.6, 0.01), PlayerBounds(1.0, 0.1, 0.2, 0.01))
-    lift = lifted(model, x_hat[:, 0].reshape(-1))
-    return CovarianceGame(lift, stack(x_hat[:, 1:]), stack(u_hat), bounds, payoff), model
+    return small_game(vortex_field(), payoff)
 
 
 def _random_strategies(game: CovarianceGame, seed: int, scale: float = 0.5) -> tuple[Strategy, Strategy]:

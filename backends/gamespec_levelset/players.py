@@ -62,9 +62,11 @@ class _PlayerProblem:
         ]
         if game.feedforward == "nominal":
             self.constraints.append(self.V - self.U_hat == 0)
+        self.spread_maps = np.array(
+            [np.kron(np.eye(2), _root(game.noise_rows[k] @ game.noise_rows[k].T).T) for k in range(1, N)]
+        ).reshape(-1, 8, 8)
         for k in range(1, N):
-            L = _root(game.noise_rows[k] @ game.noise_rows[k].T)
-            spread = cp.norm(np.kron(np.eye(2), L.T) @ self.kappa[8 * (k - 1) : 8 * k])
+            spread = cp.norm(self.spread_maps[k - 1] @ self.kappa[8 * (k - 1) : 8 * k])
             self.constraints.append(cp.norm(V2[k]) + b.chance_factor * spread <= b.max_speed)
         self.proximal = (
             PROXIMAL * cp.sum_squares(self.V - self.U_hat) / max(1.0, float(self.U_hat @ self.U_hat))
@@ -234,6 +236,30 @@ class EvaderStep(_PlayerProblem):
         self.problem = cp.Problem(cp.Maximize(linear - self.proximal), self.constraints)
         self.current = start
         self.log = ConvexConcaveLog()
+        b = game.bounds[1]
+        speeds = np.linalg.norm(self.U_hat.reshape(game.N, 2)[1:], axis=1)
+        self.radii = (b.max_speed - speeds) / b.chance_factor
+        self.inverse_maps = np.linalg.pinv(self.spread_maps) if game.N > 1 else None
+
+    def tangent_step(self, slope: np.ndarray) -> tuple[Strategy | None, StepReport]:
+        """The maximizer of the linearization ``slope · κ`` over the evader's set. With ``V = Û``
+        (feedforward nominal) the set is a product over steps of ``‖S_k κ_k‖ ≤ ρ_k`` (eq. 5.36,
+        ``ρ_k = (v_max − ‖û_k‖)/√(2 log 1/β)``), and each factor's maximizer is closed-form,
+        ``κ_k = ρ_k S_k⁺ h_k/‖h_k‖`` with ``h_k = S_k⁺ᵀ g_k``; otherwise the conic problem is solved."""
+        if self.game.feedforward == "nominal":
+            h = np.einsum("kij,ki->kj", self.inverse_maps, slope.reshape(-1, 8))
+            norms = np.linalg.norm(h, axis=1, keepdims=True)
+            direction = np.where(norms > 0, h / np.where(norms > 0, norms, 1.0), 0.0)
+            kappa = np.zeros((self.game.N, 2, 4))
+            kappa[1:] = (self.radii[:, None] * np.einsum("kij,kj->ki", self.inverse_maps, direction)).reshape(
+                -1, 2, 4
+            )
+            return Strategy(self.U_hat.reshape(-1, 2).copy(), kappa), StepReport(Status.OPTIMAL)
+        self.slope.value = slope / max(np.linalg.norm(slope), 1e-300)  # the maximizer is scale-free
+        status = self.run(self.problem)
+        if not status.ok:
+            return None, StepReport(status, f"evader step: solver reported {self.problem.status}")
+        return self.strategy(), StepReport(status)
 
     def respond(self, pursuer: Strategy) -> tuple[Strategy | None, StepReport]:
         """The better of the procedure from the current strategy and from its mirror ``(V, −K)``
@@ -263,13 +289,10 @@ class EvaderStep(_PlayerProblem):
         values = [self.game.value((pursuer, current)) / self.scale]
         converged = self.slope is None
         for _ in range(0 if converged else self.max_iterations):
-            slope = self.game.gradient((pursuer, current), 1)[1:].reshape(-1)
-            self.slope.value = slope / max(np.linalg.norm(slope), 1e-300)  # the maximizer is scale-free
-            status = self.run(self.problem)
-            if not status.ok:
-                message = f"evader step: solver reported {self.problem.status}"
-                return None, StepReport(status, message), values, False
-            current = self.strategy()
+            step, report = self.tangent_step(self.game.gradient((pursuer, current), 1)[1:].reshape(-1))
+            if step is None:
+                return None, report, values, False
+            current = step
             values.append(self.game.value((pursuer, current)) / self.scale)
             if values[-1] - values[-2] <= self.tolerance * max(abs(values[-2]), 1e-12):
                 converged = True

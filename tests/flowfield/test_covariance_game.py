@@ -111,3 +111,24 @@ def test_evader_convex_concave_steps_never_lower_the_payoff() -> None:
     assert values[-1] > values[0]
     violations = game.violations((open_loop[0], response))
     assert max(v for k, v in violations.items() if k.startswith("evader")) <= 1e-6
+
+
+def test_closed_form_tangent_step_is_the_conic_maximizer() -> None:
+    """With ``V = Û`` the evader's linearized step separates per step; its closed form against the
+    conic problem (Clarabel) on the same set, for random slopes."""
+    game, _ = small_game(vortex_field(), feedforward="nominal")
+    open_loop = game.nominal()
+    evader = EvaderStep(game, "CLARABEL", {}, game.value(open_loop), 1e-6, 30, open_loop[1])
+    rng = np.random.default_rng(7)
+    for _ in range(3):
+        slope = rng.normal(size=8 * (N - 1))
+        closed, report = evader.tangent_step(slope)
+        assert report.status.ok
+        evader.slope.value = slope / np.linalg.norm(slope)
+        assert evader.run(evader.problem).ok
+        conic = evader.strategy()
+        gain = slope @ closed.kappa[1:].reshape(-1)
+        assert gain == pytest.approx(slope @ conic.kappa[1:].reshape(-1), rel=1e-6)
+        np.testing.assert_allclose(closed.kappa, conic.kappa, atol=1e-5 * np.abs(closed.kappa).max())
+        violations = game.violations((open_loop[0], closed))
+        assert max(v for k, v in violations.items() if k.startswith("evader")) <= 1e-9

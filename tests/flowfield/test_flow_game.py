@@ -26,10 +26,11 @@ SPEC = {
         "evader": {"initial": [1, 0.5], "max_speed": 0.75, "delta_u": 0.15},
         "capture_radius": 0.09,
         "step": 0.2,
+        "feedforward": "nominal",
     },
     "method": {
         "grid": {"lower": [-2.5, -3.0], "upper": [4.0, 3.0], "nodes": [53, 49]},
-        "game": {"max_iterations": 3},
+        "game": {"scheme": "minimax", "max_iterations": 12},
         "monte_carlo": {"samples": 20000, "seed": 1},
     },
 }
@@ -53,7 +54,8 @@ def test_capture_time_and_point(result) -> None:
 
 def test_monte_carlo_agrees_with_eq_5_39(result) -> None:
     """For a uniform flow the linearized model is exact and Euler–Maruyama is exact, so the Monte
-    Carlo frequency of capture at T̂ has mean eq. 5.39 (both loops)."""
+    Carlo frequency of capture at T̂ has mean eq. 5.39 (both loops; in closed loop the evader's
+    mixed strategy, so the mixture of its support points' probabilities)."""
     carlo = result.metrics["monte_carlo_capture_probability"]
     for loop in ("open_loop", "closed_loop"):
         p = result.metrics[f"capture_probability_{loop}"]
@@ -65,8 +67,12 @@ def test_monte_carlo_agrees_with_eq_5_39(result) -> None:
 def test_result_reports_the_game_honestly(result) -> None:
     assert isinstance(result.metrics["game_converged"], bool)
     history = result.metrics["best_response"]["history"]
-    assert history and result.metrics["best_response"]["scheme"] == "gauss_seidel"
+    assert history and result.metrics["game_scheme"] == "minimax"
     assert result.ok == result.metrics["game_converged"]
+    mixture = result.metrics["evader_mixture"]
+    assert sum(mixture["weights"]) == pytest.approx(1.0)
+    scale = result.metrics["payoff_open_loop"]
+    assert result.objective == pytest.approx(scale * np.dot(mixture["weights"], mixture["payoffs"]))
     assert result.checks["max_constraint_violation"] <= 1e-6
     for values in result.metrics["evader_convex_concave"]["payoffs"]:
         assert np.all(np.diff(values) >= -1e-6 * np.abs(values[:-1]))

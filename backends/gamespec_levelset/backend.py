@@ -27,7 +27,7 @@ from gamespec.flowfield.covariance_game import PLAYERS, CovarianceGame, Strategy
 from gamespec.flowfield.extremals import capture_by_extremals
 from gamespec.flowfield.hamiltonian import FlowHamiltonian
 from gamespec.flowfield.levelset import LevelSetSolver, capture_by_level_sets
-from gamespec.flowfield.linearize import lifted, zero_order_hold
+from gamespec.flowfield.linearize import DiscreteModel, lifted, zero_order_hold
 from gamespec.flowfield.nominal import NominalPaths, from_extremals, from_level_sets
 from gamespec.flowfield.problem import FlowGameData, evaluate
 from gamespec.flowfield.simulation import simulate
@@ -198,16 +198,41 @@ class FlowGameModel(CompiledModel):
         )
 
 
-def _game(spec: FlowGameSpec, options: FlowGameOptions, data: FlowGameData, reach: Reachability) -> Result:
-    """Stages 2–4: linearization, the covariance game, capture probabilities and Monte Carlo."""
-    T = reach.capture_time
-    N = max(1, round(T / data.step))
+@dataclass(frozen=True)
+class Linearized:
+    """Stage 2: the discrete model along the nominal paths, the game about them, the step times."""
+
+    model: DiscreteModel
+    game: CovarianceGame
+    time: np.ndarray
+
+
+def linearized_game(data: FlowGameData, reach: Reachability) -> Linearized:
+    """``N = round(T̂/step)`` steps, the zero-order hold (eqs. 5.5–5.8), the lifting (eq. 5.10) and
+    the covariance game about the sampled nominal paths."""
+    N = max(1, round(reach.capture_time / data.step))
     model = zero_order_hold(data.field, reach.paths, N)
     lift = lifted(model, data.origins.reshape(-1))
     tau, x_hat, u_hat = reach.paths.sampled(N)
     game = CovarianceGame(
         lift, _stack(x_hat[:, 1:]), _stack(u_hat), data.bounds, data.payoff, data.feedforward
     )
+    return Linearized(model, game, tau)
+
+
+@dataclass(frozen=True)
+class Players:
+    """The two players of the file's scheme, their steps, and the engine's settings."""
+
+    pursuer: PursuerStep | MinimaxPursuerStep
+    evader: EvaderStep
+    players: list[GamePlayer]
+    settings: Settings
+    scale: float
+
+
+def game_players(spec: FlowGameSpec, options: FlowGameOptions, game: CovarianceGame) -> Players:
+    """Gauss–Seidel's (Algorithm 3) or the minimax scheme's players, scaled by the open-loop payoff."""
     open_loop = game.nominal()
     scale = max(game.value(open_loop), 1e-300)
     m = spec.method
@@ -225,17 +250,31 @@ def _game(spec: FlowGameSpec, options: FlowGameOptions, data: FlowGameData, reac
         open_loop[1],
     )
     answer = (
-        MinimaxEvader(evader, pursuer, m.game.gap, open_loop[1]) if m.game.scheme == "minimax" else evader
+        MinimaxEvader(evader, pursuer, m.game.gap, open_loop[1])
+        if isinstance(pursuer, MinimaxPursuerStep)
+        else evader
     )
     players = [GamePlayer("pursuer", pursuer), GamePlayer("evader", answer)]
     settings = Settings(
         scheme="gauss_seidel", tolerance=m.game.tolerance, max_iterations=m.game.max_iterations
     )
+    return Players(pursuer, evader, players, settings, scale)
+
+
+def _game(spec: FlowGameSpec, options: FlowGameOptions, data: FlowGameData, reach: Reachability) -> Result:
+    """Stages 2–4: linearization, the covariance game, capture probabilities and Monte Carlo."""
+    T = reach.capture_time
+    stage = linearized_game(data, reach)
+    model, game, tau = stage.model, stage.game, stage.time
+    open_loop = game.nominal()
+    m = spec.method
+    cast = game_players(spec, options, game)
+    pursuer, evader, scale = cast.pursuer, cast.evader, cast.scale
 
     def payoff(strategies: dict[str, Strategy]) -> float:
         return game.value((strategies["pursuer"], strategies["evader"]))
 
-    run = iterate(players, dict(zip(PLAYERS, open_loop, strict=True)), settings, payoff)
+    run = iterate(cast.players, dict(zip(PLAYERS, open_loop, strict=True)), cast.settings, payoff)
     p_star = run.strategies["pursuer"]
     mixture = _evader_mixture(pursuer, run.strategies["evader"])
     eps = data.capture_radius
@@ -263,7 +302,7 @@ def _game(spec: FlowGameSpec, options: FlowGameOptions, data: FlowGameData, reac
         "payoff_open_loop": scale,
         "payoff_closed_loop": sum(w * game.value((p_star, e)) for w, e in mixture),
         "payoff_pursuer_feedback": game.value((p_star, open_loop[1])),
-        "steps": N,
+        "steps": model.N,
         "step": model.step,
         "reachability": reach.metrics,
     }

@@ -117,7 +117,7 @@ class ConvexConcaveMethod(StrictModel):
     """The evader's convex–concave procedure: stop when ``J`` rises by less than ``tolerance · J``."""
 
     tolerance: float = Field(1e-6, gt=0)
-    max_iterations: int = Field(50, ge=1, le=1000)
+    max_iterations: int = Field(500, ge=1, le=10_000)
 
 
 class MonteCarloMethod(StrictModel):

@@ -4,7 +4,8 @@ blue the evader as in the thesis:
 - ``reachable_sets.png``: both reachable sets at ``T̂`` (the upper level read, or the extremal
   fronts) with the nominal paths and the capture point (Figs. 5.1, 5.4(a));
 - ``dispersion.png``: closed-loop Monte Carlo paths of both agents (Figs. 5.3, 5.4(b));
-- ``capture_probability.png``: eq. 5.39 per step, open and closed loop.
+- ``capture_probability.png``: eq. 5.39 per step, open loop, closed loop, and the pursuer's
+  feedback against the open-loop evader.
 
 :func:`plot_capture_sweep` draws the capture probability at ``T̂`` against a swept parameter (the
 noise level α: Fig. 5.2) from the points of a ``gamespec sweep`` folder (``gamespec plot DIR``) or
@@ -28,6 +29,9 @@ from gamespec.plotting import LEGEND_RIGHT, headline
 from gamespec.result import Result
 
 COLORS = ("tab:red", "tab:blue")
+LOOPS = (("open_loop", "o"), ("closed_loop", "s"), ("pursuer_feedback", "^"))
+"""Eq. 5.39 in open loop, at the game's solution, and with the pursuer's feedback against the
+open-loop evader."""
 
 
 def _level(result: Result) -> str:
@@ -66,8 +70,10 @@ def _dispersion(ax: Axes, result: Result) -> None:
 
 def _probability(ax: Axes, result: Result) -> None:
     t = result.time[1:]
-    ax.plot(t, result.arrays["capture_probability_open_loop"], "o-", label="open loop")
-    ax.plot(t, result.arrays["capture_probability_closed_loop"], "s-", label="closed loop")
+    for loop, marker in LOOPS:
+        if f"capture_probability_{loop}" in result.arrays:
+            label = loop.replace("_", " ")
+            ax.plot(t, result.arrays[f"capture_probability_{loop}"], marker + "-", label=label)
     ax.set_xlabel("t")
     ax.set_ylabel("capture probability (eq. 5.39)")
 
@@ -94,9 +100,6 @@ def plot(result: Result, output_dir: Path, *, animate: bool = False) -> list[Pat
         plt.close(fig)
         written.append(output_dir / name)
     return written
-
-
-LOOPS = (("open_loop", "o"), ("closed_loop", "s"), ("pursuer_feedback", "^"))
 
 
 def capture_rows(values: Iterable[Mapping[str, Any]]) -> list[Mapping[str, Any]]:

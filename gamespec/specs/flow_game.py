@@ -4,10 +4,17 @@
 names, e.g. eq. 5.37 or eq. 5.40) and the diffusion ``g(x)`` (a 2 × 2 matrix of expressions, or
 ``{identity: s}``) — both players' starts, speed limits and the bounds of eqs. 5.35–5.36
 (``delta_x``, ``delta_u``, ``beta``), the nominal speed fraction ``v̂/v_max``, the capture radius ε,
-the step ``T̂/N`` and the payoff (``trace``: eq. 5.34; ``frobenius``: eq. 5.17). Any number may be
-an expression over ``parameters``; the flow's expressions may use the position names as well.
-``method`` sets the reachability grid and scheme, the Gauss–Seidel stopping rule (Algorithm 3), the
-evader's convex–concave procedure and the Monte Carlo.
+the step ``T̂/N``, the payoff (``trace``: eq. 5.34; ``frobenius``: eq. 5.17) and the feedforward
+(``free``: ``V`` within eq. 5.35; ``nominal``: ``V = Û``, the means on the nominal paths). Any
+number may be an expression over ``parameters``; the flow's expressions may use the position names
+as well. ``method`` sets the reachability grid and scheme, the game's iteration (``gauss_seidel``,
+Algorithm 3, or ``minimax``, the pursuer's security strategy against the evader's mixed strategy)
+and its stopping rule, the evader's convex–concave procedure and the Monte Carlo.
+
+Validation at load evaluates every entry through the symbolic layer only (SymPy and
+:func:`gamespec.symbolic.calculus.numeric_function` at a probe point) into
+:class:`FlowGameValues`; the numerics build their objects from those values
+(:func:`gamespec.flowfield.problem.evaluate`).
 """
 
 from __future__ import annotations
@@ -21,7 +28,7 @@ import sympy as sp
 from pydantic import Field, FiniteFloat, model_validator
 
 from gamespec.errors import ExpressionError, SpecError
-from gamespec.specs.base import SpecBase, StrictModel, Value
+from gamespec.specs.base import ProblemParameters, SpecBase, StrictModel, Value
 from gamespec.symbolic.calculus import jacobian, numeric_function
 from gamespec.symbolic.language import RESERVED, parse, symbol
 
@@ -158,14 +165,21 @@ class FlowGameMethod(StrictModel):
         return self
 
 
-class FlowGameSpec(SpecBase):
-    """Two agents in a stochastic flow field: reachability, nominal paths, covariance game (ch. 5)."""
+class FlowGameSpec(ProblemParameters, SpecBase):
+    """Two agents in a stochastic flow field: reachability, nominal paths, covariance game (ch. 5);
+    its runtime parameters are ``problem.parameters`` (``gamespec sweep --param alpha=…``)."""
 
     kind: Literal["flow_field_game"] = "flow_field_game"
     problem: FlowGameProblem
     method: FlowGameMethod
 
     default_backend = "levelset"
+
+    @property
+    def objective_sense(self) -> str:
+        """``saddle``: the objective is the game's value, which the pursuer minimizes and the
+        evader maximizes."""
+        return "saddle"
 
     @model_validator(mode="after")
     def _evaluates(self) -> FlowGameSpec:

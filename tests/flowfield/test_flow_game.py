@@ -5,6 +5,7 @@ Monte Carlo of the SDE must agree within sampling error), and the bad-input cont
 from __future__ import annotations
 
 import copy
+import json
 from pathlib import Path
 
 import numpy as np
@@ -127,3 +128,23 @@ def test_hj_reachability_backend_agrees(result) -> None:
     assert other.metrics["reachability"]["engine"].startswith("hj_reachability")
     cell_time = 6.5 / 52 / 1.6
     assert other.metrics["capture_time"] == pytest.approx(result.metrics["capture_time"], abs=0.1 * cell_time)
+
+
+def test_fig_5_2_from_a_sweep(tmp_path: Path, cli) -> None:
+    """``gamespec sweep`` over the noise parameter keeps each point's capture probabilities, and
+    ``gamespec plot`` on the folder draws them against it (Fig. 5.2); the stage that does not
+    depend on the noise (reachability) is computed once per worker."""
+    data = copy.deepcopy(SPEC)
+    data["method"]["monte_carlo"]["samples"] = 2000
+    data["solver"] = {"backend": "levelset", "options": {"levelset": {"cross_check": False}}}
+    path = tmp_path / "uniform.yaml"
+    path.write_text(yaml.safe_dump(data))
+    code, out, err = cli("sweep", path, "--param", "noise=0.03,0.06", "--out", tmp_path / "study", "--json")
+    assert code == 0, err
+    rows = json.loads(out)
+    assert [r["noise"] for r in rows] == [0.03, 0.06]
+    for row in rows:
+        assert {"open_loop", "closed_loop"} <= set(row["metrics"]["monte_carlo_capture_probability"])
+    code, out, err = cli("plot", tmp_path / "study", "--out", tmp_path / "figures")
+    assert code == 0, err
+    assert (tmp_path / "figures" / "capture_probability_noise.png").stat().st_size > 0

@@ -148,3 +148,12 @@ def test_fig_5_2_from_a_sweep(tmp_path: Path, cli) -> None:
     code, out, err = cli("plot", tmp_path / "study", "--out", tmp_path / "figures")
     assert code == 0, err
     assert (tmp_path / "figures" / "capture_probability_noise.png").stat().st_size > 0
+
+
+def test_summary_leads_with_the_capture(result) -> None:
+    from gamespec.summaries import outcome
+
+    rows = dict(outcome(result))
+    assert rows["capture time T̂"] == result.metrics["capture_time"]
+    assert rows["P(capture at T̂), closed loop"] == result.metrics["capture_probability_closed_loop"]
+    assert rows["game converged"].startswith(str(result.metrics["game_converged"]))

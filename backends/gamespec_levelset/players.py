@@ -137,20 +137,16 @@ class MinimaxPursuerStep(_PlayerProblem):
     and the game's value is ``min_p max_e J`` (Bohnenblust, Karlin and Shapley 1950, games with
     convex payoff). The restricted value ``t`` is a lower bound of that value; the multipliers of
     the constraints ``J(p, e_j) ≤ t`` sum to one and are the evader's mixed strategy over ``𝒮``
-    (``weights``). When the evader's best response to the answer is already in ``𝒮``, no response
+    (``weights``); an evader strategy within ``distinct`` of a support point is not added again.
+    When the evader's best response to the answer is already in ``𝒮``, no response
     it finds raises ``J`` above ``t``: the iteration has stopped at the value, up to the evader's
     search being local (the convex–concave procedure)."""
 
     def __init__(
-        self,
-        game: CovarianceGame,
-        solver: str,
-        solver_options: dict[str, Any],
-        scale: float,
-        tolerance: float,
+        self, game: CovarianceGame, solver: str, solver_options: dict[str, Any], scale: float, distinct: float
     ) -> None:
         super().__init__(game, 0, solver, solver_options)
-        self.scale, self.tolerance = scale, tolerance
+        self.scale, self.distinct = scale, distinct
         self.support: list[Strategy] = []
         self.weights = np.zeros(0)
         self.bound = float("nan")
@@ -177,7 +173,7 @@ class MinimaxPursuerStep(_PlayerProblem):
     def respond(self, evader: Strategy) -> tuple[Strategy | None, StepReport]:
         import cvxpy as cp
 
-        if all(_distance(evader, e) > self.tolerance for e in self.support):
+        if all(_distance(evader, e) > self.distinct for e in self.support):
             self.support.append(evader)
         t = cp.Variable()
         bounds = self._payoff_constraints(t)

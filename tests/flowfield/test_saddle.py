@@ -56,13 +56,15 @@ def test_gauss_seidel_cycles_in_a_linear_flow():
     assert max(copies) < (game.value((p, last)) + game.value((p, before))) / 2
 
 
-@pytest.mark.parametrize("field", [linear_field, vortex_field])
-def test_minimax_stops_with_a_certified_value(field):
+@pytest.mark.parametrize(
+    ("field", "payoff"), [(linear_field, "trace"), (vortex_field, "trace"), (vortex_field, "frobenius")]
+)
+def test_minimax_stops_with_a_certified_value(field, payoff):
     """At the stop: the multipliers are a mixed strategy (≥ 0, sum 1) on the support points where
     ``J(p*, e_j) = t`` (complementary slackness), no support point exceeds ``t``, the evader's answer
     to ``p*`` stays below ``(1 + gap) t``, and ``t`` is at least what the pursuer's best response to
     the passive evader (the first support point) reaches."""
-    game, _ = small_game(field(), feedforward="nominal")
+    game, _ = small_game(field(), payoff, feedforward="nominal")
     run, pursuer, evader, scale = _run(game, minimax=True)
     assert run.converged, run.message
     p, t, w = run.strategies["pursuer"], pursuer.bound, pursuer.weights

@@ -10,9 +10,14 @@ point when ``J`` rises by less than the tolerance. Its history is reported.
 
 Both feasible sets are eqs. 5.35a–b and the chance constraint eq. 5.36, all second-order cones; in
 eq. 5.36 the matrix norm ``‖Σ^{y1/2} K_kⁱᵀ‖`` is bounded by its Frobenius norm (a conservative SOC
-form of Theorem 5's ``σ_max``). ``V`` does not enter ``J`` (eq. 5.34 depends on ``K`` only), so it
-is fixed by a small proximal term ``ρ ‖V − Û‖²`` that breaks ties toward the nominal control.
+form of Theorem 5's ``σ_max``). ``V`` does not enter ``J`` (eq. 5.34 depends on ``K`` only): with
+``feedforward: nominal`` it is ``Û``; with ``free`` a small proximal term ``ρ ‖V − Û‖²`` breaks
+ties toward the nominal control (a player still moves ``V`` where that frees speed for its gains).
 Problems are scaled so that the open-loop payoff is 1.
+
+Algorithm 3 pairs :class:`PursuerStep` with :class:`EvaderStep`; the ``minimax`` scheme pairs
+:class:`MinimaxPursuerStep` (the pursuer's security strategy over the evader strategies seen) with
+:class:`MinimaxEvader` (the evader's step, kept only when it beats the restricted value).
 """
 
 from __future__ import annotations

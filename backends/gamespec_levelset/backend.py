@@ -334,8 +334,9 @@ def _game(spec: FlowGameSpec, options: FlowGameOptions, data: FlowGameData, reac
             ]
             hit = proportion(np.concatenate([e.separation()[:, -1] <= eps for e in ensembles]))
             estimates[name] = {"estimate": hit.estimate, "low": hit.low, "high": hit.high, "samples": hit.n}
-            paths = np.concatenate([e.positions[:DISPERSION_PATHS] for e in ensembles])
-            arrays[f"monte_carlo_{name}"] = paths[:DISPERSION_PATHS]
+            kept = [-(-DISPERSION_PATHS * len(e.positions) // carlo.samples) for e in ensembles]
+            paths = np.concatenate([e.positions[:n] for e, n in zip(ensembles, kept, strict=True)])
+            arrays[f"monte_carlo_{name}"] = paths[:DISPERSION_PATHS]  # each support point in its share
         metrics["monte_carlo_capture_probability"] = estimates
     X_bar = np.vstack([data.origins.reshape(1, 4), game.mean(closed)])
     V, _ = game.controls(closed)

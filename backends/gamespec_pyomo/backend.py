@@ -30,6 +30,7 @@ from gamespec_pyomo.model import build_model
 from gamespec_pyomo.nlfile import NLFile
 from gamespec_pyomo.solvers import (
     PRINT_LEVEL,
+    Run,
     check_options,
     find_executable,
     iterations_in,
@@ -146,6 +147,13 @@ class PyomoModel(CollocationModel):
         opts["max_wall_time"] = self.options.max_wall_time
         return opts | self.options.options
 
+    def _execute(self) -> Run:
+        """Run the executable on the NL file of the model as it stands; load the solution it finds."""
+        run = run_solver(self.executable, self.nl.text(), self._solver_options())
+        if len(run.results.solution) > 0:
+            self.nl.load(run.results.solution(0))
+        return run
+
     def solve_once(
         self, parameters: dict[str, float] | None = None, guess: Result | None = None, inputs: Inputs = None
     ) -> Result:
@@ -160,12 +168,10 @@ class PyomoModel(CollocationModel):
             self._set_start(start.X, start.U, start.d, start.T, b)
         m.dual.clear()
         tic = time.perf_counter()
-        run = run_solver(self.executable, self.nl.text(), self._solver_options())
+        run = self._execute()
+        elapsed = time.perf_counter() - tic
         results, log = run.results, run.log
         loaded = len(results.solution) > 0
-        if loaded:
-            self.nl.load(results.solution(0))
-        elapsed = time.perf_counter() - tic
         self._solved = self._solved or loaded
         termination = str(results.solver.termination_condition)
         # Pyomo's SOL reader stores the solver's message with ':' escaped as '\x3a'.

@@ -1,0 +1,123 @@
+"""The Pyomo backend at large N (issue 16, item 7): the NL file written once per compiled model
+against Pyomo's ``SolverFactory`` writing the whole file on every solve (the backend before), on
+Zermelo's minimum-time file and the cart-pole swing-up at N = 100, 300 and 1000 Radau intervals.
+
+Per size, on one compiled model: the NL text alone (a fresh write of the model by Pyomo's writer
+against :meth:`NLFile.text`), then cold re-solves (from the file's guess, so both paths solve the
+same NLP from the same start) through either path, interleaved, the smallest time of each kept.
+Times are CPU seconds of this process (the NL text, the SOL file, loading, the Result) and the
+solver's own wall time from its log (``wall_time`` of ripopt, ``Total seconds in IPOPT``); the last
+test fits the growth exponents ``t ~ N^k`` over the sizes. Both paths must reach the same optimum
+(1e-8 relative) with the same iteration count.
+
+Run: ``python -m pytest benchmarks/test_bench_pyomo.py --benchmark-enable -m slow -s``.
+"""
+
+from __future__ import annotations
+
+import io
+import tempfile
+import time
+from pathlib import Path
+
+import numpy as np
+import pytest
+from gamespec_pyomo.nlfile import WRITER_CONFIG
+from gamespec_pyomo.solvers import Run, pyomo_solver
+from pyomo.repn.plugins.nl_writer import NLWriter
+
+import gamespec
+from gamespec.solving import get_backend
+from tests.conftest import PROBLEMS
+
+FILES = {
+    "zermelo_min_time": PROBLEMS / "ch6" / "zermelo_min_time.yaml",
+    "cart_pole": PROBLEMS / "ocp" / "cart_pole_swing_up.yaml",
+}
+SIZES = (100, 300, 1000)
+PAIRS = 2
+_ROWS: dict[tuple[str, int], dict[str, float]] = {}
+
+
+def _whole_file(compiled) -> Run:
+    """The backend before: Pyomo's SolverFactory writes the whole NL file, runs the executable and
+    loads the SOL file through its symbol map."""
+    with tempfile.TemporaryDirectory() as tmp:
+        log = Path(tmp) / "solver.log"
+        results = pyomo_solver(compiled.executable).solve(
+            compiled.model, options=compiled._solver_options(), logfile=str(log), load_solutions=False
+        )
+        if len(results.solution) > 0:
+            compiled.model.solutions.load_from(results)
+        return Run(results, log.read_text(), results.solver.time)
+
+
+def _fresh_write(model) -> None:
+    NLWriter().write(model, io.StringIO(), None, None, **WRITER_CONFIG)
+
+
+def _cpu(call) -> tuple[float, object]:
+    tic = time.process_time()
+    out = call()
+    return time.process_time() - tic, out
+
+
+def _timed_solve(compiled) -> dict[str, float]:
+    cpu, result = _cpu(compiled.solve)
+    assert result.ok, result.message
+    solver = result.solver_stats["solver_time_s"]
+    return {"cpu": cpu, "solver": solver, "objective": result.objective, "iterations": result.iterations}
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("n", SIZES)
+@pytest.mark.parametrize("case", sorted(FILES))
+def test_resolve_new_against_old(benchmark, monkeypatch, case: str, n: int) -> None:
+    benchmark.group = f"pyomo {case}, N = {n}"
+    spec = gamespec.load(FILES[case], [f"method.intervals={n}", "solver.options.pyomo.warm_start=false"])
+    compiled = get_backend("pyomo").compile(spec)
+    compiled.solve()
+    write = {"old": min(_cpu(lambda: _fresh_write(compiled.model))[0] for _ in range(PAIRS))}
+    write["new"] = min(_cpu(compiled.nl.text)[0] for _ in range(PAIRS))
+    new_execute = compiled._execute
+    runs: dict[str, list[dict[str, float]]] = {"old": [], "new": []}
+    for _ in range(PAIRS):
+        for path in ("old", "new"):
+            execute = new_execute if path == "new" else lambda: _whole_file(compiled)
+            monkeypatch.setattr(compiled, "_execute", execute)
+            runs[path].append(_timed_solve(compiled))
+    old, new = (min(runs[p], key=lambda r: r["cpu"]) for p in ("old", "new"))
+    assert new["objective"] == pytest.approx(old["objective"], rel=1e-8)
+    assert new["iterations"] == old["iterations"]
+    row = {
+        "write_old_s": write["old"],
+        "write_new_s": write["new"],
+        "write_ratio": write["new"] / write["old"],
+        "ours_old_s": old["cpu"],
+        "ours_new_s": new["cpu"],
+        "ours_ratio": new["cpu"] / old["cpu"],
+        "solver_s": min(r["solver"] for r in runs["old"] + runs["new"]),
+        "iterations": new["iterations"],
+    }
+    _ROWS[case, n] = row
+    benchmark.extra_info.update(row)
+    benchmark.pedantic(compiled.nl.text, rounds=1)
+    print(f"\n{case} N={n}: " + ", ".join(f"{k}={v:.3g}" for k, v in row.items()))
+
+
+def _exponent(case: str, key: str) -> float:
+    """The least-squares slope of log(time) against log(N)."""
+    times = [_ROWS[case, n][key] for n in SIZES]
+    return float(np.polyfit(np.log(SIZES), np.log(times), 1)[0])
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("case", sorted(FILES))
+def test_growth_exponents(benchmark, case: str) -> None:
+    if any((case, n) not in _ROWS for n in SIZES):
+        pytest.skip("needs every size of this case in the same run")
+    benchmark.group = f"pyomo {case}, growth exponents"
+    exponents = {key: _exponent(case, key) for key in ("write_old_s", "ours_old_s", "ours_new_s", "solver_s")}
+    benchmark.extra_info.update(exponents)
+    benchmark.pedantic(lambda: None, rounds=1)
+    print(f"\n{case}: N-growth exponents " + ", ".join(f"{k}={v:.2f}" for k, v in exponents.items()))

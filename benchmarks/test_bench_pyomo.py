@@ -6,9 +6,10 @@ Per size, on one compiled model: the NL text alone (a fresh write of the model b
 against :meth:`NLFile.text`), then cold re-solves (from the file's guess, so both paths solve the
 same NLP from the same start) through either path, interleaved, the smallest time of each kept.
 Times are CPU seconds of this process (the NL text, the SOL file, loading, the Result) and the
-solver's own wall time from its log (``wall_time`` of ripopt, ``Total seconds in IPOPT``); the last
-test fits the growth exponents ``t ~ N^k`` over the sizes. Both paths must reach the same optimum
-(1e-8 relative) with the same iteration count.
+solver's own wall time from its log (``wall_time`` of ripopt, ``Total seconds in IPOPT``), also per
+iteration (the cart-pole's iteration count is not monotone in N); ``test_growth_exponents`` fits
+``t ~ N^k`` over the sizes, and the last test times ripopt alone on a plain chain NLP. Both paths
+must reach the same optimum (1e-8 relative) with the same iteration count.
 
 Run: ``python -m pytest benchmarks/test_bench_pyomo.py --benchmark-enable -m slow -s``.
 """
@@ -22,8 +23,15 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from gamespec_pyomo.nlfile import WRITER_CONFIG
-from gamespec_pyomo.solvers import Run, pyomo_solver
+from gamespec_pyomo.nlfile import WRITER_CONFIG, NLFile
+from gamespec_pyomo.solvers import (
+    PRINT_LEVEL,
+    Run,
+    find_executable,
+    pyomo_solver,
+    run_solver,
+    solver_seconds_in,
+)
 from pyomo.repn.plugins.nl_writer import NLWriter
 
 import gamespec
@@ -99,6 +107,7 @@ def test_resolve_new_against_old(benchmark, monkeypatch, case: str, n: int) -> N
         "solver_s": min(r["solver"] for r in runs["old"] + runs["new"]),
         "iterations": new["iterations"],
     }
+    row["solver_per_iteration_s"] = row["solver_s"] / row["iterations"]
     _ROWS[case, n] = row
     benchmark.extra_info.update(row)
     benchmark.pedantic(compiled.nl.text, rounds=1)
@@ -117,7 +126,45 @@ def test_growth_exponents(benchmark, case: str) -> None:
     if any((case, n) not in _ROWS for n in SIZES):
         pytest.skip("needs every size of this case in the same run")
     benchmark.group = f"pyomo {case}, growth exponents"
-    exponents = {key: _exponent(case, key) for key in ("write_old_s", "ours_old_s", "ours_new_s", "solver_s")}
+    keys = ("write_old_s", "write_new_s", "ours_old_s", "ours_new_s", "solver_s", "solver_per_iteration_s")
+    exponents = {key: _exponent(case, key) for key in keys}
     benchmark.extra_info.update(exponents)
     benchmark.pedantic(lambda: None, rounds=1)
     print(f"\n{case}: N-growth exponents " + ", ".join(f"{k}={v:.2f}" for k, v in exponents.items()))
+
+
+def _chain(n: int, one_sum: bool):
+    """min sum (x_i - 1/2)^2 subject to x_{i+1} = x_i + sin(x_i)/1000: the objective as one expression
+    over all n variables, or as n epigraph rows y_i = (x_i - 1/2)^2 under a linear objective."""
+    import pyomo.environ as pyo
+
+    m = pyo.ConcreteModel()
+    m.x = pyo.Var(range(n), initialize=1.0)
+    step = lambda m, i: m.x[i + 1] - m.x[i] - 1e-3 * pyo.sin(m.x[i]) == 0  # noqa: E731
+    m.chain = pyo.Constraint(range(n - 1), rule=step)
+    if one_sum:
+        m.objective = pyo.Objective(expr=sum((m.x[i] - 0.5) ** 2 for i in range(n)))
+    else:
+        m.y = pyo.Var(range(n), initialize=0.0)
+        m.epigraph = pyo.Constraint(range(n), rule=lambda m, i: m.y[i] == (m.x[i] - 0.5) ** 2)
+        m.objective = pyo.Objective(expr=sum(m.y[i] for i in range(n)))
+    return m
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("one_sum", [False, True], ids=["epigraph_rows", "one_sum"])
+def test_ripopt_growth_on_a_plain_chain(benchmark, one_sum: bool) -> None:
+    """ripopt's own wall time on a problem with no collocation in it, at n = 1000 and 3000: the
+    growth exponent of the solver alone (and of its Hessian of one expression in n variables)."""
+    exe = find_executable("ripopt")
+    benchmark.group = "ripopt alone, growth exponent"
+    seconds, terminations = [], []
+    for n in (1000, 3000):
+        run = run_solver(exe, NLFile(_chain(n, one_sum)).text(), {"print_level": PRINT_LEVEL["ripopt"]})
+        seconds.append(solver_seconds_in(run.log))
+        terminations.append(run.results.solver.termination_condition)
+    exponent = float(np.log(seconds[1] / seconds[0]) / np.log(3.0))
+    benchmark.extra_info.update({"solver_s": seconds, "exponent": exponent})
+    benchmark.pedantic(lambda: None, rounds=1)
+    assert all(str(t) == "optimal" for t in terminations)
+    print(f"\nripopt alone ({'one sum' if one_sum else 'epigraph rows'}): {seconds} s, N^{exponent:.2f}")

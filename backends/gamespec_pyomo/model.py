@@ -11,8 +11,8 @@ once and a re-solve rewrites only its bounds and start (:mod:`gamespec_pyomo.nlf
 eliminates variables with equal bounds before it starts.
 Constraints: the defects ``D X - T W F(X, U, t) = 0``, path constraints at every evaluation point,
 boundary constraints over the end values and integral constraints ``T q^T g``; objective ``Phi + T
-q^T L`` in minimization form. The ``scaling_factor`` Suffix (``1/scale``, applied by Pyomo's NL
-writer) gives the solver the scaled variables the casadi backend gives IPOPT.
+q^T L`` in minimization form. The ``scaling_factor`` Suffix (``1/scale``, written to the NL file as
+a suffix, which ripopt reads) gives the solver the scaled variables the casadi backend gives IPOPT.
 """
 
 from __future__ import annotations

@@ -1,6 +1,6 @@
 """A Pyomo model's AMPL NL file, written once and re-solved by rewriting two segments.
 
-Pyomo's NL writer walks every expression of the model on every write (0.2–0.6 s at N = 1000
+Pyomo's NL writer walks every expression of the model on every write (0.2–0.7 s at N = 1000
 collocation intervals). In an NL file the expressions, the Jacobian pattern and the constraint
 ranges depend only on the model's structure when nothing in it is a Param or a fixed Var (those
 are written as constants): with parameters, grid inputs and a fixed horizon as Vars held by equal

@@ -7,8 +7,7 @@ its first solve there (for JAX: tracing and XLA compilation included, as one ``g
 sees it, not the import of jax), ``warm`` the best of the two that follow. Seconds are CPU seconds of
 all threads (``time.process_time``) and wall seconds. The reference is extremal shooting with
 ``--directions`` directions and RK4 step 1e-3; its change from half as many directions is printed
-as its own error. Being a script run by path, it can time another checkout of gamespec put first
-on ``PYTHONPATH``.
+as its own error.
 """
 
 from __future__ import annotations
@@ -27,6 +26,7 @@ import gamespec
 from gamespec.flowfield.grid import Grid
 from gamespec.flowfield.hamiltonian import FlowHamiltonian
 from gamespec.flowfield.levelset import LevelSetReach, LevelSetSolver, capture_by_level_sets
+from gamespec.flowfield.problem import evaluate
 
 HUGO = Path(__file__).resolve().parents[1] / "problems" / "ch5" / "hurricane_hugo.yaml"
 
@@ -34,7 +34,7 @@ HUGO = Path(__file__).resolve().parents[1] / "problems" / "ch5" / "hurricane_hug
 def capture(n: int, engine: str = "numpy") -> LevelSetReach:
     """The capture search on the Hugo file at n × n nodes, the file's scheme and CFL number."""
     spec = gamespec.load(HUGO)
-    data, m = spec.data(), spec.method
+    data, m = evaluate(spec), spec.method
     grid = Grid(data.grid.lower, data.grid.upper, (n, n))
     if engine == "jax":
         from gamespec_levelset.hj_solver import HJSolver
@@ -88,7 +88,7 @@ def main() -> None:
         return
     from gamespec.flowfield.extremals import capture_by_extremals
 
-    data = gamespec.load(HUGO).data()
+    data = evaluate(gamespec.load(HUGO))
     ref, half = (
         capture_by_extremals(data.field, data.origins, data.nominal_speeds, 10.0, directions=d, dt=1e-3)
         for d in (args.directions, args.directions // 2)

@@ -15,10 +15,16 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 from functools import cached_property
+from typing import TYPE_CHECKING
 
 import numpy as np
-import scipy.sparse as sps
 from numpy.polynomial import legendre
+
+if TYPE_CHECKING:
+    import scipy.sparse as sps
+
+Triplets = tuple[np.ndarray, np.ndarray, np.ndarray, tuple[int, int]]
+"""A sparse matrix as ``(rows, cols, values, shape)``."""
 
 
 def radau_points(degree: int) -> np.ndarray:
@@ -116,8 +122,9 @@ class Grid:
         return lagrange_matrices(radau_points(self.degree))[1]
 
     @cached_property
-    def matrices(self) -> tuple[sps.csr_matrix, sps.csr_matrix, np.ndarray]:
-        """``(D, W, q)``: defects ``D X - T W F`` and the Lagrange quadrature weights ``q``."""
+    def triplets(self) -> tuple[Triplets, Triplets, np.ndarray]:
+        """``(D, W, q)`` with ``D`` and ``W`` as ``(rows, cols, values, shape)`` (what a backend's
+        own sparse matrix is built from, without SciPy) and ``q`` the Lagrange quadrature weights."""
         h = np.diff(self.breaks)
         d = self.points_per_interval
         if self.scheme == "radau":
@@ -131,18 +138,30 @@ class Grid:
                         rows.append(k * d + j)
                         cols.append(k * d + r)
                         vals.append(block[j, r])
-            dmat = sps.csr_matrix((vals, (rows, cols)), shape=(self.intervals * d, self.n_nodes))
-            scale = np.repeat(h, d)
-            wmat = sps.diags(scale).tocsr()
+            shape = (self.intervals * d, self.n_nodes)
+            diagonal = np.arange(self.intervals * d)
+            w_triplets = (diagonal, diagonal, np.repeat(h, d), (self.intervals * d, self.intervals * d))
             q = np.repeat(h, d) * np.tile(weights, self.intervals)
-            return dmat, wmat, q
+            return (np.array(rows), np.array(cols), np.array(vals), shape), w_triplets, q
         k = np.arange(self.intervals)
-        dmat = sps.csr_matrix(
-            (np.r_[-np.ones(self.intervals), np.ones(self.intervals)], (np.r_[k, k], np.r_[k, k + 1])),
-            shape=(self.intervals, self.n_nodes),
+        shape = (self.intervals, self.n_nodes)
+        rows, cols = np.r_[k, k], np.r_[k, k + 1]
+        d_triplets = (rows, cols, np.r_[-np.ones(self.intervals), np.ones(self.intervals)], shape)
+        w_values = np.r_[h, h] / 2.0
+        q = np.bincount(cols, weights=w_values, minlength=self.n_nodes)
+        return d_triplets, (rows, cols, w_values, shape), q
+
+    @cached_property
+    def matrices(self) -> tuple[sps.csr_matrix, sps.csr_matrix, np.ndarray]:
+        """``(D, W, q)``: defects ``D X - T W F`` and the Lagrange quadrature weights ``q``
+        (:attr:`triplets` as SciPy sparse matrices)."""
+        import scipy.sparse as sps
+
+        d_triplets, w_triplets, q = self.triplets
+        dmat, wmat = (
+            sps.csr_matrix((vals, (rows, cols)), shape=shape)
+            for rows, cols, vals, shape in (d_triplets, w_triplets)
         )
-        wmat = sps.csr_matrix((np.r_[h, h] / 2.0, (np.r_[k, k], np.r_[k, k + 1])), shape=dmat.shape)
-        q = np.asarray(wmat.sum(axis=0)).ravel()
         return dmat, wmat, q
 
     def costate_scale(self) -> np.ndarray:

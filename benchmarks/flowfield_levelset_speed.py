@@ -58,6 +58,8 @@ def _worker(engine: str, n: int) -> dict:
         import hj_reachability  # noqa: F401  (imported before the clock starts)
     runs = [timed(lambda: capture(n, engine)) for _ in range(3)]
     reach = runs[0][0]
+    if reach.capture_time is None:
+        raise SystemExit(reach.message)
     return {
         "capture_time": reach.capture_time,
         "capture_point": [float(v) for v in reach.capture_point],

@@ -19,7 +19,7 @@ import numpy as np
 from pydantic import Field, ValidationInfo, field_validator
 
 from gamespec.backend import Availability, Inputs
-from gamespec.backend.collocation import CollocationBackend, CollocationModel
+from gamespec.backend.collocation import IPOPT_DEFAULTS, CollocationBackend, CollocationModel
 from gamespec.errors import BackendError
 from gamespec.ocp.transcription import Guess, Transcription
 from gamespec.result import Result, Status
@@ -147,7 +147,7 @@ class CasadiModel(CollocationModel):
         self.lbg, self.ubg = np.concatenate(lower), np.concatenate(upper)
         ipopt = {"print_level": 0, "sb": "yes", "tol": options.tol, "max_iter": options.max_iter}
         ipopt["max_wall_time"] = options.max_wall_time
-        nlp_opts = {"ipopt": ipopt | options.ipopt, "print_time": False}
+        nlp_opts = {"ipopt": ipopt | IPOPT_DEFAULTS | options.ipopt, "print_time": False}
         self.solver = ca.nlpsol(
             "gamespec", options.solver, {"x": w, "p": p_all, "f": objective, "g": g}, nlp_opts
         )

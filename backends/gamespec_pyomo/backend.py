@@ -21,7 +21,7 @@ import numpy as np
 from pydantic import Field, ValidationInfo, field_validator
 
 from gamespec.backend import Availability, Inputs
-from gamespec.backend.collocation import CollocationBackend, CollocationModel
+from gamespec.backend.collocation import IPOPT_DEFAULTS, CollocationBackend, CollocationModel
 from gamespec.errors import BackendError
 from gamespec.ocp.transcription import Bounds, Transcription
 from gamespec.result import Result
@@ -131,6 +131,9 @@ class PyomoModel(CollocationModel):
         name = self.executable.name
         opts = {"tol": self.options.tol, "max_iter": self.options.max_iter, "print_level": PRINT_LEVEL[name]}
         opts["max_wall_time"] = self.options.max_wall_time
+        if name == "ipopt":
+            # Through Ipopt's options file (Pyomo's OF_ prefix), which takes every Ipopt option.
+            opts |= {f"OF_{k}": v for k, v in IPOPT_DEFAULTS.items() if k not in self.options.options}
         with tempfile.TemporaryDirectory(prefix="gamespec-pyomo-") as tmp:
             log = Path(tmp) / "solver.log"
             try:

@@ -97,6 +97,11 @@ class PyomoModel(CollocationModel):
         else:
             m.T.set_value(b.t_lower)
 
+    def _set_integral_bounds(self, params: dict[str, float]) -> None:
+        for r, (lo, hi) in enumerate(self.tr.ocp.integral_bounds(params)):
+            self.model.integral_lower[r].set_value(lo)
+            self.model.integral_upper[r].set_value(hi)
+
     def _set_start(self, X: np.ndarray, U: np.ndarray, d: np.ndarray, T: float, b: Bounds) -> None:
         m = self.model
         for name, value in zip(self.tr.ocp.design, np.clip(d, b.d_lower, b.d_upper), strict=True):
@@ -167,6 +172,7 @@ class PyomoModel(CollocationModel):
             param.set_value(float(Win[i, col]))
         b = tr.bounds(params)
         self._set_bounds(b)
+        self._set_integral_bounds(params)
         if guess is not None or not (self._solved and self.options.warm_start):
             start = tr.guess(params, guess)
             self._set_start(start.X, start.U, start.d, start.T, b)

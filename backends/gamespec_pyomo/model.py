@@ -127,9 +127,10 @@ def build_model(tr: Transcription, params: Mapping[str, float]) -> Any:
         m.T * sum(float(w) * terms[r] for w, terms in zip(q, integrands, strict=True))
         for r in range(len(ocp.integrals))
     ]
-    m.integral = pyo.Constraint(
-        range(len(ocp.integrals)), rule=lambda _m, r: _relation(ocp.integrals[r], integral[r])
-    )
+    n_int = range(len(ocp.integrals))
+    m.integral_lower = pyo.Param(n_int, mutable=True, initialize={r: ocp.integrals[r].lower for r in n_int})
+    m.integral_upper = pyo.Param(n_int, mutable=True, initialize={r: ocp.integrals[r].upper for r in n_int})
+    m.integral = pyo.Constraint(n_int, rule=lambda _m, r: _integral_relation(m, tr, r, integral[r]))
     running = sum(float(w) * term for w, term in zip(q, L, strict=True))
     m.objective = pyo.Objective(expr=translate(ocp.mayer, ends, lib) + m.T * running + tr.rate_penalty(m.U))
     m.dual = pyo.Suffix(direction=pyo.Suffix.IMPORT)
@@ -140,6 +141,18 @@ def build_model(tr: Transcription, params: Mapping[str, float]) -> Any:
     for (j, _), var in m.U.items():
         m.scaling_factor[var] = 1.0 / su[j]
     return m
+
+
+def _integral_relation(m: Any, tr: Transcription, r: int, expr: Any) -> Any:
+    """Integral constraint ``r`` with its finite bounds as the mutable Params ``integral_lower[r]``
+    and ``integral_upper[r]`` (set per solve: they may be expressions of the parameters); an equality
+    when the file gives the same bound twice."""
+    spec = tr.spec.problem.integral_constraints[r]
+    if spec.lower is not None and spec.lower == spec.upper:
+        return expr == m.integral_lower[r]
+    lower = None if spec.lower is None else m.integral_lower[r]
+    upper = None if spec.upper is None else m.integral_upper[r]
+    return (lower, expr, upper)
 
 
 def _row(matrix: Any, row: int) -> zip:

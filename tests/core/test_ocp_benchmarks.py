@@ -111,7 +111,8 @@ def _duality_gap_bound(name: str) -> float:
         pairs += int(np.sum(np.isfinite(lower) & free) + np.sum(np.isfinite(upper) & free))
     if tr.free_time:
         pairs += int(np.isfinite(b.t_lower)) + int(np.isfinite(b.t_upper))
-    sides = sum(int(np.isfinite(r.lower)) + int(np.isfinite(r.upper)) for r in tr.ocp.path if not r.is_equality)
+    inequalities = [r for r in tr.ocp.path if not r.is_equality]
+    sides = sum(int(np.isfinite(r.lower)) + int(np.isfinite(r.upper)) for r in inequalities)
     return TOL * (pairs + sides * len(tr.grid.eval_index))
 
 

@@ -129,6 +129,31 @@ def test_an_integral_constraint_matches_a_quadrature_state(backend: str) -> None
     assert integral.checks["max_constraint_violation"] < 1e-8
 
 
+@pytest.mark.parametrize("backend", ["casadi", "pyomo"])
+def test_an_integral_bound_over_the_parameters_follows_them_on_a_re_solve(backend: str) -> None:
+    """integral(x) = A with x(0) = 0, x(1) = 1: x = a t^2 + b t with a = 3 - 6A, b = 1 - a, and
+    J = integral((2at + b)^2) = 4a^2/3 + 2ab + b^2 (4/3 at A = 1/3, 1.12 at A = 0.4)."""
+    data = _isoperimetric(False, backend)
+    data["problem"]["parameters"] = {"A": 1 / 3}
+    data["problem"]["integral_constraints"] = [{"integrand": "x", "lower": "A", "upper": "A"}]
+    solver = gamespec.compile_spec(spec_from_dict(data))
+    for area in (1 / 3, 0.4):
+        a = 3 - 6 * area
+        b = 1 - a
+        result = solver.solve(parameters={"A": area})
+        assert result.status == gamespec.Status.OPTIMAL
+        assert result.objective == pytest.approx(4 * a * a / 3 + 2 * a * b + b * b, abs=1e-8)
+        assert result.checks["max_constraint_violation"] < 1e-8
+
+
+def test_an_integral_bound_over_what_is_not_a_parameter_is_refused() -> None:
+    data = _isoperimetric(False, "casadi")
+    data["problem"]["integral_constraints"] = [{"integrand": "x", "upper": "x_f"}]
+    with pytest.raises(SpecError, match="undefined symbol 'x_f'") as err:
+        spec_from_dict(data)
+    assert err.value.field == "problem.integral_constraints.0.upper"
+
+
 def _bounded_in_time(as_bound: bool) -> dict:
     """max x(1), x' = u, with u <= 1 - t: x(1) = 1/2 (the bound is active throughout)."""
     controls = {"u": {"lower": -1.0, "upper": "1 - t"}} if as_bound else {"u": {"lower": -1.0}}
@@ -211,6 +236,29 @@ def test_one_spelling_of_nlp_options_reaches_both_backends() -> None:
 def test_the_wall_time_limit_stops_a_solve(backend: str) -> None:
     spec = gamespec.load(HANG_GLIDER, ["solver.options.nlp.max_wall_time=1e-4", f"solver.backend={backend}"])
     assert gamespec.solve(spec).status == gamespec.Status.TIME_LIMIT
+
+
+@pytest.mark.parametrize("group", ["states", "controls", "parameters"])
+def test_tau_is_refused_as_a_name_with_the_reason(group: str) -> None:
+    data = _isoperimetric(False, "casadi")
+    problem = data["problem"]
+    if group == "states":
+        problem["states"]["tau"] = {"initial": 0.0}
+        problem["dynamics"]["tau"] = "1"
+    elif group == "controls":
+        problem["controls"]["tau"] = {}
+    else:
+        problem["parameters"] = {"tau": 1.0}
+    with pytest.raises(SpecError, match=r"'tau' cannot be a symbol name.*normalized time"):
+        spec_from_dict(data)
+
+
+def test_a_caret_in_a_file_names_the_field_and_the_column_of_the_caret() -> None:
+    data = _isoperimetric(False, "casadi")
+    data["problem"]["objective"]["lagrange"] = "u^2"
+    with pytest.raises(SpecError, match=r"at column 2: '\^' is not a power: use \*\* for powers") as err:
+        spec_from_dict(data)
+    assert err.value.field == "problem.objective.lagrange"
 
 
 def test_a_caret_says_to_use_double_star_at_its_column() -> None:

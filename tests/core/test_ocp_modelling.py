@@ -4,17 +4,20 @@ the expressions written out, derived parameters against the number they evaluate
 from __future__ import annotations
 
 import itertools
+import math
 
 import numpy as np
 import pytest
 import sympy as sp
 
 import gamespec
+from gamespec.backend.refinement import refined_mesh
 from gamespec.errors import ExpressionError, SpecError
 from gamespec.loader import spec_from_dict
 from gamespec.ocp.symbolic import SymbolicOcp
 from gamespec.ocp.transcription import Transcription
 from gamespec.solving import get_backend
+from gamespec.specs.ocp import RefineSpec
 from gamespec.symbolic.language import parse
 from tests.conftest import PROBLEMS
 
@@ -296,20 +299,48 @@ def test_the_chattering_check_fires_on_goddard_and_a_rate_penalty_removes_it(bac
     assert smooth.objective == pytest.approx(raw.objective, rel=1e-4)
 
 
+@pytest.mark.parametrize("strategy", ["h", "hp"])
 @pytest.mark.parametrize("backend", ["casadi", "pyomo"])
-def test_mesh_refinement_reaches_its_tolerance_on_the_hang_glider(backend: str) -> None:
+def test_mesh_refinement_reaches_its_tolerance_on_the_hang_glider(backend: str, strategy: str) -> None:
     tolerance = 1e-6
-    spec = gamespec.load(HANG_GLIDER, ["method.intervals=10", f"method.refine.tolerance={tolerance}"])
+    overrides = ["method.intervals=10", f"method.refine.tolerance={tolerance}"]
+    spec = gamespec.load(HANG_GLIDER, [*overrides, f"method.refine.strategy={strategy}"])
     result = gamespec.solve(spec, backend)
     history = result.metrics["refinement"]
     defects = [entry["max_defect_relative"] for entry in history]
     assert result.status == gamespec.Status.OPTIMAL and result.metrics["refinement_converged"]
     assert result.checks["max_defect_relative"] <= tolerance
     assert all(later < earlier for earlier, later in itertools.pairwise(defects))
-    assert [e["intervals"] for e in history] == sorted({e["intervals"] for e in history})
+    assert all(later["variables"] > earlier["variables"] for earlier, later in itertools.pairwise(history))
+    assert max(e["max_degree"] for e in history) <= (3 if strategy == "h" else spec.method.refine.max_degree)
     # Betts' x_f (the file's reference); the interval gaps, each below the tolerance relative to the
     # state's scale, add up to at most intervals * tolerance of it at the end.
     assert result.objective == pytest.approx(1248.03103, rel=history[-1]["intervals"] * tolerance)
+
+
+def test_hp_refinement_raises_the_degree_where_the_rule_predicts_the_tolerance() -> None:
+    """The ph rule: an interval of N points with defect e needs P = ceil(log(e/tol)/log N) more;
+    within max_degree it gets them, beyond it is split into intervals of the file's degree."""
+    options = RefineSpec(tolerance=1e-6, strategy="hp", max_degree=10)
+    breaks = np.array([0.0, 0.25, 0.5, 1.0])
+    mesh, degrees = refined_mesh(breaks, np.array([3, 3, 3]), np.array([1e-7, 1e-3, 1e-1]), options, 3)
+    assert degrees[:2] == [3, 3 + math.ceil(math.log(1e3) / math.log(3))]
+    wanted = 3 + math.ceil(math.log(1e5) / math.log(3))
+    assert degrees[2:] == [3] * math.ceil(wanted / 3)
+    assert mesh[:3] == [0.0, 0.25, 0.5] and np.allclose(np.diff(mesh[2:]), 0.5 / len(degrees[2:]))
+
+
+@pytest.mark.parametrize("backend", ["casadi", "pyomo"])
+def test_a_mesh_of_mixed_degrees_is_exact_on_a_quadratic_solution(backend: str) -> None:
+    """The isoperimetric problem's x = t^2 is a polynomial of degree 2: every interval of degree
+    >= 2 collocates it exactly, whatever its neighbours' degrees."""
+    data = _isoperimetric(False, backend)
+    data["method"] = {"intervals": 4, "degrees": [2, 5, 3, 4]}
+    result = gamespec.solve(spec_from_dict(data))
+    assert result.status == gamespec.Status.OPTIMAL
+    assert result.objective == pytest.approx(4 / 3, abs=1e-8)
+    assert np.allclose(result.states["x"], result.time**2, atol=1e-8)
+    assert result.checks["max_defect"] < 1e-10
 
 
 def test_each_check_has_a_verdict_against_its_tolerance() -> None:

@@ -13,27 +13,22 @@ from __future__ import annotations
 import json
 import sys
 import warnings
+from collections.abc import Iterator
+from contextlib import contextmanager, nullcontext
+from functools import cache
 from pathlib import Path
-from typing import Annotated
+from typing import TYPE_CHECKING, Annotated
 
-import numpy as np
 import typer
-import yaml
-from rich.console import Console
-from rich.markup import escape
-from rich.table import Table
 
 from gamespec import registry
 from gamespec.errors import GamespecError
-from gamespec.loader import load
-from gamespec.result import Result, status_ok, writable_folder
-from gamespec.studies.compare import (
-    LEGEND,
-    compare_backends,
-    comparison_table,
-    parse_backend_list,
-    row_notes,
-)
+
+if TYPE_CHECKING:
+    from rich.console import Console
+    from rich.table import Table
+
+    from gamespec.result import Result
 
 app = typer.Typer(
     add_completion=False,
@@ -41,9 +36,21 @@ app = typer.Typer(
     rich_markup_mode=None,
     help="gamespec: declarative optimal control and differential games on interchangeable backends.",
 )
-console = Console()
-err_console = Console(stderr=True)
 _MOUNTED: set[str] = set()
+
+
+@cache
+def _console(stderr: bool = False) -> Console:
+    """rich's console on stdout (or stderr), made on first use: rich is imported only to print."""
+    from rich.console import Console
+
+    return Console(stderr=stderr)
+
+
+def _escape(text: str) -> str:
+    from rich.markup import escape
+
+    return escape(text)
 
 
 def mount_commands() -> None:
@@ -70,7 +77,7 @@ def _version(value: bool) -> None:
     if value:
         from importlib.metadata import version
 
-        console.print(f"gamespec {version('gamespec')}", highlight=False)
+        _console().print(f"gamespec {version('gamespec')}", highlight=False)
         raise typer.Exit()
 
 
@@ -92,8 +99,10 @@ def _fmt(value: object) -> str:
 @app.command()
 def validate(file: FileArg, set_: SetOpt = None) -> None:
     """Check a problem file; exit 0 when valid, exit 2 with the reason otherwise."""
+    from gamespec.loader import load
+
     spec = load(file, set_ or [])
-    console.print(f"[green]valid[/green] {file} (kind {spec.kind}, name {spec.name})")
+    _console().print(f"[green]valid[/green] {file} (kind {spec.kind}, name {spec.name})")
 
 
 @app.command()
@@ -106,12 +115,14 @@ def solve(
     plot: Annotated[bool, typer.Option("--plot", help="Also write plots (into --out or .).")] = False,
 ) -> None:
     """Solve a problem file and print a summary (or the Result as JSON)."""
+    from gamespec.loader import load
+    from gamespec.result import writable_folder
     from gamespec.solving import solve as run_solve
 
     spec = load(file, set_ or [])
     if out is not None:
         writable_folder(out)
-    with err_console.status(f"solving {spec.name} ...", spinner="dots"):
+    with _console(stderr=True).status(f"solving {spec.name} ...", spinner="dots"):
         result = run_solve(spec, backend)
     if out is not None:
         _remove_previous_figures(out)
@@ -121,13 +132,13 @@ def solve(
 
         for path in plot_result(result, out or Path(".")):
             if not json_:
-                console.print(f"wrote {path}", markup=False, highlight=False)
+                _console().print(f"wrote {path}", markup=False, highlight=False)
     if json_:
         sys.stdout.write(result.to_json() + "\n")
     else:
         _print_summary(result)
         if out is not None:
-            console.print(f"saved to {out}/")
+            _console().print(f"saved to {out}/")
     if not result.ok:
         print(
             f"error: {spec.name}: solve ended with status {result.status.value}: {result.message}",
@@ -152,21 +163,23 @@ def _remove_previous_figures(folder: Path) -> None:
 def _print_summary(result: Result) -> None:
     """The kind's outcome first (:mod:`gamespec.summaries`), then status, timings and checks, then
     the other scalar metrics; each key once."""
+    from rich.table import Table
+
     from gamespec.summaries import outcome
 
     table = Table(title=f"{result.problem} on {result.backend}: {result.status.value}", show_header=False)
     lead = outcome(result)
     for key, value in lead:
-        table.add_row(escape(key), escape(_fmt(value)), style="bold")
+        table.add_row(_escape(key), _escape(_fmt(value)), style="bold")
     if lead:
         table.add_section()
     general = {k: v for k, v in result.summary().items() if k != "problem" and v not in (None, "")}
     for key, value in general.items():
-        table.add_row(key, escape(_fmt(value)))
+        table.add_row(key, _escape(_fmt(value)))
     for key, value in result.metrics.items():
         if isinstance(value, int | float | str) and key not in general:
-            table.add_row(key, escape(_fmt(value)))
-    console.print(table)
+            table.add_row(key, _escape(_fmt(value)))
+    _console().print(table)
 
 
 @app.command()
@@ -178,18 +191,28 @@ def compare(
     json_: JsonOpt = False,
 ) -> None:
     """Solve one file on several backends with the same discretization; one table."""
+    from gamespec.loader import load
+    from gamespec.result import status_ok, writable_folder
+    from gamespec.studies.compare import (
+        LEGEND,
+        compare_backends,
+        comparison_table,
+        parse_backend_list,
+        row_notes,
+    )
+
     spec = load(file, set_ or [])
     entries = parse_backend_list(backends)
     if out is not None:
         writable_folder(out)
-    rows = compare_backends(spec, entries, out=out, progress=err_console)
+    rows = compare_backends(spec, entries, out=out, progress=_console(stderr=True))
     if json_:
         sys.stdout.write(json.dumps(rows, indent=2) + "\n")
     else:
-        console.print(comparison_table(rows, f"{spec.name}: backend comparison"))
-        console.print(LEGEND, style="dim", highlight=False)
+        _console().print(comparison_table(rows, f"{spec.name}: backend comparison"))
+        _console().print(LEGEND, style="dim", highlight=False)
         for note in row_notes(rows):
-            console.print(note, markup=False, highlight=False)
+            _console().print(note, markup=False, highlight=False)
     if not any(status_ok(row.get("status", "")) for row in rows):
         print(f"error: {spec.name}: no backend solved the problem", file=sys.stderr)
         raise typer.Exit(1)
@@ -229,6 +252,8 @@ def sweep(
     json_: JsonOpt = False,
 ) -> None:
     """Solve a file over a grid of parameter values; one row per point, saved as it finishes."""
+    from gamespec.loader import load
+    from gamespec.result import status_ok, writable_folder
     from gamespec.studies.executors import executor as make_executor
     from gamespec.studies.sweep import parse_range
     from gamespec.studies.sweep import sweep as run_sweep
@@ -243,7 +268,7 @@ def sweep(
         sys.stdout.write(json.dumps(rows, indent=2) + "\n")
     else:
         names = [name for name, _ in ranges]
-        console.print(_rows_table(rows, [*names, *SWEEP_COLUMNS], f"sweep of {file.name}"))
+        _console().print(_rows_table(rows, [*names, *SWEEP_COLUMNS], f"sweep of {file.name}"))
         tally = f"{run.computed} computed now, {run.reused} reused"
         print(f"{len(rows)} points in {out} ({tally})", file=sys.stderr)
     failed = [r for r in rows if not status_ok(r["status"])]
@@ -253,6 +278,8 @@ def sweep(
 
 
 def _rows_table(rows: list[dict], columns: list[str], title: str) -> Table:
+    from rich.table import Table
+
     table = Table(title=title)
     for col in columns:
         table.add_column(col, justify="right")
@@ -295,7 +322,7 @@ def results(
         present = {name for row in rows for name in row}
         shown = [c for c in [*study.get("parameters", []), *RESULT_COLUMNS] if c in present]
         title = f"{study.get('type', 'study')} {study.get('problem', '')}: {len(rows)} points".strip()
-        console.print(_rows_table(rows, shown or ["key"], title))
+        _console().print(_rows_table(rows, shown or ["key"], title))
     for path in (write_csv(rows, csv) if csv else None, write_parquet(rows, parquet) if parquet else None):
         if path is not None:
             print(f"wrote {path}", file=sys.stderr)
@@ -309,6 +336,10 @@ def show(
     set_: SetOpt = None,
 ) -> None:
     """Print the (validated, optionally transformed) problem as YAML."""
+    import yaml
+
+    from gamespec.loader import load
+
     spec = load(file, set_ or [])
     if transformed:
         from gamespec.solving import transformed as transformed_spec
@@ -328,6 +359,7 @@ def plot(
     (a sweep: outputs against each parameter, and the cost/sensitivity trade-off when its points are
     desensitized Results; a compare: bars per backend)."""
     from gamespec.plotting import plot_result
+    from gamespec.result import Result, writable_folder
     from gamespec.studies.store import ResultStore, is_store
 
     folder = writable_folder(out or (result if result.is_dir() else result.parent))
@@ -338,7 +370,7 @@ def plot(
     else:
         paths = plot_result(Result.load(result), folder, animate=animate)
     for path in paths:
-        console.print(f"wrote {path}")
+        _console().print(f"wrote {path}")
 
 
 @app.command()
@@ -355,6 +387,7 @@ def schema(
 def backends() -> None:
     """List installed backends: whether each is available (and why not), its kinds and features."""
     from rich import box
+    from rich.table import Table
 
     table = Table(title="gamespec backends", box=box.SIMPLE_HEAD, show_edge=False)
     table.add_column("backend", no_wrap=True)
@@ -364,18 +397,18 @@ def backends() -> None:
         try:
             cls = registry.backend_class(name)
         except (ImportError, GamespecError) as err:
-            table.add_row(name, "", f"[red]no[/red]: cannot load ({escape(str(err))})")
+            table.add_row(name, "", f"[red]no[/red]: cannot load ({_escape(str(err))})")
             continue
         avail = cls.available()
         status = "[green]yes[/green]" if avail.ok else "[red]no[/red]"
-        details = [f"{status}: {escape(avail.reason)}"]
+        details = [f"{status}: {_escape(avail.reason)}"]
         if cls.features:
             details.append(f"features: {', '.join(sorted(cls.features))}")
         details.append(f"from {registry.distribution('gamespec.backends', name)}")
         table.add_row(
             name, "\n".join(_kinds_through_transforms(cls.kinds)), "\n".join(details), end_section=True
         )
-    console.print(table)
+    _console().print(table)
 
 
 def _kinds_through_transforms(kinds: frozenset[str]) -> list[str]:
@@ -399,6 +432,17 @@ _ClickException = next(c for c in typer.BadParameter.__mro__ if c.__name__ == "C
 """Click's root exception (vendored by recent typer, a separate package before): usage errors."""
 
 
+@contextmanager
+def _quiet() -> Iterator[None]:
+    """No warning is shown, and NumPy's floating-point errors are ignored where NumPy is imported
+    already; where a command imports it later, they reach the same filter as warnings. NumPy is
+    not imported for it: ``--help`` and ``validate`` of most files never need it."""
+    numpy = sys.modules.get("numpy")
+    with warnings.catch_warnings(), numpy.errstate(all="ignore") if numpy else nullcontext():
+        warnings.simplefilter("ignore")
+        yield
+
+
 def run(argv: list[str] | None = None) -> int:
     """Run the CLI on ``argv`` and return the exit code: user errors and usage errors → 2 with one
     line on stderr. Warnings (numpy's, a solver's) are not printed: what a solve found is in its
@@ -406,8 +450,7 @@ def run(argv: list[str] | None = None) -> int:
     mount_commands()
     command = typer.main.get_command(app)
     try:
-        with warnings.catch_warnings(), np.errstate(all="ignore"):
-            warnings.simplefilter("ignore")
+        with _quiet():
             code = command.main(args=argv, prog_name="gamespec", standalone_mode=False)
     except SystemExit as exit_:
         return exit_.code if isinstance(exit_.code, int) else (0 if exit_.code is None else 1)

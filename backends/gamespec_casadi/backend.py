@@ -21,6 +21,7 @@ from pydantic import Field, ValidationInfo, field_validator
 from gamespec.backend import Availability, Inputs
 from gamespec.backend.collocation import IPOPT_DEFAULTS, CollocationBackend, CollocationModel
 from gamespec.errors import BackendError
+from gamespec.ocp.collocation import Triplets
 from gamespec.ocp.transcription import Guess, Transcription
 from gamespec.result import Result, Status
 from gamespec.specs.base import StrictModel
@@ -80,6 +81,13 @@ def casadi_library(ca: Any) -> Library:
     )
 
 
+def transposed(ca: Any, triplets: Triplets) -> Any:
+    """The transpose of a sparse matrix given as :attr:`~gamespec.ocp.collocation.Grid.triplets`,
+    as a sparse ``casadi.DM`` (built without SciPy)."""
+    rows, cols, values, (n_rows, n_cols) = triplets
+    return ca.DM.triplet(cols.tolist(), rows.tolist(), ca.DM(values), n_cols, n_rows)
+
+
 class CasadiModel(CollocationModel):
     """The NLP and its solver, built once."""
 
@@ -119,8 +127,8 @@ class CasadiModel(CollocationModel):
         horizon = T if tr.free_time else p_all[npar + nw * k]
         t_eval = tr.t0 + horizon * ca.DM(grid.eval_tau).T
         F, Lv, G, Iv = point(X[:, grid.eval_index.tolist()], U, Win, t_eval, params)
-        D, W, q = grid.matrices
-        defects = X @ ca.DM(D.T) - horizon * (F @ ca.DM(W.T))
+        D, W, q = grid.triplets
+        defects = X @ transposed(ca, D) - horizon * (F @ transposed(ca, W))
 
         ends = dict(zip(ocp.x0, ca.vertsplit(X[:, 0]), strict=True))
         ends |= dict(zip(ocp.xf, ca.vertsplit(X[:, -1]), strict=True)) | {ocp.tf: tr.t0 + horizon}

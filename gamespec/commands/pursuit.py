@@ -9,8 +9,6 @@ from pathlib import Path
 from typing import Annotated
 
 import typer
-from rich.console import Console
-from rich.table import Table
 
 pursuit_app = typer.Typer(no_args_is_help=True, help="Pursuit-evasion studies (thesis ch. 2–3).")
 
@@ -47,6 +45,9 @@ def study(
 
     Resumes from the file's ``store`` (or OUT/points); the Result is the one `gamespec solve` gives.
     """
+    from rich.console import Console
+    from rich.table import Table
+
     from gamespec.errors import SpecError
     from gamespec.loader import load
     from gamespec.plotting import plot_result

@@ -193,7 +193,7 @@ def max_constraint_violation(tr: Transcription, sol: Trajectory, params: Mapping
     worst += [_relation_violation(r, running, t_eval.shape) for r in tr.ocp.path]
     ends = _end_values(tr, X, U, T, params)
     worst += [_relation_violation(r, ends, ()) for r in tr.ocp.boundary]
-    q = tr.grid.matrices[2]
+    q = tr.grid.triplets[2]
     for r, (lo, hi) in zip(tr.ocp.integrals, tr.ocp.integral_bounds(params), strict=True):
         g = np.broadcast_to(np.asarray(translate(r.expr, running, NUMPY), dtype=float), t_eval.shape)
         worst.append(_violation(np.array([T * q @ g]), lo, hi))

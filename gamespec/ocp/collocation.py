@@ -15,10 +15,16 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 from functools import cache, cached_property
+from typing import TYPE_CHECKING
 
 import numpy as np
-import scipy.sparse as sps
 from numpy.polynomial import legendre
+
+if TYPE_CHECKING:
+    import scipy.sparse as sps
+
+Triplets = tuple[np.ndarray, np.ndarray, np.ndarray, tuple[int, int]]
+"""A sparse matrix as ``(rows, cols, values, shape)``."""
 
 
 @cache
@@ -148,8 +154,9 @@ class Grid:
         return np.concatenate([_radau_weights(int(d)) for d in self.interval_degrees])
 
     @cached_property
-    def matrices(self) -> tuple[sps.csr_matrix, sps.csr_matrix, np.ndarray]:
-        """``(D, W, q)``: defects ``D X - T W F`` and the Lagrange quadrature weights ``q``."""
+    def triplets(self) -> tuple[Triplets, Triplets, np.ndarray]:
+        """``(D, W, q)`` with ``D`` and ``W`` as ``(rows, cols, values, shape)`` (what a backend's
+        own sparse matrix is built from, without SciPy) and ``q`` the Lagrange quadrature weights."""
         h = np.diff(self.breaks)
         if self.scheme == "radau":
             degrees = self.interval_degrees
@@ -163,18 +170,30 @@ class Grid:
                         cols.append(start + r)
                         vals.append(block[j, r])
             n_points = self.n_nodes - 1
-            dmat = sps.csr_matrix((vals, (rows, cols)), shape=(n_points, self.n_nodes))
+            diagonal = np.arange(n_points)
             scale = np.repeat(h, degrees)
-            wmat = sps.diags(scale).tocsr()
+            w_triplets = (diagonal, diagonal, scale, (n_points, n_points))
             q = scale * self.radau_weights
-            return dmat, wmat, q
+            return (np.array(rows), np.array(cols), np.array(vals), (n_points, self.n_nodes)), w_triplets, q
         k = np.arange(self.intervals)
-        dmat = sps.csr_matrix(
-            (np.r_[-np.ones(self.intervals), np.ones(self.intervals)], (np.r_[k, k], np.r_[k, k + 1])),
-            shape=(self.intervals, self.n_nodes),
+        shape = (self.intervals, self.n_nodes)
+        rows, cols = np.r_[k, k], np.r_[k, k + 1]
+        d_triplets = (rows, cols, np.r_[-np.ones(self.intervals), np.ones(self.intervals)], shape)
+        w_values = np.r_[h, h] / 2.0
+        q = np.bincount(cols, weights=w_values, minlength=self.n_nodes)
+        return d_triplets, (rows, cols, w_values, shape), q
+
+    @cached_property
+    def matrices(self) -> tuple[sps.csr_matrix, sps.csr_matrix, np.ndarray]:
+        """``(D, W, q)``: defects ``D X - T W F`` and the Lagrange quadrature weights ``q``
+        (:attr:`triplets` as SciPy sparse matrices)."""
+        import scipy.sparse as sps
+
+        d_triplets, w_triplets, q = self.triplets
+        dmat, wmat = (
+            sps.csr_matrix((vals, (rows, cols)), shape=shape)
+            for rows, cols, vals, shape in (d_triplets, w_triplets)
         )
-        wmat = sps.csr_matrix((np.r_[h, h] / 2.0, (np.r_[k, k], np.r_[k, k + 1])), shape=dmat.shape)
-        q = np.asarray(wmat.sum(axis=0)).ravel()
         return dmat, wmat, q
 
     def costate_scale(self) -> np.ndarray:

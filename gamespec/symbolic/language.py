@@ -14,8 +14,8 @@ import math
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass
 from functools import lru_cache
+from typing import Any
 
-import numpy as np
 import sympy as sp
 
 from gamespec.errors import ExpressionError
@@ -67,9 +67,16 @@ _FLOAT_FUNCTIONS: dict[type, Callable[..., float]] = {
     sp.tanh: math.tanh,
     sp.Min: min,
     sp.Max: max,
-    sp.sign: lambda x: float(np.sign(x)),
-    sp.Heaviside: lambda x, *h: float(np.heaviside(x, 0.5)),
+    sp.sign: lambda x: float(_numpy().sign(x)),
+    sp.Heaviside: lambda x, *h: float(_numpy().heaviside(x, 0.5)),
 }
+
+
+def _numpy() -> Any:
+    """NumPy, imported when a constant's sign or unit step is first evaluated."""
+    import numpy as np
+
+    return np
 
 
 @lru_cache(maxsize=4096)

@@ -7,12 +7,11 @@ memoised per node, so shared sub-expressions are translated once.
 from __future__ import annotations
 
 import math
-from collections.abc import Callable, Mapping
+from collections.abc import Callable, Iterator, Mapping
 from dataclasses import dataclass, field
-from functools import reduce
+from functools import cached_property, reduce
 from typing import Any
 
-import numpy as np
 import sympy as sp
 
 from gamespec.errors import ExpressionError
@@ -58,20 +57,40 @@ _SYMPY_NAMES: dict[type, str] = {
 
 def _numpy_heaviside(x: Any) -> Any:
     """The unit step with SymPy's value ``heaviside(0) = 1/2``."""
+    import numpy as np
+
     return np.heaviside(x, 0.5)
 
 
-NUMPY = Library.from_namespace(
-    np,
-    asin=np.arcsin,
-    acos=np.arccos,
-    atan=np.arctan,
-    atan2=np.arctan2,
-    min=np.minimum,
-    max=np.maximum,
-    heaviside=_numpy_heaviside,
-    power=np.power,
-)
+def _numpy_power(base: Any, exponent: Any) -> Any:
+    import numpy as np
+
+    return np.power(base, exponent)
+
+
+class _NumpyFunctions(Mapping[str, Callable[..., Any]]):
+    """NumPy's functions by gamespec's names, looked up in NumPy at the first use: a bound or
+    parameter without functions (``-pi``, ``2*xf``) is evaluated at load without importing NumPy."""
+
+    @cached_property
+    def _table(self) -> Mapping[str, Callable[..., Any]]:
+        import numpy as np
+
+        renamed = {"asin": np.arcsin, "acos": np.arccos, "atan": np.arctan, "atan2": np.arctan2}
+        renamed |= {"min": np.minimum, "max": np.maximum, "heaviside": _numpy_heaviside}
+        return Library.from_namespace(np, **renamed).functions
+
+    def __getitem__(self, name: str) -> Callable[..., Any]:
+        return self._table[name]
+
+    def __iter__(self) -> Iterator[str]:
+        return iter(self._table)
+
+    def __len__(self) -> int:
+        return len(self._table)
+
+
+NUMPY = Library(_NumpyFunctions(), power=_numpy_power)
 
 
 def translate(expr: sp.Expr, values: Mapping[sp.Symbol, Any], library: Library) -> Any:

@@ -253,7 +253,7 @@ def report(result: Result, spec: OptimalControlSpec, inverse: InverseData) -> Re
 def _penalty_value(spec: OptimalControlSpec, result: Result, penalty: Penalty) -> float:
     """The added cost on the solution, with the transcription's own quadrature (``T q·L``)."""
     grid = Transcription(spec).grid
-    _, _, q = grid.matrices
+    _, _, q = grid.triplets
     idx = grid.eval_index
     t = np.asarray(result.time)
     values: dict[sp.Symbol, Any] = {symbol(k): v for k, v in result.parameters.items()}

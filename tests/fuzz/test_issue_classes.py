@@ -278,7 +278,7 @@ def test_usage_errors_are_one_line(args) -> None:
 
 
 def test_warnings_do_not_reach_stderr(monkeypatch) -> None:
-    import gamespec.cli
+    import gamespec.loader
 
     def noisy(*args, **kwargs):
         warnings.warn("a solver's warning", RuntimeWarning, stacklevel=1)
@@ -287,7 +287,7 @@ def test_warnings_do_not_reach_stderr(monkeypatch) -> None:
 
     import gamespec
 
-    monkeypatch.setattr(gamespec.cli, "load", noisy)
+    monkeypatch.setattr(gamespec.loader, "load", noisy)
     outcome = run_cli(["validate", ZERMELO])
     assert outcome.code == 2
     assert outcome.err == "error: noisy.yaml: f: the reason\n"

@@ -58,7 +58,10 @@ class Transcription:
         self.ocp = SymbolicOcp(spec)
         m = spec.method
         mesh = None if m.mesh is None else tuple(m.mesh)
-        self.grid = Grid(m.scheme, m.intervals, m.degree if m.scheme == "radau" else 1, m.grading, mesh)
+        degrees = None if m.degrees is None else tuple(m.degrees)
+        self.grid = Grid(
+            m.scheme, m.intervals, m.degree if m.scheme == "radau" else 1, m.grading, mesh, degrees
+        )
         self.t0 = spec.problem.time.initial
 
     @property

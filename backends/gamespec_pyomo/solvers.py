@@ -149,8 +149,8 @@ class Run:
 def run_solver(exe: Executable, nl_text: str, options: dict[str, Any]) -> Run:
     """Run ``exe`` on the NL file ``nl_text`` as Pyomo's AMPL solvers do (``key=value`` on the command
     line and in ``<name>_options``; an ``OF_key`` option in the options file ``<name>.opt`` in the
-    working directory, where Ipopt reads every option it has) and read its SOL file with Pyomo's reader (duals included);
-    BackendError when it exits with an error or writes no SOL file."""
+    working directory, where Ipopt reads every option it has) and read its SOL file with Pyomo's
+    reader (duals included); BackendError when it exits with an error or writes no SOL file."""
     from pyomo.opt.plugins.sol import ResultsReader_sol
 
     in_file = {key.removeprefix("OF_"): value for key, value in options.items() if key.startswith("OF_")}

@@ -102,7 +102,8 @@ def test_options_file_options_reach_the_solvers_working_directory(tmp_path) -> N
     fake.write_text(f'#!/bin/sh\ncat ipopt.opt > "{seen}.opt"\necho "$@" > "{seen}.args"\nexit 3\n')
     fake.chmod(fake.stat().st_mode | stat.S_IEXEC)
     with pytest.raises(BackendError, match="exit status 3"):
-        solvers.run_solver(solvers.Executable("ipopt", str(fake), "test"), "", {"tol": 1e-8, "OF_mumps_permuting_scaling": 0})
+        options = {"tol": 1e-8, "OF_mumps_permuting_scaling": 0}
+        solvers.run_solver(solvers.Executable("ipopt", str(fake), "test"), "", options)
     assert (tmp_path / "seen.opt").read_text() == "mumps_permuting_scaling 0\n"
     assert "tol=1e-08" in (tmp_path / "seen.args").read_text()
     assert "mumps" not in (tmp_path / "seen.args").read_text()

@@ -216,18 +216,7 @@ class OcpProblem(StrictModel):
     def parameter_values(self, base: Mapping[str, float] | None = None) -> dict[str, float]:
         """Every parameter's value, in declaration order: the numeric ones from ``base`` (else the
         file), each derived one evaluated over the values before it."""
-        base = base or {}
-        values: dict[str, float] = {}
-        for name, raw in self.parameters.items():
-            if isinstance(raw, str):
-                expr = parse(raw, {n: symbol(n) for n in values})
-                value = numeric(expr, {symbol(k): v for k, v in values.items()})
-                if not math.isfinite(value):
-                    raise SpecError(f"evaluates to {value}", field=f"problem.parameters.{name}")
-                values[name] = value
-            else:
-                values[name] = float(base.get(name, raw))
-        return values
+        return parameter_values(self.parameters, base)
 
     def evaluate(self, params: Mapping[str, float]) -> EvaluatedValues:
         """Bounds, fixed end values and a fixed final time as floats for these parameter values;
@@ -362,6 +351,25 @@ class OcpProblem(StrictModel):
                     else str(err)
                 )
                 raise SpecError(reason, field=f"problem.{field}") from None
+
+
+def parameter_values(
+    parameters: Mapping[str, float | str], base: Mapping[str, float] | None = None
+) -> dict[str, float]:
+    """Every parameter's value, in declaration order: the numeric ones from ``base`` (else
+    ``parameters``), each derived one (an expression) evaluated over the values before it."""
+    base = base or {}
+    values: dict[str, float] = {}
+    for name, raw in parameters.items():
+        if isinstance(raw, str):
+            expr = parse(raw, {n: symbol(n) for n in values})
+            value = numeric(expr, {symbol(k): v for k, v in values.items()})
+            if not math.isfinite(value):
+                raise SpecError(f"evaluates to {value}", field=f"problem.parameters.{name}")
+            values[name] = value
+        else:
+            values[name] = float(base.get(name, raw))
+    return values
 
 
 def is_time_varying(raw: float | str | None) -> bool:

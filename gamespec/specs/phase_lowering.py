@@ -77,11 +77,22 @@ class Lowering:
     """Whether a jump or a boundary constraint uses a phase's start or end time."""
 
 
-def _read(text: Any, symbols: Mapping[str, sp.Expr], field: str, source: str, relation: bool = False) -> Any:
+def _read(
+    text: Any,
+    symbols: Mapping[str, sp.Expr],
+    field: str,
+    source: str,
+    relation: bool = False,
+    phase: str | None = None,
+) -> Any:
+    """Parse ``text`` over ``symbols``; a SpecError naming ``problem.<field>`` (and ``phase``, where
+    a shared field is read in one phase) when it does not parse."""
     try:
         return (parse_relation if relation else parse)(text, symbols)
     except ExpressionError as err:
-        raise SpecError(str(err), field=f"problem.{field}", source=source) from None
+        shared = phase is not None and not field.startswith("phases.")
+        where = f" (in phase {phase!r})" if shared else ""
+        raise SpecError(f"{err}{where}", field=f"problem.{field}", source=source) from None
 
 
 def relation_texts(rel: Relation) -> list[str]:
@@ -142,7 +153,7 @@ class _Lowerer:
             symbols = self.params | self.design | {n: symbol(n) for n in names} | {"t": TIME}
         for name, raw in (self.p.definitions | ph.definitions).items():
             where = f"phases.{k}.definitions.{name}" if name in ph.definitions else f"definitions.{name}"
-            symbols[name] = _read(raw, symbols, where, self.source)
+            symbols[name] = _read(raw, symbols, where, self.source, phase=ph.name)
         return symbols
 
     def ends(self, phases: Mapping[str, tuple[str, Any]], t_first: sp.Expr, t_last: sp.Expr) -> dict:
@@ -177,7 +188,7 @@ class _Lowerer:
             D = self.durations[k]
             if ph.duration.free:
                 lo, hi = ph.duration.bounds
-                design[name] = {"lower": lo, "upper": hi, "guess": spans[k]}
+                design[name] = {"lower": lo, "upper": hi, "guess": ph.duration.guess}
             else:
                 parameters[name] = ph.duration.value
             own = self.phase_controls(ph, k)
@@ -212,17 +223,17 @@ class _Lowerer:
                         source=self.source,
                     )
                 where = f"{field}.dynamics.{x}" if x in ph.dynamics else f"dynamics.{x}"
-                dynamics[x_names[x]] = to_text(D * _read(raw, running, where, self.source))
+                dynamics[x_names[x]] = to_text(D * _read(raw, running, where, self.source, phase=ph.name))
             for u, entry in own.items():
                 path += self.time_bounds(entry, running[u], running, f"{field}.controls.{u}")
                 controls[u_names[u]] = entry
             cost = ph.lagrange if ph.lagrange is not None else p.objective.lagrange
             where = f"{field}.lagrange" if ph.lagrange is not None else "objective.lagrange"
-            lagrange += D * _read(cost, running, where, self.source)
+            lagrange += D * _read(cost, running, where, self.source, phase=ph.name)
             texts = [(f"path_constraints.{i}", c) for i, c in enumerate(p.path_constraints)]
             texts += [(f"{field}.path_constraints.{i}", c) for i, c in enumerate(ph.path_constraints)]
             for where, text in texts:
-                path += relation_texts(_read(text, running, where, self.source, relation=True))
+                path += relation_texts(_read(text, running, where, self.source, True, ph.name))
             names = {n: (c, c) for n, c in (x_names | u_names).items()}
             ends = self.ends(names, self.starts[k], self.starts[k + 1])
             for i, text in enumerate(ph.boundary_constraints):
@@ -310,36 +321,36 @@ class _Lowerer:
                 found.append(to_text(sense(var - bound, 0, evaluate=False)))
         return found
 
-    def duration_guesses(self) -> list[float]:
-        """Each phase's duration guess: its fixed value, its guess, else the middle of its bounds."""
+    def duration_guesses(self) -> list[sp.Expr]:
+        """Each phase's duration guess over the lowered parameters: a fixed duration's parameter, a
+        free one's guess, else the middle of its bounds (a SpecError unless each is positive for the
+        file's parameter values)."""
         values = {symbol(n): v for n, v in self.values.items()}
         found = []
         for k, ph in enumerate(self.p.phases):
             d = ph.duration
             raws = [d.value] if not d.free else [d.guess] if d.guess is not None else list(d.bounds)
-            numbers = [
-                numeric(_read(r, self.params, f"phases.{k}.duration", self.source), values) for r in raws
-            ]
-            if not all(math.isfinite(v) and v > 0 for v in numbers):
+            exprs = [_read(r, self.params, f"phases.{k}.duration", self.source) for r in raws]
+            if not all(math.isfinite(v := numeric(e, values)) and v > 0 for e in exprs):
                 raise SpecError("a duration must be positive", field=f"problem.phases.{k}.duration")
-            found.append(sum(numbers) / len(numbers))
+            found.append(self.durations[k] if not d.free else sum(exprs) / len(exprs))
         return found
 
     def spread_guess(
-        self, ph: PhaseSpec, k: int, spans: list[float], names: dict[str, str]
+        self, ph: PhaseSpec, k: int, spans: list[sp.Expr], names: dict[str, str]
     ) -> dict[str, str]:
         """For each state the phase gives no guess for whose value is fixed at the start of the
         first phase and at the end of the last: the straight line between them over the whole
         horizon (duration guesses), as an expression of the phase's normalized time."""
         tau = symbol(NORMALIZED_TIME)
-        start, total = sum(spans[:k]), sum(spans)
+        start, total = sum(spans[:k], sp.Integer(0)), sum(spans, sp.Integer(0))
         found = {}
         for x, st in self.p.states.items():
             if x in ph.guess.states or st.initial is None or st.final is None:
                 continue
             a = _read(st.initial, self.params, f"states.{x}.initial", self.source)
             b = _read(st.final, self.params, f"states.{x}.final", self.source)
-            fraction = (sp.Float(start) + sp.Float(spans[k]) * tau) / sp.Float(total)
+            fraction = (start + spans[k] * tau) / total
             found[names[x]] = to_text(a + (b - a) * fraction)
         return found
 

@@ -127,7 +127,7 @@ class _Lowerer:
         self.durations = [symbol(duration_name(ph.name)) for ph in self.p.phases]
         t0 = sp.Float(self.p.time.initial)
         self.starts = [t0 + sum(self.durations[:k], sp.Integer(0)) for k in range(len(self.p.phases) + 1)]
-        self.constants = self.params | self.design | {str(d): d for d in self.durations}
+        self.constants = self.params | self.design
         self.values = parameter_values(self.p.parameters)
 
     def phase_controls(self, ph: PhaseSpec, k: int) -> dict[str, dict[str, Any]]:
@@ -378,7 +378,14 @@ class _Lowerer:
             },
             "method": self.spec.method.model_dump(),
         }
-        return OptimalControlSpec.model_validate(data)
+        try:
+            return OptimalControlSpec.model_validate(data)
+        except SpecError as err:
+            field = f"problem.phases.{k}.{(err.field or '').removeprefix('problem.')}".rstrip(".")
+            raise SpecError(err.reason, field=field, source=self.source) from None
+        except ValidationError as err:
+            reason = err.errors()[0]["msg"]
+            raise SpecError(reason, field=f"problem.phases.{k}", source=self.source) from None
 
 
 def lower(spec: MultiPhaseSpec) -> Lowering:

@@ -159,8 +159,26 @@ class MultiPhaseProblem(StrictModel):
 
 
 class MultiPhaseSpec(ProblemParameters, SpecBase):
-    """A multi-phase optimal-control problem (kind ``multiphase_optimal_control``), lowered to one
-    ``optimal_control`` problem; its runtime parameters are ``problem.parameters``."""
+    """A multi-phase optimal-control problem: phases in sequence, each with its own dynamics
+    (``phases[k].dynamics`` replaces ``problem.dynamics`` by state), duration (a value, or ``free``
+    within bounds: a switching time), running cost, path and boundary constraints, controls (a
+    subset of ``problem.controls``, bounds narrowed), state bounds and end values, and guess;
+    consecutive phases are linked by continuity of every state or by a jump
+    (``jump: {m: m_f - structure}``, over the previous phase's end). Solved as one NLP: the
+    ``phases`` transform lowers it to one ``optimal_control`` problem in which each phase has its
+    own copy of the states and controls on a normalized time in [0, 1], its duration a design
+    variable (free) or a parameter (fixed), the links boundary constraints (``gamespec show FILE
+    --transformed`` prints it). All phases share the collocation grid of ``method`` in their own
+    normalized time.
+
+    The Result runs over the whole horizon, phase after phase (each boundary twice: the end of one
+    phase and the start of the next); ``metrics.phases`` gives each phase's name, start, end and
+    duration, ``arrays.phase`` the phase of each time point, and the plots mark the boundaries.
+    Checks: ``max_constraint_violation`` (links included), ``max_defect`` and
+    ``max_defect_relative`` overall, and per phase ``<check>/<phase>`` (defects, bounds and path
+    constraints, control swings, the Hamiltonian's variation on autonomous phases and, on a phase
+    of free duration, ``hamiltonian_end_error/<phase>`` = ``max |H + dPhi/dt_f|``, the switching
+    time's transversality condition). Its runtime parameters are ``problem.parameters``."""
 
     kind: Literal["multiphase_optimal_control"] = "multiphase_optimal_control"
     problem: MultiPhaseProblem

@@ -19,7 +19,7 @@ expression is checked at load with the field that holds it.
 
 from __future__ import annotations
 
-from typing import Literal
+from typing import ClassVar, Literal
 
 from pydantic import Field, field_validator, model_validator
 
@@ -29,6 +29,7 @@ from gamespec.specs.ocp import (
     NORMALIZED_TIME,
     ControlSpec,
     DesignSpec,
+    FreeOrFixed,
     MethodSpec,
     ObjectiveSpec,
     StateSpec,
@@ -38,26 +39,15 @@ from gamespec.specs.plot import PlotHint
 from gamespec.symbolic.language import RESERVED
 
 
-class DurationSpec(StrictModel):
+class DurationSpec(FreeOrFixed):
     """A phase's duration: a value (a number or an expression of the parameters), or ``free``
     within ``bounds`` (numbers or expressions of the parameters) from ``guess`` (the middle of the
     bounds when omitted). A phase may give a number or an expression instead of the mapping."""
 
     value: Value | Literal["free"] = "free"
-    bounds: tuple[Value, Value] | None = None
-    guess: Number | None = None
 
-    @model_validator(mode="after")
-    def _free_needs_bounds(self) -> DurationSpec:
-        if self.free and self.bounds is None:
-            raise ValueError("a free duration needs bounds: [lower, upper]")
-        if not self.free and (self.bounds is not None or self.guess is not None):
-            raise ValueError("bounds and guess are only for a free duration (value: free)")
-        return self
-
-    @property
-    def free(self) -> bool:
-        return self.value == "free"
+    fixed_field: ClassVar[str] = "value"
+    what: ClassVar[str] = "duration"
 
 
 class PhaseGuessSpec(StrictModel):

@@ -14,7 +14,7 @@ import itertools
 import math
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass
-from typing import Literal
+from typing import ClassVar, Literal
 
 from pydantic import Field, field_validator, model_validator
 
@@ -98,27 +98,39 @@ class ObjectiveSpec(StrictModel):
     lagrange: Value = 0.0
 
 
-class TimeSpec(StrictModel):
+class FreeOrFixed(StrictModel):
+    """A value that is either fixed or ``free`` within ``bounds`` (numbers or expressions of the
+    parameters) from ``guess``: a final time, a phase's duration. A subclass names the field of the
+    value (``fixed_field``, free when it reads ``free``) and what it is (``what``)."""
+
+    bounds: tuple[Value, Value] | None = None
+    guess: Number | None = None
+
+    fixed_field: ClassVar[str] = ""
+    what: ClassVar[str] = ""
+
+    @property
+    def free(self) -> bool:
+        return getattr(self, self.fixed_field) == "free"
+
+    @model_validator(mode="after")
+    def _free_needs_bounds(self) -> FreeOrFixed:
+        if self.free and self.bounds is None:
+            raise ValueError(f"a free {self.what} needs bounds: [lower, upper]")
+        if not self.free and self.bounds is not None:
+            raise ValueError(f"bounds are only for a free {self.what} ({self.fixed_field}: free)")
+        return self
+
+
+class TimeSpec(FreeOrFixed):
     """Initial time, and the final time: a value, or ``free`` within ``bounds`` (numbers or
     expressions of the parameters) from ``guess``."""
 
     initial: Number = 0.0
     final: Value | Literal["free"] = 1.0
-    bounds: tuple[Value, Value] | None = None
-    guess: Number | None = None
 
-    @model_validator(mode="after")
-    def _free_needs_bounds(self) -> TimeSpec:
-        if self.final == "free":
-            if self.bounds is None:
-                raise ValueError("a free final time needs bounds: [lower, upper]")
-        elif self.bounds is not None:
-            raise ValueError("bounds are only for a free final time (final: free)")
-        return self
-
-    @property
-    def free(self) -> bool:
-        return self.final == "free"
+    fixed_field: ClassVar[str] = "final"
+    what: ClassVar[str] = "final time"
 
 
 class OcpProblem(StrictModel):

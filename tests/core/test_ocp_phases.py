@@ -236,3 +236,13 @@ def test_each_phase_runs_on_its_own_time(backend: str) -> None:
     result = gamespec.solve(spec_from_dict(data), backend=backend)
     assert result.metrics["phases"][0]["end"] == pytest.approx(2.0, rel=IPOPT_LEVEL)
     assert "hamiltonian_end_error/a" not in result.checks
+
+
+def test_mesh_refinement_refines_the_phases_to_the_tolerance() -> None:
+    tolerance = 1e-8
+    spec = gamespec.load(ROCKET, ["method.intervals=3", f"method.refine={{tolerance: {tolerance}}}"])
+    result = gamespec.solve(spec)
+    history = [entry["max_defect_relative"] for entry in result.metrics["refinement"]]
+    assert result.metrics["refinement_converged"] and history[-1] <= tolerance < history[0]
+    assert all(result.checks[f"max_defect_relative/{p}"] <= tolerance for p in ("stage1", "stage2"))
+    assert len(result.time) == 2 * (3 * result.metrics["refinement"][-1]["intervals"] + 1)

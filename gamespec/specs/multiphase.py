@@ -23,8 +23,7 @@ from typing import ClassVar, Literal
 
 from pydantic import Field, field_validator, model_validator
 
-from gamespec.errors import SpecError
-from gamespec.specs.base import Number, ProblemParameters, SpecBase, StrictModel, Value
+from gamespec.specs.base import Number, SpecBase, StrictModel, Value
 from gamespec.specs.ocp import (
     NORMALIZED_TIME,
     ControlSpec,
@@ -32,6 +31,7 @@ from gamespec.specs.ocp import (
     FreeOrFixed,
     MethodSpec,
     ObjectiveSpec,
+    OcpFamily,
     StateSpec,
 )
 from gamespec.specs.phase_lowering import SEPARATOR, lower
@@ -148,7 +148,7 @@ class MultiPhaseProblem(StrictModel):
         return self
 
 
-class MultiPhaseSpec(ProblemParameters, SpecBase):
+class MultiPhaseSpec(OcpFamily, SpecBase):
     """A multi-phase optimal-control problem: phases in sequence, each with its own dynamics
     (``phases[k].dynamics`` replaces ``problem.dynamics`` by state), duration (a value, or ``free``
     within bounds: a switching time), running cost, path and boundary constraints, controls (a
@@ -179,17 +179,6 @@ class MultiPhaseSpec(ProblemParameters, SpecBase):
 
     @model_validator(mode="after")
     def _lowers(self) -> MultiPhaseSpec:
-        for i, pair in enumerate(self.plot.planar):
-            unknown = [n for n in pair if n not in self.problem.states]
-            if unknown:
-                raise SpecError(f"{', '.join(unknown)} is not a state", field=f"plot.planar.{i}")
+        self.check_plot_names()
         lower(self)
         return self
-
-    @property
-    def objective_sense(self) -> str:
-        return self.problem.objective.sense
-
-    def runtime_parameters(self) -> dict[str, float]:
-        """The numeric parameters (derived ones follow them and are not set on their own)."""
-        return {n: float(v) for n, v in self.problem.parameters.items() if not isinstance(v, str)}

@@ -516,7 +516,33 @@ class GuessSpec(StrictModel):
     result: str | None = None
 
 
-class OptimalControlSpec(ProblemParameters, SpecBase):
+class OcpFamily(ProblemParameters):
+    """What the optimal-control kinds share: the objective's sense, the numeric parameters as
+    runtime parameters, and a ``plot`` section that names their states and controls."""
+
+    def check_plot_names(self) -> None:
+        """A SpecError naming the ``plot`` field that names no state (planar) or no state, control
+        or ``t`` (units)."""
+        states = set(self.problem.states)
+        for i, pair in enumerate(self.plot.planar):
+            unknown = [n for n in pair if n not in states]
+            if unknown:
+                raise SpecError(f"{', '.join(unknown)} is not a state", field=f"plot.planar.{i}")
+        named = {*self.problem.states, *self.problem.controls, "t"}
+        for name in self.plot.units:
+            if name not in named:
+                raise SpecError(f"{name!r} is not a state, a control or t", field=f"plot.units.{name}")
+
+    @property
+    def objective_sense(self) -> str:
+        return self.problem.objective.sense
+
+    def runtime_parameters(self) -> dict[str, float]:
+        """The numeric parameters (derived ones follow them and are not set on their own)."""
+        return {n: float(v) for n, v in self.problem.parameters.items() if not isinstance(v, str)}
+
+
+class OptimalControlSpec(OcpFamily, SpecBase):
     """An optimal-control problem (kind ``optimal_control``); its runtime parameters are
     ``problem.parameters``, its starting point ``guess`` and ``problem.time.guess``."""
 
@@ -539,24 +565,8 @@ class OptimalControlSpec(ProblemParameters, SpecBase):
 
     @model_validator(mode="after")
     def _plot_names(self) -> OptimalControlSpec:
-        states = set(self.problem.states)
-        for i, pair in enumerate(self.plot.planar):
-            unknown = [n for n in pair if n not in states]
-            if unknown:
-                raise SpecError(f"{', '.join(unknown)} is not a state", field=f"plot.planar.{i}")
-        named = {*self.problem.states, *self.problem.controls, "t"}
-        for name in self.plot.units:
-            if name not in named:
-                raise SpecError(f"{name!r} is not a state, a control or t", field=f"plot.units.{name}")
+        self.check_plot_names()
         return self
-
-    @property
-    def objective_sense(self) -> str:
-        return self.problem.objective.sense
-
-    def runtime_parameters(self) -> dict[str, float]:
-        """The numeric parameters (derived ones follow them and are not set on their own)."""
-        return {n: float(v) for n, v in self.problem.parameters.items() if not isinstance(v, str)}
 
     def required_features(self) -> frozenset[str]:
         p = self.problem

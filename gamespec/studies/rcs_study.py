@@ -80,6 +80,8 @@ class RcsStudyModel(PointStudyModel):
             arrays=study.arrays(rows),
             metrics={
                 "table": study.summarize(rows),
+                "points": len(rows),
+                "solved": solved,
                 "sigma": self.spec.std,
                 "sigma_is": self.spec.sigma_is,
                 "radius": self.spec.radius,

@@ -98,3 +98,16 @@ def test_reloaded_parameters_resolve_the_compiled_game():
     assert solver.compiled.model.builds == builds
     np.testing.assert_allclose(result.controls["v1"], want["v"][0], atol=SOLVER_TOL)
     assert result.objective == pytest.approx(want["payoff"], abs=SOLVER_TOL)
+
+
+def test_summary_leads_with_the_equilibrium_and_the_game_value(cli):
+    """``gamespec solve`` says how the iteration ended and the value, read from the Result."""
+    from gamespec.summaries import outcome
+
+    result = compile_spec(load(FILE)).solve()
+    rows = dict(outcome(result))
+    run = result.metrics["best_response"]["pursuer"]
+    assert rows["equilibrium"] == f"{run['outcome']} after {run['iterations']} Gauss–Seidel iterations"
+    assert rows["game value"] == result.objective
+    code, out, _ = cli("solve", str(FILE))
+    assert code == 0 and "Gauss–Seidel iterations" in out and "game value" in out

@@ -12,6 +12,7 @@ from gamespec.errors import SpecError
 from gamespec.games.problems import player_problem, views
 from gamespec.loader import load
 from gamespec.solving import compile_spec
+from gamespec.summaries import outcome
 from tests.conftest import PROBLEMS
 from tests.core.test_chain import test_transforms  # noqa: F401  (the chain's test-only transforms)
 from tests.games.test_lq_game import FILE, SOLVER_TOL, closed_form, expected
@@ -143,6 +144,10 @@ def test_asymmetric_obstacle_first_steps_and_the_pursuers_belief():
     )
     assert result.arrays["lookahead/pursuer/xp"].shape == (3, spec.method.intervals + 1)
     assert set(m["per_step"][0]["games"]) == {"pursuer", "evader"}
+    rows = dict(outcome(result))
+    assert rows["captured"] is False and "capture time" not in rows
+    assert rows["receding-horizon steps"] == 3
+    assert rows["pursuer: closest to the obstacle"] == m["pursuer_min_obstacle_distance"]
 
 
 @pytest.mark.parametrize("timing", ["absolute", "relative"])

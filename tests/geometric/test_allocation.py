@@ -25,10 +25,14 @@ def _teams(seed: int, n: int, m: int, heterogeneous: bool):
 def test_lemmas_5_and_7_shortest_pair_is_allocated(seed: int, n: int, m: int, hetero: bool) -> None:
     """The pair with the shortest time |p_i - e_j| / (u_i + v_j) is in F (A2; AVAA when homogeneous).
 
-    Constant bearing only: the lemmas' proofs rest on the CB Apollonius circle, on which that time is
-    the capture time. Under pure pursuit the allocation does not always assign that pair (seed 1,
-    n = 16, m = 2, heterogeneous speeds: it goes to the other evader); whether that is the lemmas'
-    scope or a defect of the PP allocation is open."""
+    Constant bearing only, as the thesis states it: §3.4 assumes the pursuers follow CB, and the
+    proofs rest on the CB Apollonius circle, on which that time is the capture time. Under pure
+    pursuit the region is the refined Apollonius curve of §3.3 (eq. 3.24's limaçon made convex by
+    the bitangent across its dimple), whose nearest point to the evader is the bitangent at
+    ``A²/4B`` (:func:`~gamespec_geometric.apollonius.refined_pp_reach`), nearer than the head-on
+    capture point; another pursuer's chord can then hide pair (i*, j*)'s curve, the lemma's proof
+    step fails, and the allocation need not assign that pair (seed 1, n = 16, m = 2, heterogeneous
+    speeds: the pursuer is redundant for the nearer evader)."""
     pursuers, evaders, u, v = _teams(seed, n, m, hetero)
     result = allocate(pursuers, evaders, u, v, algorithm="a2", strategy="cb")
     times = np.linalg.norm(pursuers[:, None] - evaders[None], axis=2) / (u[:, None] + v[None, :])

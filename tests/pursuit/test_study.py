@@ -12,8 +12,10 @@ import pytest
 import gamespec
 from gamespec.pursuit import regions, study
 from gamespec.pursuit.study import StudyPoint
+from gamespec.result import Result
 from gamespec.studies import suboptimal_study
 from gamespec.studies.store import ResultStore
+from gamespec.summaries import outcome
 from tests.conftest import PROBLEMS
 
 STUDY = PROBLEMS / "ch2" / "pure_pursuit_suboptimal_study.yaml"
@@ -75,6 +77,9 @@ def test_solve_saves_points_resumes_and_plots(tmp_path, monkeypatch, cli) -> Non
     again = json.loads(out)
     assert again["metrics"]["computed"] == 0
     assert again["metrics"]["table"] == first["metrics"]["table"]
+    rows = dict(outcome(Result.load(run)))
+    assert (rows["points"], rows["solved"], rows["computed in this run"]) == (4, 4, 0)
+    assert rows["store"] == str(store)
 
     code, out, err = cli("plot", run)
     assert code == 0, err

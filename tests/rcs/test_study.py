@@ -7,7 +7,9 @@ import pytest
 import yaml
 
 from gamespec.rcs.study import layout
+from gamespec.result import Result
 from gamespec.specs.rcs_study import RcsStudySpec
+from gamespec.summaries import outcome
 from tests.conftest import PROBLEMS
 
 STUDY = PROBLEMS / "ch6" / "rcs_multi_obstacle_study.yaml"
@@ -57,6 +59,11 @@ def test_reduced_study_through_the_cli(cli, tmp_path):
     assert result["metrics"]["sigma"] == pytest.approx(0.1)
     code, out, _ = cli("solve", str(path), "--set", "sigma=0.1", "--json", "--out", str(tmp_path / "res"))
     assert code == 0 and json.loads(out)["metrics"]["computed"] == 0  # resumed from the store
+    rows = dict(outcome(Result.load(tmp_path / "res")))
+    assert rows["points"] == rows["solved"] == 2 and rows["computed in this run"] == 0
+    assert rows["store"] == str(tmp_path / "points")
+    code, out, _ = cli("solve", str(path), "--set", "sigma=0.1")
+    assert code == 0 and "computed in this run" in out
     code, _, _ = cli("plot", str(tmp_path / "res"), "--out", str(tmp_path / "fig"))
     assert code == 0
     assert {p.name for p in (tmp_path / "fig").iterdir()} >= {

@@ -29,6 +29,7 @@ from gamespec.specs.ocp import (
     ControlSpec,
     DesignSpec,
     FreeOrFixed,
+    IntegralConstraintSpec,
     MethodSpec,
     ObjectiveSpec,
     OcpFamily,
@@ -124,6 +125,9 @@ class MultiPhaseProblem(StrictModel):
     time: StartSpec = Field(default_factory=StartSpec)
     path_constraints: list[str] = Field(default_factory=list, description="Imposed in every phase.")
     boundary_constraints: list[str] = Field(default_factory=list)
+    integral_constraints: list[IntegralConstraintSpec] = Field(
+        default_factory=list, description="Over the whole horizon: the integrand summed over the phases."
+    )
     phases: list[PhaseSpec] = Field(min_length=1)
 
     @model_validator(mode="after")

@@ -8,7 +8,8 @@ scaling of one phase, ``dx/ds = D_k f_k``), so that
 
 - dynamics: ``dx__k/ds = D_k f_k(x__k, u__k, S_k + D_k s)``;
 - cost: the Mayer term over the first phase's start and the last phase's end, with
-  ``t_f = t0 + sum D_k``, plus ``integral_0^1 sum_k D_k L_k ds``;
+  ``t_f = t0 + sum D_k``, plus ``integral_0^1 sum_k D_k L_k ds``; an integral constraint over the
+  whole horizon likewise integrates ``sum_k D_k g_k``;
 - path constraints and bounds that use ``t``: imposed on each phase's copy at its own time;
 - links: ``x__{k+1}(0) = x__k(1)`` (continuity) or ``x__{k+1}(0) = jump(x__k(1), ...)``, boundary
   constraints of the one problem.
@@ -179,6 +180,7 @@ class _Lowerer:
         boundary: list[str] = []
         guess: dict[str, dict[str, Any]] = {"states": {}, "controls": {}}
         lagrange = sp.Integer(0)
+        integrands = [sp.Integer(0) for _ in p.integral_constraints]
         lowered: list[LoweredPhase] = []
         timed = False
         spans = self.duration_guesses()
@@ -230,6 +232,9 @@ class _Lowerer:
             cost = ph.lagrange if ph.lagrange is not None else p.objective.lagrange
             where = f"{field}.lagrange" if ph.lagrange is not None else "objective.lagrange"
             lagrange += D * _read(cost, running, where, self.source, phase=ph.name)
+            for i, c in enumerate(p.integral_constraints):
+                where = f"integral_constraints.{i}.integrand"
+                integrands[i] += D * _read(c.integrand, running, where, self.source, phase=ph.name)
             texts = [(f"path_constraints.{i}", c) for i, c in enumerate(p.path_constraints)]
             texts += [(f"{field}.path_constraints.{i}", c) for i, c in enumerate(ph.path_constraints)]
             for where, text in texts:
@@ -296,6 +301,10 @@ class _Lowerer:
                 "time": {"initial": 0.0, "final": 1.0},
                 "path_constraints": path,
                 "boundary_constraints": boundary,
+                "integral_constraints": [
+                    c.model_dump() | {"integrand": to_text(g)}
+                    for c, g in zip(p.integral_constraints, integrands, strict=True)
+                ],
             },
             "method": spec.method.model_dump(),
             "guess": guess,

@@ -246,3 +246,29 @@ def test_mesh_refinement_refines_the_phases_to_the_tolerance() -> None:
     assert result.metrics["refinement_converged"] and history[-1] <= tolerance < history[0]
     assert all(result.checks[f"max_defect_relative/{p}"] <= tolerance for p in ("stage1", "stage2"))
     assert len(result.time) == 2 * (3 * result.metrics["refinement"][-1]["intervals"] + 1)
+
+
+@pytest.mark.parametrize("backend", BACKENDS)
+def test_an_integral_constraint_runs_over_every_phase(backend: str) -> None:
+    """integral of x dt = A over the horizon, in two phases as in one (the same discretization)."""
+    constraint = [{"integrand": "x", "lower": 0.8, "upper": 0.8}]
+    data = _two_phases((1.0, 1.0), 4)
+    data["problem"]["integral_constraints"] = constraint
+    two = gamespec.solve(spec_from_dict(data), backend=backend)
+    problem = copy.deepcopy(REST_TO_REST) | {"time": {"final": 2.0}, "integral_constraints": constraint}
+    one_spec = {"kind": "optimal_control", "name": "one", "problem": problem, "method": {"intervals": 8}}
+    one = gamespec.solve(spec_from_dict(one_spec), backend=backend)
+    assert two.ok and one.ok
+    assert two.objective == pytest.approx(one.objective, rel=IPOPT_LEVEL)
+    assert two.objective > 12.0 / 2.0**3
+
+
+def test_each_stage_hamiltonian_tends_to_its_transversality_value() -> None:
+    """The Mayer term v_f does not depend on t_f, so H = 0 on each stage of free duration; the
+    costate estimates of LGR collocation converge at least at second order in h (degree 3)."""
+    errors = []
+    for intervals in (10, 40):
+        result = gamespec.solve(gamespec.load(ROCKET, [f"method.intervals={intervals}"]))
+        errors.append([result.checks[f"hamiltonian_end_error/{p}"] for p in ("stage1", "stage2")])
+    coarse, fine = np.array(errors)
+    assert np.all(fine < coarse / 4.0**2)

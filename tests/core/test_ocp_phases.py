@@ -272,3 +272,36 @@ def test_each_stage_hamiltonian_tends_to_its_transversality_value() -> None:
         errors.append([result.checks[f"hamiltonian_end_error/{p}"] for p in ("stage1", "stage2")])
     coarse, fine = np.array(errors)
     assert np.all(fine < coarse / 4.0**2)
+
+
+@pytest.mark.parametrize("backend", BACKENDS)
+def test_three_arcs_switch_at_their_closed_form(backend: str) -> None:
+    """Minimum time from rest at x0 to rest at 0 with |v| <= vmax: full thrust, a cruise on the
+X
+    relay). Switches at vmax and t_f - vmax, t_f = 2 vmax + (x0 - vmax**2) / vmax."""
+    x0, vmax = 2.0, 0.9
+    free = {"value": "free", "bounds": [0.01, 10.0], "guess": 1.0}
+    data = {
+        "kind": "multiphase_optimal_control",
+        "problem": {
+            "parameters": {"x0": x0, "vmax": vmax},
+            "states": {
+                "x": {"initial": "x0", "final": 0.0},
+                "v": {"initial": 0.0, "final": 0.0, "lower": "-vmax"},
+            },
+            "dynamics": {"x": "v"},
+            "objective": {"mayer": "t_f"},
+            "phases": [
+                {"name": "accelerate", "duration": free, "dynamics": {"v": -1}},
+                {"name": "cruise", "duration": free, "dynamics": {"v": 0}},
+                {"name": "brake", "duration": free, "dynamics": {"v": 1}},
+            ],
+        },
+        "method": {"intervals": 4},
+    }
+    result = gamespec.solve(spec_from_dict(data), backend=backend)
+    t_f = 2 * vmax + (x0 - vmax**2) / vmax
+    assert result.ok
+    assert [p["end"] for p in result.metrics["phases"]] == pytest.approx(
+        [vmax, t_f - vmax, t_f], rel=IPOPT_LEVEL
+    )

@@ -277,8 +277,9 @@ def test_each_stage_hamiltonian_tends_to_its_transversality_value() -> None:
 @pytest.mark.parametrize("backend", BACKENDS)
 def test_three_arcs_switch_at_their_closed_form(backend: str) -> None:
     """Minimum time from rest at x0 to rest at 0 with |v| <= vmax: full thrust, a cruise on the
-X
-    relay). Switches at vmax and t_f - vmax, t_f = 2 vmax + (x0 - vmax**2) / vmax."""
+    constraint |v| = vmax, full braking: a free arc, a constrained arc and a last arc, the structure
+    of the relay's arcs in §2.5 (Proposition 3, switching times tau_1, tau_2). Switches at vmax and
+    t_f - vmax, t_f = 2 vmax + (x0 - vmax**2) / vmax."""
     x0, vmax = 2.0, 0.9
     free = {"value": "free", "bounds": [0.01, 10.0], "guess": 1.0}
     data = {

@@ -22,6 +22,7 @@ the phase times (no explicit ``t``, no ``t_0``/``t_f`` in jumps or boundary cons
 
 from __future__ import annotations
 
+from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
@@ -71,6 +72,52 @@ def _switching_times_free(lowering: Lowering) -> bool:
     return True
 
 
+def _joined(parts: list[np.ndarray], at_nodes: bool) -> np.ndarray:
+    """A phase's values from those of its pieces in order: at the nodes the start of each piece
+    after the first is the end of the one before (continuity) and is dropped; at the evaluation
+    points (none at a piece's start) they are laid end to end."""
+    if at_nodes:
+        parts = [parts[0], *(p[..., 1:] for p in parts[1:])]
+    return np.concatenate(parts, axis=-1)
+
+
+@dataclass(frozen=True)
+class PhaseArrays:
+    """One phase's solution on its own normalized time: nodes, evaluation points and interval
+    boundaries in [0, 1], states (rows in the file's order), controls (by name) and costates."""
+
+    s_nodes: np.ndarray
+    s_eval: np.ndarray
+    breaks: np.ndarray
+    X: np.ndarray
+    controls: dict[str, np.ndarray]
+    lam: np.ndarray | None
+
+
+def phase_arrays(
+    result: Result, phase: LoweredPhase, grid: tuple[np.ndarray, np.ndarray, np.ndarray]
+) -> PhaseArrays:
+    """``phase``'s pieces joined (see :func:`_joined`); ``grid``: the lowered nodes, evaluation
+    points and interval boundaries."""
+    m = len(phase.pieces)
+    s_nodes, s_eval, breaks = ([(j + g) / m for j in range(m)] for g in grid)
+    names = list(phase.pieces[0].states)
+    X = _joined([np.array([result.states[pc.states[n]] for n in names]) for pc in phase.pieces], True)
+    controls = {
+        n: _joined([result.controls[pc.controls[n]] for pc in phase.pieces], False)
+        for n in phase.pieces[0].controls
+    }
+    lam = None
+    if all(f"lambda_{c}" in result.costates for pc in phase.pieces for c in pc.states.values()):
+        lam = _joined(
+            [np.array([result.costates[f"lambda_{pc.states[n]}"] for n in names]) for pc in phase.pieces],
+            False,
+        )
+    return PhaseArrays(
+        _joined(s_nodes, True), _joined(s_eval, False), _joined(breaks, True), X, controls, lam
+    )
+
+
 def split_by_phase(result: Result, lowering: Lowering) -> Result:
     """``result`` (of ``lowering.target``) as the multi-phase problem's Result (see the module doc)."""
     if result.time is None or not result.states:
@@ -81,52 +128,48 @@ def split_by_phase(result: Result, lowering: Lowering) -> Result:
     starts = lowering.t0 + np.concatenate([[0.0], np.cumsum(durations)])
     s_nodes = np.asarray(result.time)
     s_eval = np.asarray(result.control_time if result.control_time is not None else result.time)
-    breaks = s_nodes[:: lowered.grid.points_per_interval]
+    grid = (s_nodes, s_eval, s_nodes[:: lowered.grid.points_per_interval])
     X_all = np.array([result.states[n] for n in lowered.ocp.states])
     U_all = np.array([result.controls[n] for n in lowered.ocp.controls]).reshape(lowered.n_u, len(s_eval))
-    state_names = list(lowering.phases[0].states)
-    control_names = list(dict.fromkeys(n for ph in lowering.phases for n in ph.controls))
-    has_costates = all(f"lambda_{c}" in result.costates for ph in lowering.phases for c in ph.states.values())
-    pieces: dict[str, list[np.ndarray]] = {"time": [], "control_time": [], "phase": [], "control_phase": []}
+    state_names = list(lowering.phases[0].pieces[0].states)
+    control_names = list(dict.fromkeys(n for ph in lowering.phases for n in ph.pieces[0].controls))
+    joined: dict[str, list[np.ndarray]] = {"time": [], "control_time": [], "phase": [], "control_phase": []}
     states = {n: [] for n in state_names}
     controls = {n: [] for n in control_names}
-    costates = {f"lambda_{n}": [] for n in state_names} if has_costates else {}
+    costates: dict[str, list[np.ndarray]] = {f"lambda_{n}": [] for n in state_names}
     checks = {k: result.checks[k] for k in OVERALL_CHECKS if k in result.checks}
     end_value = None
     if _switching_times_free(lowering):
         end_value = _end_value(lowering, lowered, X_all, U_all, values)
     for k, ph in enumerate(lowering.phases):
-        tr = _phase_transcription(ph, starts[k], starts[k + 1], breaks)
-        pieces["time"].append(starts[k] + durations[k] * s_nodes)
-        pieces["control_time"].append(starts[k] + durations[k] * s_eval)
-        pieces["phase"].append(np.full(len(s_nodes), k))
-        pieces["control_phase"].append(np.full(len(s_eval), k))
-        X = np.array([result.states[ph.states[n]] for n in state_names])
-        U = np.array([result.controls[ph.controls[n]] for n in tr.ocp.controls]).reshape(tr.n_u, len(s_eval))
+        arrays = phase_arrays(result, ph, grid)
+        tr = _phase_transcription(ph, starts[k], starts[k + 1], arrays.breaks)
+        joined["time"].append(starts[k] + durations[k] * arrays.s_nodes)
+        joined["control_time"].append(starts[k] + durations[k] * arrays.s_eval)
+        joined["phase"].append(np.full(len(arrays.s_nodes), k))
+        joined["control_phase"].append(np.full(len(arrays.s_eval), k))
         for i, n in enumerate(state_names):
-            states[n].append(X[i])
+            states[n].append(arrays.X[i])
         for n in control_names:
-            controls[n].append(
-                result.controls[ph.controls[n]] if n in ph.controls else np.full(len(s_eval), np.nan)
-            )
-        lam = None
-        if has_costates:
-            lam = np.array([result.costates[f"lambda_{ph.states[n]}"] for n in state_names])
-            for i, n in enumerate(state_names):
-                costates[f"lambda_{n}"].append(lam[i])
-        sol = Trajectory(X, U, np.zeros((0, U.shape[1])), float(durations[k]))
+            controls[n].append(arrays.controls.get(n, np.full(len(arrays.s_eval), np.nan)))
+        lam = arrays.lam
+        for i, n in enumerate(state_names if lam is not None else []):
+            costates[f"lambda_{n}"].append(lam[i])
+        U = np.array([arrays.controls[n] for n in tr.ocp.controls]).reshape(tr.n_u, len(arrays.s_eval))
+        sol = Trajectory(arrays.X, U, np.zeros((0, U.shape[1])), float(durations[k]))
         own = solution_checks(tr, sol, values, lam)
         if lam is not None and ph.free and end_value is not None and "hamiltonian_variation" in own:
             H = hamiltonian(tr, sol, values, lam)
             own["hamiltonian_end_error"] = float(np.max(np.abs(H - end_value)))
         checks |= {f"{name}/{ph.name}": value for name, value in own.items()}
-    arrays = {k: v for k, v in result.arrays.items() if k != "costate_time"}
-    arrays |= {
-        "phase": np.concatenate(pieces["phase"]),
-        "control_phase": np.concatenate(pieces["control_phase"]),
+    has_costates = all(len(v) == len(lowering.phases) for v in costates.values())
+    extra = {k: v for k, v in result.arrays.items() if k != "costate_time"}
+    extra |= {
+        "phase": np.concatenate(joined["phase"]),
+        "control_phase": np.concatenate(joined["control_phase"]),
     }
     if has_costates:
-        arrays["costate_time"] = np.concatenate(pieces["control_time"])
+        extra["costate_time"] = np.concatenate(joined["control_time"])
     user = lowering.phases[0].check_spec.problem.design
     design = {n: v for n, v in result.metrics.get("design", {}).items() if n in user}
     phases = [
@@ -144,13 +187,13 @@ def split_by_phase(result: Result, lowering: Lowering) -> Result:
         metrics["design"] = design
     return result.model_copy(
         update={
-            "time": np.concatenate(pieces["time"]),
-            "control_time": np.concatenate(pieces["control_time"]),
+            "time": np.concatenate(joined["time"]),
+            "control_time": np.concatenate(joined["control_time"]),
             "t_final": float(starts[-1]),
             "states": {n: np.concatenate(v) for n, v in states.items()},
             "controls": {n: np.concatenate(v) for n, v in controls.items()},
-            "costates": {n: np.concatenate(v) for n, v in costates.items()},
-            "arrays": arrays,
+            "costates": {n: np.concatenate(v) for n, v in costates.items()} if has_costates else {},
+            "arrays": extra,
             "checks": checks,
             "metrics": metrics,
         }

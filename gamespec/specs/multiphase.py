@@ -23,6 +23,7 @@ from typing import ClassVar, Literal
 
 from pydantic import Field, field_validator, model_validator
 
+from gamespec.limits import MAX_INTERVALS
 from gamespec.specs.base import Number, SpecBase, StrictModel, Value
 from gamespec.specs.ocp import (
     NORMALIZED_TIME,
@@ -88,6 +89,9 @@ class PhaseSpec(StrictModel):
         "(<state>_f, <control>_f, t_f); states not named are continuous.",
     )
     guess: PhaseGuessSpec = Field(default_factory=PhaseGuessSpec)
+    intervals: int | None = Field(
+        None, ge=1, le=MAX_INTERVALS, description="Collocation intervals of this phase (method.intervals)."
+    )
 
     @field_validator("duration", mode="before")
     @classmethod
@@ -162,8 +166,8 @@ class MultiPhaseSpec(OcpFamily, SpecBase):
     ``phases`` transform lowers it to one ``optimal_control`` problem in which each phase has its
     own copy of the states and controls on a normalized time in [0, 1], its duration a design
     variable (free) or a parameter (fixed), the links boundary constraints (``gamespec show FILE
-    --transformed`` prints it). All phases share the collocation grid of ``method`` in their own
-    normalized time.
+    --transformed`` prints it). Each phase has ``method.intervals`` collocation intervals in its
+    own normalized time, or its own ``intervals`` (then on a uniform grid).
 
     The Result runs over the whole horizon, phase after phase (each boundary twice: the end of one
     phase and the start of the next); ``metrics.phases`` gives each phase's name, start, end and

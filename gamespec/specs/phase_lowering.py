@@ -14,14 +14,19 @@ scaling of one phase, ``dx/ds = D_k f_k``), so that
 - links: ``x__{k+1}(0) = x__k(1)`` (continuity) or ``x__{k+1}(0) = jump(x__k(1), ...)``, boundary
   constraints of the one problem.
 
-The phases share the collocation grid of ``method`` in their own normalized time: a phase of any
-duration is resolved by the same number of intervals. Everything is built in SymPy over the names the
-file gives and printed with :func:`~gamespec.symbolic.printer.to_text`; a bad expression is a
-SpecError naming the field of the multi-phase file that holds it.
+The copies share the collocation grid of the one problem in their own normalized time. When the
+phases set their own numbers of intervals ``N_k``, the grid has ``g = gcd(N_k)`` uniform intervals
+and phase ``k`` is ``N_k / g`` consecutive *pieces* (copies ``x__k__j`` on ``t = S_k + D_k (j + s) /
+m_k``, linked by continuity), so that each phase has exactly its ``N_k`` intervals and the NLP the
+size of the sum (interval counts with a large common divisor keep the number of copies small).
+Everything is built in SymPy over the names the file gives and printed with
+:func:`~gamespec.symbolic.printer.to_text`; a bad expression is a SpecError naming the field of the
+multi-phase file that holds it.
 """
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from collections.abc import Mapping
 from dataclasses import dataclass
@@ -54,17 +59,41 @@ def duration_name(phase: str) -> str:
 
 
 @dataclass(frozen=True)
-class LoweredPhase:
-    """One phase in the lowered problem: the lowered names of its states and controls (user name →
-    lowered name), of its duration, whether that is free, and the phase alone as a fixed-time
-    ``optimal_control`` spec in the file's names (``check_spec``, for the per-phase checks)."""
+class Piece:
+    """One copy of a phase's states and controls on the common grid: user name → lowered name."""
 
-    name: str
     states: dict[str, str]
     controls: dict[str, str]
+
+
+@dataclass(frozen=True)
+class LoweredPhase:
+    """One phase in the lowered problem: its pieces in order (one, or ``intervals / g`` when the
+    phases set their own numbers of intervals, g their greatest common divisor), the lowered name of
+    its duration, whether that is free, and the phase alone as a fixed-time ``optimal_control``
+    spec in the file's names (``check_spec``, for the per-phase checks)."""
+
+    name: str
+    pieces: list[Piece]
     duration: str
     free: bool
     check_spec: OptimalControlSpec
+
+
+@dataclass
+class _Parts:
+    """The lowered problem's sections as they are gathered, piece by piece."""
+
+    states: dict[str, dict] = dataclasses.field(default_factory=dict)
+    controls: dict[str, dict] = dataclasses.field(default_factory=dict)
+    dynamics: dict[str, str] = dataclasses.field(default_factory=dict)
+    path: list[str] = dataclasses.field(default_factory=list)
+    boundary: list[str] = dataclasses.field(default_factory=list)
+    guess: dict[str, dict[str, Any]] = dataclasses.field(
+        default_factory=lambda: {"states": {}, "controls": {}}
+    )
+    lagrange: sp.Expr = dataclasses.field(default_factory=lambda: sp.Integer(0))
+    integrands: list[sp.Expr] = dataclasses.field(default_factory=list)
 
 
 @dataclass(frozen=True)
@@ -143,22 +172,18 @@ class _Lowerer:
             )
         return {n: _merged(self.p.controls[n], c) for n, c in ph.controls.items()}
 
-    def running(self, ph: PhaseSpec, k: int, controls: Mapping[str, Any], renamed: bool) -> dict[str, Any]:
-        """The symbols of phase ``k``'s running expressions: lowered copies at ``t = S_k + D_k s``
-        (``renamed``), else the file's names at the real time; definitions expanded."""
-        names = [*self.p.states, *controls]
-        if renamed:
-            symbols = self.constants | {n: symbol(copy_name(n, ph.name)) for n in names}
-            symbols["t"] = self.starts[k] + self.durations[k] * TIME
-        else:
-            symbols = self.params | self.design | {n: symbol(n) for n in names} | {"t": TIME}
+    def running(self, ph: PhaseSpec, k: int, piece: Piece, j: int, m: int) -> dict[str, Any]:
+        """The symbols of piece ``j`` of ``m`` of phase ``k``: its lowered copies, at
+        ``t = S_k + D_k (j + s) / m``; definitions expanded."""
+        symbols = self.constants | {n: symbol(c) for n, c in (piece.states | piece.controls).items()}
+        symbols["t"] = self.starts[k] + self.durations[k] * (j + TIME) / m
         for name, raw in (self.p.definitions | ph.definitions).items():
             where = f"phases.{k}.definitions.{name}" if name in ph.definitions else f"definitions.{name}"
             symbols[name] = _read(raw, symbols, where, self.source, phase=ph.name)
         return symbols
 
     def ends(self, phases: Mapping[str, tuple[str, Any]], t_first: sp.Expr, t_last: sp.Expr) -> dict:
-        """End symbols ``<name>_0``, ``<name>_f`` (lowered ``<copy>_0`` of the phase that starts and
+        """End symbols ``<name>_0``, ``<name>_f`` (lowered ``<copy>_0`` of the piece that starts and
         ``<copy>_f`` of the one that ends, per name in ``phases``) and ``t_0``, ``t_f``."""
         found = dict(self.constants)
         for name, (first, last) in phases.items():
@@ -168,109 +193,94 @@ class _Lowerer:
                 found[f"{name}_f"] = symbol(f"{last}_f")
         return found | {"t_0": t_first, "t_f": t_last}
 
+    def grid(self) -> tuple[int, list[int]]:
+        """The common number of intervals and each phase's number of pieces: ``method.intervals``
+        and one piece each, unless a phase sets its own ``intervals`` (then their greatest common
+        divisor g, and ``intervals / g`` pieces of g intervals per phase, on a uniform grid)."""
+        method = self.spec.method
+        if all(ph.intervals is None for ph in self.p.phases):
+            return method.intervals, [1] * len(self.p.phases)
+        if method.mesh is not None or method.grading != 1.0:
+            raise SpecError(
+                "phases that set their own intervals need a uniform method grid (no mesh, grading 1)",
+                field="method",
+                source=self.source,
+            )
+        counts = [ph.intervals or method.intervals for ph in self.p.phases]
+        common = math.gcd(*counts)
+        return common, [n // common for n in counts]
+
+    def check_phase(self, ph: PhaseSpec, k: int) -> None:
+        p = self.p
+        undeclared = sorted((set(ph.dynamics) | set(ph.states) | set(ph.jump)) - set(p.states))
+        if undeclared:
+            raise SpecError(
+                f"undeclared states {undeclared}", field=f"problem.phases.{k}", source=self.source
+            )
+        if k == 0 and ph.jump:
+            raise SpecError("the first phase has no phase before it", field=f"problem.phases.{k}.jump")
+        missing = [x for x in p.states if x not in ph.dynamics and x not in p.dynamics]
+        if missing:
+            raise SpecError(
+                f"no dynamics for state {missing[0]!r} (neither the phase nor problem.dynamics gives them)",
+                field=f"problem.phases.{k}.dynamics",
+                source=self.source,
+            )
+
     def lower(self) -> Lowering:
         p, spec = self.p, self.spec
-        last = len(p.phases) - 1
         parameters: dict[str, Any] = dict(p.parameters)
         design = {n: d.model_dump() for n, d in p.design.items()}
-        states: dict[str, dict] = {}
-        controls: dict[str, dict] = {}
-        dynamics: dict[str, str] = {}
-        path: list[str] = []
-        boundary: list[str] = []
-        guess: dict[str, dict[str, Any]] = {"states": {}, "controls": {}}
-        lagrange = sp.Integer(0)
-        integrands = [sp.Integer(0) for _ in p.integral_constraints]
+        parts = _Parts(integrands=[sp.Integer(0) for _ in p.integral_constraints])
         lowered: list[LoweredPhase] = []
         timed = False
         spans = self.duration_guesses()
+        common, counts = self.grid()
         for k, ph in enumerate(p.phases):
-            field = f"phases.{k}"
+            self.check_phase(ph, k)
             name = duration_name(ph.name)
-            D = self.durations[k]
             if ph.duration.free:
                 lo, hi = ph.duration.bounds
                 design[name] = {"lower": lo, "upper": hi, "guess": ph.duration.guess}
             else:
                 parameters[name] = ph.duration.value
             own = self.phase_controls(ph, k)
-            undeclared = sorted((set(ph.dynamics) | set(ph.states) | set(ph.jump)) - set(p.states))
-            if undeclared:
-                raise SpecError(
-                    f"undeclared states {undeclared}", field=f"problem.{field}", source=self.source
-                )
-            if k == 0 and ph.jump:
-                raise SpecError("the first phase has no phase before it", field=f"problem.{field}.jump")
-            running = self.running(ph, k, own, renamed=True)
-            x_names = {n: copy_name(n, ph.name) for n in p.states}
-            u_names = {n: copy_name(n, ph.name) for n in own}
-            check_states: dict[str, dict] = {}
-            for x, shared in p.states.items():
-                entry = _merged(shared, ph.states.get(x))
-                mine = ph.states.get(x)
-                entry["initial"] = mine.initial if mine and mine.initial is not None else None
-                entry["final"] = mine.final if mine and mine.final is not None else None
-                if k == 0 and entry["initial"] is None:
-                    entry["initial"] = shared.initial
-                if k == last and entry["final"] is None:
-                    entry["final"] = shared.final
-                check_states[x] = dict(entry)
-                path += self.time_bounds(entry, running[x], running, f"{field}.states.{x}")
-                states[x_names[x]] = entry
-                raw = ph.dynamics.get(x, p.dynamics.get(x))
-                if raw is None:
-                    raise SpecError(
-                        f"no dynamics for state {x!r} (neither the phase nor problem.dynamics gives them)",
-                        field=f"problem.{field}.dynamics",
-                        source=self.source,
-                    )
-                where = f"{field}.dynamics.{x}" if x in ph.dynamics else f"dynamics.{x}"
-                dynamics[x_names[x]] = to_text(D * _read(raw, running, where, self.source, phase=ph.name))
-            for u, entry in own.items():
-                path += self.time_bounds(entry, running[u], running, f"{field}.controls.{u}")
-                controls[u_names[u]] = entry
-            cost = ph.lagrange if ph.lagrange is not None else p.objective.lagrange
-            where = f"{field}.lagrange" if ph.lagrange is not None else "objective.lagrange"
-            lagrange += D * _read(cost, running, where, self.source, phase=ph.name)
-            for i, c in enumerate(p.integral_constraints):
-                where = f"integral_constraints.{i}.integrand"
-                integrands[i] += D * _read(c.integrand, running, where, self.source, phase=ph.name)
-            texts = [(f"path_constraints.{i}", c) for i, c in enumerate(p.path_constraints)]
-            texts += [(f"{field}.path_constraints.{i}", c) for i, c in enumerate(ph.path_constraints)]
-            for where, text in texts:
-                path += relation_texts(_read(text, running, where, self.source, True, ph.name))
-            names = {n: (c, c) for n, c in (x_names | u_names).items()}
-            ends = self.ends(names, self.starts[k], self.starts[k + 1])
+            m = counts[k]
+            labels = [ph.name] if m == 1 else [f"{ph.name}{SEPARATOR}{j}" for j in range(m)]
+            pieces = [
+                Piece({n: copy_name(n, c) for n in p.states}, {n: copy_name(n, c) for n in own})
+                for c in labels
+            ]
+            check_states = {x: self.phase_state(ph, k, x) for x in p.states}
+            for j, piece in enumerate(pieces):
+                self.piece(parts, ph, k, piece, j, m, check_states, spans)
+                if j > 0:
+                    for x in p.states:
+                        start, end = symbol(f"{piece.states[x]}_0"), symbol(f"{pieces[j - 1].states[x]}_f")
+                        parts.boundary.append(to_text(sp.Eq(start - end, 0, evaluate=False)))
+            copies = {
+                n: (pieces[0].states.get(n, pieces[0].controls.get(n)), c)
+                for n, c in (pieces[-1].states | pieces[-1].controls).items()
+            }
+            ends = self.ends(copies, self.starts[k], self.starts[k + 1])
             for i, text in enumerate(ph.boundary_constraints):
-                rel = _read(text, ends, f"{field}.boundary_constraints.{i}", self.source, relation=True)
+                rel = _read(text, ends, f"phases.{k}.boundary_constraints.{i}", self.source, relation=True)
                 timed |= self.timed(rel.expr)
-                boundary += relation_texts(rel)
+                parts.boundary += relation_texts(rel)
             if k > 0:
-                before = lowered[-1]
+                before = lowered[-1].pieces[-1]
                 prior = {n: (None, c) for n, c in (before.states | before.controls).items()}
                 previous = self.ends(prior, self.starts[k - 1], self.starts[k])
                 for x in p.states:
                     end = symbol(f"{before.states[x]}_f")
                     if x in ph.jump:
-                        end = _read(ph.jump[x], previous, f"{field}.jump.{x}", self.source)
+                        end = _read(ph.jump[x], previous, f"phases.{k}.jump.{x}", self.source)
                         timed |= self.timed(end)
-                    boundary.append(to_text(sp.Eq(symbol(f"{x_names[x]}_0") - end, 0, evaluate=False)))
-            for group, given, renames in (
-                ("states", ph.guess.states, x_names),
-                ("controls", ph.guess.controls, u_names),
-            ):
-                unknown = sorted(set(given) - set(renames))
-                if unknown:
-                    raise SpecError(
-                        f"names no {group[:-1]} of this phase: {unknown}",
-                        field=f"problem.{field}.guess.{group}",
-                        source=self.source,
-                    )
-                guess[group] |= {renames[n]: v for n, v in given.items()}
-            guess["states"] |= self.spread_guess(ph, k, spans, x_names)
+                    start = symbol(f"{pieces[0].states[x]}_0")
+                    parts.boundary.append(to_text(sp.Eq(start - end, 0, evaluate=False)))
             check = self.check_spec(ph, k, own, check_states)
-            lowered.append(LoweredPhase(ph.name, x_names, u_names, name, ph.duration.free, check))
-        first, final = lowered[0], lowered[-1]
+            lowered.append(LoweredPhase(ph.name, pieces, name, ph.duration.free, check))
+        first, final = lowered[0].pieces[0], lowered[-1].pieces[-1]
         names = {
             n: (first.states.get(n, first.controls.get(n)), final.states.get(n, final.controls.get(n)))
             for n in [*p.states, *p.controls]
@@ -281,7 +291,7 @@ class _Lowerer:
         for i, text in enumerate(p.boundary_constraints):
             rel = _read(text, ends, f"boundary_constraints.{i}", self.source, relation=True)
             timed |= self.timed(rel.expr)
-            boundary += relation_texts(rel)
+            parts.boundary += relation_texts(rel)
         data = {
             "kind": "optimal_control",
             "name": spec.name,
@@ -289,25 +299,25 @@ class _Lowerer:
             "solver": spec.solver.model_dump(),
             "problem": {
                 "parameters": parameters,
-                "states": states,
-                "controls": controls,
+                "states": parts.states,
+                "controls": parts.controls,
                 "design": design,
-                "dynamics": dynamics,
+                "dynamics": parts.dynamics,
                 "objective": {
                     "sense": p.objective.sense,
                     "mayer": to_text(mayer),
-                    "lagrange": to_text(lagrange),
+                    "lagrange": to_text(parts.lagrange),
                 },
                 "time": {"initial": 0.0, "final": 1.0},
-                "path_constraints": path,
-                "boundary_constraints": boundary,
+                "path_constraints": parts.path,
+                "boundary_constraints": parts.boundary,
                 "integral_constraints": [
                     c.model_dump() | {"integrand": to_text(g)}
-                    for c, g in zip(p.integral_constraints, integrands, strict=True)
+                    for c, g in zip(p.integral_constraints, parts.integrands, strict=True)
                 ],
             },
-            "method": spec.method.model_dump(),
-            "guess": guess,
+            "method": spec.method.model_dump() | {"intervals": common},
+            "guess": parts.guess,
         }
         try:
             target = OptimalControlSpec.model_validate(data)
@@ -316,6 +326,77 @@ class _Lowerer:
             raise SpecError(f"the lowered problem is invalid: {reason}", field="problem.phases") from None
         target.with_source(spec.source, spec.file_hash)
         return Lowering(target, lowered, float(p.time.initial), timed)
+
+    def phase_state(self, ph: PhaseSpec, k: int, x: str) -> dict[str, Any]:
+        """State ``x`` in phase ``k``: its bounds there, its value at the phase's start (the shared
+        initial value in the first phase) and end (the shared final value in the last)."""
+        shared, mine = self.p.states[x], ph.states.get(x)
+        entry = _merged(shared, mine)
+        entry["initial"] = mine.initial if mine and mine.initial is not None else None
+        entry["final"] = mine.final if mine and mine.final is not None else None
+        if k == 0 and entry["initial"] is None:
+            entry["initial"] = shared.initial
+        if k == len(self.p.phases) - 1 and entry["final"] is None:
+            entry["final"] = shared.final
+        return entry
+
+    def piece(
+        self,
+        parts: _Parts,
+        ph: PhaseSpec,
+        k: int,
+        piece: Piece,
+        j: int,
+        m: int,
+        phase_states: dict[str, dict],
+        spans: list[sp.Expr],
+    ) -> None:
+        """Add piece ``j`` of ``m`` of phase ``k`` to ``parts``: its states (the phase's start value
+        on the first piece, its end value on the last), controls, dynamics, running cost, integrands,
+        path constraints and guess."""
+        p, field = self.p, f"phases.{k}"
+        running = self.running(ph, k, piece, j, m)
+        D = self.durations[k] / m
+        for x, lowered in piece.states.items():
+            entry = dict(phase_states[x])
+            entry["initial"] = entry["initial"] if j == 0 else None
+            entry["final"] = entry["final"] if j == m - 1 else None
+            parts.path += self.time_bounds(entry, running[x], running, f"{field}.states.{x}")
+            parts.states[lowered] = entry
+            raw = ph.dynamics.get(x, p.dynamics.get(x))
+            where = f"{field}.dynamics.{x}" if x in ph.dynamics else f"dynamics.{x}"
+            parts.dynamics[lowered] = to_text(D * _read(raw, running, where, self.source, phase=ph.name))
+        for u, lowered in piece.controls.items():
+            entry = dict(self.phase_controls(ph, k)[u])
+            parts.path += self.time_bounds(entry, running[u], running, f"{field}.controls.{u}")
+            parts.controls[lowered] = entry
+        cost = ph.lagrange if ph.lagrange is not None else p.objective.lagrange
+        where = f"{field}.lagrange" if ph.lagrange is not None else "objective.lagrange"
+        parts.lagrange += D * _read(cost, running, where, self.source, phase=ph.name)
+        for i, c in enumerate(p.integral_constraints):
+            where = f"integral_constraints.{i}.integrand"
+            parts.integrands[i] += D * _read(c.integrand, running, where, self.source, phase=ph.name)
+        texts = [(f"path_constraints.{i}", c) for i, c in enumerate(p.path_constraints)]
+        texts += [(f"{field}.path_constraints.{i}", c) for i, c in enumerate(ph.path_constraints)]
+        for where, text in texts:
+            parts.path += relation_texts(_read(text, running, where, self.source, True, ph.name))
+        tau = symbol(NORMALIZED_TIME)
+        along = self.params | {NORMALIZED_TIME: tau}
+        for group, given, renames in (
+            ("states", ph.guess.states, piece.states),
+            ("controls", ph.guess.controls, piece.controls),
+        ):
+            unknown = sorted(set(given) - set(renames))
+            if unknown:
+                raise SpecError(
+                    f"names no {group[:-1]} of this phase: {unknown}",
+                    field=f"problem.{field}.guess.{group}",
+                    source=self.source,
+                )
+            for n, raw in given.items():
+                expr = _read(raw, along, f"{field}.guess.{group}.{n}", self.source)
+                parts.guess[group][renames[n]] = to_text(expr.subs(tau, (j + tau) / m))
+        parts.guess["states"] |= self.spread_guess(ph, k, (j, m), spans, piece.states)
 
     def timed(self, expr: sp.Expr) -> bool:
         """Whether ``expr`` depends on a duration (uses ``t_0`` or ``t_f``)."""
@@ -346,12 +427,13 @@ class _Lowerer:
         return found
 
     def spread_guess(
-        self, ph: PhaseSpec, k: int, spans: list[sp.Expr], names: dict[str, str]
+        self, ph: PhaseSpec, k: int, at: tuple[int, int], spans: list[sp.Expr], names: dict[str, str]
     ) -> dict[str, str]:
         """For each state the phase gives no guess for whose value is fixed at the start of the
         first phase and at the end of the last: the straight line between them over the whole
-        horizon (duration guesses), as an expression of the phase's normalized time."""
+        horizon (duration guesses), as an expression of the normalized time of piece ``at = (j, m)``."""
         tau = symbol(NORMALIZED_TIME)
+        j, m = at
         start, total = sum(spans[:k], sp.Integer(0)), sum(spans, sp.Integer(0))
         found = {}
         for x, st in self.p.states.items():
@@ -359,7 +441,7 @@ class _Lowerer:
                 continue
             a = _read(st.initial, self.params, f"states.{x}.initial", self.source)
             b = _read(st.final, self.params, f"states.{x}.final", self.source)
-            fraction = (start + spans[k] * tau) / total
+            fraction = (start + spans[k] * (j + tau) / m) / total
             found[names[x]] = to_text(a + (b - a) * fraction)
         return found
 

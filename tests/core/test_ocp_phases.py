@@ -306,3 +306,35 @@ def test_three_arcs_switch_at_their_closed_form(backend: str) -> None:
     assert [p["end"] for p in result.metrics["phases"]] == pytest.approx(
         [vmax, t_f - vmax, t_f], rel=IPOPT_LEVEL
     )
+
+
+@pytest.mark.parametrize("backend", BACKENDS)
+def test_phases_with_their_own_intervals_match_the_single_phase_mesh(backend: str) -> None:
+    """Phases of 2 and 6 intervals discretize as one phase on the mesh with 2 intervals on [0, 1]
+    and 6 on [1, 2] (the dynamics are nonlinear, so the discretization error shows in the
+    optimum unless the meshes are the same)."""
+    problem = {
+        "states": {"x": {"initial": 1.0}},
+        "controls": {"u": {}},
+        "dynamics": {"x": "-x**3 + u"},
+        "objective": {"lagrange": "x**2 + u**2"},
+    }
+    phases = [
+        {"name": "coarse", "duration": 1.0, "intervals": 2},
+        {"name": "fine", "duration": 1.0, "intervals": 6},
+    ]
+    two_spec = {"kind": "multiphase_optimal_control", "problem": problem | {"phases": phases}}
+    two = gamespec.solve(spec_from_dict(two_spec), backend=backend)
+    mesh = [*np.linspace(0.0, 0.5, 3)[:-1], *np.linspace(0.5, 1.0, 7)]
+    one_spec = {
+        "kind": "optimal_control",
+        "problem": problem | {"time": {"final": 2.0}},
+        "method": {"mesh": [float(b) for b in mesh]},
+    }
+    one = gamespec.solve(spec_from_dict(one_spec), backend=backend)
+    uniform = gamespec.solve(spec_from_dict(one_spec | {"method": {"intervals": 8}}), backend=backend)
+    assert two.ok and one.ok
+    assert two.objective == pytest.approx(one.objective, rel=IPOPT_LEVEL * 1e-2)
+    assert abs(uniform.objective - one.objective) > 1e2 * abs(two.objective - one.objective)
+    assert np.bincount(two.arrays["phase"]).tolist() == [2 * 3 + 1, 6 * 3 + 1]
+    assert two.states["x"] == pytest.approx(np.interp(two.time, one.time, one.states["x"]), abs=1e-7)

@@ -12,6 +12,18 @@ With ``damping`` ``w < 1`` a player that supports it keeps ``(1 − w) s_p^i + w
 turns a Jacobi map whose eigenvalues lie outside the unit disc into a contraction when their real
 parts are below 1); a player without ``blend`` takes its plain response.
 
+With ``acceleration="anderson"`` the next point the players answer is not the last sweep's
+responses ``g_i = G(x_i)`` but Anderson's extrapolation (type II, Walker & Ni 2011) from the last
+``memory`` sweeps: ``x_{i+1} = g_i − ΔG γ`` with ``γ = argmin ‖f_i − ΔF γ‖₂``, ``f = g − x`` the
+residuals and ``ΔF``, ``ΔG`` the differences of successive residuals and responses. On a linear
+sweep map its iterates are GMRES's, so it converges, in at most as many sweeps as the joint
+strategy has entries, where the plain iteration spirals outwards. The stopping rule does not
+change: a player's change is still ``distance(G_p(x_i), x_{i,p})``, the distance from the point it
+answered to its best response there, and the run returns the last sweep's responses. A response
+that fails at an extrapolated point drops the memory and is asked again at the last responses
+(a plain step); only a failure there stops the run. Acceleration needs players whose strategies
+are vectors (:class:`VectorSpacePlayer`).
+
 The engine knows nothing of a strategy beyond the player's ``distance``. It stops with an honest
 outcome: ``converged``; ``iteration_limit``; ``cycling`` (the joint strategy returns to an earlier
 iterate, much closer to it than to the previous one, or the largest change over the last ``window``
@@ -89,10 +101,21 @@ class BlendingPlayer(Player, Protocol):
     def blend(self, old: Any, new: Any, weight: float) -> Any: ...
 
 
+@runtime_checkable
+class VectorSpacePlayer(Player, Protocol):
+    """A player whose strategies are points of a vector space: ``flatten(s)`` is a 1-D array and
+    ``unflatten(v, like)`` its inverse (shaped like the strategy ``like``); Anderson acceleration
+    combines strategies through them."""
+
+    def flatten(self, strategy: Any) -> np.ndarray: ...
+
+    def unflatten(self, vector: np.ndarray, like: Any) -> Any: ...
+
+
 @dataclass(frozen=True)
 class VectorPlayer:
-    """A player whose strategy is a NumPy array (Euclidean distance, convex blend); ``response``
-    maps the others' strategies to ``(strategy or None, Response)``."""
+    """A player whose strategy is a NumPy array (Euclidean distance, convex blend, flattening);
+    ``response`` maps the others' strategies to ``(strategy or None, Response)``."""
 
     name: str
     response: Callable[[Mapping[str, Any]], tuple[np.ndarray | None, Response]]
@@ -106,6 +129,12 @@ class VectorPlayer:
     def blend(self, old: np.ndarray, new: np.ndarray, weight: float) -> np.ndarray:
         return (1 - weight) * np.asarray(old) + weight * np.asarray(new)
 
+    def flatten(self, strategy: np.ndarray) -> np.ndarray:
+        return np.asarray(strategy, dtype=float).ravel()
+
+    def unflatten(self, vector: np.ndarray, like: np.ndarray) -> np.ndarray:
+        return np.reshape(vector, np.shape(like))
+
 
 @dataclass(frozen=True)
 class Settings:
@@ -117,12 +146,16 @@ class Settings:
     damping: float = 1.0
     window: int = 10
     growth: float = 2.0
+    acceleration: Literal["none", "anderson"] = "none"
+    memory: int = 5
 
     def __post_init__(self) -> None:
         if not 0 < self.damping <= 1:
             raise ValueError(f"damping must lie in (0, 1], got {self.damping}")
         if self.tolerance <= 0 or self.max_iterations < 1 or self.window < 1 or self.growth <= 1:
             raise ValueError("tolerance > 0, max_iterations ≥ 1, window ≥ 1 and growth > 1 are required")
+        if self.memory < 1:
+            raise ValueError(f"memory must be at least 1, got {self.memory}")
 
 
 @dataclass
@@ -180,6 +213,7 @@ class BestResponseRun:
             "scheme": self.settings.scheme,
             "tolerance": self.settings.tolerance,
             "damping": self.settings.damping,
+            "acceleration": self.settings.acceleration,
             "failed_player": self.failed_player or None,
             "players": {
                 name: {"status": r.status.value, "message": r.message, "responses": r.responses}
@@ -187,6 +221,47 @@ class BestResponseRun:
             },
             "history": [{"changes": it.changes, "payoff": it.payoff} for it in self.history],
         }
+
+
+class _Anderson:
+    """Anderson's extrapolation (type II) from the last ``memory`` sweeps: the points answered
+    ``x_j`` and the responses ``g_j`` as joint vectors (players' :meth:`VectorSpacePlayer.flatten`
+    in order), ``x_{i+1} = g_i − ΔG γ`` with ``γ`` the least-squares solution of ``ΔF γ = f_i``
+    (numpy's rank cutoff, so nearly dependent differences do not blow ``γ`` up)."""
+
+    def __init__(self, players: Sequence[Player], memory: int) -> None:
+        plain = [p.name for p in players if not isinstance(p, VectorSpacePlayer)]
+        if plain:
+            raise ValueError(f"Anderson acceleration needs vector strategies (flatten/unflatten): {plain}")
+        self.players = [p for p in players if isinstance(p, VectorSpacePlayer)]
+        self.memory = memory
+        self.points: list[np.ndarray] = []
+        self.responses: list[np.ndarray] = []
+
+    def reset(self) -> None:
+        self.points, self.responses = [], []
+
+    def _joint(self, strategies: Strategies) -> np.ndarray:
+        return np.concatenate([p.flatten(strategies[p.name]) for p in self.players])
+
+    def _split(self, vector: np.ndarray, like: Strategies) -> Strategies:
+        sizes = [p.flatten(like[p.name]).size for p in self.players]
+        parts = np.split(vector, np.cumsum(sizes)[:-1])
+        return {p.name: p.unflatten(v, like[p.name]) for p, v in zip(self.players, parts, strict=True)}
+
+    def next(self, point: Strategies, responses: Strategies) -> Strategies | None:
+        """The next point after the sweep answered ``point`` with ``responses`` (the responses
+        themselves while the memory holds one sweep); None when the extrapolation is not finite."""
+        keep = self.memory + 1
+        self.points = [*self.points, self._joint(point)][-keep:]
+        self.responses = [*self.responses, self._joint(responses)][-keep:]
+        if len(self.points) < 2:
+            return responses
+        G = np.array(self.responses).T
+        F = G - np.array(self.points).T
+        gamma = np.linalg.lstsq(np.diff(F, axis=1), F[:, -1], rcond=None)[0]
+        extrapolated = G[:, -1] - np.diff(G, axis=1) @ gamma
+        return self._split(extrapolated, responses) if np.isfinite(extrapolated).all() else None
 
 
 class _Iterator:
@@ -209,6 +284,10 @@ class _Iterator:
         self.settings = settings
         self.payoff = payoff
         self.current: Strategies = {name: start[name] for name in names}
+        self.point: Strategies = dict(self.current)
+        self.extrapolated = False
+        accelerated = settings.acceleration == "anderson"
+        self.anderson = _Anderson(self.players, settings.memory) if accelerated else None
         self.records = {name: PlayerRecord() for name in names}
         self.history: list[Iteration] = []
         self.recent: list[Strategies] = [dict(self.current)]
@@ -229,10 +308,11 @@ class _Iterator:
         return strategy
 
     def sweep(self) -> tuple[Strategies, str]:
-        """One Jacobi or Gauss–Seidel sweep; the failed player's name ('' when none failed)."""
+        """One Jacobi or Gauss–Seidel sweep answering ``self.point``; the failed player's name ('' when
+        none failed)."""
         gauss_seidel = self.settings.scheme == "gauss_seidel"
-        previous = dict(self.current)
-        following = dict(self.current)
+        previous = dict(self.point)
+        following = dict(self.point)
         for player in self.players:
             strategy = self._respond(player, following if gauss_seidel else previous)
             if strategy is None:
@@ -266,10 +346,13 @@ class _Iterator:
     def step(self) -> Outcome | None:
         """One iteration; the outcome when the iteration stops here."""
         following, failed = self.sweep()
+        if failed and self.extrapolated:
+            self._plain_point()
+            following, failed = self.sweep()
         if failed:
             self.failed = failed
             return Outcome.PLAYER_FAILED
-        changes = {p.name: float(p.distance(following[p.name], self.current[p.name])) for p in self.players}
+        changes = {p.name: float(p.distance(following[p.name], self.point[p.name])) for p in self.players}
         payoff = float(self.payoff(following)) if self.payoff is not None else None
         self.history.append(Iteration(changes, payoff))
         if not np.isfinite(list(changes.values())).all():
@@ -280,7 +363,25 @@ class _Iterator:
         if self._returned_to_earlier(following, max(changes.values())):
             return Outcome.CYCLING
         self.recent = [*self.recent[-2 * self.settings.window :], dict(following)]
+        self._next_point(following)
         return self._trend()
+
+    def _plain_point(self) -> None:
+        """Answer the last responses next (a plain step), forgetting Anderson's memory."""
+        self.point, self.extrapolated = dict(self.current), False
+        if self.anderson is not None:
+            self.anderson.reset()
+
+    def _next_point(self, following: Strategies) -> None:
+        """The point the next sweep answers: the responses, or Anderson's extrapolation from them."""
+        if self.anderson is None:
+            self.point = following
+            return
+        extrapolated = self.anderson.next(self.point, following)
+        if extrapolated is None:
+            self._plain_point()
+        else:
+            self.point, self.extrapolated = extrapolated, True
 
 
 _STATUS = {

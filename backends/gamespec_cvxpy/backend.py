@@ -2,14 +2,15 @@
 
 The mean steering upper game (eq. 4.43, Prop. 10) is a CVXPY QP; the constrained covariance game is
 Algorithm 2 on the best-response engine with the stopper's best response (eq. 4.59b, closed form)
-and the controller's best response under the relaxed terminal constraint eq. 4.61 in the form
-eq. 4.62 (``σ_max(W) ≤ 1``, an SDP in whitened gains, :mod:`gamespec.lqgame.scaling`), built once
-with ``cp.Parameter``s and re-solved every iteration. A step the solver fails on numerically is
-retried on ``fallback_solver`` when the options name one, and otherwise stops the run with the last
-iterate and the status ``numerical_error``. When the controller's problem is infeasible, a second
-problem on the same parameters, ``min σ_max(W)``, gives the smallest achievable scaling
-``γ* = σ²`` of ``Σ_N``. Without a terminal covariance the covariance game is the UCSG closed form
-(eq. 4.59). cvxpy is imported only when this backend is used.
+and the controller's best response under the relaxed terminal constraint eq. 4.61 normalized as in
+eq. 4.62 (``W Wᵀ ⪯ I``, an SDP in whitened gains, :mod:`gamespec.lqgame.scaling`, with one small
+cone per column of ``W``: :meth:`CovariancePlayers.terminal_cone`), built once with
+``cp.Parameter``s and re-solved every iteration. A step the solver fails on numerically is retried
+on ``fallback_solver`` when the options name one, and otherwise stops the run with the last iterate
+and the status ``numerical_error``. When the controller's problem is infeasible, a second problem
+on the same parameters, ``min γ`` subject to ``W Wᵀ ⪯ γ I``, gives the smallest achievable scaling
+``γ* = σ_max(W)²`` of ``Σ_N``. Without a terminal covariance the covariance game is the UCSG closed
+form (eq. 4.59). cvxpy is imported only when this backend is used.
 """
 
 from __future__ import annotations
@@ -44,10 +45,11 @@ STATUS_MAP = {
 
 RETRY_SOLVER_OPTIONS: dict[str, dict[str, Any]] = {"CLARABEL": {"chordal_decomposition_enable": False}}
 """Settings of a second attempt at a step a solver fails on numerically (the same tolerances).
-Clarabel splits the PSD cone of eq. 4.62 by chordal decomposition, a heuristic whose interior point
-can stall where the controller cannot steer some terminal states (the rows of ``W`` it leaves
-constant, e.g. the target's acceleration in the missile endgame); on the whole cone it reports
-``optimal`` or ``infeasible``."""
+Clarabel's chordal decomposition is a heuristic whose interior point can stall: it did on eq. 4.62
+posed as one (n + p)-square cone where the controller cannot steer some terminal states (the rows
+of ``W`` it leaves constant, e.g. the target's acceleration in the missile endgame), and the whole
+cone gave ``optimal`` or ``infeasible``. The column cones of :meth:`CovariancePlayers.terminal_cone`
+are dense and leave it nothing to split; the second attempt stays for the problems it does split."""
 
 
 class CvxpyOptions(LQSolverOptions):
@@ -156,9 +158,10 @@ class MeanProblem:
 class CovariancePlayers:
     """Both players' best responses of Algorithm 2: the stopper's in closed form (eq. 4.59b, an
     unconstrained strictly concave QP, solved exactly by one linear solve rather than to a conic
-    solver's tolerance) and the controller's SDP under eq. 4.62, built once on ``cp.Parameter``s in
-    the whitened, normalized gains ``κ = s R_K⁻¹ ζ`` of :mod:`gamespec.lqgame.scaling`, so the solver
-    sees a unit Hessian and a unit constraint map whatever the problem's magnitudes."""
+    solver's tolerance) and the controller's SDP under eq. 4.61–4.62 (:meth:`terminal_cone`), built
+    once on ``cp.Parameter``s in the whitened, normalized gains ``κ = s R_K⁻¹ ζ`` of
+    :mod:`gamespec.lqgame.scaling`, so the solver sees a unit Hessian and a unit constraint map
+    whatever the problem's magnitudes."""
 
     def __init__(self, model: GameModel, options: CvxpyOptions) -> None:
         import cvxpy as cp
@@ -174,9 +177,30 @@ class CovariancePlayers:
         self.offset = cp.Parameter(self.w0.size)
         W = cp.reshape(self.offset + self.gains.map(T_WK) @ self.zeta, (n, p), order="F")
         payoff = cp.sum_squares(self.zeta) + 2 * self.c @ self.zeta
-        self.controller = _Problem(cp.Problem(cp.Minimize(payoff), [cp.sigma_max(W) <= 1]), options)
-        self.scaling = _Problem(cp.Problem(cp.Minimize(cp.sigma_max(W))), options)
+        self.controller = _Problem(cp.Problem(cp.Minimize(payoff), self.terminal_cone(W, 1.0)), options)
+        gamma = cp.Variable()
+        self.scaling = _Problem(cp.Problem(cp.Minimize(gamma), self.terminal_cone(W, gamma)), options)
         self.steps = 0
+
+    @staticmethod
+    def terminal_cone(W: Any, bound: Any) -> list[Any]:
+        """``W Wᵀ ⪯ bound · I`` for the n × p expression ``W``: eq. 4.61 normalized by ``Σ_N^{-1/2}``
+        (with ``bound = 1`` the constraint eq. 4.62, ``‖W‖₂ ≤ 1``, squared), as
+        ``Σ_j Z_j ⪯ bound · I`` and ``[[Z_j, w_j], [w_jᵀ, 1]] ⪰ 0`` (``Z_j ⪰ w_j w_jᵀ``) for each
+        column ``w_j``. ``W Wᵀ = Σ_j w_j w_jᵀ``, so the two are equivalent; this is the chordal
+        decomposition of the arrow-shaped ``[[bound · I, W], [Wᵀ, I]] ⪰ 0``: p cones of size n + 1
+        instead of one of size n + p, whose scaling an interior-point solver holds as one dense block
+        of side (n + p)(n + p + 1)/2. With no decomposition of its own to do, Clarabel also re-solves
+        on new parameter values without a new setup."""
+        import cvxpy as cp
+
+        n, p = W.shape
+        Y = [cp.Variable((n + 1, n + 1), PSD=True) for _ in range(p)]
+        return [
+            cp.vstack([Yj[:n, n] for Yj in Y]).T == W,
+            cp.hstack([Yj[n, n] for Yj in Y]) == 1,
+            bound * np.eye(n) - sum(Yj[:n, :n] for Yj in Y) >> 0,
+        ]
 
     def stopper_step(self, kappa: np.ndarray) -> tuple[np.ndarray, StepReport]:
         """eq. 4.59b: ``ℓ = −H_LL⁻¹(g_L + H_LK κ)``."""
@@ -198,7 +222,7 @@ class CovariancePlayers:
         """``min_K ‖W‖₂²`` for the current parameters: the least ``γ`` with ``Σ_N(K) ⪯ γ Σ_N``."""
         status = self.scaling.solve()
         value = self.scaling.problem.value
-        return float(value) ** 2 if status.ok and value is not None else None
+        return float(value) if status.ok and value is not None else None
 
     @property
     def seconds(self) -> float:
@@ -216,11 +240,12 @@ class CovariancePlayers:
         else:
             kappa0, ell0 = (gains_to_vector(G) for G in start_gains)
         run = algorithm_2(self.stopper_step, self.controller_step, kappa0, ell0, settings)
+        accelerated = " + anderson" if settings.acceleration == "anderson" else ""
         outcome = CovarianceOutcome(
             run.strategies[CONTROLLER],
             run.strategies[STOPPER],
             run.status,
-            f"{settings.scheme} (Algorithm 2, eq. 4.62)",
+            f"{settings.scheme}{accelerated} (Algorithm 2, eq. 4.62)",
             message=run.message,
             iterations=run.iterations,
             history=list(zip(run.changes(CONTROLLER), run.changes(STOPPER), strict=True)),
@@ -269,14 +294,7 @@ class CvxpyModel(LQCompiledModel):
         """Algorithm 2 (warm-started from ``guess``'s gains) or, without Σ_N, the UCSG closed form."""
         if self.players is None:
             return super()._solve_covariance(guess)
-        method = self.spec.method
-        settings = Settings(
-            scheme=method.scheme,
-            tolerance=method.tolerance,
-            max_iterations=method.max_iterations,
-            damping=method.damping,
-        )
-        return self.players.solve(settings, self._start_gains(guess))
+        return self.players.solve(self.spec.method.settings(), self._start_gains(guess))
 
 
 class CvxpyBackend(LQBackend):

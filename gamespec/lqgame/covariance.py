@@ -17,9 +17,10 @@ with the players' best responses supplied by a backend.
 from __future__ import annotations
 
 from collections.abc import Callable
+from functools import cached_property
 
 import numpy as np
-from scipy.linalg import sqrtm
+from scipy.linalg import lu_factor, lu_solve, sqrtm
 
 from gamespec.best_response import BestResponseRun, Response, Settings, VectorPlayer, iterate
 from gamespec.lqgame.lifting import Lifted
@@ -96,9 +97,14 @@ class CovarianceGame:
         z = -np.linalg.solve(H, np.concatenate([self.g_K, self.g_L]))
         return z[: self.g_K.size], z[self.g_K.size :]
 
+    @cached_property
+    def _stopper_factor(self) -> tuple[np.ndarray, np.ndarray]:
+        """The LU factors of ``H_LL``, computed once for every best response of the stopper."""
+        return lu_factor(self.H_LL)
+
     def stopper_response(self, kappa: np.ndarray) -> np.ndarray:
         """The stopper's best response ``argmax_L J_Σ(K, L)`` (eq. 4.59b with K fixed)."""
-        return -np.linalg.solve(self.H_LL, self.g_L + self.H_KL.T @ kappa)
+        return -lu_solve(self._stopper_factor, self.g_L + self.H_KL.T @ kappa)
 
     def stopper_linear_term(self, kappa: np.ndarray) -> np.ndarray:
         """The stopper's linear coefficient ``g_L + H_LKκ`` given the controller's gains."""

@@ -22,6 +22,7 @@ import numpy as np
 import sympy as sp
 from pydantic import Discriminator, Field, Tag, field_validator, model_validator
 
+from gamespec.best_response import Settings
 from gamespec.errors import ExpressionError, SpecError
 from gamespec.limits import MAX_INTERVALS, MAX_MAGNITUDE, MAX_SAMPLE_VALUES, MAX_SAMPLES
 from gamespec.specs.base import Number, ProblemParameters, SpecBase, StrictModel, Value
@@ -163,7 +164,7 @@ class MonteCarloSpec(StrictModel):
 
 class LQMethodSpec(StrictModel):
     """The best-response iteration of the covariance game (Algorithm 2: scheme, stopping rule,
-    damping; :mod:`gamespec.best_response`) and the Monte Carlo check."""
+    damping, acceleration; :mod:`gamespec.best_response`) and the Monte Carlo check."""
 
     tolerance: Number = Field(1e-5, gt=0, description="Bound on ε_k and ε_ℓ (section 4.5).")
     max_iterations: int = Field(100, ge=1)
@@ -173,7 +174,24 @@ class LQMethodSpec(StrictModel):
     damping: float = Field(
         1.0, gt=0, le=1, description="Weight w of a new response: K_{i+1} = (1 − w) K_i + w BR (1: none)."
     )
+    acceleration: Literal["none", "anderson"] = Field(
+        "none",
+        description="anderson: each sweep answers Anderson's extrapolation from the last `memory` sweeps "
+        "(same best responses, same stopping rule; converges where the plain scheme spirals outwards).",
+    )
+    memory: int = Field(5, ge=1, description="Sweeps Anderson's extrapolation uses.")
     monte_carlo: MonteCarloSpec = Field(default_factory=MonteCarloSpec)
+
+    def settings(self) -> Settings:
+        """The best-response engine's settings of this method."""
+        return Settings(
+            scheme=self.scheme,
+            tolerance=self.tolerance,
+            max_iterations=self.max_iterations,
+            damping=self.damping,
+            acceleration=self.acceleration,
+            memory=self.memory,
+        )
 
 
 class LQGameSpec(ProblemParameters, SpecBase):

@@ -126,18 +126,23 @@ def test_slow_convergence_reaches_the_iteration_limit():
     assert run.iterations == 30 and not run.converged
 
 
+def _failing_once(player: VectorPlayer, call: int) -> VectorPlayer:
+    """``player``, except that its ``call``-th response fails (infeasible, "empty set")."""
+    calls = []
+
+    def respond(others):
+        calls.append(1)
+        if len(calls) == call:
+            return None, StepReport(Status.INFEASIBLE, "empty set")
+        return player.respond(others)
+
+    return VectorPlayer(player.name, respond)
+
+
 def test_a_failed_player_stops_the_run_with_its_status():
     game = QuadraticGame(sigma=0.6)
     u_player, v_player = game.players()
-    calls = []
-
-    def failing(others):
-        calls.append(1)
-        if len(calls) == 3:
-            return None, StepReport(Status.INFEASIBLE, "empty set")
-        return v_player.respond(others)
-
-    run = iterate([u_player, VectorPlayer("v", failing)], game.start(), Settings(scheme="gauss_seidel"))
+    run = iterate([u_player, _failing_once(v_player, 3)], game.start(), Settings(scheme="gauss_seidel"))
     assert run.outcome is Outcome.PLAYER_FAILED and run.status is Status.INFEASIBLE
     assert run.failed_player == "v" and "empty set" in run.message
     assert run.iterations == 2
@@ -199,3 +204,72 @@ def test_the_lq_mean_game_saddle_of_prop_9():
         bound = 2 * 1e-11 * rate / (1 - rate) + 1e-12 * np.abs(U).max()
         np.testing.assert_allclose(run.strategies["u"], U, atol=bound)
         np.testing.assert_allclose(run.strategies["v"], V, atol=bound)
+
+
+@pytest.mark.parametrize("sigma", [0.6, 2.0, 5.0])
+def test_anderson_terminates_like_gmres(sigma: float):
+    """On a linear sweep map Anderson acceleration with a memory of the joint dimension d is GMRES
+    (Walker & Ni 2011), exact after at most d steps: one plain sweep to start, d extrapolated ones,
+    and the sweep that measures the change make at most d + 2 sweeps, whether plain Jacobi
+    converges (σ < 1) or spirals outwards (σ > 1). The run stops on the plain change ≤ tol and
+    returns responses, here the closed-form saddle."""
+    game = QuadraticGame(sigma=sigma, seed=2)
+    d = game.a.size + game.b.size
+    settings = Settings(tolerance=1e-10, acceleration="anderson", memory=d)
+    run = iterate(game.players(), game.start(), settings, game.payoff)
+    assert run.outcome is Outcome.CONVERGED and run.status is Status.OPTIMAL
+    assert run.iterations <= d + 2 and run.history[-1].largest <= 1e-10
+    u, v = game.saddle()
+    np.testing.assert_allclose(run.strategies["u"], u, atol=1e-9)
+    np.testing.assert_allclose(run.strategies["v"], v, atol=1e-9)
+    assert run.as_metrics()["acceleration"] == "anderson"
+
+
+def test_anderson_on_gauss_seidel_needs_the_rank_of_the_sweep():
+    """A Gauss–Seidel sweep depends on the last player's strategy alone (dimension m = 2): its map
+    has rank m, its minimal polynomial degree at most m + 1, so Anderson stops within m + 3 sweeps
+    even with the memory cut to m."""
+    game = QuadraticGame(sigma=5.0, seed=0)
+    m = game.b.size
+    settings = Settings(scheme="gauss_seidel", tolerance=1e-10, acceleration="anderson", memory=m)
+    run = iterate(game.players(), game.start(), settings)
+    assert run.converged and run.iterations <= m + 3
+    np.testing.assert_allclose(run.strategies["v"], game.saddle()[1], atol=1e-9)
+
+
+def test_a_failure_at_an_extrapolated_point_is_retried_at_the_responses():
+    """v fails once, on its third call: a point Anderson extrapolated (the memory holds two sweeps
+    by then). The engine forgets the memory, asks again at the last responses and goes on to the
+    saddle; v answered once more than there were sweeps."""
+    game = QuadraticGame(sigma=2.0, seed=1)
+    u_player, v_player = game.players()
+    settings = Settings(tolerance=1e-10, acceleration="anderson", memory=5)
+    run = iterate([u_player, _failing_once(v_player, 3)], game.start(), settings)
+    assert run.converged and run.status is Status.OPTIMAL
+    assert run.players["v"].responses == run.iterations + 1
+    np.testing.assert_allclose(run.strategies["u"], game.saddle()[0], atol=1e-9)
+
+
+def test_a_failure_at_the_responses_stops_an_accelerated_run():
+    """The first sweep answers the start, not an extrapolation: a failure there is the run's."""
+    game = QuadraticGame(sigma=0.6)
+    u_player, _ = game.players()
+    failing = VectorPlayer("v", lambda o: (None, StepReport(Status.INFEASIBLE, "empty set")))
+    run = iterate([u_player, failing], game.start(), Settings(acceleration="anderson"))
+    assert run.outcome is Outcome.PLAYER_FAILED and run.status is Status.INFEASIBLE
+    assert run.players["v"].responses == 1
+
+
+def test_anderson_needs_vector_strategies():
+    class Opaque:
+        name = "w"
+
+        def respond(self, others):
+            return "x", StepReport(Status.OPTIMAL)
+
+        def distance(self, a, b):
+            return 0.0
+
+    game = QuadraticGame(sigma=0.6)
+    with pytest.raises(ValueError, match="vector strategies"):
+        iterate([*game.players(), Opaque()], {**game.start(), "w": "x"}, Settings(acceleration="anderson"))

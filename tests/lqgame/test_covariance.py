@@ -11,7 +11,7 @@ from scipy.linalg import sqrtm
 
 import gamespec
 from gamespec.best_response import Settings
-from gamespec.lqgame.covariance import lift_gains, vector_to_gains
+from gamespec.lqgame.covariance import gains_to_vector, lift_gains, vector_to_gains
 from gamespec.lqgame.solution import GameModel
 from gamespec.result import Status
 from tests.conftest import PROBLEMS
@@ -95,6 +95,25 @@ def test_whitened_controller_step_is_the_unscaled_problems_minimizer(model: Game
     np.testing.assert_allclose(kappa, x.value, atol=1e-5 * max(1.0, np.abs(x.value).max()))
 
 
+@pytest.mark.parametrize("shape", [(4, 9), (3, 1), (1, 5)])
+def test_terminal_cone_is_the_squared_spectral_norm(shape: tuple[int, int]):
+    """The column form of eq. 4.61, ``Σ_j Z_j ⪯ t I`` with ``Z_j ⪰ w_j w_jᵀ``: its least ``t`` is
+    ``σ_max(W)²`` (``W Wᵀ = Σ_j w_j w_jᵀ``), and with ``t = 1`` it admits ``W`` exactly when
+    ``‖W‖₂ ≤ 1`` (eq. 4.62), here on either side of the boundary."""
+    import cvxpy as cp
+
+    W = np.random.default_rng(sum(shape)).standard_normal(shape)
+    sigma = np.linalg.norm(W, 2)
+    t = cp.Variable()
+    problem = cp.Problem(cp.Minimize(t), CovariancePlayers.terminal_cone(W, t))
+    problem.solve(solver="CLARABEL")
+    assert t.value == pytest.approx(sigma**2, rel=1e-6)
+    for factor, feasible in ((1 - 1e-3, True), (1 + 1e-3, False)):
+        problem = cp.Problem(cp.Minimize(0), CovariancePlayers.terminal_cone(factor * W / sigma, 1.0))
+        problem.solve(solver="CLARABEL")
+        assert (problem.status == "optimal") is feasible
+
+
 @pytest.mark.parametrize("seed", [0, 1])
 def test_jacobi_meets_the_terminal_constraint(seed: int):
     """Algorithm 2 with a target tighter than the UCSG reaches (halfway to the least scaling the
@@ -142,9 +161,9 @@ def test_smallest_scaling_is_tight():
         assert report.status.ok is feasible
 
 
-HORIZON_25 = ["problem.horizon=25", "method.monte_carlo.samples=0"]
-"""§4.5.1 at N = 25, where Jacobi's iterates spiral outwards: ε_k and ε_ℓ alternate and each grows
-by about 1.4 every two iterations."""
+HORIZON_25 = ["problem.horizon=25", "method.monte_carlo.samples=0", "method.acceleration=none"]
+"""§4.5.1 at N = 25 with the plain iteration, where Jacobi's iterates spiral outwards: ε_k and ε_ℓ
+alternate and each grows by about 1.4 every two iterations."""
 
 
 def test_jacobi_that_diverges_says_so():
@@ -172,33 +191,100 @@ def test_a_covariance_game_past_its_iteration_limit_is_not_ok():
     assert len(result.metrics["convergence_history"]) == 6
 
 
+def _contraction_rate(result: gamespec.Result) -> float:
+    """The rate ρ per sweep a converged plain run contracted at, from its own history."""
+    largest = [max(h) for h in result.metrics["convergence_history"]]
+    return (largest[-1] / largest[0]) ** (1 / (len(largest) - 1))
+
+
 @pytest.mark.slow
 def test_damping_makes_the_horizon_25_game_converge():
-    """With w = 1/2 the relaxed Jacobi map's spectrum is pulled towards 1 − w: the N = 25 game
-    converges, to a point where the stopper's gains answer the controller's (eq. 4.59b) and
-    Σ_N(K, L) ⪯ Σ_N."""
+    """With w = 1/2 the relaxed Jacobi map ``G_w = (1 − w) x + w G(x)`` is pulled towards 1 − w: the
+    N = 25 game converges, to a point where the stopper's gains answer the controller's (eq. 4.59b)
+    and Σ_N(K, L) ⪯ Σ_N. The file's accelerated run stops at ``‖G(x) − x‖ ≤ tol`` per player, so
+    ``‖G_w(x) − x‖ ≤ w·tol`` and, ``G_w`` contracting at ρ, its responses lie within
+    ``tol + w·tol/(1 − ρ)`` of the damped run's fixed point (which lies within ``tol·ρ/(1 − ρ)``
+    of the damped run's answer)."""
     result = gamespec.solve(gamespec.load(EXAMPLE, [*HORIZON_25, "method.damping=0.5"]))
     assert result.status is Status.OPTIMAL, result.message
     assert result.checks["terminal_covariance_violation"] < 1e-6
     assert result.checks["stopper_response_gap"] < 1e-4
+    accelerated = gamespec.solve(gamespec.load(EXAMPLE, HORIZON_25[:2]))
+    tol, rate, w = gamespec.load(EXAMPLE).method.tolerance, _contraction_rate(result), 0.5
+    bound = np.sqrt(2) * (tol + w * tol / (1 - rate)) + tol * rate / (1 - rate)
+    for gains in ("K", "L"):
+        assert np.abs(accelerated.arrays[gains] - result.arrays[gains]).max() <= bound
+
+
+def test_the_accelerated_file_converges_at_horizon_25():
+    """§4.5.1 at N = 25 as the file stands (Anderson-accelerated Jacobi): converged, Σ_N(K, L) ⪯ Σ_N,
+    and the stopper's gains answer the controller's (eq. 4.59b) up to what a stop at a change ≤ tol
+    leaves: ``ℓ = BR_L(κ_x)`` for the point ``κ_x`` it answered, ``‖κ − κ_x‖ ≤ tol``, and
+    ``BR_L`` is affine with the slope ``Γ = −H_LL⁻¹H_LK``, so the gap is at most ``‖Γ‖₂ tol``."""
+    spec = gamespec.load(EXAMPLE, ["problem.horizon=25", "method.monte_carlo.samples=0"])
+    result = gamespec.solve(spec)
+    assert result.status is Status.OPTIMAL, result.message
+    assert result.metrics["best_response"]["acceleration"] == "anderson"
+    assert result.checks["terminal_covariance_violation"] < 1e-6
+    cov = GameModel.build(spec.game()).covariance
+    slope = np.linalg.norm(np.linalg.solve(cov.H_LL, cov.H_KL.T), 2)
+    assert result.checks["stopper_response_gap"] <= slope * spec.method.tolerance
+
+
+TIGHT = {"tol_gap_abs": 1e-11, "tol_gap_rel": 1e-11, "tol_feas": 1e-11, "tol_ktratio": 1e-9}
+"""Clarabel's tolerances for checks of a best response at the level of the game's own tolerance
+(its defaults, 1e-8 on the duality gap, leave gains about 1e-4 apart between solver paths)."""
+
+
+def test_the_accelerated_answer_is_a_mutual_best_response():
+    """§4.5.1 at N = 20 (the file's accelerated Jacobi, Clarabel at :data:`TIGHT`): the returned
+    gains are the responses ``κ = BR_K(ℓ_x)``, ``ℓ = BR_L(κ_x)`` to a point within the last changes
+    ``ε_k = ‖κ − κ_x‖``, ``ε_ℓ = ‖ℓ − ℓ_x‖`` (≤ tol). So the stopper's best response to κ, affine
+    with the slope ``Γ = −H_LL⁻¹H_LK``, is ℓ within ``‖Γ‖₂ ε_k``, and the controller's, re-solved
+    from scratch on ℓ, is κ within the tolerance."""
+    spec = gamespec.load(EXAMPLE, ["problem.horizon=20", "method.monte_carlo.samples=0"])
+    result = gamespec.solve(spec, options={"solver_options": TIGHT})
+    assert result.status is Status.OPTIMAL, result.message
+    model = GameModel.build(spec.game())
+    cov = model.covariance
+    kappa, ell = gains_to_vector(result.arrays["K"]), gains_to_vector(result.arrays["L"])
+    eps_k, _ = result.metrics["convergence_history"][-1]
+    slope = np.linalg.norm(np.linalg.solve(cov.H_LL, cov.H_KL.T), 2)
+    assert np.linalg.norm(cov.stopper_response(kappa) - ell) <= slope * eps_k * (1 + 1e-6)
+    response, report = CovariancePlayers(model, CvxpyOptions(solver_options=TIGHT)).controller_step(ell)
+    assert report.status is Status.OPTIMAL
+    assert np.linalg.norm(response - kappa) <= spec.method.tolerance
+
+
+def test_accelerated_jacobi_finds_the_plain_fixed_point():
+    """§4.5.1 at N = 20, where plain Jacobi contracts slowly (ρ from its history, about 0.5 per
+    sweep): the accelerated run answers the same best responses and stops on the same rule, a
+    change ≤ tol per player, so with ``G`` contracting at ρ its responses ``g = G(x)`` are within
+    ``√2·tol·ρ/(1 − ρ)`` of the fixed point as well (``‖x − x*‖ ≤ ‖x − g‖ + ρ‖x − x*‖``), the plain
+    run's within ``tol·ρ/(1 − ρ)``; the payoffs agree to the same order."""
+    common = ["problem.horizon=20", "method.monte_carlo.samples=0"]
+    plain = gamespec.solve(gamespec.load(EXAMPLE, [*common, "method.acceleration=none"]))
+    accelerated = gamespec.solve(gamespec.load(EXAMPLE, common))
+    assert plain.status is Status.OPTIMAL and accelerated.status is Status.OPTIMAL
+    assert accelerated.iterations < plain.iterations
+    tol, rate = gamespec.load(EXAMPLE).method.tolerance, _contraction_rate(plain)
+    bound = (1 + np.sqrt(2)) * tol * rate / (1 - rate)
+    for gains in ("K", "L"):
+        assert np.abs(accelerated.arrays[gains] - plain.arrays[gains]).max() <= bound
 
 
 def test_gauss_seidel_finds_the_jacobi_fixed_point():
     """Both schemes stop near a fixed point of the same best responses (§4.5.1, N = 10): a run
     stopped at a change ≤ tol is within ``tol·ρ/(1 − ρ)`` of it, ``ρ`` the contraction rate
     estimated from the run's own history."""
-    settings = ["method.monte_carlo.samples=0"]
+    settings = ["method.monte_carlo.samples=0", "method.acceleration=none"]
     runs = {
         s: gamespec.solve(gamespec.load(EXAMPLE, [*settings, f"method.scheme={s}"]))
         for s in ("jacobi", "gauss_seidel")
     }
     assert all(r.status is Status.OPTIMAL for r in runs.values())
     tol = gamespec.load(EXAMPLE).method.tolerance
-    bound = 0.0
-    for run in runs.values():
-        largest = [max(h) for h in run.metrics["convergence_history"]]
-        rate = (largest[-1] / largest[0]) ** (1 / (len(largest) - 1))
-        bound += tol * rate / (1 - rate)
+    bound = sum(tol * _contraction_rate(run) / (1 - _contraction_rate(run)) for run in runs.values())
     for gains in ("K", "L"):
         gap = np.abs(runs["gauss_seidel"].arrays[gains] - runs["jacobi"].arrays[gains]).max()
         assert gap <= bound + 1e-7

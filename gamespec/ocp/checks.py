@@ -37,6 +37,10 @@ RK4_STEPS = 16
 CHATTERING_SWINGS = 10.0
 """A control that sweeps its range more often than this (total variation over the range it spans)
 chatters: a bang-bang or bang-singular profile sweeps it a few times, on every mesh."""
+CONSTANT_SPAN = 1e-6
+"""A control whose range is below this fraction of ``max(1, max |u|)`` is constant: an interior-point
+solver leaves a control that sits on a bound about its tolerance inside it, and the noise of that
+must not read as sweeps."""
 
 
 @dataclass(frozen=True)
@@ -161,12 +165,14 @@ def verdicts(checks: Mapping[str, float | None], defect_tolerance: float | None)
 
 def control_swings(U: np.ndarray) -> np.ndarray:
     """Per control, its total variation ``sum_k |u_{k+1} - u_k|`` over the evaluation points divided
-    by the range it spans (0 for a constant control): how many times it sweeps that range."""
+    by the range it spans (0 for a constant control, one that spans less than
+    :data:`CONSTANT_SPAN` of its magnitude): how many times it sweeps that range."""
     if U.shape[1] < 2:
         return np.zeros(U.shape[0])
     variation = np.sum(np.abs(np.diff(U, axis=1)), axis=1)
     span = np.ptp(U, axis=1)
-    return np.where(span > 0, variation / np.where(span > 0, span, 1.0), 0.0)
+    moving = span > CONSTANT_SPAN * np.maximum(1.0, np.max(np.abs(U), axis=1))
+    return np.where(moving, variation / np.where(moving, span, 1.0), 0.0)
 
 
 def _violation(values: np.ndarray, lower: np.ndarray | float, upper: np.ndarray | float) -> float:

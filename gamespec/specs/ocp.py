@@ -14,7 +14,7 @@ import itertools
 import math
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass
-from typing import Literal
+from typing import ClassVar, Literal
 
 from pydantic import Field, field_validator, model_validator
 
@@ -98,27 +98,39 @@ class ObjectiveSpec(StrictModel):
     lagrange: Value = 0.0
 
 
-class TimeSpec(StrictModel):
+class FreeOrFixed(StrictModel):
+    """A value that is either fixed or ``free`` within ``bounds`` (numbers or expressions of the
+    parameters) from ``guess``: a final time, a phase's duration. A subclass names the field of the
+    value (``fixed_field``, free when it reads ``free``) and what it is (``what``)."""
+
+    bounds: tuple[Value, Value] | None = None
+    guess: Number | None = None
+
+    fixed_field: ClassVar[str] = ""
+    what: ClassVar[str] = ""
+
+    @property
+    def free(self) -> bool:
+        return getattr(self, self.fixed_field) == "free"
+
+    @model_validator(mode="after")
+    def _free_needs_bounds(self) -> FreeOrFixed:
+        if self.free and self.bounds is None:
+            raise ValueError(f"a free {self.what} needs bounds: [lower, upper]")
+        if not self.free and self.bounds is not None:
+            raise ValueError(f"bounds are only for a free {self.what} ({self.fixed_field}: free)")
+        return self
+
+
+class TimeSpec(FreeOrFixed):
     """Initial time, and the final time: a value, or ``free`` within ``bounds`` (numbers or
     expressions of the parameters) from ``guess``."""
 
     initial: Number = 0.0
     final: Value | Literal["free"] = 1.0
-    bounds: tuple[Value, Value] | None = None
-    guess: Number | None = None
 
-    @model_validator(mode="after")
-    def _free_needs_bounds(self) -> TimeSpec:
-        if self.final == "free":
-            if self.bounds is None:
-                raise ValueError("a free final time needs bounds: [lower, upper]")
-        elif self.bounds is not None:
-            raise ValueError("bounds are only for a free final time (final: free)")
-        return self
-
-    @property
-    def free(self) -> bool:
-        return self.final == "free"
+    fixed_field: ClassVar[str] = "final"
+    what: ClassVar[str] = "final time"
 
 
 class OcpProblem(StrictModel):
@@ -220,18 +232,7 @@ class OcpProblem(StrictModel):
     def parameter_values(self, base: Mapping[str, float] | None = None) -> dict[str, float]:
         """Every parameter's value, in declaration order: the numeric ones from ``base`` (else the
         file), each derived one evaluated over the values before it."""
-        base = base or {}
-        values: dict[str, float] = {}
-        for name, raw in self.parameters.items():
-            if isinstance(raw, str):
-                expr = parse(raw, {n: symbol(n) for n in values})
-                value = numeric(expr, {symbol(k): v for k, v in values.items()})
-                if not math.isfinite(value):
-                    raise SpecError(f"evaluates to {value}", field=f"problem.parameters.{name}")
-                values[name] = value
-            else:
-                values[name] = float(base.get(name, raw))
-        return values
+        return parameter_values(self.parameters, base)
 
     def evaluate(self, params: Mapping[str, float]) -> EvaluatedValues:
         """Bounds, fixed end values and a fixed final time as floats for these parameter values;
@@ -375,6 +376,25 @@ class OcpProblem(StrictModel):
                     else str(err)
                 )
                 raise SpecError(reason, field=f"problem.{field}") from None
+
+
+def parameter_values(
+    parameters: Mapping[str, float | str], base: Mapping[str, float] | None = None
+) -> dict[str, float]:
+    """Every parameter's value, in declaration order: the numeric ones from ``base`` (else
+    ``parameters``), each derived one (an expression) evaluated over the values before it."""
+    base = base or {}
+    values: dict[str, float] = {}
+    for name, raw in parameters.items():
+        if isinstance(raw, str):
+            expr = parse(raw, {n: symbol(n) for n in values})
+            value = numeric(expr, {symbol(k): v for k, v in values.items()})
+            if not math.isfinite(value):
+                raise SpecError(f"evaluates to {value}", field=f"problem.parameters.{name}")
+            values[name] = value
+        else:
+            values[name] = float(base.get(name, raw))
+    return values
 
 
 def is_time_varying(raw: float | str | None) -> bool:
@@ -532,7 +552,33 @@ class GuessSpec(StrictModel):
     result: str | None = None
 
 
-class OptimalControlSpec(ProblemParameters, SpecBase):
+class OcpFamily(ProblemParameters):
+    """What the optimal-control kinds share: the objective's sense, the numeric parameters as
+    runtime parameters, and a ``plot`` section that names their states and controls."""
+
+    def check_plot_names(self) -> None:
+        """A SpecError naming the ``plot`` field that names no state (planar) or no state, control
+        or ``t`` (units)."""
+        states = set(self.problem.states)
+        for i, pair in enumerate(self.plot.planar):
+            unknown = [n for n in pair if n not in states]
+            if unknown:
+                raise SpecError(f"{', '.join(unknown)} is not a state", field=f"plot.planar.{i}")
+        named = {*self.problem.states, *self.problem.controls, "t"}
+        for name in self.plot.units:
+            if name not in named:
+                raise SpecError(f"{name!r} is not a state, a control or t", field=f"plot.units.{name}")
+
+    @property
+    def objective_sense(self) -> str:
+        return self.problem.objective.sense
+
+    def runtime_parameters(self) -> dict[str, float]:
+        """The numeric parameters (derived ones follow them and are not set on their own)."""
+        return {n: float(v) for n, v in self.problem.parameters.items() if not isinstance(v, str)}
+
+
+class OptimalControlSpec(OcpFamily, SpecBase):
     """An optimal-control problem (kind ``optimal_control``); its runtime parameters are
     ``problem.parameters``, its starting point ``guess`` and ``problem.time.guess``."""
 
@@ -555,24 +601,8 @@ class OptimalControlSpec(ProblemParameters, SpecBase):
 
     @model_validator(mode="after")
     def _plot_names(self) -> OptimalControlSpec:
-        states = set(self.problem.states)
-        for i, pair in enumerate(self.plot.planar):
-            unknown = [n for n in pair if n not in states]
-            if unknown:
-                raise SpecError(f"{', '.join(unknown)} is not a state", field=f"plot.planar.{i}")
-        named = {*self.problem.states, *self.problem.controls, "t"}
-        for name in self.plot.units:
-            if name not in named:
-                raise SpecError(f"{name!r} is not a state, a control or t", field=f"plot.units.{name}")
+        self.check_plot_names()
         return self
-
-    @property
-    def objective_sense(self) -> str:
-        return self.problem.objective.sense
-
-    def runtime_parameters(self) -> dict[str, float]:
-        """The numeric parameters (derived ones follow them and are not set on their own)."""
-        return {n: float(v) for n, v in self.problem.parameters.items() if not isinstance(v, str)}
 
     def required_features(self) -> frozenset[str]:
         p = self.problem

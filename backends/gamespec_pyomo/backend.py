@@ -20,7 +20,7 @@ import numpy as np
 from pydantic import Field, ValidationInfo, field_validator
 
 from gamespec.backend import Availability, Inputs
-from gamespec.backend.collocation import CollocationBackend, CollocationModel
+from gamespec.backend.collocation import IPOPT_DEFAULTS, CollocationBackend, CollocationModel
 from gamespec.errors import BackendError
 from gamespec.ocp.transcription import Bounds, Transcription
 from gamespec.result import Result
@@ -114,6 +114,14 @@ class PyomoModel(CollocationModel):
         else:
             _fix(m.T, b.t_lower)
 
+    def _set_integral_bounds(self, params: dict[str, float]) -> None:
+        """The integral constraints' bounds for this solve, as bounds of the Var each integral equals
+        (so the NL file's constraint ranges stay structural, :mod:`gamespec_pyomo.nlfile`)."""
+        for r, (lo, hi) in enumerate(self.tr.ocp.integral_bounds(params)):
+            var = self.model.integral_value[r]
+            var.setlb(_bound(lo))
+            var.setub(_bound(hi))
+
     def _set_start(self, X: np.ndarray, U: np.ndarray, d: np.ndarray, T: float, b: Bounds) -> None:
         m = self.model
         for name, value in zip(self.tr.ocp.design, np.clip(d, b.d_lower, b.d_upper), strict=True):
@@ -145,6 +153,9 @@ class PyomoModel(CollocationModel):
         name = self.executable.name
         opts = {"tol": self.options.tol, "max_iter": self.options.max_iter, "print_level": PRINT_LEVEL[name]}
         opts["max_wall_time"] = self.options.max_wall_time
+        if name == "ipopt":
+            # Through Ipopt's options file (Pyomo's OF_ prefix), which takes every Ipopt option.
+            opts |= {f"OF_{k}": v for k, v in IPOPT_DEFAULTS.items() if k not in self.options.options}
         return opts | self.options.options
 
     def _execute(self) -> Run:
@@ -163,6 +174,7 @@ class PyomoModel(CollocationModel):
         self._set_data(params, Win)
         b = tr.bounds(params)
         self._set_bounds(b)
+        self._set_integral_bounds(params)
         if guess is not None or not (self._solved and self.options.warm_start):
             start = tr.guess(params, guess)
             self._set_start(start.X, start.U, start.d, start.T, b)

@@ -148,10 +148,13 @@ class Run:
 
 def run_solver(exe: Executable, nl_text: str, options: dict[str, Any]) -> Run:
     """Run ``exe`` on the NL file ``nl_text`` as Pyomo's AMPL solvers do (``key=value`` on the command
-    line and in ``<name>_options``) and read its SOL file with Pyomo's reader (duals included);
-    BackendError when it exits with an error or writes no SOL file."""
+    line and in ``<name>_options``; an ``OF_key`` option in the options file ``<name>.opt`` in the
+    working directory, where Ipopt reads every option it has) and read its SOL file with Pyomo's
+    reader (duals included); BackendError when it exits with an error or writes no SOL file."""
     from pyomo.opt.plugins.sol import ResultsReader_sol
 
+    in_file = {key.removeprefix("OF_"): value for key, value in options.items() if key.startswith("OF_")}
+    options = {key: value for key, value in options.items() if not key.startswith("OF_")}
     env = os.environ.copy()
     env[f"{exe.name}_options"] = " ".join(
         f'{key}="{value}"' if isinstance(value, str) and " " in value else f"{key}={value}"
@@ -160,10 +163,14 @@ def run_solver(exe: Executable, nl_text: str, options: dict[str, Any]) -> Run:
     with tempfile.TemporaryDirectory(prefix="gamespec-pyomo-") as tmp:
         nl = Path(tmp) / "model.nl"
         nl.write_text(nl_text)
+        if in_file:
+            (Path(tmp) / f"{exe.name}.opt").write_text("".join(f"{k} {v}\n" for k, v in in_file.items()))
         cmd = [exe.path, str(nl), "-AMPL", *(f"{key}={value}" for key, value in options.items())]
         tic = time.perf_counter()
         try:
-            done = subprocess.run(cmd, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True, env=env)
+            done = subprocess.run(
+                cmd, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True, env=env, cwd=tmp
+            )
         except OSError as err:
             raise BackendError(f"{exe.name} failed to run: {err}") from None
         seconds = time.perf_counter() - tic

@@ -18,6 +18,7 @@ from gamespec.flowfield.extremals import capture_by_extremals
 from gamespec.flowfield.grid import Grid
 from gamespec.flowfield.hamiltonian import FlowHamiltonian
 from gamespec.flowfield.levelset import LevelSetSolver, capture_by_level_sets
+from gamespec.flowfield.problem import evaluate
 from gamespec.loader import load
 
 FILES = ("problems/ch5/linear_flow.yaml", "problems/ch5/hurricane_hugo.yaml")
@@ -25,7 +26,7 @@ FILES = ("problems/ch5/linear_flow.yaml", "problems/ch5/hurricane_hugo.yaml")
 
 def table(path: str, scale: list[float]) -> list[str]:
     spec = load(Path(path))
-    data = spec.data()
+    data = evaluate(spec)
     speeds = data.nominal_speeds
     fine = capture_by_extremals(
         data.field, data.origins, speeds, spec.method.max_time, directions=1440, dt=1e-3

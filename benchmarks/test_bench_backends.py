@@ -1,7 +1,7 @@
 """The two OCP backends side by side on every shipped ``optimal_control`` file: build (spec →
 backend model) and a cold solve of the built model (from the file's guess, warm start off), each
-in its own group so the CasADi/Pyomo ratio reads off directly. The Pyomo solve includes writing
-the NL file and running the solver process (Pyomo's NL interface has no persistent model).
+in its own group so the CasADi/Pyomo ratio reads off directly. The Pyomo build writes the NL file
+once; its solve rewrites the file's bounds and start segments and runs the solver process.
 
 Run: ``python -m pytest benchmarks/test_bench_backends.py --benchmark-enable``.
 """

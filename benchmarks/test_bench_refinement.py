@@ -1,6 +1,7 @@
 """Adaptive mesh refinement against a uniform mesh of the same final accuracy (issue 17, item 5):
-the hang glider refined from 10 intervals to a relative defect of 1e-6, against the coarsest uniform
-mesh (doubling from the refined interval count) whose relative defect is at least as small. Both
+the hang glider refined from 10 intervals to a relative defect of 1e-6, by splitting intervals (h) and
+by raising their degree where the defect predicts it suffices (hp), against the coarsest uniform mesh
+(doubling from the h-refined interval count) whose relative defect is at least as small as h's. All
 build + solve from the file's guess; the NLP size is in ``extra_info``.
 
 Run: ``python -m pytest benchmarks/test_bench_refinement.py --benchmark-enable``; compare the means
@@ -22,8 +23,9 @@ def _solve(overrides: list[str]) -> gamespec.Result:
     return gamespec.solve(gamespec.load(HANG_GLIDER, overrides))
 
 
-def _refined() -> gamespec.Result:
-    return _solve(["method.intervals=10", f"method.refine.tolerance={TOLERANCE}"])
+def _refined(strategy: str = "h") -> gamespec.Result:
+    refine = [f"method.refine.tolerance={TOLERANCE}", f"method.refine.strategy={strategy}"]
+    return _solve(["method.intervals=10", *refine])
 
 
 @cache
@@ -38,6 +40,14 @@ def _uniform_intervals() -> int:
 def test_refined_mesh(benchmark) -> None:
     benchmark.group = "hang glider to a relative defect of 1e-6"
     result = benchmark.pedantic(_refined, rounds=3, warmup_rounds=1)
+    benchmark.extra_info["intervals"] = result.metrics["refinement"][-1]["intervals"]
+    benchmark.extra_info["variables"] = result.metrics["refinement"][-1]["variables"]
+    assert result.metrics["refinement_converged"]
+
+
+def test_hp_refined_mesh(benchmark) -> None:
+    benchmark.group = "hang glider to a relative defect of 1e-6"
+    result = benchmark.pedantic(_refined, args=("hp",), rounds=3, warmup_rounds=1)
     benchmark.extra_info["intervals"] = result.metrics["refinement"][-1]["intervals"]
     benchmark.extra_info["variables"] = result.metrics["refinement"][-1]["variables"]
     assert result.metrics["refinement_converged"]

@@ -26,8 +26,11 @@ are vectors (:class:`VectorSpacePlayer`).
 
 The engine knows nothing of a strategy beyond the player's ``distance``. It stops with an honest
 outcome: ``converged``; ``iteration_limit``; ``cycling`` (the joint strategy returns to an earlier
-iterate, much closer to it than to the previous one, or the largest change over the last ``window``
-iterations is no smaller than over the ``window`` before); ``diverged`` (a non-finite change, or
+iterate, within tolerance and much closer to it than to the previous one; or a period-k cycle,
+``2 ≤ k ≤ window``: each of the last k iterates lies within ``cycle_ratio`` times the smallest change
+of the last 2k iterations of the iterate k before it, and the change has not shrunk over the period;
+or the largest change over the last ``window`` iterations is no smaller than over the ``window``
+before); ``diverged`` (a non-finite change, or
 that largest change at least ``growth`` times the one before); or ``player_failed`` (a response
 whose status carries no solution). :class:`BestResponseRun` maps the outcome to a
 :class:`~gamespec.result.Status` and packs the history for ``Result.metrics["best_response"]``.
@@ -146,6 +149,7 @@ class Settings:
     damping: float = 1.0
     window: int = 10
     growth: float = 2.0
+    cycle_ratio: float = 1e-2
     acceleration: Literal["none", "anderson"] = "none"
     memory: int = 5
 
@@ -154,6 +158,8 @@ class Settings:
             raise ValueError(f"damping must lie in (0, 1], got {self.damping}")
         if self.tolerance <= 0 or self.max_iterations < 1 or self.window < 1 or self.growth <= 1:
             raise ValueError("tolerance > 0, max_iterations ≥ 1, window ≥ 1 and growth > 1 are required")
+        if not 0 < self.cycle_ratio < 1:
+            raise ValueError(f"cycle_ratio must lie in (0, 1), got {self.cycle_ratio}")
         if self.memory < 1:
             raise ValueError(f"memory must be at least 1, got {self.memory}")
 
@@ -330,6 +336,25 @@ class _Iterator:
             for old in self.recent[:-1]
         )
 
+    def _distance(self, a: Strategies, b: Strategies) -> float:
+        return max(float(p.distance(a[p.name], b[p.name])) for p in self.players)
+
+    def _repeats_with_period(self, period: int) -> bool:
+        """The last ``period`` iterates each repeat the one ``period`` before within ``cycle_ratio``
+        times the smallest change of the last ``2·period`` iterations, and the change has not shrunk
+        over the period. A converging alternation ``s_i = qⁱ a`` (``−1 < q < 0``) comes back to within
+        ``(1 − |q|)/|q|`` times its change, and the change shrinks by ``q²`` per period of two: it
+        passes both tests only when ``|q| ≳ 1 − cycle_ratio/2``, a contraction too slow to converge
+        in fewer than about ``(2/cycle_ratio) · ln(change/tolerance)`` iterations."""
+        recent, ratio = self.recent, self.settings.cycle_ratio
+        if len(recent) < 2 * period + 1:
+            return False
+        changes = [it.largest for it in self.history[-2 * period :]]
+        if changes[-1] < (1 - ratio) * changes[-1 - period]:
+            return False
+        bound = ratio * min(changes)
+        return all(self._distance(recent[-1 - j], recent[-1 - j - period]) <= bound for j in range(period))
+
     def _trend(self) -> Outcome | None:
         """Cycling or divergence from the largest changes of the last two windows."""
         w = self.settings.window
@@ -363,6 +388,8 @@ class _Iterator:
         if self._returned_to_earlier(following, max(changes.values())):
             return Outcome.CYCLING
         self.recent = [*self.recent[-2 * self.settings.window :], dict(following)]
+        if any(self._repeats_with_period(k) for k in range(2, self.settings.window + 1)):
+            return Outcome.CYCLING
         self._next_point(following)
         return self._trend()
 

@@ -1,4 +1,5 @@
-"""Plots of ``optimal_control`` Results: states, controls and, for declared planar pairs, the path.
+"""Plots of ``optimal_control`` Results: states, controls and, for declared planar pairs, the path;
+the boundaries between the phases of a ``multiphase_optimal_control`` Result are marked.
 
 Plotters read Results only (never solver objects) and are registered per kind in the
 ``gamespec.plotters`` entry-point group; :func:`plot_result` dispatches on ``result.kind``. The
@@ -59,6 +60,7 @@ def plot_trajectories(result: Result, output_dir: Path, *, animate: bool = False
             axes[1, 0].plot(tc, values, ".-", label=_label(name, units), markersize=3)
         axes[1, 0].set_ylabel("controls")
         axes[1, 0].legend(**LEGEND_RIGHT)
+    _mark_phases(result, axes[:, 0])
     axes[-1, 0].set_xlabel(_label("t", units))
     title = headline(result)
     if result.t_final is not None and result.objective is not None:
@@ -80,6 +82,22 @@ def plot_trajectories(result: Result, output_dir: Path, *, animate: bool = False
 
         paths += plot_rcs(result, output_dir)
     return paths
+
+
+def _mark_phases(result: Result, axes) -> None:
+    """A dotted vertical line at each boundary between phases (``metrics["phases"]`` of a
+    multi-phase Result), named by the phase that starts there."""
+    for phase in result.metrics.get("phases", [])[1:]:
+        for ax in axes:
+            ax.axvline(phase["start"], color="0.4", ls=":", lw=1)
+        axes[0].annotate(
+            phase["name"],
+            (phase["start"], 1.0),
+            xycoords=("data", "axes fraction"),
+            fontsize="small",
+            xytext=(3, -10),
+            textcoords="offset points",
+        )
 
 
 def plot_plane(result: Result, pairs: list[tuple[str, str]], path: Path) -> Path:

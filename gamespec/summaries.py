@@ -24,3 +24,12 @@ def outcome(result: Result) -> Rows:
 def optimal_control_summary(result: Result) -> Rows:
     """The objective and the final time of an ``optimal_control`` Result."""
     return [("objective J", result.objective), ("t_f", result.t_final)]
+
+
+def multiphase_summary(result: Result) -> Rows:
+    """The objective, the final time and each phase's span of a ``multiphase_optimal_control`` Result."""
+    spans = [
+        (f"phase {p['name']}", f"{p['start']:.6g} to {p['end']:.6g}")
+        for p in result.metrics.get("phases", [])
+    ]
+    return [*optimal_control_summary(result), *spans]

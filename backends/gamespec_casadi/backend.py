@@ -19,7 +19,7 @@ import numpy as np
 from pydantic import Field, ValidationInfo, field_validator
 
 from gamespec.backend import Availability, Inputs
-from gamespec.backend.collocation import CollocationBackend, CollocationModel
+from gamespec.backend.collocation import IPOPT_DEFAULTS, CollocationBackend, CollocationModel
 from gamespec.errors import BackendError
 from gamespec.ocp.transcription import Guess, Transcription
 from gamespec.result import Result, Status
@@ -90,7 +90,7 @@ def nlp_solver(nlp: Any, options: CasadiOptions) -> Any:
 
     ipopt = {"print_level": 0, "sb": "yes", "tol": options.tol, "max_iter": options.max_iter}
     ipopt["max_wall_time"] = options.max_wall_time
-    nlp_opts = {"ipopt": ipopt | options.ipopt, "print_time": False}
+    nlp_opts = {"ipopt": ipopt | IPOPT_DEFAULTS | options.ipopt, "print_time": False}
     if options.graph == "assembled" and options.solver == "ipopt":
         from gamespec_casadi.assembly import assembled_nlp
 
@@ -135,6 +135,15 @@ class CasadiModel(CollocationModel):
         T = float(w[-1]) if self.tr.free_time else params_T
         return X, U, d, T
 
+    def _constraint_bounds(self, params: dict[str, float]) -> tuple[np.ndarray, np.ndarray]:
+        """``lbg, ubg`` with the integral constraints' bounds (the last rows of g) for ``params``."""
+        n = len(self.tr.ocp.integrals)
+        if not n:
+            return self.lbg, self.ubg
+        lbg, ubg = self.lbg.copy(), self.ubg.copy()
+        lbg[-n:], ubg[-n:] = np.array(self.tr.ocp.integral_bounds(params)).T
+        return lbg, ubg
+
     def solve_once(
         self, parameters: dict[str, float] | None = None, guess: Result | None = None, inputs: Inputs = None
     ) -> Result:
@@ -152,7 +161,8 @@ class CasadiModel(CollocationModel):
         horizon = [] if tr.free_time else [b.t_lower]
         p_val = np.concatenate([[params[n] for n in tr.ocp.parameters], Win.ravel(order="F"), horizon])
         tic = time.perf_counter()
-        sol = self.solver(x0=np.clip(w0, lbx, ubx), lbx=lbx, ubx=ubx, lbg=self.lbg, ubg=self.ubg, p=p_val)
+        lbg, ubg = self._constraint_bounds(params)
+        sol = self.solver(x0=np.clip(w0, lbx, ubx), lbx=lbx, ubx=ubx, lbg=lbg, ubg=ubg, p=p_val)
         elapsed = time.perf_counter() - tic
         stats = self.solver.stats()
         native = stats.get("return_status", "unknown")

@@ -5,10 +5,13 @@ eq. 5.22 on the grid (:mod:`gamespec.flowfield.levelset`) and integrates the nom
 along ∇φ (eqs. 5.23–5.26); ``extremals`` shoots the characteristics (:mod:`gamespec.flowfield.
 extremals`) and takes the extremals through ``x_f`` as the nominal paths. Then: ``N = round(T̂/step)``
 steps, the zero-order hold of the linearized dynamics (eqs. 5.5–5.8), the lifting (eq. 5.10),
-Gauss–Seidel (Algorithm 3) on the best-response engine with the players of :mod:`.players`, the
-capture probability (eq. 5.39) per step in open and closed loop, and a Monte Carlo of the nonlinear
-SDE in both loops. The reachability and nominal paths depend on the drift only, so a re-solve with
-new values of parameters that enter only the diffusion (α) reuses them.
+the game on the best-response engine with the players of :mod:`.players` (Gauss–Seidel,
+Algorithm 3, or the ``minimax`` scheme), the capture probability (eq. 5.39) per step in open loop,
+closed loop (the game's solution: the pursuer's strategy against the evader's, mixed for
+``minimax``) and with the pursuer's strategy against the open-loop evader, and a Monte Carlo of
+the nonlinear SDE in open and closed loop (the samples split among the evader's mixture). The
+reachability and nominal paths depend on the drift only, so a re-solve with new values of
+parameters that enter only the diffusion (α) reuses them.
 """
 
 from __future__ import annotations
@@ -27,15 +30,21 @@ from gamespec.flowfield.covariance_game import PLAYERS, CovarianceGame, Strategy
 from gamespec.flowfield.extremals import capture_by_extremals
 from gamespec.flowfield.hamiltonian import FlowHamiltonian
 from gamespec.flowfield.levelset import LevelSetSolver, capture_by_level_sets
-from gamespec.flowfield.linearize import lifted, zero_order_hold
+from gamespec.flowfield.linearize import DiscreteModel, lifted, zero_order_hold
 from gamespec.flowfield.nominal import NominalPaths, from_extremals, from_level_sets
-from gamespec.flowfield.problem import FlowGameData
+from gamespec.flowfield.problem import FlowGameData, evaluate
 from gamespec.flowfield.simulation import simulate
 from gamespec.montecarlo import proportion
 from gamespec.result import Result, Status
 from gamespec.specs.base import SpecBase, StrictModel
 from gamespec.specs.flow_game import FlowGameSpec
-from gamespec_levelset.players import EvaderStep, GamePlayer, PursuerStep
+from gamespec_levelset.players import (
+    EvaderStep,
+    GamePlayer,
+    MinimaxEvader,
+    MinimaxPursuerStep,
+    PursuerStep,
+)
 
 DISPERSION_PATHS = 200
 """Sample paths kept in the Result for the dispersion figures (Figs. 5.3, 5.4b)."""
@@ -83,6 +92,7 @@ def _level_set_reach(
         "scheme": "weno5" if engine == "jax" else m.scheme,
         "nodes": list(data.grid.shape),
         "time_steps": reach.steps,
+        "band_level": reach.band,
     }
     arrays = {"reach_margin_time": reach.times, "reach_margin": reach.margins}
     if reach.capture_time is None:
@@ -167,7 +177,7 @@ class FlowGameModel(CompiledModel):
         refuse_inputs(inputs, self.spec.kind)
         start = time.perf_counter()
         values = {**self.spec.problem.parameters, **(parameters or {})}
-        data = self.spec.data(values)
+        data = evaluate(self.spec, values)
         reach = self.reachability(data)
         if reach.capture_time is None:
             return Result(
@@ -192,18 +202,48 @@ class FlowGameModel(CompiledModel):
         )
 
 
-def _game(spec: FlowGameSpec, options: FlowGameOptions, data: FlowGameData, reach: Reachability) -> Result:
-    """Stages 2–4: linearization, the covariance game, capture probabilities and Monte Carlo."""
-    T = reach.capture_time
-    N = max(1, round(T / data.step))
+@dataclass(frozen=True)
+class Linearized:
+    """Stage 2: the discrete model along the nominal paths, the game about them, the step times."""
+
+    model: DiscreteModel
+    game: CovarianceGame
+    time: np.ndarray
+
+
+def linearized_game(data: FlowGameData, reach: Reachability) -> Linearized:
+    """``N = round(T̂/step)`` steps, the zero-order hold (eqs. 5.5–5.8), the lifting (eq. 5.10) and
+    the covariance game about the sampled nominal paths."""
+    N = max(1, round(reach.capture_time / data.step))
     model = zero_order_hold(data.field, reach.paths, N)
     lift = lifted(model, data.origins.reshape(-1))
     tau, x_hat, u_hat = reach.paths.sampled(N)
-    game = CovarianceGame(lift, _stack(x_hat[:, 1:]), _stack(u_hat), data.bounds, data.payoff)
+    game = CovarianceGame(
+        lift, _stack(x_hat[:, 1:]), _stack(u_hat), data.bounds, data.payoff, data.feedforward
+    )
+    return Linearized(model, game, tau)
+
+
+@dataclass(frozen=True)
+class Players:
+    """The two players of the file's scheme, their steps, and the engine's settings."""
+
+    pursuer: PursuerStep | MinimaxPursuerStep
+    evader: EvaderStep
+    players: list[GamePlayer]
+    settings: Settings
+    scale: float
+
+
+def game_players(spec: FlowGameSpec, options: FlowGameOptions, game: CovarianceGame) -> Players:
+    """Gauss–Seidel's (Algorithm 3) or the minimax scheme's players, scaled by the open-loop payoff."""
     open_loop = game.nominal()
     scale = max(game.value(open_loop), 1e-300)
     m = spec.method
-    pursuer = PursuerStep(game, options.solver, options.solver_options, scale)
+    if m.game.scheme == "minimax":
+        pursuer = MinimaxPursuerStep(game, options.solver, options.solver_options, scale, m.game.tolerance)
+    else:
+        pursuer = PursuerStep(game, options.solver, options.solver_options, scale)
     evader = EvaderStep(
         game,
         options.solver,
@@ -213,55 +253,91 @@ def _game(spec: FlowGameSpec, options: FlowGameOptions, data: FlowGameData, reac
         m.convex_concave.max_iterations,
         open_loop[1],
     )
-    players = [GamePlayer("pursuer", pursuer), GamePlayer("evader", evader)]
+    answer = (
+        MinimaxEvader(evader, pursuer, m.game.gap, open_loop[1])
+        if isinstance(pursuer, MinimaxPursuerStep)
+        else evader
+    )
+    players = [GamePlayer("pursuer", pursuer), GamePlayer("evader", answer)]
     settings = Settings(
         scheme="gauss_seidel", tolerance=m.game.tolerance, max_iterations=m.game.max_iterations
     )
+    return Players(pursuer, evader, players, settings, scale)
+
+
+def _game(spec: FlowGameSpec, options: FlowGameOptions, data: FlowGameData, reach: Reachability) -> Result:
+    """Stages 2–4: linearization, the covariance game, capture probabilities and Monte Carlo."""
+    T = reach.capture_time
+    stage = linearized_game(data, reach)
+    model, game, tau = stage.model, stage.game, stage.time
+    open_loop = game.nominal()
+    m = spec.method
+    cast = game_players(spec, options, game)
+    pursuer, evader, scale = cast.pursuer, cast.evader, cast.scale
 
     def payoff(strategies: dict[str, Strategy]) -> float:
         return game.value((strategies["pursuer"], strategies["evader"]))
 
-    run = iterate(players, dict(zip(PLAYERS, open_loop, strict=True)), settings, payoff)
-    closed = (run.strategies["pursuer"], run.strategies["evader"])
+    run = iterate(cast.players, dict(zip(PLAYERS, open_loop, strict=True)), cast.settings, payoff)
+    p_star = run.strategies["pursuer"]
+    mixture = _evader_mixture(pursuer, run.strategies["evader"])
     eps = data.capture_radius
     prob = {
-        name: capture_probabilities(*game.relative(s), eps)
-        for name, s in (("open", open_loop), ("closed", closed))
+        "open_loop": capture_probabilities(*game.relative(open_loop), eps),
+        "closed_loop": sum(w * capture_probabilities(*game.relative((p_star, e)), eps) for w, e in mixture),
+        "pursuer_feedback": capture_probabilities(*game.relative((p_star, open_loop[1])), eps),
     }
+    closed = (p_star, max(mixture, key=lambda we: we[0])[1])
     metrics: dict[str, Any] = {
         "capture_time": T,
         "capture_point": [float(v) for v in reach.capture_point],
-        "capture_probability_open_loop": float(prob["open"][-1]),
-        "capture_probability_closed_loop": float(prob["closed"][-1]),
+        **{f"capture_probability_{k}": float(v[-1]) for k, v in prob.items()},
         "game_converged": run.converged,
+        "game_scheme": m.game.scheme,
         "best_response": run.as_metrics(),
         "evader_convex_concave": {"payoffs": evader.log.steps, "converged": evader.log.converged},
         "evader_alternation": evader.log.alternation(),
+        "evader_mixture": {
+            "weights": [w for w, _ in mixture],
+            "payoffs": [game.value((p_star, e)) / scale for _, e in mixture],
+        },
         "payoff": data.payoff,
+        "feedforward": data.feedforward,
         "payoff_open_loop": scale,
-        "steps": N,
+        "payoff_closed_loop": sum(w * game.value((p_star, e)) for w, e in mixture),
+        "payoff_pursuer_feedback": game.value((p_star, open_loop[1])),
+        "steps": model.N,
         "step": model.step,
         "reachability": reach.metrics,
     }
+    if m.game.scheme == "minimax":
+        metrics["minimax_lower_bound"] = pursuer.bound * scale
     arrays = {
         **reach.arrays,
         "nominal_time": reach.paths.times,
         "nominal_positions": reach.paths.positions,
-        "capture_probability_open_loop": prob["open"],
-        "capture_probability_closed_loop": prob["closed"],
+        **{f"capture_probability_{k}": v for k, v in prob.items()},
         "gains": game.controls(closed)[1],
+        "evader_support_gains": np.stack([e.kappa for _, e in mixture]),
     }
     carlo = m.monte_carlo
     if carlo.samples:
+        draws = np.random.default_rng(carlo.seed).multinomial(carlo.samples, [w for w, _ in mixture])
         estimates = {}
-        for name, strategies in (("open_loop", open_loop), ("closed_loop", closed)):
-            V, K = game.controls(strategies)
-            paths = simulate(
-                data.field, model, data.origins.reshape(-1), V, K, carlo.samples, carlo.seed, carlo.substeps
-            )
-            hit = proportion(paths.separation()[:, -1] <= eps)
+        for name, plays in (
+            ("open_loop", [(carlo.samples, open_loop)]),
+            ("closed_loop", [(n, (p_star, e)) for n, (_, e) in zip(draws, mixture, strict=True) if n]),
+        ):
+            x0 = data.origins.reshape(-1)
+            ensembles = [
+                simulate(data.field, model, x0, *game.controls(s), n, carlo.seed + j, carlo.substeps)
+                for j, (n, s) in enumerate(plays)
+            ]
+            hit = proportion(np.concatenate([e.separation()[:, -1] <= eps for e in ensembles]))
             estimates[name] = {"estimate": hit.estimate, "low": hit.low, "high": hit.high, "samples": hit.n}
-            arrays[f"monte_carlo_{name}"] = paths.positions[:DISPERSION_PATHS]
+            kept = [-(-DISPERSION_PATHS * len(e.positions) // carlo.samples) for e in ensembles]
+            paths = np.concatenate([e.positions[:n] for e, n in zip(ensembles, kept, strict=True)])
+            arrays[f"monte_carlo_{name}"] = paths[:DISPERSION_PATHS]  # each support point in its share
         metrics["monte_carlo_capture_probability"] = estimates
     X_bar = np.vstack([data.origins.reshape(1, 4), game.mean(closed)])
     V, _ = game.controls(closed)
@@ -272,7 +348,7 @@ def _game(spec: FlowGameSpec, options: FlowGameOptions, data: FlowGameData, reac
     return Result(
         status=run.status,
         message=run.message,
-        objective=game.value(closed),
+        objective=metrics["payoff_closed_loop"],
         t_final=T,
         iterations=run.iterations,
         time=tau,
@@ -283,6 +359,16 @@ def _game(spec: FlowGameSpec, options: FlowGameOptions, data: FlowGameData, reac
         metrics=metrics,
         checks={"max_constraint_violation": max(0.0, *violations.values())},
     )
+
+
+def _evader_mixture(
+    pursuer: PursuerStep | MinimaxPursuerStep, last: Strategy
+) -> list[tuple[float, Strategy]]:
+    """The evader's play against the pursuer's last strategy: its last response (Gauss–Seidel), or
+    the mixed strategy over the support that the minimax pursuer's multipliers give."""
+    if isinstance(pursuer, MinimaxPursuerStep) and pursuer.support:
+        return [(float(w), e) for w, e in zip(pursuer.weights, pursuer.support, strict=True) if w > 1e-9]
+    return [(1.0, last)]
 
 
 class _FlowGameBackend(Backend):
@@ -296,7 +382,10 @@ class _FlowGameBackend(Backend):
 
 
 class LevelSetBackend(_FlowGameBackend):
-    """Reachability by the level-set equation 5.22 on the file's grid."""
+    """Reachability by the level-set equation 5.22 on the file's grid, in NumPy: each step updates
+    only the box around the levels the capture search reads (:mod:`gamespec.flowfield.band`).
+    Nothing to compile, so the fastest for one solve; see ``hj_reachability`` for repeated solves on
+    one grid in one process."""
 
     name = "levelset"
     method = "levelset"
@@ -311,7 +400,11 @@ class ExtremalBackend(_FlowGameBackend):
 
 class HJReachabilityBackend(_FlowGameBackend):
     """Reachability by hj_reachability (JAX) on the file's grid (WENO5, TVD-RK3; the scheme of
-    ``method.scheme`` is not used). Optional: needs ``pip install hj-reachability jax``."""
+    ``method.scheme`` is not used), single precision, the whole grid each step, one XLA program for
+    both agents' step compiled on the first solve for a grid, field and speeds (seconds) and reused
+    by later solves in the process. The fast option for many solves on one grid in one process
+    (per step about twice as fast as NumPy on the whole grid); for one solve, ``levelset`` is
+    faster. Optional: needs ``pip install hj-reachability jax``."""
 
     name = "hj_reachability"
     method = "hj_reachability"

@@ -10,9 +10,14 @@ point when ``J`` rises by less than the tolerance. Its history is reported.
 
 Both feasible sets are eqs. 5.35a–b and the chance constraint eq. 5.36, all second-order cones; in
 eq. 5.36 the matrix norm ``‖Σ^{y1/2} K_kⁱᵀ‖`` is bounded by its Frobenius norm (a conservative SOC
-form of Theorem 5's ``σ_max``). ``V`` does not enter ``J`` (eq. 5.34 depends on ``K`` only), so it
-is fixed by a small proximal term ``ρ ‖V − Û‖²`` that breaks ties toward the nominal control.
+form of Theorem 5's ``σ_max``). ``V`` does not enter ``J`` (eq. 5.34 depends on ``K`` only): with
+``feedforward: nominal`` it is ``Û``; with ``free`` a small proximal term ``ρ ‖V − Û‖²`` breaks
+ties toward the nominal control (a player still moves ``V`` where that frees speed for its gains).
 Problems are scaled so that the open-loop payoff is 1.
+
+Algorithm 3 pairs :class:`PursuerStep` with :class:`EvaderStep`; the ``minimax`` scheme pairs
+:class:`MinimaxPursuerStep` (the pursuer's security strategy over the evader strategies seen) with
+:class:`MinimaxEvader` (the evader's step, kept only when it beats the restricted value).
 """
 
 from __future__ import annotations
@@ -60,9 +65,13 @@ class _PlayerProblem:
             cp.norm(V2 - self.U_hat.reshape(N, 2), 2, axis=1) <= b.delta_u,
             cp.norm(V2[0]) <= b.max_speed,
         ]
+        if game.feedforward == "nominal":
+            self.constraints.append(self.V - self.U_hat == 0)
+        self.spread_maps = np.array(
+            [np.kron(np.eye(2), _root(game.noise_rows[k] @ game.noise_rows[k].T).T) for k in range(1, N)]
+        ).reshape(-1, 8, 8)
         for k in range(1, N):
-            L = _root(game.noise_rows[k] @ game.noise_rows[k].T)
-            spread = cp.norm(np.kron(np.eye(2), L.T) @ self.kappa[8 * (k - 1) : 8 * k])
+            spread = cp.norm(self.spread_maps[k - 1] @ self.kappa[8 * (k - 1) : 8 * k])
             self.constraints.append(cp.norm(V2[k]) + b.chance_factor * spread <= b.max_speed)
         self.proximal = (
             PROXIMAL * cp.sum_squares(self.V - self.U_hat) / max(1.0, float(self.U_hat @ self.U_hat))
@@ -124,6 +133,66 @@ class PursuerStep(_PlayerProblem):
         return self.strategy(), StepReport(status)
 
 
+class MinimaxPursuerStep(_PlayerProblem):
+    """The pursuer's security strategy ``min_p max_e J`` by outer approximation: it keeps every
+    evader strategy it has been shown (the support ``𝒮``) and answers ``argmin_p max_{e ∈ 𝒮} J(p, e)``,
+    a convex program (``min t`` s.t. ``J(p, e_j) ≤ t``). Why: ``J`` is convex in the evader's gains
+    too, so a pure saddle point need not exist (then Gauss–Seidel cannot converge); since ``J`` is
+    convex in the pursuer's gains, the pursuer has a pure optimal strategy in the mixed extension
+    and the game's value is ``min_p max_e J`` (Bohnenblust, Karlin and Shapley 1950, games with
+    convex payoff). The restricted value ``t`` is a lower bound of that value; the multipliers of
+    the constraints ``J(p, e_j) ≤ t`` sum to one and are the evader's mixed strategy over ``𝒮``
+    (``weights``); an evader strategy within ``distinct`` of a support point is not added again.
+    When the evader's best response to the answer is already in ``𝒮``, no response
+    it finds raises ``J`` above ``t``: the iteration has stopped at the value, up to the evader's
+    search being local (the convex–concave procedure)."""
+
+    def __init__(
+        self, game: CovarianceGame, solver: str, solver_options: dict[str, Any], scale: float, distinct: float
+    ) -> None:
+        super().__init__(game, 0, solver, solver_options)
+        self.scale, self.distinct = scale, distinct
+        self.support: list[Strategy] = []
+        self.weights = np.zeros(0)
+        self.bound = float("nan")
+        T = self.gains_map()
+        self.root = _root(T.T @ T)
+
+    def _payoff_constraints(self, t: Any) -> list[Any]:
+        """``J(p, e_j)/scale ≤ t`` for every ``e_j`` of the support, in the forms of :class:`PursuerStep`."""
+        import cvxpy as cp
+
+        T, N = self.gains_map(), self.game.N
+        out = []
+        for e in self.support:
+            c = self.game.g0 + self.game.gain_maps[1] @ e.kappa.reshape(-1)
+            if self.game.payoff == "trace":
+                value = cp.sum_squares(self.root @ self.kappa) + 2 * (T.T @ c) @ self.kappa + float(c @ c)
+                out.append(value / self.scale <= t)
+            else:
+                G = cp.reshape(c + T @ self.kappa, (2 * N, 4 * N), order="C") / np.sqrt(np.sqrt(self.scale))
+                S = cp.Variable((2 * N, 2 * N), symmetric=True)
+                out += [cp.sum_squares(S) <= t, cp.bmat([[S, G], [G.T, np.eye(4 * N)]]) >> 0]
+        return out
+
+    def respond(self, evader: Strategy) -> tuple[Strategy | None, StepReport]:
+        import cvxpy as cp
+
+        if all(_distance(evader, e) > self.distinct for e in self.support):
+            self.support.append(evader)
+        t = cp.Variable()
+        bounds = self._payoff_constraints(t)
+        problem = cp.Problem(cp.Minimize(t + self.proximal), [*self.constraints, *bounds])
+        status = self.run(problem)
+        if not status.ok:
+            return None, StepReport(status, f"pursuer step: solver reported {problem.status}")
+        step = 1 if self.game.payoff == "trace" else 2
+        duals = np.array([float(np.sum(c.dual_value)) for c in bounds[::step]])
+        self.weights = np.clip(duals, 0.0, None) / max(float(np.clip(duals, 0.0, None).sum()), 1e-300)
+        self.bound = float(t.value)
+        return self.strategy(), StepReport(status)
+
+
 @dataclass
 class ConvexConcaveLog:
     """Payoffs ``J`` along each evader step's convex–concave iterations."""
@@ -168,32 +237,95 @@ class EvaderStep(_PlayerProblem):
         self.problem = cp.Problem(cp.Maximize(linear - self.proximal), self.constraints)
         self.current = start
         self.log = ConvexConcaveLog()
+        b = game.bounds[1]
+        speeds = np.linalg.norm(self.U_hat.reshape(game.N, 2)[1:], axis=1)
+        self.radii = (b.max_speed - speeds) / b.chance_factor
+        self.inverse_maps = np.linalg.pinv(self.spread_maps) if game.N > 1 else None
+
+    def tangent_step(self, slope: np.ndarray) -> tuple[Strategy | None, StepReport]:
+        """The maximizer of the linearization ``slope · κ`` over the evader's set. With ``V = Û``
+        (feedforward nominal) the set is a product over steps of ``‖S_k κ_k‖ ≤ ρ_k`` (eq. 5.36,
+        ``ρ_k = (v_max − ‖û_k‖)/√(2 log 1/β)``), and each factor's maximizer is closed-form,
+        ``κ_k = ρ_k S_k⁺ h_k/‖h_k‖`` with ``h_k = S_k⁺ᵀ g_k``; otherwise the conic problem is solved."""
+        if self.game.feedforward == "nominal":
+            h = np.einsum("kij,ki->kj", self.inverse_maps, slope.reshape(-1, 8))
+            norms = np.linalg.norm(h, axis=1, keepdims=True)
+            direction = np.where(norms > 0, h / np.where(norms > 0, norms, 1.0), 0.0)
+            kappa = np.zeros((self.game.N, 2, 4))
+            kappa[1:] = (self.radii[:, None] * np.einsum("kij,kj->ki", self.inverse_maps, direction)).reshape(
+                -1, 2, 4
+            )
+            return Strategy(self.U_hat.reshape(-1, 2).copy(), kappa), StepReport(Status.OPTIMAL)
+        self.slope.value = slope / max(np.linalg.norm(slope), 1e-300)  # the maximizer is scale-free
+        status = self.run(self.problem)
+        if not status.ok:
+            return None, StepReport(status, f"evader step: solver reported {self.problem.status}")
+        return self.strategy(), StepReport(status)
 
     def respond(self, pursuer: Strategy) -> tuple[Strategy | None, StepReport]:
-        current = self.current
+        """The better of the procedure from the current strategy and from its mirror ``(V, −K)``
+        (the evader's set is symmetric in its gains and, for the trace payoff,
+        ``J(p, e) + J(p, ẽ) = 2‖c‖² + 2‖Tᵉκᵉ‖²`` for the mirror ``ẽ``: the mirror may lie on the side
+        where ``J`` grows). Ties keep the current strategy, so an evader indifferent between two
+        responses does not alternate."""
+        start = self.current
+        best = self._climb(pursuer, start)
+        if best[0] is not None and np.any(start.kappa):
+            mirror = self._climb(pursuer, Strategy(start.V, -start.kappa))
+            if mirror[0] is not None and mirror[2][-1] - best[2][-1] > self.tolerance * abs(best[2][-1]):
+                best = mirror
+        strategy, report, values, converged = best
+        if strategy is None:
+            return None, report
+        self.current = strategy
+        self.log.responses.append(strategy)
+        self.log.steps.append(values)
+        self.log.converged.append(converged)
+        return strategy, report
+
+    def _climb(
+        self, pursuer: Strategy, current: Strategy
+    ) -> tuple[Strategy | None, StepReport, list[float], bool]:
+        """The convex–concave procedure from ``current``: the strategy, report, payoffs, converged."""
         values = [self.game.value((pursuer, current)) / self.scale]
         converged = self.slope is None
         for _ in range(0 if converged else self.max_iterations):
-            slope = self.game.gradient((pursuer, current), 1)[1:].reshape(-1)
-            self.slope.value = slope / max(np.linalg.norm(slope), 1e-300)  # the maximizer is scale-free
-            status = self.run(self.problem)
-            if not status.ok:
-                self.log.steps.append(values)
-                self.log.converged.append(False)
-                return None, StepReport(status, f"evader step: solver reported {self.problem.status}")
-            current = self.strategy()
+            step, report = self.tangent_step(self.game.gradient((pursuer, current), 1)[1:].reshape(-1))
+            if step is None:
+                return None, report, values, False
+            current = step
             values.append(self.game.value((pursuer, current)) / self.scale)
             if values[-1] - values[-2] <= self.tolerance * max(abs(values[-2]), 1e-12):
                 converged = True
                 break
-        self.current = current
-        self.log.responses.append(current)
-        self.log.steps.append(values)
-        self.log.converged.append(converged)
         if not converged:
             message = f"evader step: convex-concave procedure stopped after {self.max_iterations} iterations"
-            return current, StepReport(Status.FEASIBLE, message)
-        return current, StepReport(Status.OPTIMAL)
+            return current, StepReport(Status.FEASIBLE, message), values, False
+        return current, StepReport(Status.OPTIMAL), values, True
+
+
+@dataclass
+class MinimaxEvader:
+    """The evader of the ``minimax`` scheme: its step's answer to the pursuer's security strategy
+    when that answer raises ``J`` above the restricted value ``t`` by more than ``gap · t`` (a new
+    strategy the pursuer has not guarded against), else its previous answer. At a mixed
+    equilibrium the evader is indifferent among its support, so its plain best response may jump
+    between support points without any gain; keeping the previous answer then lets the iteration
+    stop, and the stop certifies ``t ≤ J(p, BR_e(p)) ≤ (1 + gap) t``."""
+
+    step: EvaderStep
+    pursuer: MinimaxPursuerStep
+    gap: float
+    previous: Strategy
+
+    def respond(self, pursuer: Strategy) -> tuple[Strategy | None, StepReport]:
+        answer, report = self.step.respond(pursuer)
+        if answer is None:
+            return None, report
+        value = self.step.game.value((pursuer, answer)) / self.step.scale
+        if value > (1 + self.gap) * self.pursuer.bound:
+            self.previous = answer
+        return self.previous, report
 
 
 @dataclass(frozen=True)
@@ -202,7 +334,7 @@ class GamePlayer:
     distance ``max(‖ΔV‖, ‖ΔK‖)`` (the stopping rule of section 5.4)."""
 
     name: str
-    step: PursuerStep | EvaderStep
+    step: PursuerStep | MinimaxPursuerStep | EvaderStep | MinimaxEvader
 
     def respond(self, others: dict[str, Strategy]) -> tuple[Strategy | None, StepReport]:
         (other,) = (others[n] for n in PLAYERS if n != self.name)

@@ -2,38 +2,40 @@
 through AMPL NL/SOL files (the bundled ``ripopt``, or ``ipopt`` when one is on PATH).
 
 The model (:mod:`gamespec_pyomo.model`) is the CasADi backend's discretization written in Pyomo and
-is built once. A re-solve sets the parameter and grid-input Params and the bounds, starts from the
-last solution (or from a guess Result of any backend) and writes a fresh NL file: Pyomo's NL interface has no
-persistent solver, so NL writing counts in the solve time. Costates come from the defect
-multipliers the SOL file returns (Suffix ``dual``), as in the CasADi backend.
+is built once, and so is its NL file (:mod:`gamespec_pyomo.nlfile`). A solve fixes the parameters,
+the grid inputs and a fixed horizon through equal bounds, sets the bounds, starts from the last
+solution (or from a guess Result of any backend), rewrites the NL file's bounds and start segments
+and runs the executable. Costates come from the defect multipliers the SOL file returns (Suffix
+``dual``), as in the CasADi backend.
 """
 
 from __future__ import annotations
 
-import logging
 import math
-import tempfile
 import time
-from pathlib import Path
+from collections.abc import Mapping
 from typing import Any, ClassVar, Literal
 
 import numpy as np
 from pydantic import Field, ValidationInfo, field_validator
 
 from gamespec.backend import Availability, Inputs
-from gamespec.backend.collocation import CollocationBackend, CollocationModel
+from gamespec.backend.collocation import IPOPT_DEFAULTS, CollocationBackend, CollocationModel
 from gamespec.errors import BackendError
 from gamespec.ocp.transcription import Bounds, Transcription
 from gamespec.result import Result
 from gamespec.specs.base import StrictModel
 from gamespec.specs.ocp import OptimalControlSpec
 from gamespec_pyomo.model import build_model
+from gamespec_pyomo.nlfile import NLFile
 from gamespec_pyomo.solvers import (
     PRINT_LEVEL,
+    Run,
     check_options,
     find_executable,
     iterations_in,
     pyomo_solver,
+    run_solver,
     solver_seconds_in,
     status_of,
 )
@@ -66,6 +68,13 @@ def _bound(value: float) -> float | None:
     return float(value) if math.isfinite(value) else None
 
 
+def _fix(var: Any, value: float) -> None:
+    """Hold ``var`` at ``value`` by equal bounds (a fixed Var would be a constant of the NL file)."""
+    var.setlb(float(value))
+    var.setub(float(value))
+    var.set_value(float(value))
+
+
 class PyomoModel(CollocationModel):
     """The Pyomo model and the solver that runs on it, built once."""
 
@@ -77,8 +86,16 @@ class PyomoModel(CollocationModel):
         self.options = options
         self.executable = find_executable(options.solver)
         self.model = build_model(self.tr, self.tr.ocp.parameter_values())
-        self.solver = pyomo_solver(self.executable)
+        self.nl = NLFile(self.model)
         self._solved = False
+
+    def _set_data(self, params: Mapping[str, float], Win: np.ndarray) -> None:
+        """Fix the parameters and the grid inputs at their values for this solve."""
+        m = self.model
+        for name, value in params.items():
+            _fix(m.p[name], value)
+        for (i, col), var in m.w.items():
+            _fix(var, Win[i, col])
 
     def _set_bounds(self, b: Bounds) -> None:
         m = self.model
@@ -95,7 +112,15 @@ class PyomoModel(CollocationModel):
             m.T.setlb(b.t_lower)
             m.T.setub(b.t_upper)
         else:
-            m.T.set_value(b.t_lower)
+            _fix(m.T, b.t_lower)
+
+    def _set_integral_bounds(self, params: dict[str, float]) -> None:
+        """The integral constraints' bounds for this solve, as bounds of the Var each integral equals
+        (so the NL file's constraint ranges stay structural, :mod:`gamespec_pyomo.nlfile`)."""
+        for r, (lo, hi) in enumerate(self.tr.ocp.integral_bounds(params)):
+            var = self.model.integral_value[r]
+            var.setlb(_bound(lo))
+            var.setub(_bound(hi))
 
     def _set_start(self, X: np.ndarray, U: np.ndarray, d: np.ndarray, T: float, b: Bounds) -> None:
         m = self.model
@@ -124,33 +149,21 @@ class PyomoModel(CollocationModel):
         rows = len(m.defect) // self.tr.n_x
         return np.array([[m.dual[m.defect[i, r]] for r in range(rows)] for i in range(self.tr.n_x)])
 
-    def _run(self) -> tuple[Any, str]:
-        """Write the NL file, run the executable, read the SOL file; the results and the log."""
-        from pyomo.common.errors import ApplicationError
-
+    def _solver_options(self) -> dict[str, Any]:
         name = self.executable.name
         opts = {"tol": self.options.tol, "max_iter": self.options.max_iter, "print_level": PRINT_LEVEL[name]}
         opts["max_wall_time"] = self.options.max_wall_time
-        with tempfile.TemporaryDirectory(prefix="gamespec-pyomo-") as tmp:
-            log = Path(tmp) / "solver.log"
-            try:
-                results = self.solver.solve(
-                    self.model, options=opts | self.options.options, logfile=str(log), load_solutions=False
-                )
-            except ApplicationError as err:
-                raise BackendError(f"{name} failed to run: {err}") from None
-            return results, log.read_text()
+        if name == "ipopt":
+            # Through Ipopt's options file (Pyomo's OF_ prefix), which takes every Ipopt option.
+            opts |= {f"OF_{k}": v for k, v in IPOPT_DEFAULTS.items() if k not in self.options.options}
+        return opts | self.options.options
 
-    def _load(self, results: Any) -> bool:
-        """Load the solution when the SOL file has one (Pyomo's warning about a non-optimal status
-        is dropped: the Result carries that status)."""
-        from pyomo.common.log import LoggingIntercept
-
-        if len(results.solution) == 0:
-            return False
-        with LoggingIntercept(level=logging.WARNING, module="pyomo.core"):
-            self.model.solutions.load_from(results)
-        return True
+    def _execute(self) -> Run:
+        """Run the executable on the NL file of the model as it stands; load the solution it finds."""
+        run = run_solver(self.executable, self.nl.text(), self._solver_options())
+        if len(run.results.solution) > 0:
+            self.nl.load(run.results.solution(0))
+        return run
 
     def solve_once(
         self, parameters: dict[str, float] | None = None, guess: Result | None = None, inputs: Inputs = None
@@ -158,20 +171,19 @@ class PyomoModel(CollocationModel):
         tr, m = self.tr, self.model
         params = tr.ocp.parameter_values(parameters)
         Win = tr.input_values(params, inputs)
-        for name, value in params.items():
-            m.p[name] = value
-        for (i, col), param in m.w.items():
-            param.set_value(float(Win[i, col]))
+        self._set_data(params, Win)
         b = tr.bounds(params)
         self._set_bounds(b)
+        self._set_integral_bounds(params)
         if guess is not None or not (self._solved and self.options.warm_start):
             start = tr.guess(params, guess)
             self._set_start(start.X, start.U, start.d, start.T, b)
         m.dual.clear()
         tic = time.perf_counter()
-        results, log = self._run()
+        run = self._execute()
         elapsed = time.perf_counter() - tic
-        loaded = self._load(results)
+        results, log = run.results, run.log
+        loaded = len(results.solution) > 0
         self._solved = self._solved or loaded
         termination = str(results.solver.termination_condition)
         # Pyomo's SOL reader stores the solver's message with ':' escaped as '\x3a'.
@@ -194,7 +206,7 @@ class PyomoModel(CollocationModel):
                 "solver": self.executable.name,
                 "executable": self.executable.path,
                 "termination_condition": termination,
-                "process_time_s": results.solver.time,
+                "process_time_s": run.seconds,
                 "solver_time_s": solver_seconds_in(log),
             },
         )

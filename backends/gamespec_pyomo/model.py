@@ -2,14 +2,17 @@
 :mod:`gamespec.ocp.collocation`, row for row the NLP the CasADi backend builds, so both backends
 solve the identical discretization.
 
-Variables ``X[i, node]``, ``U[j, point]``, the design variables ``d[name]`` and the horizon ``T``, a
-Var when the final time is free (time scaling ``t = t0 + tau * T``) and a mutable Param otherwise.
-The problem's parameters are mutable Params indexed by name, and the grid inputs mutable Params
-``w[input, point]`` indexed by evaluation point, so a re-solve changes values, not the model.
+Variables ``X[i, node]``, ``U[j, point]``, the design variables ``d[name]`` and the horizon ``T``
+(time scaling ``t = t0 + tau * T``). The problem's parameters ``p[name]``, the grid inputs
+``w[input, point]`` indexed by evaluation point and, when the final time is fixed, ``T`` are Vars
+too, that the solve step fixes through equal bounds: an NL file holds a fixed Var's value as a
+constant in its expressions but a bounded Var's value in its bounds segment, so the file is written
+once and a re-solve rewrites only its bounds and start (:mod:`gamespec_pyomo.nlfile`); the solver
+eliminates variables with equal bounds before it starts.
 Constraints: the defects ``D X - T W F(X, U, t) = 0``, path constraints at every evaluation point,
 boundary constraints over the end values and integral constraints ``T q^T g``; objective ``Phi + T
-q^T L`` in minimization form. The ``scaling_factor`` Suffix (``1/scale``, applied by Pyomo's NL
-writer) gives the solver the scaled variables the casadi backend gives IPOPT.
+q^T L`` in minimization form. The ``scaling_factor`` Suffix (``1/scale``, written to the NL file as
+a suffix, which ripopt reads) gives the solver the scaled variables the casadi backend gives IPOPT.
 """
 
 from __future__ import annotations
@@ -75,7 +78,7 @@ def _relation(rel: Relation, expr: Any) -> Any:
 
 
 def build_model(tr: Transcription, params: Mapping[str, float]) -> Any:
-    """The Pyomo ``ConcreteModel`` of ``tr`` with the Params set to ``params`` and a dual Suffix."""
+    """The Pyomo ``ConcreteModel`` of ``tr`` starting from ``params``, with a dual Suffix."""
     import pyomo.environ as pyo
 
     ocp, grid = tr.ocp, tr.grid
@@ -83,15 +86,12 @@ def build_model(tr: Transcription, params: Mapping[str, float]) -> Any:
     D, W, q = grid.matrices
     k = len(grid.eval_index)
     m = pyo.ConcreteModel(name=tr.spec.name)
-    m.p = pyo.Param(ocp.parameters, mutable=True, initialize=dict(params))
-    m.w = pyo.Param(range(tr.n_w), range(k), mutable=True, initialize=0.0)
+    m.p = pyo.Var(ocp.parameters, initialize=dict(params))
+    m.w = pyo.Var(range(tr.n_w), range(k), initialize=0.0)
     m.X = pyo.Var(range(tr.n_x), range(grid.n_nodes), initialize=0.0)
     m.U = pyo.Var(range(tr.n_u), range(k), initialize=0.0)
     m.d = pyo.Var(ocp.design, initialize=0.0)
-    if tr.free_time:
-        m.T = pyo.Var(initialize=1.0)
-    else:
-        m.T = pyo.Param(mutable=True, initialize=1.0)
+    m.T = pyo.Var(initialize=1.0)
     symbols = {s: m.p[name] for s, name in zip(ocp.p, ocp.parameters, strict=True)}
     symbols |= {s: m.d[name] for s, name in zip(ocp.d, ocp.design, strict=True)}
 
@@ -127,9 +127,9 @@ def build_model(tr: Transcription, params: Mapping[str, float]) -> Any:
         m.T * sum(float(w) * terms[r] for w, terms in zip(q, integrands, strict=True))
         for r in range(len(ocp.integrals))
     ]
-    m.integral = pyo.Constraint(
-        range(len(ocp.integrals)), rule=lambda _m, r: _relation(ocp.integrals[r], integral[r])
-    )
+    n_int = range(len(ocp.integrals))
+    m.integral_value = pyo.Var(n_int, initialize=0.0)
+    m.integral = pyo.Constraint(n_int, rule=lambda _m, r: m.integral_value[r] == integral[r])
     running = sum(float(w) * term for w, term in zip(q, L, strict=True))
     m.objective = pyo.Objective(expr=translate(ocp.mayer, ends, lib) + m.T * running + tr.rate_penalty(m.U))
     m.dual = pyo.Suffix(direction=pyo.Suffix.IMPORT)

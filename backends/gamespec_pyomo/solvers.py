@@ -13,6 +13,8 @@ import os
 import re
 import shutil
 import subprocess
+import tempfile
+import time
 from dataclasses import dataclass
 from functools import cache
 from importlib.metadata import PackageNotFoundError, version
@@ -132,6 +134,51 @@ def check_options(choice: str, options: dict[str, Any]) -> None:
             near = difflib.get_close_matches(key, names, n=1)
             hint = f"; did you mean {near[0]!r}?" if near else ""
             raise ValueError(f"{exe.name} has no option {key!r}{hint}")
+
+
+@dataclass(frozen=True)
+class Run:
+    """One run of an executable on an NL file: Pyomo's reading of the SOL file, the log and the
+    seconds the process took."""
+
+    results: Any
+    log: str
+    seconds: float
+
+
+def run_solver(exe: Executable, nl_text: str, options: dict[str, Any]) -> Run:
+    """Run ``exe`` on the NL file ``nl_text`` as Pyomo's AMPL solvers do (``key=value`` on the command
+    line and in ``<name>_options``; an ``OF_key`` option in the options file ``<name>.opt`` in the
+    working directory, where Ipopt reads every option it has) and read its SOL file with Pyomo's
+    reader (duals included); BackendError when it exits with an error or writes no SOL file."""
+    from pyomo.opt.plugins.sol import ResultsReader_sol
+
+    in_file = {key.removeprefix("OF_"): value for key, value in options.items() if key.startswith("OF_")}
+    options = {key: value for key, value in options.items() if not key.startswith("OF_")}
+    env = os.environ.copy()
+    env[f"{exe.name}_options"] = " ".join(
+        f'{key}="{value}"' if isinstance(value, str) and " " in value else f"{key}={value}"
+        for key, value in options.items()
+    )
+    with tempfile.TemporaryDirectory(prefix="gamespec-pyomo-") as tmp:
+        nl = Path(tmp) / "model.nl"
+        nl.write_text(nl_text)
+        if in_file:
+            (Path(tmp) / f"{exe.name}.opt").write_text("".join(f"{k} {v}\n" for k, v in in_file.items()))
+        cmd = [exe.path, str(nl), "-AMPL", *(f"{key}={value}" for key, value in options.items())]
+        tic = time.perf_counter()
+        try:
+            done = subprocess.run(
+                cmd, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True, env=env, cwd=tmp
+            )
+        except OSError as err:
+            raise BackendError(f"{exe.name} failed to run: {err}") from None
+        seconds = time.perf_counter() - tic
+        sol = nl.with_suffix(".sol")
+        if done.returncode != 0 or not sol.is_file():
+            last = (done.stdout.strip().splitlines() or ["no output"])[-1]
+            raise BackendError(f"{exe.name} failed to run (exit status {done.returncode}): {last}")
+        return Run(ResultsReader_sol()(str(sol), suffixes=["dual"]), done.stdout, seconds)
 
 
 def pyomo_solver(exe: Executable) -> Any:

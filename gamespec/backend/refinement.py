@@ -1,7 +1,14 @@
-"""Adaptive h-refinement of a collocation mesh on the solver-independent defect estimate (the loop of
-GPOPS-II and dymos, in its simplest form): solve, split every interval whose defect relative to the
-state scale exceeds ``method.refine.tolerance`` into two halves, re-solve on the new mesh from the
-last solution, until no interval does or ``max_iterations`` refinements were made.
+"""Adaptive refinement of a collocation mesh on the solver-independent defect estimate (the loop of
+GPOPS-II and dymos): solve, refine every interval whose defect relative to the state scale exceeds
+``method.refine.tolerance``, re-solve on the new mesh from the last solution, until no interval does
+or ``max_iterations`` refinements were made.
+
+``h`` splits each such interval into two halves of its degree. ``hp`` follows the ph rule of
+Patterson, Hager & Rao (2015): on a smooth solution the LGR error of an interval of N points falls
+by about a factor N per added point, so ``P = ceil(log(e / tol) / log(N))`` more points should meet
+the tolerance; the interval gets degree N + P when that is at most ``max_degree``, and otherwise (the
+defect falls too slowly for a polynomial: a corner, a switch) is split into ``max(2, ceil((N + P) /
+d0))`` equal intervals of the file's degree d0.
 
 The model is rebuilt for each mesh (its NLP changes size) by the backend's own model class, so the
 loop is the same for every collocation backend; the history goes to ``metrics["refinement"]``.
@@ -9,6 +16,7 @@ loop is the same for every collocation backend; the history goes to ``metrics["r
 
 from __future__ import annotations
 
+import math
 from collections.abc import Mapping
 from typing import TYPE_CHECKING, Any
 
@@ -20,6 +28,7 @@ from gamespec.result import Result
 if TYPE_CHECKING:
     from gamespec.backend.collocation import CollocationModel
     from gamespec.ocp.transcription import Transcription
+    from gamespec.specs.ocp import RefineSpec
 
 
 def trajectory_of(tr: Transcription, result: Result) -> tuple[Trajectory, dict[str, float]]:
@@ -31,15 +40,31 @@ def trajectory_of(tr: Transcription, result: Result) -> tuple[Trajectory, dict[s
     return Trajectory(X, U, Win, float(result.t_final) - tr.t0), values
 
 
-def split(breaks: np.ndarray, marked: np.ndarray) -> list[float]:
-    """``breaks`` with the midpoint of every marked interval added."""
-    mids = 0.5 * (breaks[:-1] + breaks[1:])[marked]
-    return sorted({*breaks.tolist(), *mids.tolist()})
+def refined_mesh(
+    breaks: np.ndarray, degrees: np.ndarray, defects: np.ndarray, options: RefineSpec, base_degree: int
+) -> tuple[list[float], list[int]]:
+    """The next mesh: interval boundaries and per-interval degrees (see the module docstring)."""
+    mesh, new_degrees = [0.0], []
+    for a, b, d, e in zip(breaks[:-1], breaks[1:], degrees.tolist(), defects, strict=True):
+        pieces, degree = 1, d
+        if e > options.tolerance and options.strategy == "h":
+            pieces = 2
+        elif e > options.tolerance:
+            wanted = d + math.ceil(math.log(e / options.tolerance) / math.log(max(d, 2)))
+            if wanted <= options.max_degree:
+                degree = wanted
+            else:
+                pieces, degree = max(2, math.ceil(wanted / base_degree)), base_degree
+        mesh += np.linspace(a, b, pieces + 1)[1:].tolist()
+        new_degrees += [degree] * pieces
+    mesh[-1] = 1.0
+    return mesh, new_degrees
 
 
 def _entry(tr: Transcription, result: Result) -> dict[str, Any]:
     return {
         "intervals": tr.grid.intervals,
+        "max_degree": int(tr.grid.interval_degrees.max()),
         "variables": int(tr.grid.n_nodes * tr.n_x + len(tr.grid.eval_index) * tr.n_u),
         "status": result.status.value,
         "objective": result.objective,
@@ -65,11 +90,17 @@ def refined(
         if not result.ok:
             break
         sol, values = trajectory_of(current.tr, result)
-        marked = relative_defects(current.tr, sol, values) > options.tolerance
-        if not marked.any():
+        defects = relative_defects(current.tr, sol, values)
+        if not (defects > options.tolerance).any():
             break
-        mesh = split(current.tr.grid.breaks, marked)
-        method = current.tr.spec.method.model_copy(update={"mesh": mesh, "intervals": len(mesh) - 1})
+        grid = current.tr.grid
+        mesh, degrees = refined_mesh(
+            grid.breaks, grid.interval_degrees, defects, options, model.tr.spec.method.degree
+        )
+        update = {"mesh": mesh, "intervals": len(mesh) - 1}
+        if options.strategy == "hp":
+            update["degrees"] = degrees
+        method = current.tr.spec.method.model_copy(update=update)
         spec = current.tr.spec.model_copy(update={"method": method})
         current = type(model)(spec, model.options)
         result = current.solve_once(parameters, guess=result, inputs=inputs)

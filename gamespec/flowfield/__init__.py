@@ -1,9 +1,9 @@
 """Pursuit-evasion in stochastic flow fields (chapter 5): the numerics.
 
 The flow field (:mod:`.field`), forward reachability by level sets on a grid (:mod:`.grid`,
-:mod:`.upwind`, :mod:`.tvd_rk`, :mod:`.hamiltonian`, :mod:`.levelset`, :mod:`.capture`) and by
-extremal shooting (:mod:`.extremals`), the nominal trajectories (:mod:`.nominal`), their
-linearization and zero-order hold (:mod:`.linearize`), the covariance game (:mod:`.covariance_game`),
-the capture probability (:mod:`.capture_probability`) and the Monte Carlo of the SDE
-(:mod:`.simulation`). No solver is imported here.
+:mod:`.upwind`, :mod:`.tvd_rk`, :mod:`.hamiltonian`, :mod:`.band`, :mod:`.scratch`,
+:mod:`.levelset`, :mod:`.capture`) and by extremal shooting (:mod:`.extremals`), the nominal
+trajectories (:mod:`.nominal`), their linearization and zero-order hold (:mod:`.linearize`), the
+covariance game (:mod:`.covariance_game`), the capture probability (:mod:`.capture_probability`)
+and the Monte Carlo of the SDE (:mod:`.simulation`). No solver is imported here.
 """

@@ -15,13 +15,18 @@ from dataclasses import dataclass
 import contourpy
 import numpy as np
 
+from gamespec.flowfield.band import band_window
 from gamespec.flowfield.grid import Grid
 
 
 def contours(grid: Grid, phi: np.ndarray, level: float = 0.0) -> list[np.ndarray]:
-    """The ``level`` contours of node values ``phi`` (nx, ny), each an array (M, 2) of points."""
-    x, y = np.meshgrid(*grid.axes, indexing="ij")
-    generator = contourpy.contour_generator(x, y, phi, line_type=contourpy.LineType.Separate)
+    """The ``level`` contours of node values ``phi`` (nx, ny), each an array (M, 2) of points, traced
+    on the rectangle of cells that holds the nodes below ``level`` (every cell the contour crosses)."""
+    window = band_window(phi, level, 1)
+    if window is None:
+        return []
+    x, y = (axis[w] for axis, w in zip(grid.axes, window, strict=True))
+    generator = contourpy.contour_generator(x, y, phi[window].T, line_type=contourpy.LineType.Separate)
     return [line for line in generator.lines(level) if len(line) > 1]
 
 
@@ -29,15 +34,20 @@ def refined_peak(values: np.ndarray, points: np.ndarray, k: int) -> tuple[float,
     """The parabola through samples k−1, k, k+1 of a front (by arc length): its peak value and point."""
     if k == 0 or k == len(values) - 1:
         return float(values[k]), points[k]
-    s = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(points[k - 1 : k + 2], axis=0), axis=1))])
-    c2, c1, c0 = np.polyfit(s, values[k - 1 : k + 2], 2)
+    h1, h2 = np.linalg.norm(np.diff(points[k - 1 : k + 2], axis=0), axis=1)
+    y0, y1, y2 = (float(v) for v in values[k - 1 : k + 2])
+    if h1 <= 0 or h2 <= 0:
+        return float(values[k]), points[k]
+    slope = (y1 - y0) / h1  # Newton's divided differences at s = 0, h1, h1 + h2
+    c2 = ((y2 - y1) / h2 - slope) / (h1 + h2)
     if c2 >= 0:
         return float(values[k]), points[k]
-    peak = float(np.clip(-c1 / (2 * c2), s[0], s[2]))
-    segment = 0 if peak <= s[1] else 1
-    w = (peak - s[segment]) / max(s[segment + 1] - s[segment], 1e-300)
+    c1 = slope - c2 * h1
+    peak = float(np.clip(-c1 / (2 * c2), 0.0, h1 + h2))
+    segment, start, length = (0, 0.0, h1) if peak <= h1 else (1, h1, h2)
+    w = (peak - start) / length
     point = (1 - w) * points[k - 1 + segment] + w * points[k + segment]
-    return float(np.polyval([c2, c1, c0], peak)), point
+    return y0 + (c1 + c2 * peak) * peak, point
 
 
 @dataclass(frozen=True)

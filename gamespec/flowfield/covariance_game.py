@@ -16,6 +16,13 @@ Payoffs (another ambiguity): eq. 5.17 is ``‖Σʳ‖²_F = ‖G Gᵀ‖²_F`` (
 which claims to rewrite it, is ``tr(Δᵀ Δ Σˣ) = tr Σʳ = ‖G‖²_F`` (``"trace"``); the two are not
 equal. Both are offered; both are convex in the gains, so the pursuer's step is convex and the
 evader's maximizes a convex function.
+
+Feedforward: ``J`` does not depend on ``V``, but the capture probability (eq. 5.39) does, through the
+mean. With ``"free"`` each player's ``V`` ranges over eq. 5.35; nothing in ``J`` keeps it on ``Û``,
+and a player moves it to free speed for its gains (eq. 5.36), shifting the mean relative position
+by up to ``δ_xᵖ + δ_xᵉ``. With ``"nominal"``, ``V = Û`` (section 5.3: "the mean trajectory is
+assumed to be essentially driven by … the nominal control inputs"): the means stay on the nominal
+paths, open and closed loop share them, and the feedback alone is compared.
 """
 
 from __future__ import annotations
@@ -29,6 +36,7 @@ import numpy as np
 from gamespec.flowfield.linearize import LiftedModel
 
 Payoff = Literal["trace", "frobenius"]
+Feedforward = Literal["free", "nominal"]
 PLAYERS = ("pursuer", "evader")
 
 
@@ -64,6 +72,7 @@ class CovarianceGame:
     U_hat: np.ndarray
     bounds: tuple[PlayerBounds, PlayerBounds]
     payoff: Payoff = "trace"
+    feedforward: Feedforward = "free"
 
     @property
     def N(self) -> int:
@@ -89,10 +98,15 @@ class CovarianceGame:
         """``𝒟_y`` per step, (N, 4, 4N): ``y_k = noise_rows[k] W``."""
         return self.model.D_y.reshape(self.N, 4, -1)
 
+    @cached_property
+    def control_map(self) -> np.ndarray:
+        """``Δ ℬ`` as (2N, N, 4): the relative positions' response to each step's controls."""
+        return (self.delta @ self.model.B).reshape(2 * self.N, self.N, 4)
+
     def gain_map(self, player: int) -> np.ndarray:
         """``Tⁱ`` with ``vec G = g₀ + Tᵖ vec κᵖ + Tᵉ vec κᵉ``: (2N·4N, N·8)."""
         N = self.N
-        DB = (self.delta @ self.model.B).reshape(2 * N, N, 2, 2)[:, :, player, :]
+        DB = self.control_map.reshape(2 * N, N, 2, 2)[:, :, player, :]
         T = np.einsum("rka,kbc->rckab", DB, self.noise_rows)
         return np.ascontiguousarray(T.reshape(2 * N * 4 * N, N * 8))
 
@@ -101,9 +115,10 @@ class CovarianceGame:
         return self.gain_map(0), self.gain_map(1)
 
     def factor(self, strategies: tuple[Strategy, Strategy]) -> np.ndarray:
-        """``G`` (2N × 4N) with ``Σʳ = G Gᵀ``."""
-        g = self.g0 + sum(T @ s.kappa.reshape(-1) for T, s in zip(self.gain_maps, strategies, strict=True))
-        return g.reshape(2 * self.N, -1)
+        """``G = Δ𝒟 + Δℬ K 𝒟_y`` (2N × 4N) with ``Σʳ = G Gᵀ``, step by step (``K`` block-diagonal)."""
+        K = np.concatenate([s.kappa for s in strategies], axis=1)
+        gained = np.einsum("kab,kbc->kac", K, self.noise_rows)
+        return self.g0.reshape(2 * self.N, -1) + np.einsum("rka,kac->rc", self.control_map, gained)
 
     def value(self, strategies: tuple[Strategy, Strategy]) -> float:
         """The payoff ``J`` (eq. 5.34 ``"trace"`` or eq. 5.17 ``"frobenius"``)."""
@@ -116,7 +131,8 @@ class CovarianceGame:
         """``∂J/∂κⁱ`` as (N, 2, 4)."""
         G = self.factor(strategies)
         dG = 2 * G if self.payoff == "trace" else 4 * (G @ G.T) @ G
-        return (self.gain_maps[player].T @ dG.reshape(-1)).reshape(self.N, 2, 4)
+        rows = self.control_map[:, :, 2 * player : 2 * player + 2]
+        return np.einsum("rka,rc,kbc->kab", rows, dG, self.noise_rows, optimize=True)
 
     def nominal(self) -> tuple[Strategy, Strategy]:
         """Open loop: ``V = Û``, ``K = 0``."""

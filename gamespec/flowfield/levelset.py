@@ -2,8 +2,9 @@
 
 ``φ_t + v̂|∇φ| + ∇φ·f = 0`` from ``φ(x, 0) = |x − x₀|`` (eq. 5.22), upwind in space
 (:mod:`~gamespec.flowfield.upwind`), local Lax–Friedrichs (:mod:`~gamespec.flowfield.hamiltonian`),
-TVD-RK3 in time with CFL-limited steps (:mod:`~gamespec.flowfield.tvd_rk`); both agents are advanced
-together as one array (2, nx, ny).
+TVD-RK3 in time with CFL-limited steps (:mod:`~gamespec.flowfield.tvd_rk`); φ of both agents is one
+array (2, nx, ny), each advanced in place on its own rectangle of nodes (the whole grid, or in the
+capture search the box of :mod:`~gamespec.flowfield.band` around the levels read).
 
 The initial zero level set is a single point, and the viscosity solution from the cone is flat
 inside the set: in still air ``φ(x, t) = max(|x − x₀| − v̂t, 0)`` (Hopf–Lax), so the zero level set
@@ -22,14 +23,24 @@ extrapolated linearly to ``c = 0``; ``T(c₂) − T(c₁)`` is reported as the m
 from __future__ import annotations
 
 from dataclasses import dataclass
+from functools import cached_property
 
 import numpy as np
 
+from gamespec.flowfield.band import Window, band_window
 from gamespec.flowfield.capture import first_zero, margin
 from gamespec.flowfield.grid import Grid
 from gamespec.flowfield.hamiltonian import FlowHamiltonian
+from gamespec.flowfield.scratch import Scratch
 from gamespec.flowfield.tvd_rk import tvd_rk3_step
-from gamespec.flowfield.upwind import derivatives
+from gamespec.flowfield.upwind import GHOSTS, extrapolate_ghosts, upwind_pair
+
+BAND_CELLS = 15.0
+"""How far above the highest level read the band of exact values reaches, in cells: with the
+margin, far enough that T̂ and x_f move by less than 1e-3 of their grid error on the chapter-5 fields
+(on the Hugo field at 101² and 201² nodes, by at most 6e-8 in T̂ and 1e-5 in x_f)."""
+BAND_MARGIN = GHOSTS + 2
+"""Nodes added on each side of the band's bounding box (the stencil and a front's move in a step)."""
 
 
 def initial_cones(grid: Grid, origins: np.ndarray) -> np.ndarray:
@@ -37,9 +48,25 @@ def initial_cones(grid: Grid, origins: np.ndarray) -> np.ndarray:
     return np.linalg.norm(grid.points[None] - np.asarray(origins)[:, None, None, :], axis=-1)
 
 
+class _Buffers:
+    """The padded state and stage arrays (nx + 6, ny + 6) of one agent at a time, and the scratch
+    of the spatial operator."""
+
+    def __init__(self, shape: tuple[int, int]) -> None:
+        padded = (shape[0] + 2 * GHOSTS, shape[1] + 2 * GHOSTS)
+        self.stages = tuple(np.zeros(padded) for _ in range(3))
+        self.scratch = Scratch(padded[0] * padded[1])
+
+
 @dataclass(frozen=True)
 class LevelSetSolver:
-    """The spatial operator ``−Ĥ(x, D⁻φ, D⁺φ)`` and its TVD-RK3 step on one grid."""
+    """The spatial operator ``−Ĥ(x, D⁻φ, D⁺φ)`` and its TVD-RK3 step on one grid.
+
+    A step advances each agent's φ on one rectangle of nodes, in place in padded buffers, with
+    ghost nodes extrapolated linearly from the rectangle: the whole grid, or with ``band`` the box
+    of :func:`~gamespec.flowfield.band.band_window` around the nodes below ``band``; the ring of
+    ghosts is written back (the nodes next to the box start from it when the box grows) and the
+    values further out are left as they were, above the band."""
 
     grid: Grid
     hamiltonian: FlowHamiltonian
@@ -51,21 +78,66 @@ class LevelSetSolver:
         """The CFL-limited step."""
         return self.hamiltonian.max_step(self.grid.spacing, self.cfl)
 
-    def rate(self, phi: np.ndarray) -> np.ndarray:
-        """``φ_t = −Ĥ`` for φ of shape (agents, nx, ny)."""
-        dx, dy = self.grid.spacing
-        mx, px = derivatives(phi, 1, dx, self.scheme)
-        my, py = derivatives(phi, 2, dy, self.scheme)
-        return -self.hamiltonian.numerical((mx, my), (px, py))
+    @cached_property
+    def _buffers(self) -> _Buffers:
+        return _Buffers(self.grid.shape)
 
-    def step(self, phi: np.ndarray, dt: float) -> np.ndarray:
-        return tvd_rk3_step(phi, dt, self.rate)
+    def _rate(self, agent: int, padded: np.ndarray, window: Window) -> np.ndarray:
+        """``φ_t = −Ĥ`` of ``agent`` on the nodes ``window`` of a padded array (a scratch array)."""
+        g, (dx, dy), scratch = GHOSTS, self.grid.spacing, self._buffers.scratch
+        rows, cols = window
+        mx, px = upwind_pair(
+            padded[rows.start : rows.stop + 2 * g, cols.start + g : cols.stop + g],
+            0,
+            dx,
+            self.scheme,
+            scratch,
+        )
+        my, py = upwind_pair(
+            padded[rows.start + g : rows.stop + g, cols.start : cols.stop + 2 * g],
+            1,
+            dy,
+            self.scheme,
+            scratch,
+        )
+        size = (rows.stop - rows.start, cols.stop - cols.start)
+        out = (scratch.take("hamiltonian", *size), scratch.take("work", *size))
+        h = self.hamiltonian.numerical(agent, window, (mx, my), (px, py), out)
+        return np.negative(h, out=h)
 
-    def propagate(self, phi: np.ndarray, duration: float) -> np.ndarray:
+    def _advance(self, agent: int, values: np.ndarray, dt: float, band: float | None) -> np.ndarray:
+        g = GHOSTS
+        window = (slice(0, values.shape[0]), slice(0, values.shape[1]))
+        if band is not None:
+            window = band_window(values, band, BAND_MARGIN)
+            if window is None:
+                return values
+        rows, cols = window
+        halo = (slice(rows.start, rows.stop + 2 * g), slice(cols.start, cols.stop + 2 * g))
+        nodes = (slice(rows.start + g, rows.stop + g), slice(cols.start + g, cols.stop + g))
+        stages = self._buffers.stages
+        stages[0][g:-g, g:-g] = values
+
+        def rate(stage: int) -> np.ndarray:
+            extrapolate_ghosts(stages[stage][halo])
+            return self._rate(agent, stages[stage], window)
+
+        tvd_rk3_step(stages[0][nodes], stages[1][nodes], stages[2][nodes], dt, rate)
+        extrapolate_ghosts(stages[0][halo])
+        return stages[0][g:-g, g:-g]
+
+    def step(self, phi: np.ndarray, dt: float, band: float | None = None) -> np.ndarray:
+        """φ (agents, nx, ny) after one step ``dt``; with ``band``, exact only at and below it."""
+        out = np.empty(np.shape(phi))
+        for agent, values in enumerate(np.asarray(phi, dtype=float)):
+            out[agent] = self._advance(agent, values, dt, band)
+        return out
+
+    def propagate(self, phi: np.ndarray, duration: float, band: float | None = None) -> np.ndarray:
         """φ after ``duration``, in equal CFL-limited steps."""
         count = max(1, int(np.ceil(duration / self.max_step)))
         for _ in range(count):
-            phi = self.step(phi, duration / count)
+            phi = self.step(phi, duration / count, band)
         return phi
 
 
@@ -75,8 +147,8 @@ class LevelSetReach:
     the front left the grid) at the upper level and ``capture_point`` extrapolated to level 0, the
     capture time and point of each level read (``level_times``, ``level_points``), the margin
     history ``m(t)`` of the upper level (section 5.2), the snapshots of φ (``snapshot_times``,
-    (S, 2, nx, ny)) ending with φ at the capture time, and a ``message`` saying why no capture was
-    found."""
+    (S, 2, nx, ny), capped at the ``band`` level above which φ was not kept exact) ending with φ at
+    the capture time, and a ``message`` saying why no capture was found."""
 
     grid: Grid
     levels: np.ndarray
@@ -90,6 +162,7 @@ class LevelSetReach:
     level_points: np.ndarray | None = None
     message: str = ""
     steps: int = 0
+    band: float = np.inf
 
 
 def _touches_boundary(phi: np.ndarray, level: float) -> bool:
@@ -137,31 +210,36 @@ def capture_by_level_sets(
     *,
     level_cells: tuple[float, float] = (2.0, 4.0),
     snapshot_interval: float = 0.02,
+    banded: bool = True,
 ) -> LevelSetReach:
     """Advance both sets until the margins of both levels have vanished (capture, Theorem 6), a
     set reaches the box's edge or ``t_max`` passes; then re-advance from the last snapshot to land
-    exactly on ``T̂``."""
+    exactly on ``T̂``. ``banded``: update only the box around the nodes below :data:`BAND_CELLS`
+    cells above the upper level (:mod:`~gamespec.flowfield.band`), else the whole grid."""
     grid = solver.grid
     levels = np.asarray(level_cells, dtype=float) * grid.spacing.max()
+    band = float(levels.max() + BAND_CELLS * grid.spacing.max()) if banded else np.inf
+    step_band = band if banded else None
     watches = [_LevelWatch(c) for c in levels]
     phi = initial_cones(grid, origins)
     t_read = float(levels.max() / np.min(solver.hamiltonian.speeds))
     dt = solver.max_step
-    snap_t, snaps = [0.0], [phi.astype(np.float32)]
+    snap_t, snaps = [0.0], [np.minimum(phi, band, dtype=np.float32)]
     t, steps = 0.0, 0
     message = f"no capture before t_max = {t_max:g}"
     while t < t_max and any(w.crossing is None for w in watches):
-        phi = solver.step(phi, dt)
+        phi = solver.step(phi, dt, step_band)
         t, steps = t + dt, steps + 1
         if _touches_boundary(phi, levels.max()):
             message = f"a reachable set reached the grid's edge at t = {t:.4g}: enlarge the domain"
             break
+        exact = np.minimum(phi, band)
         if t - snap_t[-1] >= snapshot_interval - 1e-12:
             snap_t.append(t)
-            snaps.append(phi.astype(np.float32))
+            snaps.append(exact.astype(np.float32))
         if t >= t_read:
             for watch in watches:
-                watch.observe(grid, phi, t)
+                watch.observe(grid, exact, t)
     upper = watches[1]
     history = {"times": np.array(upper.times), "margins": np.array(upper.margins)}
     if any(w.crossing is None for w in watches):
@@ -173,13 +251,14 @@ def capture_by_level_sets(
             snapshots=np.stack(snaps),
             message=message,
             steps=steps,
+            band=band,
         )
     level_times = np.array([w.crossing[0] for w in watches])
     level_points = np.array([w.crossing[1] for w in watches])
     capture_time = float(level_times[1])
     keep = int(np.searchsorted(snap_t, capture_time, side="right"))
     snap_t, snaps = snap_t[:keep], snaps[:keep]
-    final = solver.propagate(snaps[-1].astype(float), capture_time - snap_t[-1])
+    final = np.minimum(solver.propagate(snaps[-1].astype(float), capture_time - snap_t[-1], step_band), band)
     return LevelSetReach(
         grid,
         levels,
@@ -191,4 +270,5 @@ def capture_by_level_sets(
         level_times=level_times,
         level_points=level_points,
         steps=steps,
+        band=band,
     )

@@ -4,16 +4,19 @@ blue the evader as in the thesis:
 - ``reachable_sets.png``: both reachable sets at ``T̂`` (the upper level read, or the extremal
   fronts) with the nominal paths and the capture point (Figs. 5.1, 5.4(a));
 - ``dispersion.png``: closed-loop Monte Carlo paths of both agents (Figs. 5.3, 5.4(b));
-- ``capture_probability.png``: eq. 5.39 per step, open and closed loop.
+- ``capture_probability.png``: eq. 5.39 per step, open loop, closed loop, and the pursuer's
+  feedback against the open-loop evader.
 
-:func:`plot_noise_study` draws the capture probability at ``T̂`` against the noise level for a
-list of Results (Fig. 5.2).
+:func:`plot_capture_sweep` draws the capture probability at ``T̂`` against a swept parameter (the
+noise level α: Fig. 5.2) from the points of a ``gamespec sweep`` folder (``gamespec plot DIR``) or
+from Results' metrics.
 """
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Iterable, Mapping, Sequence
 from pathlib import Path
+from typing import Any
 
 import matplotlib
 
@@ -26,6 +29,9 @@ from gamespec.plotting import LEGEND_RIGHT, headline
 from gamespec.result import Result
 
 COLORS = ("tab:red", "tab:blue")
+LOOPS = (("open_loop", "o"), ("closed_loop", "s"), ("pursuer_feedback", "^"))
+"""Eq. 5.39 in open loop, at the game's solution, and with the pursuer's feedback against the
+open-loop evader."""
 
 
 def _level(result: Result) -> str:
@@ -64,8 +70,10 @@ def _dispersion(ax: Axes, result: Result) -> None:
 
 def _probability(ax: Axes, result: Result) -> None:
     t = result.time[1:]
-    ax.plot(t, result.arrays["capture_probability_open_loop"], "o-", label="open loop")
-    ax.plot(t, result.arrays["capture_probability_closed_loop"], "s-", label="closed loop")
+    for loop, marker in LOOPS:
+        if f"capture_probability_{loop}" in result.arrays:
+            label = loop.replace("_", " ")
+            ax.plot(t, result.arrays[f"capture_probability_{loop}"], marker + "-", label=label)
     ax.set_xlabel("t")
     ax.set_ylabel("capture probability (eq. 5.39)")
 
@@ -94,14 +102,23 @@ def plot(result: Result, output_dir: Path, *, animate: bool = False) -> list[Pat
     return written
 
 
-def plot_noise_study(results: Sequence[Result], parameter: str, path: Path) -> Path:
-    """Capture probability at ``T̂`` against ``parameter``, open vs closed loop, eq. 5.39 and the
-    Monte Carlo with its interval (Fig. 5.2)."""
-    x = np.array([r.parameters[parameter] for r in results])
+def capture_rows(values: Iterable[Mapping[str, Any]]) -> list[Mapping[str, Any]]:
+    """The points of a sweep (its saved values) that carry a flow-field game's capture probabilities."""
+    return [v for v in values if "capture_probability_open_loop" in v.get("metrics", {})]
+
+
+def plot_capture_sweep(points: Sequence[tuple[float, Mapping[str, Any]]], parameter: str, path: Path) -> Path:
+    """Capture probability at ``T̂`` against ``parameter`` — ``points`` are (value, metrics) — open
+    loop, closed loop and the pursuer's feedback against a passive evader, eq. 5.39 and the Monte
+    Carlo with its interval (Fig. 5.2)."""
+    points = sorted(points, key=lambda p: p[0])
+    x = np.array([value for value, _ in points])
     fig, ax = plt.subplots(figsize=(6, 4))
-    for loop, marker in (("open_loop", "o"), ("closed_loop", "s")):
-        ax.plot(x, [r.metrics[f"capture_probability_{loop}"] for r in results], marker + "-", label=loop)
-        carlo = [r.metrics.get("monte_carlo_capture_probability", {}).get(loop) for r in results]
+    for loop, marker in LOOPS:
+        if not all(f"capture_probability_{loop}" in m for _, m in points):
+            continue
+        ax.plot(x, [m[f"capture_probability_{loop}"] for _, m in points], marker + "-", label=loop)
+        carlo = [m.get("monte_carlo_capture_probability", {}).get(loop) for _, m in points]
         if all(carlo):
             est = np.array([c["estimate"] for c in carlo])
             err = np.array([[c["estimate"] - c["low"], c["high"] - c["estimate"]] for c in carlo]).T

@@ -37,6 +37,10 @@ RK4_STEPS = 16
 CHATTERING_SWINGS = 10.0
 """A control that sweeps its range more often than this (total variation over the range it spans)
 chatters: a bang-bang or bang-singular profile sweeps it a few times, on every mesh."""
+CONSTANT_SPAN = 1e-6
+"""A control whose range is below this fraction of ``max(1, max |u|)`` is constant: an interior-point
+solver leaves a control that sits on a bound about its tolerance inside it, and the noise of that
+must not read as sweeps."""
 
 
 @dataclass(frozen=True)
@@ -64,12 +68,13 @@ def _values(tr: Transcription, x, u, w, t, params) -> dict:
     return values | {symbol(k): v for k, v in params.items()} | {ocp.t: t}
 
 
-def control_basis(tr: Transcription, s: np.ndarray) -> np.ndarray:
-    """Weights (len(s) × points) interpolating an interval's controls at local times ``s``."""
+def control_basis(tr: Transcription, s: np.ndarray, degree: int | None = None) -> np.ndarray:
+    """Weights (len(s) × points) interpolating the controls of an interval of ``degree`` (the
+    first interval's when None) at local times ``s``."""
     grid = tr.grid
     if grid.scheme == "trapezoidal":
         return np.stack([1.0 - s, s], axis=1)
-    pts = grid.local_points[1:]
+    pts = grid.local_points(int(grid.interval_degrees[0]) if degree is None else degree)[1:]
     basis = np.ones((len(s), len(pts)))
     for r, pr in enumerate(pts):
         for q, pq in enumerate(pts):
@@ -78,38 +83,55 @@ def control_basis(tr: Transcription, s: np.ndarray) -> np.ndarray:
     return basis
 
 
-def _per_interval(tr: Transcription, V: np.ndarray) -> np.ndarray:
-    """Values at the evaluation points (rows × n_eval) as (rows, intervals, points of one interval)."""
+def _per_interval(tr: Transcription, V: np.ndarray, chosen: np.ndarray) -> np.ndarray:
+    """Values at the evaluation points (rows × n_eval) of the ``chosen`` intervals, all of one
+    degree d, as (rows, chosen intervals, d points)."""
     grid = tr.grid
     if grid.scheme == "radau":
-        return V.reshape(V.shape[0], grid.intervals, grid.points_per_interval)
-    return np.stack([V[:, :-1], V[:, 1:]], axis=2)
+        first = grid.interval_start_index[chosen]
+        d = int(grid.interval_degrees[chosen[0]])
+        return V[:, first[:, None] + np.arange(d)[None, :]]
+    return np.stack([V[:, chosen], V[:, chosen + 1]], axis=2)
 
 
 def interval_defects(tr: Transcription, sol: Trajectory, params: Mapping[str, float]) -> np.ndarray:
     """Per state and interval (n_x × intervals), the gap between an RK4 re-integration of the
-    interval from its first node and the collocated state at its end."""
+    interval from its first node and the collocated state at its end (the intervals of each degree
+    together)."""
+    grid = tr.grid
+    gaps = np.empty((tr.n_x, grid.intervals))
+    for degree in np.unique(grid.interval_degrees):
+        chosen = np.flatnonzero(grid.interval_degrees == degree)
+        gaps[:, chosen] = _rk4_gaps(tr, sol, params, chosen, int(degree))
+    return gaps
+
+
+def _rk4_gaps(
+    tr: Transcription, sol: Trajectory, params: Mapping[str, float], chosen: np.ndarray, degree: int
+) -> np.ndarray:
     X, T = sol.X, sol.T
     grid = tr.grid
     starts = grid.interval_start_index
-    h = np.diff(grid.breaks) * T
-    t0 = tr.t0 + T * grid.breaks[:-1]
-    Ui, Wi = _per_interval(tr, sol.U), _per_interval(tr, sol.Win)
-    x = X[:, starts[:-1]].astype(float)
+    h = np.diff(grid.breaks)[chosen] * T
+    t0 = tr.t0 + T * grid.breaks[chosen]
+    Ui, Wi = _per_interval(tr, sol.U, chosen), _per_interval(tr, sol.Win, chosen)
+    x = X[:, starts[chosen]].astype(float)
     ds = 1.0 / RK4_STEPS
+    halves = np.arange(2 * RK4_STEPS + 1) * ds / 2
+    bases = control_basis(tr, halves, degree)
 
-    def f(x: np.ndarray, s: float) -> np.ndarray:
-        basis = control_basis(tr, np.array([s]))[0]
-        return _running(tr, x, Ui @ basis, Wi @ basis, t0 + s * h, params)[:-1]
+    def f(x: np.ndarray, half: int) -> np.ndarray:
+        """The dynamics at local time ``half * ds / 2``."""
+        basis = bases[half]
+        return _running(tr, x, Ui @ basis, Wi @ basis, t0 + halves[half] * h, params)[:-1]
 
     for step in range(RK4_STEPS):
-        s = step * ds
-        k1 = f(x, s)
-        k2 = f(x + 0.5 * ds * h * k1, s + ds / 2)
-        k3 = f(x + 0.5 * ds * h * k2, s + ds / 2)
-        k4 = f(x + ds * h * k3, s + ds)
+        k1 = f(x, 2 * step)
+        k2 = f(x + 0.5 * ds * h * k1, 2 * step + 1)
+        k3 = f(x + 0.5 * ds * h * k2, 2 * step + 1)
+        k4 = f(x + ds * h * k3, 2 * step + 2)
         x = x + ds * h / 6.0 * (k1 + 2 * k2 + 2 * k3 + k4)
-    return np.abs(x - X[:, starts[1:]])
+    return np.abs(x - X[:, starts[chosen + 1]])
 
 
 def state_scale(X: np.ndarray) -> np.ndarray:
@@ -143,12 +165,14 @@ def verdicts(checks: Mapping[str, float | None], defect_tolerance: float | None)
 
 def control_swings(U: np.ndarray) -> np.ndarray:
     """Per control, its total variation ``sum_k |u_{k+1} - u_k|`` over the evaluation points divided
-    by the range it spans (0 for a constant control): how many times it sweeps that range."""
+    by the range it spans (0 for a constant control, one that spans less than
+    :data:`CONSTANT_SPAN` of its magnitude): how many times it sweeps that range."""
     if U.shape[1] < 2:
         return np.zeros(U.shape[0])
     variation = np.sum(np.abs(np.diff(U, axis=1)), axis=1)
     span = np.ptp(U, axis=1)
-    return np.where(span > 0, variation / np.where(span > 0, span, 1.0), 0.0)
+    moving = span > CONSTANT_SPAN * np.maximum(1.0, np.max(np.abs(U), axis=1))
+    return np.where(moving, variation / np.where(moving, span, 1.0), 0.0)
 
 
 def _violation(values: np.ndarray, lower: np.ndarray | float, upper: np.ndarray | float) -> float:
@@ -176,9 +200,9 @@ def max_constraint_violation(tr: Transcription, sol: Trajectory, params: Mapping
     ends = _end_values(tr, X, U, T, params)
     worst += [_relation_violation(r, ends, ()) for r in tr.ocp.boundary]
     q = tr.grid.triplets[2]
-    for r in tr.ocp.integrals:
+    for r, (lo, hi) in zip(tr.ocp.integrals, tr.ocp.integral_bounds(params), strict=True):
         g = np.broadcast_to(np.asarray(translate(r.expr, running, NUMPY), dtype=float), t_eval.shape)
-        worst.append(_violation(np.array([T * q @ g]), r.lower, r.upper))
+        worst.append(_violation(np.array([T * q @ g]), lo, hi))
     return float(np.max(worst))
 
 

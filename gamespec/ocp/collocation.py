@@ -14,7 +14,7 @@ collocation points. Trapezoidal: controls at the nodes. The Lagrange term is ``T
 from __future__ import annotations
 
 from dataclasses import dataclass
-from functools import cached_property
+from functools import cache, cached_property
 from typing import TYPE_CHECKING
 
 import numpy as np
@@ -27,16 +27,21 @@ Triplets = tuple[np.ndarray, np.ndarray, np.ndarray, tuple[int, int]]
 """A sparse matrix as ``(rows, cols, values, shape)``."""
 
 
+@cache
 def radau_points(degree: int) -> np.ndarray:
-    """The ``degree`` Legendre–Gauss–Radau points on (0, 1], the last at 1 (flipped LGR roots)."""
+    """The ``degree`` Legendre–Gauss–Radau points on (0, 1], the last at 1 (flipped LGR roots;
+    read-only, shared)."""
     if degree == 1:
-        return np.array([1.0])
-    # Roots of P_{d-1}(x) + P_d(x) on [-1, 1) include -1; flipping puts the fixed point at +1.
-    coeffs = np.zeros(degree + 1)
-    coeffs[degree - 1] = 1.0
-    coeffs[degree] = 1.0
-    roots = np.sort(legendre.legroots(coeffs))
-    return np.sort((1.0 - roots[::-1]) / 2.0)
+        points = np.array([1.0])
+    else:
+        # Roots of P_{d-1}(x) + P_d(x) on [-1, 1) include -1; flipping puts the fixed point at +1.
+        coeffs = np.zeros(degree + 1)
+        coeffs[degree - 1] = 1.0
+        coeffs[degree] = 1.0
+        roots = np.sort(legendre.legroots(coeffs))
+        points = np.sort((1.0 - roots[::-1]) / 2.0)
+    points.flags.writeable = False
+    return points
 
 
 def lagrange_matrices(nodes: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -54,15 +59,38 @@ def lagrange_matrices(nodes: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     return deriv, weights
 
 
+@cache
+def _radau_weights(degree: int) -> np.ndarray:
+    return lagrange_matrices(radau_points(degree))[1]
+
+
+@cache
+def _radau_block(degree: int) -> np.ndarray:
+    """``d × (d + 1)``: the derivative at each collocation point of the interpolant through the
+    interval's start and its d collocation points (local time)."""
+    return lagrange_matrices(np.concatenate([[0.0], radau_points(degree)]))[0][:, 1:].T
+
+
 @dataclass(frozen=True)
 class Grid:
-    """A collocation grid on normalized time [0, 1]."""
+    """A collocation grid on normalized time [0, 1]; Radau intervals of ``degree``, or of the
+    per-interval ``degrees`` when given (from p-refinement)."""
 
     scheme: str
     intervals: int
     degree: int
     grading: float = 1.0
     mesh: tuple[float, ...] | None = None
+    degrees: tuple[int, ...] | None = None
+
+    @cached_property
+    def interval_degrees(self) -> np.ndarray:
+        """The number of collocation points of each interval (1 per interval, trapezoidal)."""
+        if self.scheme != "radau":
+            return np.ones(self.intervals, dtype=int)
+        if self.degrees is not None:
+            return np.asarray(self.degrees, dtype=int)
+        return np.full(self.intervals, self.degree, dtype=int)
 
     @cached_property
     def breaks(self) -> np.ndarray:
@@ -79,25 +107,28 @@ class Grid:
 
     @property
     def points_per_interval(self) -> int:
+        """The points of every interval of a grid of one degree."""
         return self.degree if self.scheme == "radau" else 1
 
-    @cached_property
-    def local_points(self) -> np.ndarray:
-        """The nodes of one interval in local coordinates [0, 1], the start included."""
+    def local_points(self, degree: int) -> np.ndarray:
+        """The nodes of an interval of ``degree`` in local coordinates [0, 1], the start included."""
         if self.scheme == "radau":
-            return np.concatenate([[0.0], radau_points(self.degree)])
+            return np.concatenate([[0.0], radau_points(degree)])
         return np.array([0.0, 1.0])
 
     @cached_property
     def nodes(self) -> np.ndarray:
-        """All state nodes in tau (``intervals * points_per_interval + 1`` of them)."""
+        """All state nodes in tau (``sum of the interval degrees + 1`` of them)."""
         h = np.diff(self.breaks)
-        inner = self.breaks[:-1, None] + h[:, None] * self.local_points[None, 1:]
-        return np.concatenate([[0.0], inner.ravel()])
+        inner = [
+            a + dh * self.local_points(int(d))[1:]
+            for a, dh, d in zip(self.breaks[:-1], h, self.interval_degrees, strict=True)
+        ]
+        return np.concatenate([[0.0], *inner])
 
     @property
     def n_nodes(self) -> int:
-        return self.intervals * self.points_per_interval + 1
+        return int(self.interval_degrees.sum()) + 1
 
     @cached_property
     def eval_index(self) -> np.ndarray:
@@ -113,35 +144,37 @@ class Grid:
     @property
     def interval_start_index(self) -> np.ndarray:
         """Node index of each interval's start (the last entry is the final node)."""
-        return np.arange(self.intervals + 1) * self.points_per_interval
+        return np.concatenate([[0], np.cumsum(self.interval_degrees)])
 
     @cached_property
     def radau_weights(self) -> np.ndarray:
-        """Weights of the d-point Radau quadrature on [0, 1] (interpolation through the collocation
-        points alone; exact to degree 2d - 2, and 1 for d = 1, i.e. backward Euler)."""
-        return lagrange_matrices(radau_points(self.degree))[1]
+        """Per collocation point, the weight of its interval's d-point Radau quadrature on [0, 1]
+        (interpolation through the collocation points alone; exact to degree 2d - 2, and 1 for
+        d = 1, i.e. backward Euler)."""
+        return np.concatenate([_radau_weights(int(d)) for d in self.interval_degrees])
 
     @cached_property
     def triplets(self) -> tuple[Triplets, Triplets, np.ndarray]:
         """``(D, W, q)`` with ``D`` and ``W`` as ``(rows, cols, values, shape)`` (what a backend's
         own sparse matrix is built from, without SciPy) and ``q`` the Lagrange quadrature weights."""
         h = np.diff(self.breaks)
-        d = self.points_per_interval
         if self.scheme == "radau":
-            deriv, _ = lagrange_matrices(self.local_points)
-            weights = self.radau_weights
-            block = deriv[:, 1:].T
-            k, j, r = np.meshgrid(np.arange(self.intervals), np.arange(d), np.arange(d + 1), indexing="ij")
-            rows, cols, vals = (
-                (k * d + j).ravel(),
-                (k * d + r).ravel(),
-                np.broadcast_to(block, k.shape).ravel(),
-            )
-            shape = (self.intervals * d, self.n_nodes)
-            diagonal = np.arange(self.intervals * d)
-            w_triplets = (diagonal, diagonal, np.repeat(h, d), (self.intervals * d, self.intervals * d))
-            q = np.repeat(h, d) * np.tile(weights, self.intervals)
-            return (rows, cols, vals.copy(), shape), w_triplets, q
+            degrees = self.interval_degrees
+            rows, cols, vals = [], [], []
+            for k, start in enumerate(self.interval_start_index[:-1]):
+                d = int(degrees[k])
+                block = _radau_block(d)
+                for j in range(d):
+                    for r in range(d + 1):
+                        rows.append(start + j)
+                        cols.append(start + r)
+                        vals.append(block[j, r])
+            n_points = self.n_nodes - 1
+            diagonal = np.arange(n_points)
+            scale = np.repeat(h, degrees)
+            w_triplets = (diagonal, diagonal, scale, (n_points, n_points))
+            q = scale * self.radau_weights
+            return (np.array(rows), np.array(cols), np.array(vals), (n_points, self.n_nodes)), w_triplets, q
         k = np.arange(self.intervals)
         shape = (self.intervals, self.n_nodes)
         rows, cols = np.r_[k, k], np.r_[k, k + 1]
@@ -167,4 +200,4 @@ class Grid:
         """Per LGR defect row, the factor turning a defect multiplier into a costate estimate:
         ``lambda = -nu / w_j`` with w_j the Radau weight of the point, from the Lagrangian
         ``J + nu^T g`` with ``g = D X - T W F`` (defined for the Radau scheme only)."""
-        return -1.0 / np.tile(self.radau_weights, self.intervals)
+        return -1.0 / self.radau_weights

@@ -150,15 +150,17 @@ class SymbolicOcp:
 
     @cached_property
     def integrals(self) -> list[Relation]:
-        """Integral constraints: ``lower <= integral of expr dt <= upper`` (integrands not signed)."""
+        """Integral constraints: ``lower <= integral of expr dt <= upper`` (integrands not signed),
+        the bounds at the file's parameter values (:meth:`integral_bounds` for others)."""
+        bounds = self.integral_bounds(self.parameter_values())
         return [
-            Relation(
-                parse(c.integrand, self._running),
-                -math.inf if c.lower is None else c.lower,
-                math.inf if c.upper is None else c.upper,
-            )
-            for c in self.spec.problem.integral_constraints
+            Relation(parse(c.integrand, self._running), lo, hi)
+            for c, (lo, hi) in zip(self.spec.problem.integral_constraints, bounds, strict=True)
         ]
+
+    def integral_bounds(self, params: Mapping[str, float]) -> list[tuple[float, float]]:
+        """Per integral constraint ``(lower, upper)`` for these parameter values."""
+        return self._evaluated(params).integrals
 
     @cached_property
     def boundary(self) -> list[Relation]:

@@ -58,7 +58,10 @@ class Transcription:
         self.ocp = SymbolicOcp(spec)
         m = spec.method
         mesh = None if m.mesh is None else tuple(m.mesh)
-        self.grid = Grid(m.scheme, m.intervals, m.degree if m.scheme == "radau" else 1, m.grading, mesh)
+        degrees = None if m.degrees is None else tuple(m.degrees)
+        self.grid = Grid(
+            m.scheme, m.intervals, m.degree if m.scheme == "radau" else 1, m.grading, mesh, degrees
+        )
         self.t0 = spec.problem.time.initial
 
     @property
@@ -83,11 +86,15 @@ class Transcription:
 
     def input_grid(self, params: Mapping[str, float] | None = None) -> InputGrid:
         """Where grid inputs are tabulated: the evaluation points in normalized time and, for a fixed
-        horizon, in time (the Result's ``control_time``) for these parameter values."""
+        horizon, in time (the Result's ``control_time``) for these runtime parameter values."""
+        return self._input_grid_at(self.ocp.parameter_values(params))
+
+    def _input_grid_at(self, values: Mapping[str, float]) -> InputGrid:
+        """:meth:`input_grid` for every parameter's value (derived ones included)."""
         tau = self.grid.eval_tau
         if self.free_time:
             return InputGrid(tau, None)
-        _, tf, _ = self.ocp.final_time(self.ocp.parameter_values(params))
+        _, tf, _ = self.ocp.final_time(values)
         return InputGrid(tau, self.t0 + (tf - self.t0) * tau)
 
     def input_values(
@@ -104,7 +111,7 @@ class Transcription:
                 field="inputs",
                 source=self.spec.source,
             )
-        grid = self.input_grid(params)
+        grid = self._input_grid_at(params)
         rows = [
             on_grid(name, given[name], grid, self.spec.source)
             if name in given

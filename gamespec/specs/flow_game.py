@@ -4,15 +4,23 @@
 names, e.g. eq. 5.37 or eq. 5.40) and the diffusion ``g(x)`` (a 2 × 2 matrix of expressions, or
 ``{identity: s}``) — both players' starts, speed limits and the bounds of eqs. 5.35–5.36
 (``delta_x``, ``delta_u``, ``beta``), the nominal speed fraction ``v̂/v_max``, the capture radius ε,
-the step ``T̂/N`` and the payoff (``trace``: eq. 5.34; ``frobenius``: eq. 5.17). Any number may be
-an expression over ``parameters``; the flow's expressions may use the position names as well.
-``method`` sets the reachability grid and scheme, the Gauss–Seidel stopping rule (Algorithm 3), the
-evader's convex–concave procedure and the Monte Carlo.
+the step ``T̂/N``, the payoff (``trace``: eq. 5.34; ``frobenius``: eq. 5.17) and the feedforward
+(``free``: ``V`` within eq. 5.35; ``nominal``: ``V = Û``, the means on the nominal paths). Any
+number may be an expression over ``parameters``; the flow's expressions may use the position names
+as well. ``method`` sets the reachability grid and scheme, the game's iteration (``gauss_seidel``,
+Algorithm 3, or ``minimax``, the pursuer's security strategy against the evader's mixed strategy)
+and its stopping rule, the evader's convex–concave procedure and the Monte Carlo.
+
+Validation at load evaluates every entry through the symbolic layer only (SymPy and
+:func:`gamespec.symbolic.calculus.numeric_function` at a probe point) into
+:class:`FlowGameValues`; the numerics build their objects from those values
+(:func:`gamespec.flowfield.problem.evaluate`).
 """
 
 from __future__ import annotations
 
 from collections.abc import Mapping
+from dataclasses import dataclass
 from typing import Literal
 
 import numpy as np
@@ -20,11 +28,8 @@ import sympy as sp
 from pydantic import Field, FiniteFloat, model_validator
 
 from gamespec.errors import ExpressionError, SpecError
-from gamespec.flowfield.covariance_game import PlayerBounds
-from gamespec.flowfield.field import FlowField
-from gamespec.flowfield.grid import Grid
-from gamespec.flowfield.problem import FlowGameData
-from gamespec.specs.base import SpecBase, StrictModel, Value
+from gamespec.specs.base import ProblemParameters, SpecBase, StrictModel, Value
+from gamespec.symbolic.calculus import jacobian, numeric_function
 from gamespec.symbolic.language import RESERVED, parse, symbol
 
 
@@ -65,6 +70,11 @@ class FlowGameProblem(StrictModel):
     capture_radius: Value = Field(description="ε of eq. 5.4.")
     step: Value = Field(description="T̂/N of eq. 5.7; N = round(T̂/step).")
     payoff: Literal["trace", "frobenius"] = "trace"
+    feedforward: Literal["nominal", "free"] = Field(
+        "free",
+        description="free: each player's V moves within eq. 5.35; nominal: V = Û, the means stay on the "
+        "nominal paths (section 5.3: the mean is driven by the nominal controls).",
+    )
 
     @model_validator(mode="after")
     def _names(self) -> FlowGameProblem:
@@ -94,8 +104,18 @@ class GridSpec(StrictModel):
 
 
 class GameMethod(StrictModel):
-    """Stopping rule of Gauss–Seidel (Algorithm 3): ``max(‖ΔV‖, ‖ΔK‖) ≤ tolerance`` (ε_v = ε_k)."""
+    """The iteration and its stopping rule ``max(‖ΔV‖, ‖ΔK‖) ≤ tolerance`` (ε_v = ε_k): ``gauss_seidel``
+    is Algorithm 3 (it converges only to a pure saddle point, which this game need not have);
+    ``minimax`` keeps Gauss–Seidel's evader step and lets the pursuer answer every evader strategy
+    seen so far (its security strategy, the evader's answer a mixed strategy)."""
 
+    scheme: Literal["gauss_seidel", "minimax"] = "gauss_seidel"
+    gap: float = Field(
+        1e-3,
+        gt=0,
+        description="minimax: an evader answer counts as new when it raises J above the pursuer's "
+        "restricted value t by more than gap·t; the stop certifies J(p, BR_e(p)) ≤ (1 + gap) t.",
+    )
     tolerance: float = Field(5e-3, gt=0)
     max_iterations: int = Field(30, ge=1, le=1000)
 
@@ -104,7 +124,7 @@ class ConvexConcaveMethod(StrictModel):
     """The evader's convex–concave procedure: stop when ``J`` rises by less than ``tolerance · J``."""
 
     tolerance: float = Field(1e-6, gt=0)
-    max_iterations: int = Field(50, ge=1, le=1000)
+    max_iterations: int = Field(500, ge=1, le=10_000)
 
 
 class MonteCarloMethod(StrictModel):
@@ -145,8 +165,9 @@ class FlowGameMethod(StrictModel):
         return self
 
 
-class FlowGameSpec(SpecBase):
-    """Two agents in a stochastic flow field: reachability, nominal paths, covariance game (ch. 5)."""
+class FlowGameSpec(ProblemParameters, SpecBase):
+    """Two agents in a stochastic flow field: reachability, nominal paths, covariance game (ch. 5);
+    its runtime parameters are ``problem.parameters`` (``gamespec sweep --param alpha=…``)."""
 
     kind: Literal["flow_field_game"] = "flow_field_game"
     problem: FlowGameProblem
@@ -154,17 +175,54 @@ class FlowGameSpec(SpecBase):
 
     default_backend = "levelset"
 
+    @property
+    def objective_sense(self) -> str:
+        """``saddle``: the objective is the game's value, which the pursuer minimizes and the
+        evader maximizes."""
+        return "saddle"
+
     @model_validator(mode="after")
     def _evaluates(self) -> FlowGameSpec:
-        self.data()
+        self.values()
         return self
 
-    def data(self, parameters: Mapping[str, float] | None = None) -> FlowGameData:
-        """The evaluated game for the file's parameter values, updated by ``parameters``."""
+    def values(self, parameters: Mapping[str, float] | None = None) -> FlowGameValues:
+        """The evaluated game for the file's parameter values, updated by ``parameters``; the
+        numerics build their objects from it (:func:`gamespec.flowfield.problem.evaluate`)."""
         unknown = set(parameters or {}) - set(self.problem.parameters)
         if unknown:
             raise SpecError(f"unknown parameter(s) {sorted(unknown)}", field="problem.parameters")
-        return _Evaluator(self, {**self.problem.parameters, **(parameters or {})}).data()
+        return _Evaluator(self, {**self.problem.parameters, **(parameters or {})}).values()
+
+
+@dataclass(frozen=True)
+class PlayerValues:
+    """One agent's evaluated start, speed limit and bounds (eqs. 5.2, 5.35–5.36)."""
+
+    initial: tuple[float, float]
+    max_speed: float
+    delta_x: float
+    delta_u: float
+    beta: float
+
+
+@dataclass(frozen=True)
+class FlowGameValues:
+    """Every entry of a flow-field game evaluated: the drift (2 × 1) and diffusion (2 × 2) as SymPy
+    matrices of the ``position`` symbols only, numbers for the rest, and the grid's box."""
+
+    position: tuple[sp.Symbol, sp.Symbol]
+    drift: sp.Matrix
+    diffusion: sp.Matrix
+    players: tuple[PlayerValues, PlayerValues]
+    speed_fraction: float
+    capture_radius: float
+    step: float
+    payoff: str
+    feedforward: str
+    grid_lower: tuple[float, float]
+    grid_upper: tuple[float, float]
+    grid_nodes: tuple[int, int]
 
 
 class _Evaluator:
@@ -198,21 +256,21 @@ class _Evaluator:
             raise SpecError(f"{value!r} evaluates to {result.real:g}; need {need}", field=f"problem.{field}")
         return result.real
 
-    def player(self, name: str) -> tuple[np.ndarray, PlayerBounds]:
+    def player(self, name: str) -> PlayerValues:
         p: PlayerSpec = getattr(self.spec.problem, name)
-        origin = np.array([self.number(v, f"{name}.initial.{i}") for i, v in enumerate(p.initial)])
         beta = self.number(p.beta, f"{name}.beta", positive=True)
         if beta >= 1:
             raise SpecError("β must lie in (0, 1)", field=f"problem.{name}.beta")
-        bounds = PlayerBounds(
+        return PlayerValues(
+            initial=tuple(self.number(v, f"{name}.initial.{i}") for i, v in enumerate(p.initial)),
             max_speed=self.number(p.max_speed, f"{name}.max_speed", positive=True),
             delta_x=self.number(p.delta_x, f"{name}.delta_x", positive=True),
             delta_u=self.number(p.delta_u, f"{name}.delta_u", positive=True),
             beta=beta,
         )
-        return origin, bounds
 
-    def field(self) -> FlowField:
+    def flow(self) -> tuple[sp.Matrix, sp.Matrix]:
+        """Drift and diffusion, checked to evaluate (with the drift's Jacobian) at a probe point."""
         flow = self.spec.problem.flow
         drift = sp.Matrix([self.expression(v, f"flow.drift.{i}", True) for i, v in enumerate(flow.drift)])
         if isinstance(flow.diffusion, Identity):
@@ -224,40 +282,42 @@ class _Evaluator:
                     for i, row in enumerate(flow.diffusion)
                 ]
             )
-        field = FlowField(self.position, drift, diffusion)
-        probe = np.zeros((1, 2))
-        for label, evaluate in (
-            ("drift", field.drift),
-            ("diffusion", field.diffusion),
-            ("drift", field.jacobian),
+        for label, exprs in (
+            ("drift", list(drift)),
+            ("diffusion", list(diffusion)),
+            ("drift", list(jacobian(drift, self.position))),
         ):
             try:
-                evaluate(probe)
+                numeric_function(exprs, self.position)(np.zeros(1), np.zeros(1))
             except ExpressionError as err:
                 raise SpecError(str(err), field=f"problem.flow.{label}") from None
-        return field
+        return drift, diffusion
 
-    def data(self) -> FlowGameData:
+    def values(self) -> FlowGameValues:
         p, m = self.spec.problem, self.spec.method
-        (xp, bp), (xe, be) = self.player("pursuer"), self.player("evader")
+        pursuer, evader = self.player("pursuer"), self.player("evader")
         fraction = self.number(p.nominal_speed_fraction, "nominal_speed_fraction", positive=True)
         if fraction > 1:
             raise SpecError("v̂/v_max must not exceed 1 (eq. 5.24)", field="problem.nominal_speed_fraction")
-        if bp.max_speed <= be.max_speed:
+        if pursuer.max_speed <= evader.max_speed:
             raise SpecError(
                 "the pursuer must be faster than the evader (section 5.1)", field="problem.pursuer.max_speed"
             )
-        grid = Grid(m.grid.lower, m.grid.upper, m.grid.nodes)
-        origins = np.stack([xp, xe])
-        if not grid.contains(origins).all():
+        origins = np.array([pursuer.initial, evader.initial])
+        if not np.all((origins >= m.grid.lower) & (origins <= m.grid.upper)):
             raise SpecError("both starting points must lie inside the grid", field="method.grid")
-        return FlowGameData(
-            field=self.field(),
-            origins=origins,
-            bounds=(bp, be),
+        drift, diffusion = self.flow()
+        return FlowGameValues(
+            position=self.position,
+            drift=drift,
+            diffusion=diffusion,
+            players=(pursuer, evader),
             speed_fraction=fraction,
             capture_radius=self.number(p.capture_radius, "capture_radius", positive=True),
             step=self.number(p.step, "step", positive=True),
             payoff=p.payoff,
-            grid=grid,
+            feedforward=p.feedforward,
+            grid_lower=m.grid.lower,
+            grid_upper=m.grid.upper,
+            grid_nodes=m.grid.nodes,
         )

@@ -14,7 +14,7 @@ import itertools
 import math
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass
-from typing import Literal
+from typing import ClassVar, Literal
 
 from pydantic import Field, field_validator, model_validator
 
@@ -74,18 +74,18 @@ class DesignSpec(StrictModel):
 
 class IntegralConstraintSpec(StrictModel):
     """An isoperimetric constraint ``lower <= integral of integrand dt <= upper`` over the horizon
-    (the integrand is a running expression; an omitted bound is infinite)."""
+    (the integrand is a running expression; the bounds are numbers or expressions of the parameters,
+    re-evaluated when a compiled model is solved with new parameter values; an omitted bound is
+    infinite)."""
 
     integrand: Value
-    lower: Number | None = None
-    upper: Number | None = None
+    lower: Value | None = None
+    upper: Value | None = None
 
     @model_validator(mode="after")
     def _some_bound(self) -> IntegralConstraintSpec:
         if self.lower is None and self.upper is None:
             raise ValueError("an integral constraint needs lower, upper or both")
-        if self.lower is not None and self.upper is not None and self.lower > self.upper:
-            raise ValueError(f"lower {self.lower:g} exceeds upper {self.upper:g}")
         return self
 
 
@@ -98,27 +98,39 @@ class ObjectiveSpec(StrictModel):
     lagrange: Value = 0.0
 
 
-class TimeSpec(StrictModel):
+class FreeOrFixed(StrictModel):
+    """A value that is either fixed or ``free`` within ``bounds`` (numbers or expressions of the
+    parameters) from ``guess``: a final time, a phase's duration. A subclass names the field of the
+    value (``fixed_field``, free when it reads ``free``) and what it is (``what``)."""
+
+    bounds: tuple[Value, Value] | None = None
+    guess: Number | None = None
+
+    fixed_field: ClassVar[str] = ""
+    what: ClassVar[str] = ""
+
+    @property
+    def free(self) -> bool:
+        return getattr(self, self.fixed_field) == "free"
+
+    @model_validator(mode="after")
+    def _free_needs_bounds(self) -> FreeOrFixed:
+        if self.free and self.bounds is None:
+            raise ValueError(f"a free {self.what} needs bounds: [lower, upper]")
+        if not self.free and self.bounds is not None:
+            raise ValueError(f"bounds are only for a free {self.what} ({self.fixed_field}: free)")
+        return self
+
+
+class TimeSpec(FreeOrFixed):
     """Initial time, and the final time: a value, or ``free`` within ``bounds`` (numbers or
     expressions of the parameters) from ``guess``."""
 
     initial: Number = 0.0
     final: Value | Literal["free"] = 1.0
-    bounds: tuple[Value, Value] | None = None
-    guess: Number | None = None
 
-    @model_validator(mode="after")
-    def _free_needs_bounds(self) -> TimeSpec:
-        if self.final == "free":
-            if self.bounds is None:
-                raise ValueError("a free final time needs bounds: [lower, upper]")
-        elif self.bounds is not None:
-            raise ValueError("bounds are only for a free final time (final: free)")
-        return self
-
-    @property
-    def free(self) -> bool:
-        return self.final == "free"
+    fixed_field: ClassVar[str] = "final"
+    what: ClassVar[str] = "final time"
 
 
 class OcpProblem(StrictModel):
@@ -175,7 +187,11 @@ class OcpProblem(StrictModel):
         ]
         boundary = [f"{s}_{e}" for s in [*self.states, *self.controls] for e in "0f"] + ["t_f"]
         for name in names:
-            if not name.isidentifier() or name in RESERVED or name == NORMALIZED_TIME:
+            if name == NORMALIZED_TIME:
+                raise ValueError(
+                    f"{name!r} cannot be a symbol name (reserved: the normalized time of guesses and inputs)"
+                )
+            if not name.isidentifier() or name in RESERVED:
                 raise ValueError(f"{name!r} cannot be a symbol name (reserved or not an identifier)")
         clashes = {n for n in names if names.count(n) > 1} | (set(names) & set(boundary))
         if clashes:
@@ -216,18 +232,7 @@ class OcpProblem(StrictModel):
     def parameter_values(self, base: Mapping[str, float] | None = None) -> dict[str, float]:
         """Every parameter's value, in declaration order: the numeric ones from ``base`` (else the
         file), each derived one evaluated over the values before it."""
-        base = base or {}
-        values: dict[str, float] = {}
-        for name, raw in self.parameters.items():
-            if isinstance(raw, str):
-                expr = parse(raw, {n: symbol(n) for n in values})
-                value = numeric(expr, {symbol(k): v for k, v in values.items()})
-                if not math.isfinite(value):
-                    raise SpecError(f"evaluates to {value}", field=f"problem.parameters.{name}")
-                values[name] = value
-            else:
-                values[name] = float(base.get(name, raw))
-        return values
+        return parameter_values(self.parameters, base)
 
     def evaluate(self, params: Mapping[str, float]) -> EvaluatedValues:
         """Bounds, fixed end values and a fixed final time as floats for these parameter values;
@@ -277,6 +282,12 @@ class OcpProblem(StrictModel):
                     f"{guess:g} lies outside [{lo:g}, {hi:g}]", field=f"problem.design.{name}.guess"
                 )
             design.append((lo, hi, guess))
+        integrals = []
+        for i, c in enumerate(self.integral_constraints):
+            lo = number(c.lower, -INF, f"integral_constraints.{i}.lower")
+            hi = number(c.upper, INF, f"integral_constraints.{i}.upper")
+            _ordered(lo, hi, f"integral_constraints.{i}")
+            integrals.append((lo, hi))
         t_final = t_bounds = None
         if self.time.free:
             lo, hi = (number(b, 0.0, f"time.bounds.{i}") for i, b in enumerate(self.time.bounds))
@@ -287,7 +298,7 @@ class OcpProblem(StrictModel):
             t_final = number(self.time.final, 1.0, "time.final")
             if t_final <= self.time.initial:
                 raise SpecError("final time must be after the initial time", field="problem.time.final")
-        return EvaluatedValues(states, controls, t_final, t_bounds, design)
+        return EvaluatedValues(states, controls, t_final, t_bounds, design, integrals)
 
     def _check_expressions(self) -> None:
         """Parse every expression over the symbols its field may use; an input where it may not
@@ -342,10 +353,13 @@ class OcpProblem(StrictModel):
             if isinstance(bound, str):
                 checks.append((f"time.bounds.{i}", bound, params, False))
         checks += [(f"path_constraints.{i}", c, running, True) for i, c in enumerate(self.path_constraints)]
-        checks += [
-            (f"integral_constraints.{i}.integrand", c.integrand, running, False)
-            for i, c in enumerate(self.integral_constraints)
-        ]
+        for i, c in enumerate(self.integral_constraints):
+            checks.append((f"integral_constraints.{i}.integrand", c.integrand, running, False))
+            checks += [
+                (f"integral_constraints.{i}.{key}", bound, params, False)
+                for key, bound in (("lower", c.lower), ("upper", c.upper))
+                if isinstance(bound, str)
+            ]
         checks += [
             (f"boundary_constraints.{i}", c, ends, True) for i, c in enumerate(self.boundary_constraints)
         ]
@@ -362,6 +376,25 @@ class OcpProblem(StrictModel):
                     else str(err)
                 )
                 raise SpecError(reason, field=f"problem.{field}") from None
+
+
+def parameter_values(
+    parameters: Mapping[str, float | str], base: Mapping[str, float] | None = None
+) -> dict[str, float]:
+    """Every parameter's value, in declaration order: the numeric ones from ``base`` (else
+    ``parameters``), each derived one (an expression) evaluated over the values before it."""
+    base = base or {}
+    values: dict[str, float] = {}
+    for name, raw in parameters.items():
+        if isinstance(raw, str):
+            expr = parse(raw, {n: symbol(n) for n in values})
+            value = numeric(expr, {symbol(k): v for k, v in values.items()})
+            if not math.isfinite(value):
+                raise SpecError(f"evaluates to {value}", field=f"problem.parameters.{name}")
+            values[name] = value
+        else:
+            values[name] = float(base.get(name, raw))
+    return values
 
 
 def is_time_varying(raw: float | str | None) -> bool:
@@ -407,14 +440,15 @@ def _inputs_in(read: Callable, text: str, symbols: dict, inputs: dict) -> list[s
 @dataclass(frozen=True)
 class EvaluatedValues:
     """Per state ``(lower, upper, initial, final)`` (initial/final None when free), per control
-    ``(lower, upper)``, the fixed final time (None when free), the bounds of a free one, and per
-    design variable ``(lower, upper, guess)``."""
+    ``(lower, upper)``, the fixed final time (None when free), the bounds of a free one, per
+    design variable ``(lower, upper, guess)`` and per integral constraint ``(lower, upper)``."""
 
     states: list[tuple[float, float, float | None, float | None]]
     controls: list[tuple[float, float]]
     t_final: float | None
     t_bounds: tuple[float, float] | None = None
     design: list[tuple[float, float, float]] = dataclasses.field(default_factory=list)
+    integrals: list[tuple[float, float]] = dataclasses.field(default_factory=list)
 
 
 def bounds_midpoint(lo: float, hi: float) -> float:
@@ -434,12 +468,22 @@ def _ordered(lower: float, upper: float, field: str) -> None:
 
 
 class RefineSpec(StrictModel):
-    """Adaptive h-refinement: solve, split every interval whose defect relative to the state scale
-    (``max_defect_relative``) exceeds ``tolerance`` into two, re-solve from the last solution, until
-    none does or ``max_iterations`` refinements were made."""
+    """Adaptive mesh refinement: solve, refine every interval whose defect relative to the state
+    scale (``max_defect_relative``) exceeds ``tolerance``, re-solve from the last solution, until
+    none does or ``max_iterations`` refinements were made. ``h`` splits such an interval into two;
+    ``hp`` raises its Radau degree instead where the defect predicts that a degree up to
+    ``max_degree`` meets the tolerance (a smooth solution), and splits it otherwise."""
 
     tolerance: Number = Field(1e-6, gt=0)
     max_iterations: int = Field(8, ge=1, le=30)
+    strategy: Literal["h", "hp"] = "h"
+    max_degree: int = Field(
+        8,
+        ge=2,
+        le=12,
+        description="Highest Radau degree hp gives an interval (hang glider from 10 intervals to 1e-6:"
+        " 3 refinements with 8, 5 with 10, whose intervals overshoot and are split again).",
+    )
 
 
 class MethodSpec(StrictModel):
@@ -456,7 +500,10 @@ class MethodSpec(StrictModel):
     mesh: list[Number] | None = Field(
         None, description="Interval boundaries in normalized time, 0 to 1 increasing (sets intervals)."
     )
-    refine: RefineSpec | None = Field(None, description="Adaptive h-refinement on the defect estimate.")
+    degrees: list[int] | None = Field(
+        None, description="Radau degree of each interval (one per interval; from hp refinement)."
+    )
+    refine: RefineSpec | None = Field(None, description="Adaptive mesh refinement on the defect estimate.")
 
     @model_validator(mode="before")
     @classmethod
@@ -464,6 +511,15 @@ class MethodSpec(StrictModel):
         if isinstance(data, dict) and isinstance(data.get("mesh"), list):
             return {**data, "intervals": max(len(data["mesh"]) - 1, 1)}
         return data
+
+    @model_validator(mode="after")
+    def _one_degree_per_interval(self) -> MethodSpec:
+        if self.degrees is not None:
+            if self.scheme != "radau" or len(self.degrees) != self.intervals:
+                raise ValueError("degrees needs the radau scheme and one degree per interval")
+            if not all(1 <= d <= 12 for d in self.degrees):
+                raise ValueError("each degree must lie in [1, 12]")
+        return self
 
     @field_validator("mesh")
     @classmethod
@@ -496,7 +552,33 @@ class GuessSpec(StrictModel):
     result: str | None = None
 
 
-class OptimalControlSpec(ProblemParameters, SpecBase):
+class OcpFamily(ProblemParameters):
+    """What the optimal-control kinds share: the objective's sense, the numeric parameters as
+    runtime parameters, and a ``plot`` section that names their states and controls."""
+
+    def check_plot_names(self) -> None:
+        """A SpecError naming the ``plot`` field that names no state (planar) or no state, control
+        or ``t`` (units)."""
+        states = set(self.problem.states)
+        for i, pair in enumerate(self.plot.planar):
+            unknown = [n for n in pair if n not in states]
+            if unknown:
+                raise SpecError(f"{', '.join(unknown)} is not a state", field=f"plot.planar.{i}")
+        named = {*self.problem.states, *self.problem.controls, "t"}
+        for name in self.plot.units:
+            if name not in named:
+                raise SpecError(f"{name!r} is not a state, a control or t", field=f"plot.units.{name}")
+
+    @property
+    def objective_sense(self) -> str:
+        return self.problem.objective.sense
+
+    def runtime_parameters(self) -> dict[str, float]:
+        """The numeric parameters (derived ones follow them and are not set on their own)."""
+        return {n: float(v) for n, v in self.problem.parameters.items() if not isinstance(v, str)}
+
+
+class OptimalControlSpec(OcpFamily, SpecBase):
     """An optimal-control problem (kind ``optimal_control``); its runtime parameters are
     ``problem.parameters``, its starting point ``guess`` and ``problem.time.guess``."""
 
@@ -519,24 +601,8 @@ class OptimalControlSpec(ProblemParameters, SpecBase):
 
     @model_validator(mode="after")
     def _plot_names(self) -> OptimalControlSpec:
-        states = set(self.problem.states)
-        for i, pair in enumerate(self.plot.planar):
-            unknown = [n for n in pair if n not in states]
-            if unknown:
-                raise SpecError(f"{', '.join(unknown)} is not a state", field=f"plot.planar.{i}")
-        named = {*self.problem.states, *self.problem.controls, "t"}
-        for name in self.plot.units:
-            if name not in named:
-                raise SpecError(f"{name!r} is not a state, a control or t", field=f"plot.units.{name}")
+        self.check_plot_names()
         return self
-
-    @property
-    def objective_sense(self) -> str:
-        return self.problem.objective.sense
-
-    def runtime_parameters(self) -> dict[str, float]:
-        """The numeric parameters (derived ones follow them and are not set on their own)."""
-        return {n: float(v) for n, v in self.problem.parameters.items() if not isinstance(v, str)}
 
     def required_features(self) -> frozenset[str]:
         p = self.problem

@@ -2,7 +2,8 @@
 
 - a sweep: ``sweep_<parameter>.png`` per swept parameter, each output (objective, t_f, and the
   capture times of a Table 2.1 study) against it, one line per combination of the other parameters;
-  and ``tradeoff.png`` (Fig. 6.3(b)) when its points are desensitized Results;
+  ``tradeoff.png`` (Fig. 6.3(b)) when its points are desensitized Results; and
+  ``capture_probability_<parameter>.png`` (Fig. 5.2) when they are flow-field games;
 - a compare: ``compare.png``, bars per backend of the objective and the solve time.
 
 Read from the store only (:mod:`gamespec.studies.export`), never from solver objects.
@@ -22,6 +23,7 @@ import matplotlib.pyplot as plt
 
 from gamespec.desensitize.plotting import desensitized_rows, plot_tradeoff
 from gamespec.errors import GamespecError
+from gamespec.flowfield.plotting import capture_rows, plot_capture_sweep
 from gamespec.studies.export import study_rows
 from gamespec.studies.store import ResultStore
 
@@ -100,5 +102,9 @@ def plot_study(store: ResultStore, output_dir: str | Path) -> list[Path]:
         values = [v for v in store.items().values() if isinstance(v, dict)]
         if desensitized_rows(values):
             paths += plot_tradeoff(values, folder)
+        games = capture_rows(values)
+        for name in study.get("parameters", []) if games else []:
+            points = [(row[name], row["metrics"]) for row in games if _number(row.get(name)) is not None]
+            paths.append(plot_capture_sweep(points, name, folder / f"capture_probability_{name}.png"))
         return paths
     raise GamespecError(f"{store.folder}: not a sweep or a compare study")

@@ -206,6 +206,53 @@ def test_the_lq_mean_game_saddle_of_prop_9():
         np.testing.assert_allclose(run.strategies["v"], V, atol=bound)
 
 
+def _flipping_players(jitter: float, seed: int = 0) -> list[VectorPlayer]:
+    """A game without a pure saddle: ``J = (u + v)²``, u ∈ [−2, 2] minimizing, v ∈ [−1, 1]
+    maximizing (convex in the maximizer). ``BR_u(v) = −v`` and ``BR_v(u) = sign(u)`` (either end
+    at u = 0): the lower value ``max_v min_u J = 0`` is below the upper value ``min_u max_v J = 1``,
+    so Gauss–Seidel cannot have a fixed point; from v = 1 it alternates ``(−1, −1), (1, 1), …`` — a
+    period-2 cycle. Each response is perturbed by at most ``jitter`` (an inexact inner solver)."""
+    rng = np.random.default_rng(seed)
+    ok = StepReport(Status.OPTIMAL)
+
+    def noisy(x: float) -> np.ndarray:
+        return np.array([x + jitter * rng.uniform(-1, 1)])
+
+    return [
+        VectorPlayer("u", lambda o: (noisy(-o["v"][0]), ok)),
+        VectorPlayer("v", lambda o: (noisy(-1.0 if o["u"][0] < 0 else 1.0), ok)),
+    ]
+
+
+@pytest.mark.parametrize("jitter", [0.0, 1e-4, 3e-3])
+def test_a_period_two_cycle_within_tolerance_is_cycling(jitter: float):
+    """The iterates repeat every second sweep up to ``jitter`` (below and above the tolerance 1e-3)
+    while each sweep moves them by about 2: reported as cycling, well before the iteration limit."""
+    start = {"u": np.zeros(1), "v": np.ones(1)}
+    run = iterate(
+        _flipping_players(jitter), start, Settings(scheme="gauss_seidel", tolerance=1e-3, max_iterations=50)
+    )
+    assert run.outcome is Outcome.CYCLING and run.status is Status.NOT_CONVERGED, run.message
+    assert run.iterations <= 6
+    assert min(run.changes("u")[1:]) > 1.9
+
+
+def test_a_slowly_converging_alternation_is_not_called_a_cycle():
+    """``s_i = qⁱ`` with q = −0.9 in both players: it comes back to within (1 − |q|)/|q| ≈ 0.11 of
+    its change (above ``cycle_ratio``) and converges, as the engine must report."""
+    ok = StepReport(Status.OPTIMAL)
+    players = [
+        VectorPlayer("u", lambda o: (-0.9 * o["v"], ok)),
+        VectorPlayer("v", lambda o: (o["u"].copy(), ok)),
+    ]
+    run = iterate(
+        players,
+        {"u": np.ones(1), "v": np.ones(1)},
+        Settings(scheme="gauss_seidel", tolerance=1e-8, max_iterations=400),
+    )
+    assert run.converged, run.message
+
+
 @pytest.mark.parametrize("sigma", [0.6, 2.0, 5.0])
 def test_anderson_terminates_like_gmres(sigma: float):
     """On a linear sweep map Anderson acceleration with a memory of the joint dimension d is GMRES

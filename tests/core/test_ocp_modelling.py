@@ -4,17 +4,20 @@ the expressions written out, derived parameters against the number they evaluate
 from __future__ import annotations
 
 import itertools
+import math
 
 import numpy as np
 import pytest
 import sympy as sp
 
 import gamespec
+from gamespec.backend.refinement import refined_mesh
 from gamespec.errors import ExpressionError, SpecError
 from gamespec.loader import spec_from_dict
 from gamespec.ocp.symbolic import SymbolicOcp
 from gamespec.ocp.transcription import Transcription
 from gamespec.solving import get_backend
+from gamespec.specs.ocp import RefineSpec
 from gamespec.symbolic.language import parse
 from tests.conftest import PROBLEMS
 
@@ -129,6 +132,31 @@ def test_an_integral_constraint_matches_a_quadrature_state(backend: str) -> None
     assert integral.checks["max_constraint_violation"] < 1e-8
 
 
+@pytest.mark.parametrize("backend", ["casadi", "pyomo"])
+def test_an_integral_bound_over_the_parameters_follows_them_on_a_re_solve(backend: str) -> None:
+    """integral(x) = A with x(0) = 0, x(1) = 1: x = a t^2 + b t with a = 3 - 6A, b = 1 - a, and
+    J = integral((2at + b)^2) = 4a^2/3 + 2ab + b^2 (4/3 at A = 1/3, 1.12 at A = 0.4)."""
+    data = _isoperimetric(False, backend)
+    data["problem"]["parameters"] = {"A": 1 / 3}
+    data["problem"]["integral_constraints"] = [{"integrand": "x", "lower": "A", "upper": "A"}]
+    solver = gamespec.compile_spec(spec_from_dict(data))
+    for area in (1 / 3, 0.4):
+        a = 3 - 6 * area
+        b = 1 - a
+        result = solver.solve(parameters={"A": area})
+        assert result.status == gamespec.Status.OPTIMAL
+        assert result.objective == pytest.approx(4 * a * a / 3 + 2 * a * b + b * b, abs=1e-8)
+        assert result.checks["max_constraint_violation"] < 1e-8
+
+
+def test_an_integral_bound_over_what_is_not_a_parameter_is_refused() -> None:
+    data = _isoperimetric(False, "casadi")
+    data["problem"]["integral_constraints"] = [{"integrand": "x", "upper": "x_f"}]
+    with pytest.raises(SpecError, match="undefined symbol 'x_f'") as err:
+        spec_from_dict(data)
+    assert err.value.field == "problem.integral_constraints.0.upper"
+
+
 def _bounded_in_time(as_bound: bool) -> dict:
     """max x(1), x' = u, with u <= 1 - t: x(1) = 1/2 (the bound is active throughout)."""
     controls = {"u": {"lower": -1.0, "upper": "1 - t"}} if as_bound else {"u": {"lower": -1.0}}
@@ -213,6 +241,29 @@ def test_the_wall_time_limit_stops_a_solve(backend: str) -> None:
     assert gamespec.solve(spec).status == gamespec.Status.TIME_LIMIT
 
 
+@pytest.mark.parametrize("group", ["states", "controls", "parameters"])
+def test_tau_is_refused_as_a_name_with_the_reason(group: str) -> None:
+    data = _isoperimetric(False, "casadi")
+    problem = data["problem"]
+    if group == "states":
+        problem["states"]["tau"] = {"initial": 0.0}
+        problem["dynamics"]["tau"] = "1"
+    elif group == "controls":
+        problem["controls"]["tau"] = {}
+    else:
+        problem["parameters"] = {"tau": 1.0}
+    with pytest.raises(SpecError, match=r"'tau' cannot be a symbol name.*normalized time"):
+        spec_from_dict(data)
+
+
+def test_a_caret_in_a_file_names_the_field_and_the_column_of_the_caret() -> None:
+    data = _isoperimetric(False, "casadi")
+    data["problem"]["objective"]["lagrange"] = "u^2"
+    with pytest.raises(SpecError, match=r"at column 2: '\^' is not a power: use \*\* for powers") as err:
+        spec_from_dict(data)
+    assert err.value.field == "problem.objective.lagrange"
+
+
 def test_a_caret_says_to_use_double_star_at_its_column() -> None:
     with pytest.raises(ExpressionError, match=r"use \*\* for powers") as err:
         parse("1 + v^2", {"v": sp.Symbol("v", real=True)})
@@ -248,18 +299,48 @@ def test_the_chattering_check_fires_on_goddard_and_a_rate_penalty_removes_it(bac
     assert smooth.objective == pytest.approx(raw.objective, rel=1e-4)
 
 
+@pytest.mark.parametrize("strategy", ["h", "hp"])
 @pytest.mark.parametrize("backend", ["casadi", "pyomo"])
-def test_mesh_refinement_reaches_its_tolerance_on_the_hang_glider(backend: str) -> None:
+def test_mesh_refinement_reaches_its_tolerance_on_the_hang_glider(backend: str, strategy: str) -> None:
     tolerance = 1e-6
-    spec = gamespec.load(HANG_GLIDER, ["method.intervals=10", f"method.refine.tolerance={tolerance}"])
+    overrides = ["method.intervals=10", f"method.refine.tolerance={tolerance}"]
+    spec = gamespec.load(HANG_GLIDER, [*overrides, f"method.refine.strategy={strategy}"])
     result = gamespec.solve(spec, backend)
     history = result.metrics["refinement"]
     defects = [entry["max_defect_relative"] for entry in history]
     assert result.status == gamespec.Status.OPTIMAL and result.metrics["refinement_converged"]
     assert result.checks["max_defect_relative"] <= tolerance
     assert all(later < earlier for earlier, later in itertools.pairwise(defects))
-    assert [e["intervals"] for e in history] == sorted({e["intervals"] for e in history})
-    assert result.objective == pytest.approx(1.24797e3, rel=1e-4)  # COPS 3.0, on its own uniform mesh
+    assert all(later["variables"] > earlier["variables"] for earlier, later in itertools.pairwise(history))
+    assert max(e["max_degree"] for e in history) <= (3 if strategy == "h" else spec.method.refine.max_degree)
+    # Betts' x_f (the file's reference); the interval gaps, each below the tolerance relative to the
+    # state's scale, add up to at most intervals * tolerance of it at the end.
+    assert result.objective == pytest.approx(1248.03103, rel=history[-1]["intervals"] * tolerance)
+
+
+def test_hp_refinement_raises_the_degree_where_the_rule_predicts_the_tolerance() -> None:
+    """The ph rule: an interval of N points with defect e needs P = ceil(log(e/tol)/log N) more;
+    within max_degree it gets them, beyond it is split into intervals of the file's degree."""
+    options = RefineSpec(tolerance=1e-6, strategy="hp", max_degree=10)
+    breaks = np.array([0.0, 0.25, 0.5, 1.0])
+    mesh, degrees = refined_mesh(breaks, np.array([3, 3, 3]), np.array([1e-7, 1e-3, 1e-1]), options, 3)
+    assert degrees[:2] == [3, 3 + math.ceil(math.log(1e3) / math.log(3))]
+    wanted = 3 + math.ceil(math.log(1e5) / math.log(3))
+    assert degrees[2:] == [3] * math.ceil(wanted / 3)
+    assert mesh[:3] == [0.0, 0.25, 0.5] and np.allclose(np.diff(mesh[2:]), 0.5 / len(degrees[2:]))
+
+
+@pytest.mark.parametrize("backend", ["casadi", "pyomo"])
+def test_a_mesh_of_mixed_degrees_is_exact_on_a_quadratic_solution(backend: str) -> None:
+    """The isoperimetric problem's x = t^2 is a polynomial of degree 2: every interval of degree
+    >= 2 collocates it exactly, whatever its neighbours' degrees."""
+    data = _isoperimetric(False, backend)
+    data["method"] = {"intervals": 4, "degrees": [2, 5, 3, 4]}
+    result = gamespec.solve(spec_from_dict(data))
+    assert result.status == gamespec.Status.OPTIMAL
+    assert result.objective == pytest.approx(4 / 3, abs=1e-8)
+    assert np.allclose(result.states["x"], result.time**2, atol=1e-8)
+    assert result.checks["max_defect"] < 1e-10
 
 
 def test_each_check_has_a_verdict_against_its_tolerance() -> None:

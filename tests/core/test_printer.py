@@ -170,7 +170,9 @@ def test_round_trip_of_derivatives(expr: sp.Expr, wrt: sp.Symbol) -> None:
     assume(representable(first))
     assert_round_trip(first)
     second = sp.diff(first, wrt)
-    assume(not second.has(sp.DiracDelta) and representable(second))
+    # sign's derivative is a DiracDelta (zero almost everywhere), which the language has no form for;
+    # SymPy leaves it as an unevaluated Derivative when it cannot prove sign's argument real.
+    assume(not second.has(sp.DiracDelta, sp.Derivative) and representable(second))
     assert_round_trip(second)
 
 

@@ -34,3 +34,17 @@ def test_correlated_gaussian_against_monte_carlo() -> None:
     hit = np.mean(np.linalg.norm(z, axis=1) <= 0.09)
     p = disk_probability(mean, cov, 0.09)
     assert abs(hit - p) < 4 * np.sqrt(p * (1 - p) / z.shape[0])
+
+
+def test_a_smaller_centred_covariance_captures_more() -> None:
+    """Anderson's theorem: for a centred Gaussian and a symmetric convex set (the disk), ``P`` does
+    not increase when ``Σ`` grows in the Loewner order — why the pursuer's feedback, which keeps the
+    mean (feedforward nominal) and shrinks ``Σʳ``, raises eq. 5.39 where the mean is near zero."""
+    rng = np.random.default_rng(3)
+    for _ in range(20):
+        X, Y = rng.normal(size=(2, 2, 2)) * 0.05
+        small = X @ X.T
+        large = small + Y @ Y.T
+        assert (
+            disk_probability(np.zeros(2), small, 0.09) >= disk_probability(np.zeros(2), large, 0.09) - 1e-10
+        )

@@ -7,39 +7,13 @@ import numpy as np
 import pytest
 from gamespec_levelset.players import EvaderStep, PursuerStep
 
-from gamespec.flowfield.covariance_game import CovarianceGame, PlayerBounds, Strategy
-from gamespec.flowfield.linearize import lifted, zero_order_hold
-from gamespec.flowfield.nominal import NominalPaths
-from tests.flowfield.conftest import vortex_field
-
-N = 6
-
-
-def _paths() -> NominalPaths:
-    """Trajectories of the vortex field under turning unit headings at speeds 2.4 and 0.8, so the
-    nominal controls do drive the nominal paths (eqs. 5.23–5.26)."""
-    field, speeds = vortex_field(), np.array([2.4, 0.8])
-    t = np.linspace(0.0, 0.6, 601)
-    heading = np.stack([0.3 + 0.5 * t, 2.0 - 0.4 * t])
-    directions = np.stack([np.cos(heading), np.sin(heading)], axis=-1)
-    x = np.zeros((2, t.size, 2))
-    x[:, 0] = [[1.0, 0.5], [2.0, 1.0]]
-    for j in range(t.size - 1):  # Heun on a fine grid: second order, h = 1e-3
-        h = t[j + 1] - t[j]
-        a = field.drift(x[:, j]) + speeds[:, None] * directions[:, j]
-        b = field.drift(x[:, j] + h * a) + speeds[:, None] * directions[:, j + 1]
-        x[:, j + 1] = x[:, j] + h * (a + b) / 2
-    return NominalPaths(t, x, directions, speeds, np.zeros(2))
+from gamespec.flowfield.covariance_game import CovarianceGame, Strategy
+from tests.flowfield.conftest import SMALL_STEPS as N
+from tests.flowfield.conftest import small_game, vortex_field
 
 
 def _game(payoff: str = "trace") -> tuple[CovarianceGame, object]:
-    paths = _paths()
-    model = zero_order_hold(vortex_field(), paths, N)
-    _, x_hat, u_hat = paths.sampled(N)
-    stack = lambda a: np.concatenate([a[0], a[1]], axis=1)  # noqa: E731
-    bounds = (PlayerBounds(3.0, 0.1, 0.6, 0.01), PlayerBounds(1.0, 0.1, 0.2, 0.01))
-    lift = lifted(model, x_hat[:, 0].reshape(-1))
-    return CovarianceGame(lift, stack(x_hat[:, 1:]), stack(u_hat), bounds, payoff), model
+    return small_game(vortex_field(), payoff)
 
 
 def _random_strategies(game: CovarianceGame, seed: int, scale: float = 0.5) -> tuple[Strategy, Strategy]:
@@ -137,3 +111,24 @@ def test_evader_convex_concave_steps_never_lower_the_payoff() -> None:
     assert values[-1] > values[0]
     violations = game.violations((open_loop[0], response))
     assert max(v for k, v in violations.items() if k.startswith("evader")) <= 1e-6
+
+
+def test_closed_form_tangent_step_is_the_conic_maximizer() -> None:
+    """With ``V = Û`` the evader's linearized step separates per step; its closed form against the
+    conic problem (Clarabel) on the same set, for random slopes."""
+    game, _ = small_game(vortex_field(), feedforward="nominal")
+    open_loop = game.nominal()
+    evader = EvaderStep(game, "CLARABEL", {}, game.value(open_loop), 1e-6, 30, open_loop[1])
+    rng = np.random.default_rng(7)
+    for _ in range(3):
+        slope = rng.normal(size=8 * (N - 1))
+        closed, report = evader.tangent_step(slope)
+        assert report.status.ok
+        evader.slope.value = slope / np.linalg.norm(slope)
+        assert evader.run(evader.problem).ok
+        conic = evader.strategy()
+        gain = slope @ closed.kappa[1:].reshape(-1)
+        assert gain == pytest.approx(slope @ conic.kappa[1:].reshape(-1), rel=1e-6)
+        np.testing.assert_allclose(closed.kappa, conic.kappa, atol=1e-5 * np.abs(closed.kappa).max())
+        violations = game.violations((open_loop[0], closed))
+        assert max(v for k, v in violations.items() if k.startswith("evader")) <= 1e-9

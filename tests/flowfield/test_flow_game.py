@@ -5,6 +5,7 @@ Monte Carlo of the SDE must agree within sampling error), and the bad-input cont
 from __future__ import annotations
 
 import copy
+import json
 from pathlib import Path
 
 import numpy as np
@@ -12,6 +13,7 @@ import pytest
 import yaml
 
 from gamespec.errors import SpecError
+from gamespec.flowfield.problem import evaluate
 from gamespec.loader import load, spec_from_dict
 from gamespec.solving import solve
 
@@ -25,10 +27,11 @@ SPEC = {
         "evader": {"initial": [1, 0.5], "max_speed": 0.75, "delta_u": 0.15},
         "capture_radius": 0.09,
         "step": 0.2,
+        "feedforward": "nominal",
     },
     "method": {
         "grid": {"lower": [-2.5, -3.0], "upper": [4.0, 3.0], "nodes": [53, 49]},
-        "game": {"max_iterations": 3},
+        "game": {"scheme": "minimax", "max_iterations": 12},
         "monte_carlo": {"samples": 20000, "seed": 1},
     },
 }
@@ -52,7 +55,8 @@ def test_capture_time_and_point(result) -> None:
 
 def test_monte_carlo_agrees_with_eq_5_39(result) -> None:
     """For a uniform flow the linearized model is exact and Euler–Maruyama is exact, so the Monte
-    Carlo frequency of capture at T̂ has mean eq. 5.39 (both loops)."""
+    Carlo frequency of capture at T̂ has mean eq. 5.39 (both loops; in closed loop the evader's
+    mixed strategy, so the mixture of its support points' probabilities)."""
     carlo = result.metrics["monte_carlo_capture_probability"]
     for loop in ("open_loop", "closed_loop"):
         p = result.metrics[f"capture_probability_{loop}"]
@@ -64,8 +68,12 @@ def test_monte_carlo_agrees_with_eq_5_39(result) -> None:
 def test_result_reports_the_game_honestly(result) -> None:
     assert isinstance(result.metrics["game_converged"], bool)
     history = result.metrics["best_response"]["history"]
-    assert history and result.metrics["best_response"]["scheme"] == "gauss_seidel"
+    assert history and result.metrics["game_scheme"] == "minimax"
     assert result.ok == result.metrics["game_converged"]
+    mixture = result.metrics["evader_mixture"]
+    assert sum(mixture["weights"]) == pytest.approx(1.0)
+    scale = result.metrics["payoff_open_loop"]
+    assert result.objective == pytest.approx(scale * np.dot(mixture["weights"], mixture["payoffs"]))
     assert result.checks["max_constraint_violation"] <= 1e-6
     for values in result.metrics["evader_convex_concave"]["payoffs"]:
         assert np.all(np.diff(values) >= -1e-6 * np.abs(values[:-1]))
@@ -107,7 +115,7 @@ def test_set_parameter_on_the_command_line(tmp_path: Path, cli) -> None:
     path.write_text(yaml.safe_dump(SPEC))
     spec = load(path, ["problem.parameters.noise=0.1"])
     assert spec.problem.parameters["noise"] == 0.1
-    assert spec.data().field.diffusion(np.zeros((1, 2)))[0, 0, 0] == pytest.approx(0.1)
+    assert evaluate(spec).field.diffusion(np.zeros((1, 2)))[0, 0, 0] == pytest.approx(0.1)
     code, out, err = cli("validate", path, "--set", "problem.flow.drift=[1]")
     assert code == 2 and "problem.flow.drift" in out + err
     assert cli("validate", path, "--set", "problem.parameters.noise=0.1")[0] == 0
@@ -120,3 +128,32 @@ def test_hj_reachability_backend_agrees(result) -> None:
     assert other.metrics["reachability"]["engine"].startswith("hj_reachability")
     cell_time = 6.5 / 52 / 1.6
     assert other.metrics["capture_time"] == pytest.approx(result.metrics["capture_time"], abs=0.1 * cell_time)
+
+
+def test_fig_5_2_from_a_sweep(tmp_path: Path, cli) -> None:
+    """``gamespec sweep`` over the noise parameter keeps each point's capture probabilities, and
+    ``gamespec plot`` on the folder draws them against it (Fig. 5.2); the stage that does not
+    depend on the noise (reachability) is computed once per worker."""
+    data = copy.deepcopy(SPEC)
+    data["method"]["monte_carlo"]["samples"] = 2000
+    data["solver"] = {"backend": "levelset", "options": {"levelset": {"cross_check": False}}}
+    path = tmp_path / "uniform.yaml"
+    path.write_text(yaml.safe_dump(data))
+    code, out, err = cli("sweep", path, "--param", "noise=0.03,0.06", "--out", tmp_path / "study", "--json")
+    assert code == 0, err
+    rows = json.loads(out)
+    assert [r["noise"] for r in rows] == [0.03, 0.06]
+    for row in rows:
+        assert {"open_loop", "closed_loop"} <= set(row["metrics"]["monte_carlo_capture_probability"])
+    code, out, err = cli("plot", tmp_path / "study", "--out", tmp_path / "figures")
+    assert code == 0, err
+    assert (tmp_path / "figures" / "capture_probability_noise.png").stat().st_size > 0
+
+
+def test_summary_leads_with_the_capture(result) -> None:
+    from gamespec.summaries import outcome
+
+    rows = dict(outcome(result))
+    assert rows["capture time T̂"] == result.metrics["capture_time"]
+    assert rows["P(capture at T̂), closed loop"] == result.metrics["capture_probability_closed_loop"]
+    assert rows["game converged"].startswith(str(result.metrics["game_converged"]))

@@ -74,3 +74,23 @@ def test_a_set_leaving_the_grid_is_reported() -> None:
     reach = capture_by_level_sets(solver, np.array([[0.0, 0.0], [0.5, 0.0]]), 5.0)
     assert reach.capture_time is None
     assert "edge" in reach.message
+
+
+def test_band_update_agrees_with_the_whole_grid() -> None:
+    """Updating only the box around the nodes below the band (the levels read depend only on lower
+    ones, :mod:`gamespec.flowfield.band`) moves T̂ and x_f by far less than the grid error, and the
+    snapshots agree with the whole-grid ones below the band."""
+    field = linear_field()
+    origins = np.array([[12.0, 12.0], [14.0, 14.0]])
+    speeds = np.array([2.4, 0.8])
+    grid = Grid((3.0, 2.0), (25.0, 20.0), (67, 55))
+    solver = _solver(grid, speeds, field.drift(grid.points))
+    banded = capture_by_level_sets(solver, origins, 6.0)
+    whole = capture_by_level_sets(solver, origins, 6.0, banded=False)
+    dx = grid.spacing.max()
+    assert banded.steps == whole.steps
+    assert banded.capture_time == pytest.approx(whole.capture_time, abs=1e-3 * dx / speeds[0])
+    assert np.linalg.norm(banded.capture_point - whole.capture_point) < 1e-3 * dx
+    below = whole.snapshots[-1] < banded.levels.max()
+    assert np.abs(banded.snapshots[-1] - whole.snapshots[-1])[below].max() < 1e-3 * dx
+    assert banded.snapshots.max() <= banded.band

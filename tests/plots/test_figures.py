@@ -51,6 +51,7 @@ def test_shipped_problem_figures(path: Path, tmp_path: Path) -> None:
         "pursuit_scenario": _check_scenario,
         "lq_stochastic_game": _check_lq,
         "optimal_control": _check_ocp,
+        "multiphase_optimal_control": _check_multiphase,
         "flow_field_game": _check_flow,
         "differential_game": _check_differential_game,
     }[result.kind]
@@ -116,6 +117,15 @@ def _check_ocp(result, saved) -> None:
     pairs = result.metrics["plot"]["planar"]
     assert (f"{result.problem}_path.png" in saved) == bool(pairs)
     assert f"J = {result.objective:.6g}" in titles(saved[f"{result.problem}_time.png"])
+
+
+def _check_multiphase(result, saved) -> None:
+    """An OCP figure with a vertical line on every axis at each boundary between phases."""
+    _check_ocp(result, saved)
+    figure = saved[f"{result.problem}_time.png"]
+    for phase in result.metrics["phases"][1:]:
+        for ax in figure.axes:
+            assert any(np.allclose(line.get_xdata(), phase["start"]) for line in ax.lines), phase["name"]
 
 
 def _ocp(plot: dict | None, constraints: list[str]) -> dict:

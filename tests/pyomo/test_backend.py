@@ -32,7 +32,7 @@ def test_constrained_problem_agrees_with_casadi() -> None:
 
 
 def test_resolve_with_new_parameters_reuses_the_model() -> None:
-    """Parameters are mutable Params: a re-solve changes values, the model object stays."""
+    """Parameters are Vars held by equal bounds: a re-solve changes values, the model object stays."""
     solver = compile_spec(MIN_TIME, "pyomo")
     model = solver.compiled.model
     first = solver.solve()
@@ -46,7 +46,7 @@ def test_resolve_with_new_parameters_reuses_the_model() -> None:
 
 
 def test_parameter_final_time_resolves() -> None:
-    """A fixed final time given by a parameter is a mutable Param too."""
+    """A fixed final time given by a parameter is a Var held by equal bounds too."""
     spec = gamespec.spec_from_dict(CONSTRAINED)
     solver = compile_spec(spec, "pyomo")
     longer = solver.solve(parameters={"tf": 2.0})

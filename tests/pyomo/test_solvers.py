@@ -90,3 +90,20 @@ def test_an_ipopt_on_path_is_used_by_default(tmp_path, monkeypatch) -> None:
     assert on_path.solver_stats["executable"] == str(tmp_path / "ipopt")
     assert bundled.solver_stats["solver"] == "ripopt"
     assert on_path.objective == pytest.approx(bundled.objective, rel=1e-10)
+
+
+def test_options_file_options_reach_the_solvers_working_directory(tmp_path) -> None:
+    """``OF_key`` options (Ipopt's options file: every Ipopt option, also those its AMPL driver does
+    not list) are written to ``<name>.opt`` where the solver runs, the others go on its command line."""
+    import stat
+
+    seen = tmp_path / "seen"
+    fake = tmp_path / "ipopt"
+    fake.write_text(f'#!/bin/sh\ncat ipopt.opt > "{seen}.opt"\necho "$@" > "{seen}.args"\nexit 3\n')
+    fake.chmod(fake.stat().st_mode | stat.S_IEXEC)
+    with pytest.raises(BackendError, match="exit status 3"):
+        options = {"tol": 1e-8, "OF_mumps_permuting_scaling": 0}
+        solvers.run_solver(solvers.Executable("ipopt", str(fake), "test"), "", options)
+    assert (tmp_path / "seen.opt").read_text() == "mumps_permuting_scaling 0\n"
+    assert "tol=1e-08" in (tmp_path / "seen.args").read_text()
+    assert "mumps" not in (tmp_path / "seen.args").read_text()

@@ -1,0 +1,192 @@
+"""The ``multiphase_optimal_control`` kind: a sequence of phases, each with its own dynamics,
+duration (fixed or free), running cost, path and boundary constraints, controls and guess, linked
+by continuity of the states or by jump conditions, solved as one NLP.
+
+The states are declared once (``problem.states``: bounds, the value at the start of the first phase
+and at the end of the last); a phase may narrow a state's bounds and fix its value at the phase's
+start or end (``phases[k].states``), choose its controls (``phases[k].controls``, all by default),
+replace or add to the shared dynamics and definitions, and give the start of its states as
+expressions of the previous phase's end (``jump``: ``{m: m_f - m_stage}``, a staged rocket's mass
+drop; a state not named there is continuous). The Mayer term and ``boundary_constraints`` use
+``<state>_0`` (start of the first phase), ``<state>_f`` (end of the last), ``<control>_0``,
+``<control>_f`` and ``t_f``; a phase's own ``boundary_constraints`` use the same names at its own
+start and end, and ``t_0``, ``t_f`` for its start and end times.
+
+The kind is lowered to one ``optimal_control`` problem by the ``phases`` transform
+(:mod:`gamespec.specs.phase_lowering` says how); loading a file lowers it once, so every
+expression is checked at load with the field that holds it.
+"""
+
+from __future__ import annotations
+
+from typing import ClassVar, Literal
+
+from pydantic import Field, field_validator, model_validator
+
+from gamespec.limits import MAX_INTERVALS
+from gamespec.specs.base import Number, SpecBase, StrictModel, Value
+from gamespec.specs.ocp import (
+    NORMALIZED_TIME,
+    ControlSpec,
+    DesignSpec,
+    FreeOrFixed,
+    IntegralConstraintSpec,
+    MethodSpec,
+    ObjectiveSpec,
+    OcpFamily,
+    StateSpec,
+)
+from gamespec.specs.phase_lowering import SEPARATOR, lower
+from gamespec.specs.plot import PlotHint
+from gamespec.symbolic.language import RESERVED
+
+
+class DurationSpec(FreeOrFixed):
+    """A phase's duration: a value (a number or an expression of the parameters), or ``free``
+    within ``bounds`` (numbers or expressions of the parameters) from ``guess`` (the middle of the
+    bounds when omitted). A phase may give a number or an expression instead of the mapping."""
+
+    value: Value | Literal["free"] = "free"
+
+    fixed_field: ClassVar[str] = "value"
+    what: ClassVar[str] = "duration"
+
+
+class PhaseGuessSpec(StrictModel):
+    """A phase's starting point: per state or control a number or an expression of the phase's
+    normalized time ``tau`` (0 at its start, 1 at its end) and the parameters."""
+
+    states: dict[str, Value] = Field(default_factory=dict)
+    controls: dict[str, Value] = Field(default_factory=dict)
+
+
+class PhaseSpec(StrictModel):
+    """One phase (see the module doc)."""
+
+    name: str
+    duration: DurationSpec
+    dynamics: dict[str, Value] = Field(
+        default_factory=dict, description="Per state; replaces problem.dynamics for the states it names."
+    )
+    definitions: dict[str, Value] = Field(
+        default_factory=dict, description="Named expressions of this phase; replace shared ones by name."
+    )
+    states: dict[str, StateSpec] = Field(
+        default_factory=dict,
+        description="Per state: bounds in this phase, and its value at the phase's start and end.",
+    )
+    controls: dict[str, ControlSpec] | None = Field(
+        None, description="The controls of this phase (all shared ones when omitted), bounds narrowed."
+    )
+    lagrange: Value | None = Field(None, description="The running cost here (problem.objective.lagrange).")
+    path_constraints: list[str] = Field(default_factory=list)
+    boundary_constraints: list[str] = Field(
+        default_factory=list, description="Over this phase's <state>_0, <state>_f, t_0, t_f."
+    )
+    jump: dict[str, Value] = Field(
+        default_factory=dict,
+        description="Per state, its value at this phase's start over the previous phase's end "
+        "(<state>_f, <control>_f, t_f); states not named are continuous.",
+    )
+    guess: PhaseGuessSpec = Field(default_factory=PhaseGuessSpec)
+    intervals: int | None = Field(
+        None, ge=1, le=MAX_INTERVALS, description="Collocation intervals of this phase (method.intervals)."
+    )
+
+    @field_validator("duration", mode="before")
+    @classmethod
+    def _value_alone(cls, value: object) -> object:
+        if isinstance(value, int | float | str):
+            return {"value": value}
+        return value
+
+
+class StartSpec(StrictModel):
+    """When the first phase starts."""
+
+    initial: Number = 0.0
+
+
+class MultiPhaseProblem(StrictModel):
+    """The mathematics of a multi-phase optimal-control problem (see the module doc)."""
+
+    parameters: dict[str, Value] = Field(
+        default_factory=dict,
+        description="Numbers, or expressions of earlier parameters (derived, recomputed from them).",
+    )
+    definitions: dict[str, Value] = Field(
+        default_factory=dict, description="Named expressions shared by every phase."
+    )
+    states: dict[str, StateSpec]
+    controls: dict[str, ControlSpec] = Field(default_factory=dict)
+    design: dict[str, DesignSpec] = Field(
+        default_factory=dict, description="Free static parameters optimized with the trajectory."
+    )
+    dynamics: dict[str, Value] = Field(
+        default_factory=dict, description="Shared dynamics, per state; a phase replaces them by name."
+    )
+    objective: ObjectiveSpec = Field(default_factory=ObjectiveSpec)
+    time: StartSpec = Field(default_factory=StartSpec)
+    path_constraints: list[str] = Field(default_factory=list, description="Imposed in every phase.")
+    boundary_constraints: list[str] = Field(default_factory=list)
+    integral_constraints: list[IntegralConstraintSpec] = Field(
+        default_factory=list, description="Over the whole horizon: the integrand summed over the phases."
+    )
+    phases: list[PhaseSpec] = Field(min_length=1)
+
+    @model_validator(mode="after")
+    def _names(self) -> MultiPhaseProblem:
+        names = [*self.parameters, *self.states, *self.controls, *self.design, *self.definitions]
+        names += [n for ph in self.phases for n in ph.definitions if n not in self.definitions]
+        phases = [ph.name for ph in self.phases]
+        for name in names + phases:
+            if not name.isidentifier() or name in RESERVED or name == NORMALIZED_TIME or SEPARATOR in name:
+                raise ValueError(
+                    f"{name!r} cannot be a name (reserved, not an identifier, or has {SEPARATOR})"
+                )
+        repeated = sorted({n for n in phases if phases.count(n) > 1})
+        if repeated:
+            raise ValueError(f"phase names used twice: {', '.join(repeated)}")
+        boundary = {f"{s}_{e}" for s in [*self.states, *self.controls] for e in "0f"} | {"t_0", "t_f"}
+        clashes = {n for n in names if names.count(n) > 1} | (set(names) & boundary)
+        if clashes:
+            raise ValueError(f"names used twice: {', '.join(sorted(clashes))}")
+        if not self.states:
+            raise ValueError("at least one state is needed")
+        return self
+
+
+class MultiPhaseSpec(OcpFamily, SpecBase):
+    """A multi-phase optimal-control problem: phases in sequence, each with its own dynamics
+    (``phases[k].dynamics`` replaces ``problem.dynamics`` by state), duration (a value, or ``free``
+    within bounds: a switching time), running cost, path and boundary constraints, controls (a
+    subset of ``problem.controls``, bounds narrowed), state bounds and end values, and guess;
+    consecutive phases are linked by continuity of every state or by a jump
+    (``jump: {m: m_f - structure}``, over the previous phase's end). Solved as one NLP: the
+    ``phases`` transform lowers it to one ``optimal_control`` problem in which each phase has its
+    own copy of the states and controls on a normalized time in [0, 1], its duration a design
+    variable (free) or a parameter (fixed), the links boundary constraints (``gamespec show FILE
+    --transformed`` prints it). Each phase has ``method.intervals`` collocation intervals in its
+    own normalized time, or its own ``intervals`` (then on a uniform grid).
+
+    The Result runs over the whole horizon, phase after phase (each boundary twice: the end of one
+    phase and the start of the next); ``metrics.phases`` gives each phase's name, start, end and
+    duration, ``arrays.phase`` the phase of each time point, and the plots mark the boundaries.
+    Checks: ``max_constraint_violation`` (links included), ``max_defect`` and
+    ``max_defect_relative`` overall, and per phase ``<check>/<phase>`` (defects, bounds and path
+    constraints, control swings, the Hamiltonian's variation on autonomous phases and, on a phase
+    of free duration, ``hamiltonian_end_error/<phase>`` = ``max |H + dPhi/dt_f|``, the switching
+    time's transversality condition). Its runtime parameters are ``problem.parameters``."""
+
+    kind: Literal["multiphase_optimal_control"] = "multiphase_optimal_control"
+    problem: MultiPhaseProblem
+    method: MethodSpec = Field(default_factory=MethodSpec)
+    plot: PlotHint = Field(default_factory=PlotHint)
+
+    default_backend = "casadi"
+
+    @model_validator(mode="after")
+    def _lowers(self) -> MultiPhaseSpec:
+        self.check_plot_names()
+        lower(self)
+        return self

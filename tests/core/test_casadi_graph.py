@@ -48,6 +48,9 @@ CASES = {
     "cart_pole": lambda: gamespec.load(PROBLEMS / "ocp" / "cart_pole_swing_up.yaml"),
     "zermelo_min_time": lambda: gamespec.load(PROBLEMS / "ch6" / "zermelo_min_time.yaml"),
     "zermelo_trapezoidal": lambda: gamespec.load(ZERMELO_RANGE, ["method.scheme=trapezoidal"]),
+    "zermelo_degrees_per_interval": lambda: gamespec.load(
+        ZERMELO_RANGE, ["method.intervals=4", "method.degrees=[2, 5, 3, 1]"]
+    ),
     "design_variable": lambda: spec_from_dict(_design_problem(False, "casadi")),
     "integral_constraint": lambda: spec_from_dict(_isoperimetric(False, "casadi")),
     "linear_with_path_constraint": lambda: spec_from_dict(_bounded_in_time(False)),

@@ -14,7 +14,7 @@ import json
 import sys
 import warnings
 from collections.abc import Iterator
-from contextlib import contextmanager, nullcontext
+from contextlib import AbstractContextManager, contextmanager, nullcontext
 from functools import cache
 from pathlib import Path
 from typing import TYPE_CHECKING, Annotated
@@ -45,6 +45,15 @@ def _console(stderr: bool = False) -> Console:
     from rich.console import Console
 
     return Console(stderr=stderr)
+
+
+def _spinner(text: str) -> AbstractContextManager[object]:
+    """rich's spinner on stderr while ``text``'s work runs, where stderr is a terminal; elsewhere
+    (a pipe, a file, ``--json`` in a script) it has no one to show to, and neither rich nor its
+    refresh thread is started."""
+    if not sys.stderr.isatty():
+        return nullcontext()
+    return _console(stderr=True).status(text, spinner="dots")
 
 
 def _escape(text: str) -> str:
@@ -122,7 +131,7 @@ def solve(
     spec = load(file, set_ or [])
     if out is not None:
         writable_folder(out)
-    with _console(stderr=True).status(f"solving {spec.name} ...", spinner="dots"):
+    with _spinner(f"solving {spec.name} ..."):
         result = run_solve(spec, backend)
     if out is not None:
         _remove_previous_figures(out)

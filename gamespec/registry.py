@@ -4,13 +4,14 @@ Groups: ``gamespec.kinds`` (spec classes by ``kind``), ``gamespec.backends`` (ba
 name), ``gamespec.transforms`` (spec → spec reductions), ``gamespec.plotters`` (plot functions by
 kind), ``gamespec.summaries`` (the rows that lead a kind's solve summary), ``gamespec.executors``
 (how a study runs its points) and ``gamespec.commands`` (Typer apps mounted as ``gamespec NAME``).
-Nothing is imported until it is asked for, so ``import gamespec`` stays light.
+Nothing is imported until it is asked for, so ``import gamespec`` stays light; the installed
+distributions' entry points are read in one pass, the first time any group is asked for.
 """
 
 from __future__ import annotations
 
 from functools import cache
-from importlib.metadata import EntryPoint, entry_points
+from importlib.metadata import EntryPoint, EntryPoints, entry_points
 from typing import Any
 
 from gamespec.errors import BackendError, SpecError
@@ -31,8 +32,15 @@ _IN_PROCESS: dict[str, dict[str, Any]] = {group: {} for group in GROUPS}
 
 
 @cache
+def _installed() -> EntryPoints:
+    """Every installed distribution's entry points (one pass over their metadata; a pass per group
+    would read all of it again for each)."""
+    return entry_points()
+
+
+@cache
 def _entry_points(group: str) -> dict[str, EntryPoint]:
-    return {ep.name: ep for ep in entry_points(group=group)}
+    return {ep.name: ep for ep in _installed().select(group=group)}
 
 
 def register(group: str, name: str, obj: Any) -> None:

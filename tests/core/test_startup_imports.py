@@ -2,17 +2,21 @@
 interpreter after the command ran. Structural, not timed: ``gamespec --help`` needs neither NumPy,
 SymPy, SciPy, rich nor a backend (pydantic is not checked: typer may import it to read parameter
 types); ``validate`` of a file whose bounds use no functions neither NumPy nor a solver; a CasADi
-solve of an ``optimal_control`` file neither SciPy nor another backend. The CPU times themselves
-are measured in ``benchmarks/test_bench_startup.py``."""
+solve of an ``optimal_control`` file neither SciPy nor another backend, and with ``--json`` where
+stderr is no terminal not rich either (no spinner to draw). The plugin registry reads the installed
+distributions' entry points once for all groups. The CPU times themselves are
+measured in ``benchmarks/test_bench_startup.py``."""
 
 from __future__ import annotations
 
 import json
 import subprocess
 import sys
+from functools import cache
 
 import pytest
 
+from gamespec import registry
 from tests.conftest import PROBLEMS
 
 FILE = str(PROBLEMS / "ch6" / "zermelo_min_time.yaml")
@@ -51,3 +55,24 @@ def test_casadi_solve_imports_no_scipy_and_no_other_backend() -> None:
     assert (
         modules & {"scipy", "matplotlib", *(SOLVERS - {"casadi"}), *(BACKENDS - {"gamespec_casadi"})} == set()
     )
+
+
+def test_json_solve_without_a_terminal_imports_no_rich() -> None:
+    assert "rich" not in imported_by("solve", FILE, "--json")
+
+
+def test_registry_reads_the_installed_entry_points_once_for_all_groups(monkeypatch) -> None:
+    reads = []
+    installed = registry.entry_points
+
+    def counted():
+        reads.append(1)
+        return installed()
+
+    monkeypatch.setattr(registry, "entry_points", counted)
+    monkeypatch.setattr(registry, "_installed", cache(registry._installed.__wrapped__))
+    monkeypatch.setattr(registry, "_entry_points", cache(registry._entry_points.__wrapped__))
+    found = {group: registry.names(group) for group in registry.GROUPS}
+    assert len(reads) == 1
+    assert {"casadi", "pyomo"} <= set(found["gamespec.backends"])
+    assert "optimal_control" in found["gamespec.kinds"]

@@ -25,7 +25,7 @@ from gamespec.ocp.transcription import Guess, Transcription
 from gamespec.result import Result, Status
 from gamespec.specs.base import StrictModel
 from gamespec.specs.ocp import OptimalControlSpec
-from gamespec.symbolic.translate import Library
+from gamespec.symbolic.library import Library
 
 STATUS_MAP = {
     "Solve_Succeeded": Status.OPTIMAL,

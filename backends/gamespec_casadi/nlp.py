@@ -31,7 +31,8 @@ import casadi as ca
 import numpy as np
 
 from gamespec.ocp.transcription import Transcription
-from gamespec.symbolic.translate import Library, translate
+from gamespec.symbolic.library import Library
+from gamespec.symbolic.translate import translate
 from gamespec_casadi.sparse import Coo
 
 

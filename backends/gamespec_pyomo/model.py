@@ -26,7 +26,8 @@ import numpy as np
 from gamespec.errors import UnsupportedFeature
 from gamespec.ocp.transcription import Transcription
 from gamespec.symbolic.language import Relation
-from gamespec.symbolic.translate import Library, translate
+from gamespec.symbolic.library import Library
+from gamespec.symbolic.translate import translate
 
 
 def _minimum(a: Any, b: Any) -> Any:

@@ -28,7 +28,8 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from gamespec.symbolic.language import Relation, symbol
-from gamespec.symbolic.translate import NUMPY, translate
+from gamespec.symbolic.library import NUMPY
+from gamespec.symbolic.translate import translate
 
 if TYPE_CHECKING:
     from gamespec.ocp.transcription import Transcription

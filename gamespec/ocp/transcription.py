@@ -23,7 +23,8 @@ from gamespec.ocp.symbolic import SymbolicOcp
 from gamespec.result import Result, Status
 from gamespec.specs.ocp import NORMALIZED_TIME, OptimalControlSpec, bounds_midpoint
 from gamespec.symbolic.language import ExpressionError, parse, symbol
-from gamespec.symbolic.translate import NUMPY, translate
+from gamespec.symbolic.library import NUMPY
+from gamespec.symbolic.translate import translate
 
 
 @dataclass(frozen=True)

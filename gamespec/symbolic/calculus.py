@@ -16,8 +16,8 @@ import numpy as np
 import sympy as sp
 
 from gamespec.errors import ExpressionError
+from gamespec.symbolic.library import NUMPY, Library
 from gamespec.symbolic.tape import as_array, record
-from gamespec.symbolic.translate import NUMPY, Library
 
 
 def jacobian(exprs: Sequence[sp.Expr] | sp.Matrix, wrt: Sequence[sp.Symbol]) -> sp.Matrix:

@@ -18,7 +18,8 @@ from typing import Any
 import numpy as np
 import sympy as sp
 
-from gamespec.symbolic.translate import NUMPY, Library, translate
+from gamespec.symbolic.library import NUMPY, Library
+from gamespec.symbolic.translate import translate
 
 
 @dataclass

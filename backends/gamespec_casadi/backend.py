@@ -137,7 +137,7 @@ class CasadiModel(CollocationModel):
 
     def _constraint_bounds(self, params: dict[str, float]) -> tuple[np.ndarray, np.ndarray]:
         """``lbg, ubg`` with the integral constraints' bounds (the last rows of g) for ``params``."""
-        n = len(self.tr.ocp.integrals)
+        n = len(self.tr.ocp.running_structure.integrands)
         if not n:
             return self.lbg, self.ubg
         lbg, ubg = self.lbg.copy(), self.ubg.copy()

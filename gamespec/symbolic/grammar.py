@@ -114,12 +114,51 @@ FLOAT_FUNCTIONS: dict[str, Callable[..., float]] = {
 """The whitelisted functions on floats (``math``; ``sign`` and ``heaviside`` as in SymPy)."""
 
 
+@dataclass(frozen=True)
+class Unknown:
+    """A value that depends on a name without a number. ``scale`` bounds the numeric coefficient
+    SymPy would fold into it (``x*1e300*1e300`` is ``1e600*x``; terms add their scales), so that
+    a check without SymPy refuses what parsing into SymPy refuses as out of range."""
+
+    scale: float = 1.0
+
+
+UNKNOWN = Unknown()
+
+
+def _scale(value: float | Unknown) -> float:
+    return value.scale if isinstance(value, Unknown) else abs(value)
+
+
+def _unknown_result(func: Callable[..., Any], args: tuple[float | Unknown, ...]) -> Unknown:
+    """The :class:`Unknown` that ``func`` of ``args`` (one of them unknown) gives."""
+    scales = [_scale(a) for a in args]
+    if func is operator.add or func is operator.sub:
+        scale = scales[0] + scales[1]
+    elif func is operator.mul:
+        scale = scales[0] * scales[1]
+    elif func is operator.truediv:
+        if scales[1] == 0:
+            raise Refused("is infinite, undefined or not real")
+        scale = scales[0] / scales[1]
+    elif func is operator.pow and not isinstance(args[1], Unknown):
+        if scales[0] == 0 and args[1] < 0:
+            raise Refused("is infinite, undefined or not real")
+        try:
+            scale = scales[0] ** args[1]
+        except OverflowError:
+            raise Refused(f"number out of range (beyond {MAX_MAGNITUDE:g})") from None
+    else:
+        scale = 1.0
+    return Unknown(_checked(scale))
+
+
 class FloatAlgebra:
-    """Floats, with ``None`` for a value that depends on a name without a number: a walk over
-    ``{name: None}`` checks an expression without computing it (the checks at load), one over
-    ``{name: float}`` computes it (bounds, derived parameters). A number that is infinite, not
-    real or beyond :data:`~gamespec.limits.MAX_MAGNITUDE` (``1/0``, ``log(0)``, ``sqrt(-1)``,
-    ``exp(1000)``) is refused."""
+    """Floats, with an :class:`Unknown` for a value that depends on a name without a number: a
+    walk over ``{name: UNKNOWN}`` checks an expression without computing it (the checks at load),
+    one over ``{name: float}`` computes it (bounds, derived parameters). A number that is
+    infinite, not real or beyond :data:`~gamespec.limits.MAX_MAGNITUDE` (``1/0``, ``log(0)``,
+    ``sqrt(-1)``, ``exp(1000)``, ``x*1e300*1e300``) is refused."""
 
     def number(self, value: int | float) -> float:
         try:
@@ -130,35 +169,35 @@ class FloatAlgebra:
     def constant(self, name: str) -> float:
         return math.pi
 
-    def _apply(self, func: Callable[..., Any], *args: float | None) -> float | None:
-        if any(a is None for a in args):
-            return None
+    def _apply(self, func: Callable[..., Any], *args: float | Unknown) -> float | Unknown:
+        if any(isinstance(a, Unknown) for a in args):
+            return _unknown_result(func, args)
         try:
             value = func(*args)
-        except ZeroDivisionError:
+        except (ZeroDivisionError, ValueError):
             raise Refused("is infinite, undefined or not real") from None
         except OverflowError:
             raise Refused(f"number out of range (beyond {MAX_MAGNITUDE:g})") from None
-        except ValueError:
-            raise Refused("is infinite, undefined or not real") from None
         if isinstance(value, complex):
             raise Refused("power of a negative number is not real")
         return _checked(float(value))
 
-    def binary(self, op: type[ast.operator], left: float | None, right: float | None) -> float | None:
+    def binary(
+        self, op: type[ast.operator], left: float | Unknown, right: float | Unknown
+    ) -> float | Unknown:
         return self._apply(BINARY[op], left, right)
 
-    def negate(self, value: float | None) -> float | None:
-        return None if value is None else -value
+    def negate(self, value: float | Unknown) -> float | Unknown:
+        return value if isinstance(value, Unknown) else -value
 
-    def power(self, base: float | None, exponent: float | None) -> float | None:
+    def power(self, base: float | Unknown, exponent: float | Unknown) -> float | Unknown:
         return self._apply(operator.pow, base, exponent)
 
-    def call(self, name: str, args: list[float | None]) -> float | None:
+    def call(self, name: str, args: list[float | Unknown]) -> float | Unknown:
         return self._apply(FLOAT_FUNCTIONS[name], *args)
 
-    def scalar(self, value: float | None) -> float | None:
-        return value
+    def scalar(self, value: float | Unknown) -> float | None:
+        return None if isinstance(value, Unknown) else value
 
 
 FLOATS = FloatAlgebra()
@@ -339,17 +378,17 @@ def relation(text: str, symbols: Mapping[str, Any], algebra: Algebra) -> Relatio
 def check(text: str | float, names: Iterable[str], *, constraint: bool = False) -> None:
     """Refuse ``text`` (an ExpressionError) unless it is an expression (a constraint when
     ``constraint``) over ``names``, its number-only parts finite and real (:class:`FloatAlgebra`)."""
-    unknown = dict.fromkeys(names)
+    unknown = dict.fromkeys(names, UNKNOWN)
     if constraint:
         relation(str(text), unknown, FLOATS)
     else:
         expression(text, unknown, FLOATS)
 
 
-def number(text: str | float, values: Mapping[str, float]) -> float:
+def numeric_value(text: str | float, values: Mapping[str, float]) -> float:
     """The value of a number-only expression over ``values`` (name → float)."""
     value = expression(text, values, FLOATS)
-    if value is None:
+    if isinstance(value, Unknown):
         raise ExpressionError(str(text), "is not a number here")
     return value
 

@@ -112,15 +112,9 @@ def point_function(tr: Transcription, lib: Library) -> Any:
     x, u, d = ca.SX.sym("x", tr.n_x), ca.SX.sym("u", tr.n_u), ca.SX.sym("d", tr.n_d)
     horizon, tau = ca.SX.sym("T"), ca.SX.sym("tau")
     w, p = ca.SX.sym("w", tr.n_w), ca.SX.sym("p", len(ocp.parameters))
-    values = {"t": tr.t0 + horizon * tau}
-    for names, var in (
-        (ocp.states, x),
-        (ocp.controls, u),
-        (ocp.inputs, w),
-        (ocp.parameters, p),
-        (ocp.design, d),
-    ):
-        values |= dict(zip(names, ca.vertsplit(var), strict=True))
+    others = dict(zip(ocp.parameters + ocp.design, ca.vertsplit(ca.vertcat(p, d)), strict=True))
+    split = (ca.vertsplit(v) for v in (x, u, w))
+    values = ocp.running_values(*split, tr.t0 + horizon * tau, others)
     terms = ocp.running_terms(values, LibraryAlgebra(lib))
     f, path = ca.vertcat(*terms.dynamics), ca.vertcat(*(r.expr for r in terms.path))
     o = ca.vertcat(horizon * f, horizon * terms.lagrange, path, horizon * ca.vertcat(*terms.integrands))
@@ -189,12 +183,9 @@ def collocation_nlp(
     n_o = nx + 1 + len(running.path) + len(running.integrands)
 
     x_ends = ca.DM(sx) * X_scaled[:, [0, grid.n_nodes - 1]]
-    ends = {f"{n}_0": v for n, v in zip(ocp.states, ca.vertsplit(x_ends[:, 0]), strict=True)}
-    ends |= {f"{n}_f": v for n, v in zip(ocp.states, ca.vertsplit(x_ends[:, 1]), strict=True)}
-    ends |= dict(zip(ocp.parameters + ocp.design, ca.vertsplit(ca.vertcat(params, design)), strict=True))
-    first, last = tr.end_controls(U)
-    ends |= {f"{n}_0": v for n, v in zip(ocp.controls, first, strict=True)}
-    ends |= {f"{n}_f": v for n, v in zip(ocp.controls, last, strict=True)} | {"t_f": tr.t0 + horizon}
+    others = dict(zip(ocp.parameters + ocp.design, ca.vertsplit(ca.vertcat(params, design)), strict=True))
+    x_first_last = (ca.vertsplit(x_ends[:, 0]), ca.vertsplit(x_ends[:, 1]))
+    ends = ocp.end_values(x_first_last, tr.end_controls(U), tr.t0 + horizon, others)
     end_terms = ocp.end_terms(ends, LibraryAlgebra(lib))
     boundary = ca.vertcat(*(r.expr for r in end_terms.boundary))
     cost = end_terms.mayer + tr.rate_penalty(U)

@@ -64,12 +64,6 @@ def _running(tr: Transcription, x, u, w, t: np.ndarray, params: Mapping[str, flo
     return tr.ocp.running_function(*x, *u, *w, *p, t)
 
 
-def _values(tr: Transcription, x, u, w, t, params) -> dict:
-    ocp = tr.ocp
-    values = dict(zip(ocp.states, x, strict=True)) | dict(zip(ocp.controls, u, strict=True))
-    return values | dict(zip(ocp.inputs, w, strict=True)) | dict(params) | {"t": t}
-
-
 def control_basis(tr: Transcription, s: np.ndarray, degree: int | None = None) -> np.ndarray:
     """Weights (len(s) × points) interpolating the controls of an interval of ``degree`` (the
     first interval's when None) at local times ``s``."""
@@ -197,7 +191,7 @@ def max_constraint_violation(tr: Transcription, sol: Trajectory, params: Mapping
     worst.append(_violation(np.array([T]), b.t_lower, b.t_upper))
     worst.append(_violation(np.array([params[n] for n in tr.ocp.design]), b.d_lower, b.d_upper))
     t_eval = tr.t0 + T * tr.grid.eval_tau
-    running = _values(tr, X[:, tr.grid.eval_index], U, sol.Win, t_eval, params)
+    running = tr.ocp.running_values(X[:, tr.grid.eval_index], U, sol.Win, t_eval, params)
     terms = tr.ocp.running_terms(running, ARRAYS)
     worst += [_relation_violation(r, t_eval.shape) for r in terms.path]
     ends = tr.ocp.end_terms(_end_values(tr, X, U, T, params), ARRAYS)
@@ -212,13 +206,7 @@ def max_constraint_violation(tr: Transcription, sol: Trajectory, params: Mapping
 def _end_values(
     tr: Transcription, X: np.ndarray, U: np.ndarray, T: float, params: Mapping[str, float]
 ) -> dict:
-    ocp = tr.ocp
-    values = {f"{n}_0": X[i, 0] for i, n in enumerate(ocp.states)}
-    values |= {f"{n}_f": X[i, -1] for i, n in enumerate(ocp.states)}
-    first, last = tr.end_controls(U)
-    values |= {f"{n}_0": v for n, v in zip(ocp.controls, first, strict=True)}
-    values |= {f"{n}_f": v for n, v in zip(ocp.controls, last, strict=True)}
-    return values | {"t_f": tr.t0 + T} | dict(params)
+    return tr.ocp.end_values((X[:, 0], X[:, -1]), tr.end_controls(U), tr.t0 + T, params)
 
 
 def hamiltonian(

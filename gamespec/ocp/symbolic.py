@@ -11,7 +11,7 @@ from __future__ import annotations
 
 import ast
 import math
-from collections.abc import Callable, Mapping
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass
 from functools import cached_property
 from typing import Any
@@ -91,6 +91,30 @@ class SymbolicOcp:
         """The names an end-point expression may use."""
         ends = [f"{n}_{e}" for e in "0f" for n in [*self.states, *self.controls]]
         return [*self.parameters, *self.design, *ends, "t_f"]
+
+    def running_values(
+        self, x: Sequence[Any], u: Sequence[Any], w: Sequence[Any], t: Any, others: Mapping[str, Any]
+    ) -> dict[str, Any]:
+        """The values of :attr:`running_names` by name: one per state, control and grid input,
+        ``t``, and the parameters and design variables from ``others``."""
+        values = dict(zip(self.states, x, strict=True)) | dict(zip(self.controls, u, strict=True))
+        return values | dict(zip(self.inputs, w, strict=True)) | dict(others) | {"t": t}
+
+    def end_values(
+        self,
+        x: tuple[Sequence[Any], Sequence[Any]],
+        u: tuple[Sequence[Any], Sequence[Any]],
+        t_final: Any,
+        others: Mapping[str, Any],
+    ) -> dict[str, Any]:
+        """The values of :attr:`end_names` by name: the states ``x`` and controls ``u`` at the
+        (first, last) point, the final time, and the parameters and design variables from
+        ``others``."""
+        values: dict[str, Any] = dict(others)
+        for names, (first, last) in ((self.states, x), (self.controls, u)):
+            values |= {f"{n}_0": v for n, v in zip(names, first, strict=True)}
+            values |= {f"{n}_f": v for n, v in zip(names, last, strict=True)}
+        return values | {"t_f": t_final}
 
     def scope(self, values: Mapping[str, Any], algebra: Algebra) -> dict[str, Any]:
         """``values`` (by name) and each definition built over them and the earlier ones."""

@@ -21,6 +21,7 @@ import math
 import operator
 from collections.abc import Callable, Iterable, Mapping
 from dataclasses import dataclass
+from functools import lru_cache
 from typing import Any, Protocol
 
 from gamespec.errors import ExpressionError
@@ -233,8 +234,11 @@ class NameAlgebra:
 NAMES = NameAlgebra()
 
 
+@lru_cache(maxsize=4096)
 def syntax_tree(text: str | float) -> ast.expr:
-    """The syntax tree of ``text`` (a number as a constant), within the limits on length and size."""
+    """The syntax tree of ``text`` (a number as a constant), within the limits on length and size;
+    kept per text (the walks never change a tree), since a backend builds the same terms at every
+    collocation point."""
     if not isinstance(text, str):
         return ast.Constant(value=text)
     if len(text) > MAX_EXPRESSION_CHARS:

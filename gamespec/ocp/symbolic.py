@@ -20,7 +20,7 @@ import numpy as np
 
 from gamespec.errors import SpecError
 from gamespec.specs.ocp import EvaluatedValues, OptimalControlSpec
-from gamespec.symbolic.grammar import NAMES, Algebra, Relation, expression, relation
+from gamespec.symbolic.grammar import NAMES, Algebra, Relation, dependencies, expression, relation
 from gamespec.symbolic.library import NUMPY, LibraryAlgebra
 from gamespec.symbolic.tape import vectorized
 
@@ -150,7 +150,8 @@ class SymbolicOcp:
 
     @cached_property
     def running_structure(self) -> RunningTerms:
-        """The running terms as the sets of names they depend on (with the constraints' bounds)."""
+        """The running terms as the sets of names they depend on (:func:`dependencies`), with the
+        constraints' bounds."""
         return self.running_terms({n: frozenset({n}) for n in self.running_names}, NAMES)
 
     @cached_property
@@ -269,7 +270,7 @@ class SymbolicOcp:
     @cached_property
     def _hamiltonian_names(self) -> frozenset[str]:
         terms = self.running_structure
-        return frozenset().union(*terms.dynamics, terms.lagrange)
+        return frozenset().union(*map(dependencies, [*terms.dynamics, terms.lagrange]))
 
     @cached_property
     def running_function(self) -> Callable[..., np.ndarray]:

@@ -24,7 +24,15 @@ from gamespec.limits import MAX_INTERVALS
 from gamespec.specs.base import Number, ProblemParameters, SpecBase, StrictModel, Value
 from gamespec.specs.plot import PlotHint
 from gamespec.specs.uncertainty import UncertainParameter
-from gamespec.symbolic.grammar import NAMES, RESERVED, check, expression, numeric_value, relation
+from gamespec.symbolic.grammar import (
+    NAMES,
+    RESERVED,
+    check,
+    dependencies,
+    expression,
+    numeric_value,
+    relation,
+)
 
 INF = math.inf
 NORMALIZED_TIME = "tau"
@@ -431,7 +439,7 @@ def _inputs_in(constraint: bool, text: str, symbols: dict, inputs: dict) -> list
         used = relation(text, names, NAMES).expr if constraint else expression(text, names, NAMES)
     except ExpressionError:
         return []
-    return sorted(used & set(inputs))
+    return sorted(dependencies(used) & set(inputs))
 
 
 @dataclass(frozen=True)

@@ -204,41 +204,54 @@ class FloatAlgebra:
 FLOATS = FloatAlgebra()
 
 
+def dependencies(value: frozenset[str] | float) -> frozenset[str]:
+    """The names a value of :data:`NAMES` depends on (none for a number)."""
+    return value if isinstance(value, frozenset) else frozenset()
+
+
 class NameAlgebra:
     """The set of names an expression depends on (through the values given for the names: a
-    definition's set holds the names it is written over)."""
+    definition's set holds the names it is written over); a part without names is its number
+    (:data:`FLOATS`), so that a chained constraint keeps its bounds."""
 
-    def number(self, value: int | float) -> frozenset[str]:
-        FLOATS.number(value)
-        return frozenset()
+    def number(self, value: int | float) -> float:
+        return FLOATS.number(value)
 
-    def constant(self, name: str) -> frozenset[str]:
-        return frozenset()
+    def constant(self, name: str) -> float:
+        return FLOATS.constant(name)
 
-    def binary(self, op: type[ast.operator], left: frozenset[str], right: frozenset[str]) -> frozenset[str]:
-        return left | right
+    def _union(self, args: tuple[frozenset[str] | float, ...]) -> frozenset[str]:
+        return frozenset().union(*map(dependencies, args))
 
-    def negate(self, value: frozenset[str]) -> frozenset[str]:
-        return value
+    def _numbers(self, *args: frozenset[str] | float) -> bool:
+        return not any(isinstance(a, frozenset) for a in args)
 
-    def power(self, base: frozenset[str], exponent: frozenset[str]) -> frozenset[str]:
-        return base | exponent
+    def binary(self, op: type[ast.operator], left: Any, right: Any) -> frozenset[str] | float:
+        return FLOATS.binary(op, left, right) if self._numbers(left, right) else self._union((left, right))
 
-    def call(self, name: str, args: list[frozenset[str]]) -> frozenset[str]:
-        return frozenset().union(*args)
+    def negate(self, value: frozenset[str] | float) -> frozenset[str] | float:
+        return FLOATS.negate(value) if self._numbers(value) else value
 
-    def scalar(self, value: frozenset[str]) -> float | None:
-        return None
+    def power(self, base: Any, exponent: Any) -> frozenset[str] | float:
+        return (
+            FLOATS.power(base, exponent) if self._numbers(base, exponent) else self._union((base, exponent))
+        )
+
+    def call(self, name: str, args: list[Any]) -> frozenset[str] | float:
+        return FLOATS.call(name, args) if self._numbers(*args) else self._union(tuple(args))
+
+    def scalar(self, value: frozenset[str] | float) -> float | None:
+        return None if isinstance(value, frozenset) else value
 
 
 NAMES = NameAlgebra()
 
 
-@lru_cache(maxsize=4096)
+@lru_cache(maxsize=4096, typed=True)
 def syntax_tree(text: str | float) -> ast.expr:
     """The syntax tree of ``text`` (a number as a constant), within the limits on length and size;
-    kept per text (the walks never change a tree), since a backend builds the same terms at every
-    collocation point."""
+    kept per text and type (the walks never change a tree; ``1``, ``1.0`` and ``True`` are three
+    texts), since a backend builds the same terms at every collocation point."""
     if not isinstance(text, str):
         return ast.Constant(value=text)
     if len(text) > MAX_EXPRESSION_CHARS:
@@ -399,4 +412,4 @@ def numeric_value(text: str | float, values: Mapping[str, float]) -> float:
 
 def used_names(text: str | float, names: Mapping[str, frozenset[str]]) -> frozenset[str]:
     """The names ``text`` depends on, each name of ``names`` standing for its set."""
-    return expression(text, names, NAMES)
+    return dependencies(expression(text, names, NAMES))

@@ -115,7 +115,8 @@ class SympyAlgebra:
     """The grammar's walk building SymPy (exact numbers; :meth:`finite` on every result)."""
 
     def number(self, value: int | float) -> sp.Expr:
-        return sp.Float(value) if isinstance(value, float) else sp.Integer(value)
+        """A literal, refused when it is not finite (``1e400`` reads as infinity)."""
+        return self.finite(sp.Float(value) if isinstance(value, float) else sp.Integer(value))
 
     def constant(self, name: str) -> sp.Expr:
         return CONSTANTS[name]

@@ -25,7 +25,7 @@ from gamespec.ocp.transcription import Guess, Transcription
 from gamespec.result import Result, Status
 from gamespec.specs.base import StrictModel
 from gamespec.specs.ocp import OptimalControlSpec
-from gamespec.symbolic.translate import Library
+from gamespec.symbolic.library import Library
 
 STATUS_MAP = {
     "Solve_Succeeded": Status.OPTIMAL,
@@ -137,7 +137,7 @@ class CasadiModel(CollocationModel):
 
     def _constraint_bounds(self, params: dict[str, float]) -> tuple[np.ndarray, np.ndarray]:
         """``lbg, ubg`` with the integral constraints' bounds (the last rows of g) for ``params``."""
-        n = len(self.tr.ocp.integrals)
+        n = len(self.tr.ocp.running_structure.integrands)
         if not n:
             return self.lbg, self.ubg
         lbg, ubg = self.lbg.copy(), self.ubg.copy()

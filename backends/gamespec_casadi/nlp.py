@@ -31,7 +31,8 @@ import casadi as ca
 import numpy as np
 
 from gamespec.ocp.transcription import Transcription
-from gamespec.symbolic.translate import Library, translate
+from gamespec.symbolic.grammar import Relation
+from gamespec.symbolic.library import Library, LibraryAlgebra
 from gamespec_casadi.sparse import Coo
 
 
@@ -110,15 +111,13 @@ def point_function(tr: Transcription, lib: Library) -> Any:
     ocp = tr.ocp
     x, u, d = ca.SX.sym("x", tr.n_x), ca.SX.sym("u", tr.n_u), ca.SX.sym("d", tr.n_d)
     horizon, tau = ca.SX.sym("T"), ca.SX.sym("tau")
-    w, p = ca.SX.sym("w", tr.n_w), ca.SX.sym("p", len(ocp.p))
-    values = {ocp.t: tr.t0 + horizon * tau}
-    for symbols, var in ((ocp.x, x), (ocp.u, u), (ocp.w, w), (ocp.p, p), (ocp.d, d)):
-        values |= dict(zip(symbols, ca.vertsplit(var), strict=True))
-    f = ca.vertcat(*(translate(e, values, lib) for e in ocp.dynamics))
-    L = translate(ocp.lagrange, values, lib)
-    path = ca.vertcat(*(translate(r.expr, values, lib) for r in ocp.path))
-    integrand = ca.vertcat(*(translate(r.expr, values, lib) for r in ocp.integrals))
-    o = ca.vertcat(horizon * f, horizon * L, path, horizon * integrand)
+    w, p = ca.SX.sym("w", tr.n_w), ca.SX.sym("p", len(ocp.parameters))
+    others = dict(zip(ocp.parameters + ocp.design, ca.vertsplit(ca.vertcat(p, d)), strict=True))
+    split = (ca.vertsplit(v) for v in (x, u, w))
+    values = ocp.running_values(*split, tr.t0 + horizon * tau, others)
+    terms = ocp.running_terms(values, LibraryAlgebra(lib))
+    f, path = ca.vertcat(*terms.dynamics), ca.vertcat(*(r.expr for r in terms.path))
+    o = ca.vertcat(horizon * f, horizon * terms.lagrange, path, horizon * ca.vertcat(*terms.integrands))
     if tr.free_time:
         return ca.Function("point", [ca.vertcat(x, u, d, horizon), ca.vertcat(w, tau, p)], [o])
     return ca.Function("point", [ca.vertcat(x, u, d), ca.vertcat(w, tau, p, horizon)], [o])
@@ -149,7 +148,8 @@ def _point_selection(tr: Transcription, sx: np.ndarray, su: np.ndarray, n_var: i
 def _output_weights(tr: Transcription, n_o: int, n_boundary: int) -> tuple[Coo, np.ndarray]:
     """C and c with ``g = ... + C vec(O)`` (the defects' ``- vec(O_f W^T)``, the path rows
     ``vec(O_path^T)``, the integrals ``O_integrand q``) and ``f = ... + c^T vec(O)`` (``O_L q``)."""
-    nx, n_path, n_int = tr.n_x, len(tr.ocp.path), len(tr.ocp.integrals)
+    structure = tr.ocp.running_structure
+    nx, n_path, n_int = tr.n_x, len(structure.path), len(structure.integrands)
     _, W, q = tr.grid.triplets
     k = len(q)
     rows, cols, values, shape = W
@@ -169,7 +169,8 @@ def collocation_nlp(
     """The NLP of ``tr`` on symbols of type ``outer`` (``ca.SX`` or ``ca.MX``), the variables scaled
     by ``sx`` (states) and ``su`` (controls)."""
     ocp, grid = tr.ocp, tr.grid
-    nx, nu, nw, npar, k = tr.n_x, tr.n_u, tr.n_w, len(ocp.p), len(grid.eval_index)
+    nx, nu, nw, npar, k = tr.n_x, tr.n_u, tr.n_w, len(ocp.parameters), len(grid.eval_index)
+    running = ocp.running_structure
     X_scaled, U_scaled = outer.sym("X", nx, grid.n_nodes), outer.sym("U", nu, k)
     U = ca.diag(ca.DM(su)) @ U_scaled
     T = outer.sym("T") if tr.free_time else None
@@ -179,30 +180,30 @@ def collocation_nlp(
     Win = ca.reshape(p_all[npar : npar + nw * k], nw, k)
     horizon = T if tr.free_time else p_all[npar + nw * k]
     w = ca.vertcat(ca.vec(X_scaled), ca.vec(U_scaled), design, *([T] if tr.free_time else []))
-    n_o = nx + 1 + len(ocp.path) + len(ocp.integrals)
+    n_o = nx + 1 + len(running.path) + len(running.integrands)
 
     x_ends = ca.DM(sx) * X_scaled[:, [0, grid.n_nodes - 1]]
-    ends = dict(zip(ocp.x0, ca.vertsplit(x_ends[:, 0]), strict=True))
-    ends |= dict(zip(ocp.xf, ca.vertsplit(x_ends[:, 1]), strict=True)) | {ocp.tf: tr.t0 + horizon}
-    ends |= dict(zip(ocp.p + ocp.d, ca.vertsplit(ca.vertcat(params, design)), strict=True))
-    first, last = tr.end_controls(U)
-    ends |= dict(zip(ocp.u0, first, strict=True)) | dict(zip(ocp.uf, last, strict=True))
-    boundary = ca.vertcat(*(translate(r.expr, ends, lib) for r in ocp.boundary))
-    cost = translate(ocp.mayer, ends, lib) + tr.rate_penalty(U)
+    others = dict(zip(ocp.parameters + ocp.design, ca.vertsplit(ca.vertcat(params, design)), strict=True))
+    x_first_last = (ca.vertsplit(x_ends[:, 0]), ca.vertsplit(x_ends[:, 1]))
+    ends = ocp.end_values(x_first_last, tr.end_controls(U), tr.t0 + horizon, others)
+    end_terms = ocp.end_terms(ends, LibraryAlgebra(lib))
+    boundary = ca.vertcat(*(r.expr for r in end_terms.boundary))
+    cost = end_terms.mayer + tr.rate_penalty(U)
 
     D = Coo.of(*grid.triplets[0])
     n_defects = D.shape[0] * nx
-    weights, cost_weights = _output_weights(tr, n_o, len(ocp.boundary))
+    weights, cost_weights = _output_weights(tr, n_o, len(end_terms.boundary))
     scales = Coo.of(np.arange(nx), np.arange(nx), sx, (nx, nx))
     linear = D.kron(scales).resized((weights.shape[0], w.numel()))
     lower, upper = [np.zeros(n_defects)], [np.zeros(n_defects)]
-    for r in ocp.path:
+    for r in running.path:
         lower.append(np.full(k, r.lower))
         upper.append(np.full(k, r.upper))
-    for group in (ocp.boundary, ocp.integrals):
+    integrals = ocp.integral_bounds(ocp.parameter_values())
+    for group in (end_terms.boundary, [Relation(None, lo, hi) for lo, hi in integrals]):
         lower.append(np.array([r.lower for r in group]))
         upper.append(np.array([r.upper for r in group]))
-    first_boundary = n_defects + k * len(ocp.path)
+    first_boundary = n_defects + k * len(running.path)
     return CollocationNlp(
         w=w,
         p=p_all,
@@ -219,7 +220,7 @@ def collocation_nlp(
         weights=weights,
         cost_weights=cost_weights,
         boundary=boundary,
-        boundary_rows=list(range(first_boundary, first_boundary + len(ocp.boundary))),
+        boundary_rows=list(range(first_boundary, first_boundary + len(end_terms.boundary))),
         cost=cost,
         lbg=np.concatenate(lower),
         ubg=np.concatenate(upper),

@@ -17,7 +17,8 @@ import numpy as np
 from gamespec.flowfield.field import FlowField
 from gamespec.flowfield.grid import Grid
 from gamespec.flowfield.hamiltonian import FlowHamiltonian
-from gamespec.symbolic.translate import NUMPY, Library, translate
+from gamespec.symbolic.library import NUMPY, Library
+from gamespec.symbolic.translate import translate
 
 
 def jax_library() -> Library:

@@ -25,8 +25,8 @@ import numpy as np
 
 from gamespec.errors import UnsupportedFeature
 from gamespec.ocp.transcription import Transcription
-from gamespec.symbolic.language import Relation
-from gamespec.symbolic.translate import Library, translate
+from gamespec.symbolic.grammar import Relation
+from gamespec.symbolic.library import Library, LibraryAlgebra
 
 
 def _minimum(a: Any, b: Any) -> Any:
@@ -82,7 +82,6 @@ def build_model(tr: Transcription, params: Mapping[str, float]) -> Any:
     import pyomo.environ as pyo
 
     ocp, grid = tr.ocp, tr.grid
-    lib = pyomo_library()
     D, W, q = grid.matrices
     k = len(grid.eval_index)
     m = pyo.ConcreteModel(name=tr.spec.name)
@@ -92,46 +91,40 @@ def build_model(tr: Transcription, params: Mapping[str, float]) -> Any:
     m.U = pyo.Var(range(tr.n_u), range(k), initialize=0.0)
     m.d = pyo.Var(ocp.design, initialize=0.0)
     m.T = pyo.Var(initialize=1.0)
-    symbols = {s: m.p[name] for s, name in zip(ocp.p, ocp.parameters, strict=True)}
-    symbols |= {s: m.d[name] for s, name in zip(ocp.d, ocp.design, strict=True)}
+    others = {n: m.p[n] for n in ocp.parameters} | {n: m.d[n] for n in ocp.design}
+    algebra = LibraryAlgebra(pyomo_library())
 
     F = np.empty((tr.n_x, k), dtype=object)
     L = []
     path = []
     integrands = []
     for col, (node, tau) in enumerate(zip(grid.eval_index, grid.eval_tau, strict=True)):
-        values = symbols | {ocp.t: tr.t0 + tau * m.T}
-        values |= {s: m.X[i, int(node)] for i, s in enumerate(ocp.x)}
-        values |= {s: m.U[j, col] for j, s in enumerate(ocp.u)}
-        values |= {s: m.w[i, col] for i, s in enumerate(ocp.w)}
-        F[:, col] = [translate(f, values, lib) for f in ocp.dynamics]
-        L.append(translate(ocp.lagrange, values, lib))
-        path.append([_relation(r, translate(r.expr, values, lib)) for r in ocp.path])
-        integrands.append([translate(r.expr, values, lib) for r in ocp.integrals])
+        x = [m.X[i, int(node)] for i in range(tr.n_x)]
+        u = [m.U[j, col] for j in range(tr.n_u)]
+        w = [m.w[i, col] for i in range(tr.n_w)]
+        terms = ocp.running_terms(ocp.running_values(x, u, w, tr.t0 + tau * m.T, others), algebra)
+        F[:, col] = terms.dynamics
+        L.append(terms.lagrange)
+        path.append([_relation(r, r.expr) for r in terms.path])
+        integrands.append(terms.integrands)
+    n_path, n_int = len(ocp.running_structure.path), range(len(ocp.running_structure.integrands))
 
     def defect(_m: Any, i: int, row: int) -> Any:
         dx = sum(v * m.X[i, int(c)] for c, v in _row(D, row))
         return dx - m.T * sum(v * F[i, int(c)] for c, v in _row(W, row)) == 0
 
     m.defect = pyo.Constraint(range(tr.n_x), range(D.shape[0]), rule=defect)
-    m.path = pyo.Constraint(range(len(ocp.path)), range(k), rule=lambda _m, r, col: path[col][r])
+    m.path = pyo.Constraint(range(n_path), range(k), rule=lambda _m, r, col: path[col][r])
 
-    ends = symbols | {ocp.tf: tr.t0 + m.T}
-    ends |= {s: m.X[i, 0] for i, s in enumerate(ocp.x0)}
-    ends |= {s: m.X[i, grid.n_nodes - 1] for i, s in enumerate(ocp.xf)}
-    first, last = tr.end_controls(m.U)
-    ends |= dict(zip(ocp.u0, first, strict=True)) | dict(zip(ocp.uf, last, strict=True))
-    boundary = [_relation(r, translate(r.expr, ends, lib)) for r in ocp.boundary]
+    x_ends = ([m.X[i, 0] for i in range(tr.n_x)], [m.X[i, grid.n_nodes - 1] for i in range(tr.n_x)])
+    ends = ocp.end_terms(ocp.end_values(x_ends, tr.end_controls(m.U), tr.t0 + m.T, others), algebra)
+    boundary = [_relation(r, r.expr) for r in ends.boundary]
     m.boundary = pyo.Constraint(range(len(boundary)), rule=lambda _m, r: boundary[r])
-    integral = [
-        m.T * sum(float(w) * terms[r] for w, terms in zip(q, integrands, strict=True))
-        for r in range(len(ocp.integrals))
-    ]
-    n_int = range(len(ocp.integrals))
+    integral = [m.T * sum(float(w) * terms[r] for w, terms in zip(q, integrands, strict=True)) for r in n_int]
     m.integral_value = pyo.Var(n_int, initialize=0.0)
     m.integral = pyo.Constraint(n_int, rule=lambda _m, r: m.integral_value[r] == integral[r])
     running = sum(float(w) * term for w, term in zip(q, L, strict=True))
-    m.objective = pyo.Objective(expr=translate(ocp.mayer, ends, lib) + m.T * running + tr.rate_penalty(m.U))
+    m.objective = pyo.Objective(expr=ends.mayer + m.T * running + tr.rate_penalty(m.U))
     m.dual = pyo.Suffix(direction=pyo.Suffix.IMPORT)
     m.scaling_factor = pyo.Suffix(direction=pyo.Suffix.EXPORT)
     sx, su = tr.scales(params)

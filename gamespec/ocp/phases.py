@@ -35,7 +35,8 @@ from gamespec.result import Result
 from gamespec.specs.ocp import TimeSpec
 from gamespec.specs.phase_lowering import LoweredPhase, Lowering
 from gamespec.symbolic.language import symbol
-from gamespec.symbolic.translate import NUMPY, translate
+from gamespec.symbolic.library import NUMPY
+from gamespec.symbolic.translate import translate
 
 OVERALL_CHECKS = ("max_constraint_violation", "max_defect", "max_defect_relative", "chattering")
 """Checks of the lowered problem that keep their meaning for the whole multi-phase problem."""

@@ -1,4 +1,7 @@
-"""An ``optimal_control`` spec as SymPy objects, the one form every OCP backend translates.
+"""An ``optimal_control`` spec's expressions, built in any algebra of
+:mod:`gamespec.symbolic.grammar`: SymPy (the form the transforms differentiate and the Pyomo
+backend translates), a backend's own expressions straight from the text (the CasADi graph, NumPy
+arrays for the checks) or the names each term depends on.
 
 Everything is stated for minimization: ``J = sign * (Mayer + integral of Lagrange)``, with
 ``sign = -1`` when the file says ``maximize``. The Hamiltonian is ``H = sign*L + lambda^T f``.
@@ -6,23 +9,49 @@ Everything is stated for minimization: ``J = sign * (Mayer + integral of Lagrang
 
 from __future__ import annotations
 
+import ast
 import math
-from collections.abc import Callable, Mapping
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass
 from functools import cached_property
+from typing import Any
 
 import numpy as np
-import sympy as sp
 
 from gamespec.errors import SpecError
 from gamespec.specs.ocp import EvaluatedValues, OptimalControlSpec
-from gamespec.symbolic.calculus import numeric_function
-from gamespec.symbolic.language import TIME, Relation, parse, parse_relation, symbol
+from gamespec.symbolic.grammar import NAMES, Algebra, Relation, dependencies, expression, relation
+from gamespec.symbolic.library import NUMPY, LibraryAlgebra
+from gamespec.symbolic.tape import vectorized
+
+
+@dataclass(frozen=True)
+class RunningTerms:
+    """The running terms in one algebra: the dynamics, the Lagrange integrand (``sign`` applied),
+    the path constraints (then each bound that uses ``t`` as ``x - bound(t) >= 0`` (lower) or
+    ``<= 0`` (upper)) and the integrands of the integral constraints (not signed)."""
+
+    dynamics: list[Any]
+    lagrange: Any
+    path: list[Relation]
+    integrands: list[Any]
+
+
+@dataclass(frozen=True)
+class EndTerms:
+    """The end-point terms in one algebra: the Mayer term (``sign`` applied) and the boundary
+    constraints, over ``<state>_0``, ``<state>_f``, ``<control>_0``, ``<control>_f``, ``t_f``, the
+    parameters and the design variables."""
+
+    mayer: Any
+    boundary: list[Relation]
 
 
 @dataclass(frozen=True)
 class SymbolicOcp:
-    """The parsed problem: symbols, dynamics, objective, constraints and parameter-only values."""
+    """The parsed problem: names, the running and end terms in any algebra, and the
+    parameter-only values as floats. The SymPy forms (:attr:`dynamics`, :attr:`path`, ...) are
+    built on first use only."""
 
     spec: OptimalControlSpec
 
@@ -48,154 +77,218 @@ class SymbolicOcp:
         """Names of the grid inputs (signals tabulated at the evaluation points)."""
         return list(self.spec.problem.inputs)
 
-    @cached_property
-    def x(self) -> list[sp.Symbol]:
-        return [symbol(n) for n in self.states]
-
-    @cached_property
-    def u(self) -> list[sp.Symbol]:
-        return [symbol(n) for n in self.controls]
-
-    @cached_property
-    def p(self) -> list[sp.Symbol]:
-        return [symbol(n) for n in self.parameters]
-
-    @cached_property
-    def d(self) -> list[sp.Symbol]:
-        return [symbol(n) for n in self.design]
-
-    @cached_property
-    def w(self) -> list[sp.Symbol]:
-        return [symbol(n) for n in self.inputs]
-
-    @property
-    def t(self) -> sp.Symbol:
-        return TIME
-
-    @cached_property
-    def x0(self) -> list[sp.Symbol]:
-        return [symbol(f"{n}_0") for n in self.states]
-
-    @cached_property
-    def xf(self) -> list[sp.Symbol]:
-        return [symbol(f"{n}_f") for n in self.states]
-
-    @cached_property
-    def u0(self) -> list[sp.Symbol]:
-        """The controls at the initial time (``<control>_0``, in Mayer and boundary terms)."""
-        return [symbol(f"{n}_0") for n in self.controls]
-
-    @cached_property
-    def uf(self) -> list[sp.Symbol]:
-        return [symbol(f"{n}_f") for n in self.controls]
-
-    @cached_property
-    def tf(self) -> sp.Symbol:
-        return symbol("t_f")
-
-    @cached_property
-    def _running(self) -> dict[str, sp.Expr]:
-        """Running symbols, and each definition by its expanded expression (substituted where named)."""
-        names = [*self.parameters, *self.design, *self.inputs, *self.states, *self.controls]
-        symbols = {n: symbol(n) for n in names} | {"t": TIME}
-        for name, raw in self.spec.problem.definitions.items():
-            symbols[name] = parse(raw, symbols)
-        return symbols
-
-    @cached_property
-    def definitions(self) -> dict[str, sp.Expr]:
-        """Each named expression with the earlier ones substituted (over running symbols only)."""
-        return {n: self._running[n] for n in self.spec.problem.definitions}
-
-    @cached_property
-    def _ends(self) -> dict[str, sp.Expr]:
-        ends = {str(s): s for s in [*self.x0, *self.xf, *self.u0, *self.uf, self.tf]}
-        return {n: symbol(n) for n in [*self.parameters, *self.design]} | ends
-
-    @cached_property
-    def _params(self) -> dict[str, sp.Expr]:
-        return {n: symbol(n) for n in self.parameters}
-
     @property
     def sign(self) -> float:
         return -1.0 if self.spec.problem.objective.sense == "maximize" else 1.0
 
-    @cached_property
-    def dynamics(self) -> list[sp.Expr]:
-        dyn = self.spec.problem.dynamics
-        return [parse(dyn[n], self._running) for n in self.states]
+    @property
+    def running_names(self) -> list[str]:
+        """The names a running expression may use, in the order of :attr:`running_function`."""
+        return [*self.states, *self.controls, *self.inputs, *self.parameters, *self.design, "t"]
 
-    @cached_property
-    def lagrange(self) -> sp.Expr:
-        """The running cost in minimization form (``sign`` applied)."""
-        return self.sign * parse(self.spec.problem.objective.lagrange, self._running)
+    @property
+    def end_names(self) -> list[str]:
+        """The names an end-point expression may use."""
+        ends = [f"{n}_{e}" for e in "0f" for n in [*self.states, *self.controls]]
+        return [*self.parameters, *self.design, *ends, "t_f"]
 
-    @cached_property
-    def mayer(self) -> sp.Expr:
-        """The end cost in minimization form (``sign`` applied), over x0, xf, t_f, parameters."""
-        return self.sign * parse(self.spec.problem.objective.mayer, self._ends)
+    def running_values(
+        self, x: Sequence[Any], u: Sequence[Any], w: Sequence[Any], t: Any, others: Mapping[str, Any]
+    ) -> dict[str, Any]:
+        """The values of :attr:`running_names` by name: one per state, control and grid input,
+        ``t``, and the parameters and design variables from ``others``."""
+        values = dict(zip(self.states, x, strict=True)) | dict(zip(self.controls, u, strict=True))
+        return values | dict(zip(self.inputs, w, strict=True)) | dict(others) | {"t": t}
 
-    @cached_property
-    def path(self) -> list[Relation]:
-        """The path constraints, then each bound that uses ``t`` as ``x - bound(t) >= 0`` (lower)
-        or ``<= 0`` (upper)."""
+    def end_values(
+        self,
+        x: tuple[Sequence[Any], Sequence[Any]],
+        u: tuple[Sequence[Any], Sequence[Any]],
+        t_final: Any,
+        others: Mapping[str, Any],
+    ) -> dict[str, Any]:
+        """The values of :attr:`end_names` by name: the states ``x`` and controls ``u`` at the
+        (first, last) point, the final time, and the parameters and design variables from
+        ``others``."""
+        values: dict[str, Any] = dict(others)
+        for names, (first, last) in ((self.states, x), (self.controls, u)):
+            values |= {f"{n}_0": v for n, v in zip(names, first, strict=True)}
+            values |= {f"{n}_f": v for n, v in zip(names, last, strict=True)}
+        return values | {"t_f": t_final}
+
+    def scope(self, values: Mapping[str, Any], algebra: Algebra) -> dict[str, Any]:
+        """``values`` (by name) and each definition built over them and the earlier ones."""
+        scope = dict(values)
+        for name, raw in self.spec.problem.definitions.items():
+            scope[name] = expression(raw, scope, algebra)
+        return scope
+
+    def running_terms(self, values: Mapping[str, Any], algebra: Algebra) -> RunningTerms:
+        """The running terms over ``values`` (each of :attr:`running_names` by name)."""
         problem = self.spec.problem
-        relations = [parse_relation(c, self._running) for c in problem.path_constraints]
+        scope = self.scope(values, algebra)
+        lagrange = expression(problem.objective.lagrange, scope, algebra)
+        path = [relation(c, scope, algebra) for c in problem.path_constraints]
         for name, key, raw in problem.time_varying_bounds():
-            gap = symbol(name) - parse(raw, self._running)
-            relations.append(
-                Relation(gap, 0.0, math.inf) if key == "lower" else Relation(gap, -math.inf, 0.0)
-            )
-        return relations
+            gap = algebra.binary(ast.Sub, scope[name], expression(raw, scope, algebra))
+            path.append(Relation(gap, 0.0, math.inf) if key == "lower" else Relation(gap, -math.inf, 0.0))
+        return RunningTerms(
+            dynamics=[expression(problem.dynamics[n], scope, algebra) for n in self.states],
+            lagrange=algebra.binary(ast.Mult, algebra.number(self.sign), lagrange),
+            path=path,
+            integrands=[expression(c.integrand, scope, algebra) for c in problem.integral_constraints],
+        )
+
+    def end_terms(self, values: Mapping[str, Any], algebra: Algebra) -> EndTerms:
+        """The end-point terms over ``values`` (each of :attr:`end_names` by name)."""
+        problem = self.spec.problem
+        mayer = expression(problem.objective.mayer, values, algebra)
+        return EndTerms(
+            mayer=algebra.binary(ast.Mult, algebra.number(self.sign), mayer),
+            boundary=[relation(c, values, algebra) for c in problem.boundary_constraints],
+        )
+
+    @cached_property
+    def running_structure(self) -> RunningTerms:
+        """The running terms as the sets of names they depend on (:func:`dependencies`), with the
+        constraints' bounds."""
+        return self.running_terms({n: frozenset({n}) for n in self.running_names}, NAMES)
+
+    @cached_property
+    def end_structure(self) -> EndTerms:
+        """The end-point terms as the sets of names they depend on (with the constraints' bounds)."""
+        return self.end_terms({n: frozenset({n}) for n in self.end_names}, NAMES)
+
+    @cached_property
+    def _sympy(self) -> tuple[dict[str, Any], RunningTerms, EndTerms]:
+        """The definitions, running and end terms in SymPy (imported here, at the first use: a
+        CasADi solve never needs it)."""
+        from gamespec.symbolic.language import SYMPY
+
+        running = {n: self._symbols[n] for n in self.running_names}
+        ends = {n: self._symbols[n] for n in self.end_names}
+        return self.scope(running, SYMPY), self.running_terms(running, SYMPY), self.end_terms(ends, SYMPY)
+
+    @property
+    def definitions(self) -> dict[str, Any]:
+        """Each named expression in SymPy with the earlier ones substituted."""
+        return {n: self._sympy[0][n] for n in self.spec.problem.definitions}
+
+    @property
+    def dynamics(self) -> list[Any]:
+        """The dynamics in SymPy."""
+        return self._sympy[1].dynamics
+
+    @property
+    def lagrange(self) -> Any:
+        """The running cost in SymPy, in minimization form (``sign`` applied)."""
+        return self._sympy[1].lagrange
+
+    @property
+    def path(self) -> list[Relation]:
+        """The path constraints in SymPy (:class:`RunningTerms`)."""
+        return self._sympy[1].path
 
     @cached_property
     def integrals(self) -> list[Relation]:
-        """Integral constraints: ``lower <= integral of expr dt <= upper`` (integrands not signed),
-        the bounds at the file's parameter values (:meth:`integral_bounds` for others)."""
+        """Integral constraints in SymPy: ``lower <= integral of expr dt <= upper`` (integrands not
+        signed), the bounds at the file's parameter values (:meth:`integral_bounds` for others)."""
         bounds = self.integral_bounds(self.parameter_values())
-        return [
-            Relation(parse(c.integrand, self._running), lo, hi)
-            for c, (lo, hi) in zip(self.spec.problem.integral_constraints, bounds, strict=True)
-        ]
+        return [Relation(e, lo, hi) for e, (lo, hi) in zip(self._sympy[1].integrands, bounds, strict=True)]
 
     def integral_bounds(self, params: Mapping[str, float]) -> list[tuple[float, float]]:
         """Per integral constraint ``(lower, upper)`` for these parameter values."""
         return self._evaluated(params).integrals
 
-    @cached_property
+    @property
+    def mayer(self) -> Any:
+        """The end cost in SymPy, in minimization form (``sign`` applied)."""
+        return self._sympy[2].mayer
+
+    @property
     def boundary(self) -> list[Relation]:
-        return [parse_relation(c, self._ends) for c in self.spec.problem.boundary_constraints]
+        """The boundary constraints in SymPy."""
+        return self._sympy[2].boundary
 
     @cached_property
-    def hamiltonian_end_value(self) -> sp.Expr:
-        """``-dPhi/dt_f`` for the minimization form: the constant value of H on an autonomous,
-        free-final-time problem (transversality, e.g. eq. 2.23)."""
-        return -sp.diff(self.mayer, self.tf)
+    def _symbols(self) -> dict[str, Any]:
+        from gamespec.symbolic.language import symbol
+
+        return {n: symbol(n) for n in [*self.running_names, *self.end_names]}
+
+    @property
+    def x(self) -> list[Any]:
+        return [self._symbols[n] for n in self.states]
+
+    @property
+    def u(self) -> list[Any]:
+        return [self._symbols[n] for n in self.controls]
+
+    @property
+    def p(self) -> list[Any]:
+        return [self._symbols[n] for n in self.parameters]
+
+    @property
+    def d(self) -> list[Any]:
+        return [self._symbols[n] for n in self.design]
+
+    @property
+    def w(self) -> list[Any]:
+        return [self._symbols[n] for n in self.inputs]
+
+    @property
+    def t(self) -> Any:
+        return self._symbols["t"]
+
+    @property
+    def x0(self) -> list[Any]:
+        return [self._symbols[f"{n}_0"] for n in self.states]
+
+    @property
+    def xf(self) -> list[Any]:
+        return [self._symbols[f"{n}_f"] for n in self.states]
+
+    @property
+    def u0(self) -> list[Any]:
+        """The controls at the initial time (``<control>_0``, in Mayer and boundary terms)."""
+        return [self._symbols[f"{n}_0"] for n in self.controls]
+
+    @property
+    def uf(self) -> list[Any]:
+        return [self._symbols[f"{n}_f"] for n in self.controls]
+
+    @property
+    def tf(self) -> Any:
+        return self._symbols["t_f"]
 
     @property
     def autonomous(self) -> bool:
         """No explicit ``t`` in the dynamics and the running cost (grid inputs aside: see
         :meth:`inputs_in_hamiltonian`)."""
-        exprs = [*self.dynamics, self.lagrange]
-        return not any(TIME in e.free_symbols for e in exprs)
+        return "t" not in self._hamiltonian_names
 
     @cached_property
-    def running_arguments(self) -> list[sp.Symbol]:
-        """The symbols a running expression may use, in the order of :attr:`running_function`."""
-        return [*self.x, *self.u, *self.w, *self.p, *self.d, self.t]
+    def _hamiltonian_names(self) -> frozenset[str]:
+        terms = self.running_structure
+        return frozenset().union(*map(dependencies, [*terms.dynamics, terms.lagrange]))
 
     @cached_property
     def running_function(self) -> Callable[..., np.ndarray]:
-        """The dynamics and the Lagrange integrand, translated once: called with one array per
-        :attr:`running_arguments` it returns ``(n_x + 1, *shape)`` (the checks evaluate them often)."""
-        return numeric_function([*self.dynamics, self.lagrange], self.running_arguments)
+        """The dynamics and the Lagrange integrand, recorded once: called with one array per
+        :attr:`running_names` it returns ``(n_x + 1, *shape)`` (the checks evaluate them often)."""
+        names = self.running_names
+
+        def build(slots: list[Any], library: Any) -> list[Any]:
+            terms = self.running_terms(dict(zip(names, slots, strict=True)), LibraryAlgebra(library))
+            return [*terms.dynamics, terms.lagrange]
+
+        return vectorized(build, len(names), NUMPY)
 
     @cached_property
     def inputs_in_hamiltonian(self) -> list[int]:
         """Indices of the grid inputs that enter the dynamics or the running cost: a time-varying
         one makes H time-varying (``dH/dt = dH/dw * dw/dt`` on an optimal arc)."""
-        used = set().union(*(e.free_symbols for e in [*self.dynamics, self.lagrange]))
-        return [i for i, s in enumerate(self.w) if s in used]
+        return [i for i, n in enumerate(self.inputs) if n in self._hamiltonian_names]
 
     def parameter_values(self, overrides: Mapping[str, float] | None = None) -> dict[str, float]:
         """The file's parameter values with ``overrides`` applied, derived parameters recomputed

@@ -15,15 +15,15 @@ from typing import Any
 
 import numpy as np
 
-from gamespec.errors import SpecError
+from gamespec.errors import ExpressionError, SpecError
 from gamespec.ocp.checks import Trajectory, control_basis, solution_checks, verdicts
 from gamespec.ocp.collocation import Grid
 from gamespec.ocp.inputs import InputGrid, InputValue, on_grid
 from gamespec.ocp.symbolic import SymbolicOcp
 from gamespec.result import Result, Status
 from gamespec.specs.ocp import NORMALIZED_TIME, OptimalControlSpec, bounds_midpoint
-from gamespec.symbolic.language import ExpressionError, parse, symbol
-from gamespec.symbolic.translate import NUMPY, translate
+from gamespec.symbolic.grammar import expression
+from gamespec.symbolic.library import NUMPY, LibraryAlgebra
 
 
 @dataclass(frozen=True)
@@ -186,13 +186,11 @@ class Transcription:
         if raw == "linear":
             a, b = _linear_ends(start, end, lo, hi)
             return a + (b - a) * tau
-        symbols = {n: symbol(n) for n in params} | {NORMALIZED_TIME: symbol(NORMALIZED_TIME)}
         try:
-            expr = parse(raw, symbols)
+            value = expression(raw, dict(params) | {NORMALIZED_TIME: tau}, LibraryAlgebra(NUMPY))
         except ExpressionError as err:
             raise SpecError(str(err), field=field, source=self.spec.source) from None
-        values = {symbol(k): v for k, v in params.items()} | {symbol(NORMALIZED_TIME): tau}
-        return np.broadcast_to(np.asarray(translate(expr, values, NUMPY), dtype=float), tau.shape).copy()
+        return np.broadcast_to(np.asarray(value, dtype=float), tau.shape).copy()
 
     def _guess_from_result(self, previous: Result) -> Guess:
         t = np.asarray(previous.time)

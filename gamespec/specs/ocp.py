@@ -2,8 +2,9 @@
 
 Three sections as in rockit: ``problem`` (what), ``method`` (transcription) and ``solver`` (which
 backend, with per-backend options), plus an optional ``guess``. Every expression is a string in the
-safe language of :mod:`gamespec.symbolic.language`; this module checks that each one parses over the
-symbols it may use, so a typo stops at load time with the field that holds it.
+safe language of :mod:`gamespec.symbolic.grammar`; this module checks that each one parses over the
+names it may use, so a typo stops at load time with the field that holds it (the whitelist walk in
+floats: no SymPy at load).
 """
 
 from __future__ import annotations
@@ -12,7 +13,7 @@ import ast
 import dataclasses
 import itertools
 import math
-from collections.abc import Callable, Mapping
+from collections.abc import Mapping
 from dataclasses import dataclass
 from typing import ClassVar, Literal
 
@@ -23,8 +24,15 @@ from gamespec.limits import MAX_INTERVALS
 from gamespec.specs.base import Number, ProblemParameters, SpecBase, StrictModel, Value
 from gamespec.specs.plot import PlotHint
 from gamespec.specs.uncertainty import UncertainParameter
-from gamespec.symbolic.language import RESERVED, parse, parse_relation, symbol
-from gamespec.symbolic.translate import numeric
+from gamespec.symbolic.grammar import (
+    NAMES,
+    RESERVED,
+    check,
+    dependencies,
+    expression,
+    numeric_value,
+    relation,
+)
 
 INF = math.inf
 NORMALIZED_TIME = "tau"
@@ -238,14 +246,13 @@ class OcpProblem(StrictModel):
         """Bounds, fixed end values and a fixed final time as floats for these parameter values;
         a SpecError naming the field when one is not finite, a lower bound exceeds its upper
         bound, or a fixed value lies outside its bounds."""
-        symbols = {n: symbol(n) for n in self.parameters}
-        values = {symbol(k): float(v) for k, v in params.items()}
+        values = {n: float(params[n]) for n in self.parameters if n in params}
 
         def number(raw: float | str | None, default: float, field: str) -> float:
             if raw is None or (default in (-INF, INF) and is_time_varying(raw)):
                 return default
             if isinstance(raw, str):
-                raw = numeric(parse(raw, symbols), values)
+                raw = numeric_value(raw, values)
             if not math.isfinite(raw):
                 raise SpecError(f"evaluates to {raw} (a finite number is needed)", field=f"problem.{field}")
             return float(raw)
@@ -303,11 +310,11 @@ class OcpProblem(StrictModel):
     def _check_expressions(self) -> None:
         """Parse every expression over the symbols its field may use; an input where it may not
         appear (bounds, end values, Mayer and boundary terms, the final time) is named as such."""
-        params = {n: symbol(n) for n in self.parameters}
-        inputs = {n: symbol(n) for n in self.inputs}
-        design = {n: symbol(n) for n in self.design}
+        params = dict.fromkeys(self.parameters)
+        inputs = dict.fromkeys(self.inputs)
+        design = dict.fromkeys(self.design)
         running = {**params, **design, **inputs}
-        running |= {n: symbol(n) for n in [*self.states, *self.controls, "t"]}
+        running |= dict.fromkeys([*self.states, *self.controls, "t"])
         checks: list[tuple[str, object, dict, bool]] = []
         earlier: dict = {}
         for name, raw in self.parameters.items():
@@ -316,14 +323,14 @@ class OcpProblem(StrictModel):
             earlier[name] = params[name]
         for name, raw in self.definitions.items():
             checks.append((f"definitions.{name}", raw, dict(running), False))
-            running[name] = symbol(name)
+            running[name] = None
         ends = {
             **params,
             **design,
-            **{f"{s}_{e}": symbol(f"{s}_{e}") for s in [*self.states, *self.controls] for e in "0f"},
-            "t_f": symbol("t_f"),
+            **dict.fromkeys(f"{s}_{e}" for s in [*self.states, *self.controls] for e in "0f"),
+            "t_f": None,
         }
-        timed = params | {"t": symbol("t")}
+        timed = params | {"t": None}
         for group, items in (("states", self.states), ("controls", self.controls), ("design", self.design)):
             for name, spec in items.items():
                 for key, value in spec.model_dump(exclude={"scale"}).items():
@@ -338,7 +345,7 @@ class OcpProblem(StrictModel):
                             )
                         checks.append((f"{group}.{name}.{key}", value, timed if along else params, False))
         checks += [
-            (f"inputs.{n}.default", i.default, params | {NORMALIZED_TIME: symbol(NORMALIZED_TIME)}, False)
+            (f"inputs.{n}.default", i.default, params | {NORMALIZED_TIME: None}, False)
             for n, i in self.inputs.items()
             if isinstance(i.default, str)
         ]
@@ -363,12 +370,11 @@ class OcpProblem(StrictModel):
         checks += [
             (f"boundary_constraints.{i}", c, ends, True) for i, c in enumerate(self.boundary_constraints)
         ]
-        for field, text, symbols, relation in checks:
-            read = parse_relation if relation else parse
+        for field, text, symbols, constraint in checks:
             try:
-                read(text, symbols)
+                check(text, symbols, constraint=constraint)
             except ExpressionError as err:
-                used = _inputs_in(read, text, symbols, inputs)
+                used = _inputs_in(constraint, text, symbols, inputs)
                 reason = (
                     f"uses grid input(s) {', '.join(used)}: inputs are signals along the horizon and "
                     "may appear only in dynamics, the Lagrange integrand and path constraints"
@@ -387,8 +393,7 @@ def parameter_values(
     values: dict[str, float] = {}
     for name, raw in parameters.items():
         if isinstance(raw, str):
-            expr = parse(raw, {n: symbol(n) for n in values})
-            value = numeric(expr, {symbol(k): v for k, v in values.items()})
+            value = numeric_value(raw, values)
             if not math.isfinite(value):
                 raise SpecError(f"evaluates to {value}", field=f"problem.parameters.{name}")
             values[name] = value
@@ -412,10 +417,10 @@ def _bound_over_time(text: str, timed: dict, running: dict, field: str) -> None:
     """A bound may use the parameters and ``t``; one over states or controls is refused with a
     pointer to ``path_constraints``."""
     try:
-        parse(text, timed)
+        check(text, timed)
     except ExpressionError:
         try:
-            parse(text, running)
+            check(text, running)
         except ExpressionError:
             return
         raise SpecError(
@@ -425,16 +430,16 @@ def _bound_over_time(text: str, timed: dict, running: dict, field: str) -> None:
         ) from None
 
 
-def _inputs_in(read: Callable, text: str, symbols: dict, inputs: dict) -> list[str]:
+def _inputs_in(constraint: bool, text: str, symbols: dict, inputs: dict) -> list[str]:
     """The grid inputs that ``text`` uses, when it parses once they are allowed (else none)."""
     if not inputs or set(inputs) <= set(symbols):
         return []
+    names = {n: frozenset({n}) for n in symbols | inputs}
     try:
-        parsed = read(text, symbols | inputs)
+        used = relation(text, names, NAMES).expr if constraint else expression(text, names, NAMES)
     except ExpressionError:
         return []
-    expr = getattr(parsed, "expr", parsed)
-    return sorted(n for n, s in inputs.items() if s in expr.free_symbols)
+    return sorted(dependencies(used) & set(inputs))
 
 
 @dataclass(frozen=True)

@@ -1,11 +1,22 @@
-"""The symbolic layer under the specs (DESIGN.md, "Layers"), four modules:
+"""The symbolic layer under the specs (DESIGN.md, "Layers"):
 
-- :mod:`~gamespec.symbolic.language`: the safe expression language of problem files, parsed by a
-  whitelist into SymPy (``parse``, ``parse_relation``, ``symbol``, ``FUNCTIONS``);
+- :mod:`~gamespec.symbolic.grammar`: the safe expression language of problem files, one whitelist
+  walk that builds its value in an algebra (``expression``, ``relation``; floats for the checks at
+  load, ``check`` and ``numeric_value``; the names a term depends on, ``NAMES``), without SymPy;
+- :mod:`~gamespec.symbolic.library`: a backend's functions (``Library``, ``NUMPY``) and the algebra
+  that builds that backend's expressions straight from the text (``LibraryAlgebra``: the CasADi
+  graph, the Pyomo model, NumPy arrays for the checks);
+- :mod:`~gamespec.symbolic.language`: the same walk into SymPy (``parse``, ``parse_relation``,
+  ``symbol``, ``FUNCTIONS``), for the transforms that differentiate and the generated problems;
 - :mod:`~gamespec.symbolic.printer`: SymPy back to that language (``to_text``, with
   ``parse(to_text(e)) == e``), so generated problems are built in SymPy, never from f-strings;
 - :mod:`~gamespec.symbolic.translate`: SymPy into a backend's own expressions by walking the tree
-  (``Library``, ``translate``, ``numeric``, ``NUMPY``);
+  (``translate``, ``numeric``);
+- :mod:`~gamespec.symbolic.tape`: a walk recorded once and replayed over NumPy arrays;
 - :mod:`~gamespec.symbolic.calculus`: Jacobians and gradients of expression maps, vectorized NumPy
   evaluation and the linearization about a trajectory (eqs. 5.5–5.6).
+
+SymPy's import costs more than a small solve (about 0.2 s of CPU), so only the modules that need a
+computer-algebra system import it: loading, validating and solving an ``optimal_control`` file on
+CasADi or Pyomo never do.
 """

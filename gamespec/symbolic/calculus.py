@@ -3,7 +3,7 @@ equations, chapter 5's linearization about a nominal trajectory).
 
 :func:`jacobian` and :func:`gradient` are SymPy's derivatives of an expression map;
 :func:`numeric_function` evaluates expressions over arrays through a tape recorded once by
-:func:`~gamespec.symbolic.tape.record` (no ``lambdify``, no code generation);
+:func:`~gamespec.symbolic.tape.vectorized` (no ``lambdify``, no code generation);
 :func:`linearize` gives ``A(t) = ∂f/∂x`` (eq. 5.6) and ``B(t) = ∂f/∂u`` along a trajectory, the
 matrices of the linearized dynamics ``dx ≈ (B u + r + A x) dt`` (eq. 5.5).
 """
@@ -16,8 +16,9 @@ import numpy as np
 import sympy as sp
 
 from gamespec.errors import ExpressionError
-from gamespec.symbolic.tape import as_array, record
-from gamespec.symbolic.translate import NUMPY, Library
+from gamespec.symbolic.library import NUMPY, Library
+from gamespec.symbolic.tape import vectorized
+from gamespec.symbolic.translate import translate
 
 
 def jacobian(exprs: Sequence[sp.Expr] | sp.Matrix, wrt: Sequence[sp.Symbol]) -> sp.Matrix:
@@ -45,15 +46,11 @@ def numeric_function(
         names = ", ".join(sorted(map(str, free)))
         raise ExpressionError(", ".join(map(str, exprs)), f"symbols {names} are not arguments")
 
-    tape = record(exprs, args, library)
+    def build(slots: list, lib: Library) -> list:
+        values = dict(zip(args, slots, strict=True))
+        return [translate(e, values, lib) for e in exprs]
 
-    def evaluate(*values: np.ndarray | float) -> np.ndarray:
-        if len(values) != len(args):
-            raise TypeError(f"expected {len(args)} arrays ({', '.join(map(str, args))}), got {len(values)}")
-        arrays = [np.asarray(v, dtype=float) for v in values]
-        return as_array(tape(arrays), np.broadcast_shapes(*(a.shape for a in arrays)))
-
-    return evaluate
+    return vectorized(build, len(args), library)
 
 
 def linearize(

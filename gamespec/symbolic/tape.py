@@ -1,7 +1,8 @@
 """Expressions translated once into a tape of NumPy operations, then evaluated many times.
 
-:func:`~gamespec.symbolic.translate.translate` walks a SymPy tree on every call, which dominates
-when the same expressions are evaluated over and over (an RK4 re-integration calls the dynamics
+Walking an expression (a SymPy tree with :func:`~gamespec.symbolic.translate.translate`, a file's
+text with :class:`~gamespec.symbolic.library.LibraryAlgebra`) on every call dominates when the same
+expressions are evaluated over and over (an RK4 re-integration calls the dynamics
 ``4 * RK4_STEPS`` times per check). :func:`record` runs that same walk once over :class:`Slot`
 placeholders, so the translation rules stay in one place: every arithmetic operation and library
 function applied to a slot appends one step to a :class:`Tape` instead of computing a value. The
@@ -16,9 +17,8 @@ from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
-import sympy as sp
 
-from gamespec.symbolic.translate import NUMPY, Library, translate
+from gamespec.symbolic.library import NUMPY, Library
 
 
 @dataclass
@@ -63,6 +63,18 @@ class Slot:
     def __rtruediv__(self, other: Any) -> Slot:
         return self.tape.push(operator.truediv, other, self)
 
+    def __sub__(self, other: Any) -> Slot:
+        return self.tape.push(operator.sub, self, other)
+
+    def __rsub__(self, other: Any) -> Slot:
+        return self.tape.push(operator.sub, other, self)
+
+    def __pow__(self, other: Any) -> Slot:
+        return self.tape.push(operator.pow, self, other)
+
+    def __rpow__(self, other: Any) -> Slot:
+        return self.tape.push(operator.pow, other, self)
+
     def __neg__(self) -> Slot:
         return self.tape.push(operator.neg, self)
 
@@ -77,18 +89,33 @@ def _recording(library: Library, tape: Tape) -> Library:
     return Library(functions, power=recorder(library.power))
 
 
-def record(
-    exprs: Sequence[sp.Expr], args: Sequence[sp.Symbol], library: Library = NUMPY
-) -> Callable[[Sequence[Any]], list[Any]]:
-    """A function of the argument values returning the value of each expression (a number for an
-    expression that depends on no argument), with the tree walked once, here."""
-    tape = Tape(len(args))
-    slots = {a: Slot(tape, i) for i, a in enumerate(args)}
-    outputs = [translate(e, slots, _recording(library, tape)) for e in exprs]
+Build = Callable[[list[Slot], Library], Sequence[Any]]
+"""Builds the outputs from one value per argument with a library's functions."""
+
+
+def record(build: Build, n_args: int, library: Library = NUMPY) -> Callable[[Sequence[Any]], list[Any]]:
+    """A function of the argument values returning the value of each output of ``build`` (a
+    number for an output that depends on no argument), with ``build`` run once, here, on slots."""
+    tape = Tape(n_args)
+    outputs = list(build([Slot(tape, i) for i in range(n_args)], _recording(library, tape)))
 
     def evaluate(values: Sequence[Any]) -> list[Any]:
         registers = tape.run(values)
         return [registers[o.index] if isinstance(o, Slot) else o for o in outputs]
+
+    return evaluate
+
+
+def vectorized(build: Build, n_args: int, library: Library = NUMPY) -> Callable[..., np.ndarray]:
+    """The outputs of ``build`` as a vectorized function: called with one array (or number) per
+    argument, broadcast together to a shape ``s``, it returns an array ``(outputs, *s)``."""
+    tape = record(build, n_args, library)
+
+    def evaluate(*values: np.ndarray | float) -> np.ndarray:
+        if len(values) != n_args:
+            raise TypeError(f"expected {n_args} arrays, got {len(values)}")
+        arrays = [np.asarray(v, dtype=float) for v in values]
+        return as_array(tape(arrays), np.broadcast_shapes(*(a.shape for a in arrays)))
 
     return evaluate
 

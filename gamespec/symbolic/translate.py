@@ -1,40 +1,20 @@
 """SymPy → a backend's own expressions, by walking the tree (no code generation, no ``eval``).
 
-A :class:`Library` names the functions of the target (NumPy, CasADi, Pyomo, ...). The walk is
-memoised per node, so shared sub-expressions are translated once.
+A :class:`~gamespec.symbolic.library.Library` names the functions of the target (NumPy, CasADi,
+Pyomo, ...). The walk is memoised per node, so shared sub-expressions are translated once.
 """
 
 from __future__ import annotations
 
 import math
-from collections.abc import Callable, Iterator, Mapping
-from dataclasses import dataclass, field
-from functools import cached_property, reduce
+from collections.abc import Mapping
+from functools import reduce
 from typing import Any
 
 import sympy as sp
 
 from gamespec.errors import ExpressionError
-
-
-@dataclass(frozen=True)
-class Library:
-    """The target's elementary functions, by the names of :data:`gamespec.symbolic.language.FUNCTIONS`."""
-
-    functions: Mapping[str, Callable[..., Any]]
-    power: Callable[[Any, Any], Any] = field(default=lambda a, b: a**b)
-
-    @classmethod
-    def from_namespace(
-        cls, namespace: Any, *, power: Callable[[Any, Any], Any] | None = None, **renamed: Callable[..., Any]
-    ) -> Library:
-        """The functions of :data:`gamespec.symbolic.language.FUNCTIONS` taken from ``namespace`` by
-        the same name (``namespace.sin`` ...), except those given in ``renamed``."""
-        from gamespec.symbolic.language import FUNCTIONS
-
-        functions = {name: renamed.get(name) or getattr(namespace, name) for name in FUNCTIONS}
-        return cls(functions) if power is None else cls(functions, power=power)
-
+from gamespec.symbolic.library import NUMPY, Library
 
 _SYMPY_NAMES: dict[type, str] = {
     sp.sin: "sin",
@@ -53,44 +33,6 @@ _SYMPY_NAMES: dict[type, str] = {
     sp.sign: "sign",
     sp.Heaviside: "heaviside",
 }
-
-
-def _numpy_heaviside(x: Any) -> Any:
-    """The unit step with SymPy's value ``heaviside(0) = 1/2``."""
-    import numpy as np
-
-    return np.heaviside(x, 0.5)
-
-
-def _numpy_power(base: Any, exponent: Any) -> Any:
-    import numpy as np
-
-    return np.power(base, exponent)
-
-
-class _NumpyFunctions(Mapping[str, Callable[..., Any]]):
-    """NumPy's functions by gamespec's names, looked up in NumPy at the first use: a bound or
-    parameter without functions (``-pi``, ``2*xf``) is evaluated at load without importing NumPy."""
-
-    @cached_property
-    def _table(self) -> Mapping[str, Callable[..., Any]]:
-        import numpy as np
-
-        renamed = {"asin": np.arcsin, "acos": np.arccos, "atan": np.arctan, "atan2": np.arctan2}
-        renamed |= {"min": np.minimum, "max": np.maximum, "heaviside": _numpy_heaviside}
-        return Library.from_namespace(np, **renamed).functions
-
-    def __getitem__(self, name: str) -> Callable[..., Any]:
-        return self._table[name]
-
-    def __iter__(self) -> Iterator[str]:
-        return iter(self._table)
-
-    def __len__(self) -> int:
-        return len(self._table)
-
-
-NUMPY = Library(_NumpyFunctions(), power=_numpy_power)
 
 
 def translate(expr: sp.Expr, values: Mapping[sp.Symbol, Any], library: Library) -> Any:

@@ -15,8 +15,9 @@ from hypothesis import strategies as st
 
 from gamespec.errors import ExpressionError
 from gamespec.symbolic.language import FUNCTIONS, float_value, parse, parse_relation, symbol
+from gamespec.symbolic.library import NUMPY
 from gamespec.symbolic.printer import to_text
-from gamespec.symbolic.translate import NUMPY, translate
+from gamespec.symbolic.translate import translate
 
 SYMBOLS = {name: symbol(name) for name in ("x", "y", "t")}
 X, Y, T = SYMBOLS.values()

@@ -1,9 +1,10 @@
 """Start-up guards (issue 16, item 2): what a command imports, read from ``sys.modules`` in a fresh
 interpreter after the command ran. Structural, not timed: ``gamespec --help`` needs neither NumPy,
 SymPy, SciPy, rich nor a backend (pydantic is not checked: typer may import it to read parameter
-types); ``validate`` of a file whose bounds use no functions neither NumPy nor a solver; a CasADi
-solve of an ``optimal_control`` file neither SciPy nor another backend, and with ``--json`` where
-stderr is no terminal not rich either (no spinner to draw). The plugin registry reads the installed
+types); ``validate`` of a file whose bounds use no functions neither NumPy, SymPy nor a solver (the
+whitelist walk in floats); a CasADi solve of an ``optimal_control`` file neither SymPy (its terms
+are built from the text), SciPy nor another backend, and with ``--json`` where stderr is no
+terminal not rich either (no spinner to draw). The plugin registry reads the installed
 distributions' entry points once for all groups, and the console script leaves the objects of a
 finished command frozen out of the exit's garbage collections. The CPU times themselves are
 measured in ``benchmarks/test_bench_startup.py``."""
@@ -46,16 +47,16 @@ def test_help_imports_no_heavy_package(argv: list[str]) -> None:
     assert imported_by(*argv) & heavy == set()
 
 
-def test_validate_imports_no_numpy_and_no_solver() -> None:
-    assert imported_by("validate", FILE) & {"numpy", "scipy", "matplotlib", *SOLVERS, *BACKENDS} == set()
+def test_validate_imports_no_numpy_no_sympy_and_no_solver() -> None:
+    heavy = {"numpy", "sympy", "scipy", "matplotlib", *SOLVERS, *BACKENDS}
+    assert imported_by("validate", FILE) & heavy == set()
 
 
-def test_casadi_solve_imports_no_scipy_and_no_other_backend() -> None:
+def test_casadi_solve_imports_no_sympy_no_scipy_and_no_other_backend() -> None:
     modules = imported_by("solve", FILE)
     assert {"casadi", "gamespec_casadi"} <= modules
-    assert (
-        modules & {"scipy", "matplotlib", *(SOLVERS - {"casadi"}), *(BACKENDS - {"gamespec_casadi"})} == set()
-    )
+    others = {*(SOLVERS - {"casadi"}), *(BACKENDS - {"gamespec_casadi"})}
+    assert modules & {"sympy", "scipy", "matplotlib", *others} == set()
 
 
 def test_json_solve_without_a_terminal_imports_no_rich() -> None:

@@ -13,7 +13,8 @@ from gamespec_pyomo.model import pyomo_library
 
 from gamespec.errors import UnsupportedFeature
 from gamespec.symbolic.language import parse, symbol
-from gamespec.symbolic.translate import NUMPY, translate
+from gamespec.symbolic.library import NUMPY
+from gamespec.symbolic.translate import translate
 
 X = symbol("x")
 EXPRESSIONS = ["sign(x)", "heaviside(x)", "sign(x - 1)*heaviside(1 - x) + heaviside(x)**2"]

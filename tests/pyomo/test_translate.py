@@ -12,7 +12,8 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from gamespec.symbolic.language import parse, symbol
-from gamespec.symbolic.translate import NUMPY, translate
+from gamespec.symbolic.library import NUMPY
+from gamespec.symbolic.translate import translate
 
 EXPRESSIONS = [
     "sin(x)*cos(y) - tan(x/4)",

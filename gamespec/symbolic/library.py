@@ -1,0 +1,108 @@
+"""A backend's elementary functions (:class:`Library`) and the walk of
+:mod:`gamespec.symbolic.grammar` building that backend's expressions (:class:`LibraryAlgebra`)
+straight from a file's text, without SymPy; :data:`NUMPY` is NumPy's library.
+"""
+
+from __future__ import annotations
+
+import ast
+import operator
+from collections.abc import Callable, Iterator, Mapping
+from dataclasses import dataclass
+from functools import cached_property
+from typing import Any
+
+from gamespec.symbolic.grammar import BINARY, FLOATS, FUNCTION_ARITY
+
+
+@dataclass(frozen=True)
+class Library:
+    """A target's elementary functions, by the names of :data:`FUNCTION_ARITY`."""
+
+    functions: Mapping[str, Callable[..., Any]]
+    power: Callable[[Any, Any], Any] = operator.pow
+
+    @classmethod
+    def from_namespace(
+        cls, namespace: Any, *, power: Callable[[Any, Any], Any] | None = None, **renamed: Callable[..., Any]
+    ) -> Library:
+        """The functions of :data:`FUNCTION_ARITY` taken from ``namespace`` by the same name
+        (``namespace.sin`` ...), except those given in ``renamed``."""
+        functions = {name: renamed.get(name) or getattr(namespace, name) for name in FUNCTION_ARITY}
+        return cls(functions) if power is None else cls(functions, power=power)
+
+
+def _numpy_heaviside(x: Any) -> Any:
+    """The unit step with SymPy's value ``heaviside(0) = 1/2``."""
+    import numpy as np
+
+    return np.heaviside(x, 0.5)
+
+
+def _numpy_power(base: Any, exponent: Any) -> Any:
+    import numpy as np
+
+    return np.power(base, exponent)
+
+
+class _NumpyFunctions(Mapping[str, Callable[..., Any]]):
+    """NumPy's functions by gamespec's names, looked up in NumPy at the first use: a bound or
+    parameter without functions (``-pi``, ``2*xf``) is evaluated at load without importing NumPy."""
+
+    @cached_property
+    def _table(self) -> Mapping[str, Callable[..., Any]]:
+        import numpy as np
+
+        renamed = {"asin": np.arcsin, "acos": np.arccos, "atan": np.arctan, "atan2": np.arctan2}
+        renamed |= {"min": np.minimum, "max": np.maximum, "heaviside": _numpy_heaviside}
+        return Library.from_namespace(np, **renamed).functions
+
+    def __getitem__(self, name: str) -> Callable[..., Any]:
+        return self._table[name]
+
+    def __iter__(self) -> Iterator[str]:
+        return iter(self._table)
+
+    def __len__(self) -> int:
+        return len(self._table)
+
+
+NUMPY = Library(_NumpyFunctions(), power=_numpy_power)
+
+
+class LibraryAlgebra:
+    """A backend's own expressions (CasADi, NumPy arrays, a tape), built with ``library`` over the
+    values given for the names; a part without names is computed in floats
+    (:data:`~gamespec.symbolic.grammar.FLOATS`, which refuses ``1/0``)."""
+
+    def __init__(self, library: Library) -> None:
+        self.library = library
+
+    @staticmethod
+    def _numbers(*args: Any) -> bool:
+        return all(isinstance(a, int | float) for a in args)
+
+    def number(self, value: int | float) -> float:
+        return FLOATS.number(value)
+
+    def constant(self, name: str) -> float:
+        return FLOATS.constant(name)
+
+    def binary(self, op: type[ast.operator], left: Any, right: Any) -> Any:
+        return FLOATS.binary(op, left, right) if self._numbers(left, right) else BINARY[op](left, right)
+
+    def negate(self, value: Any) -> Any:
+        return -value
+
+    def power(self, base: Any, exponent: Any) -> Any:
+        if self._numbers(base, exponent):
+            return FLOATS.power(base, exponent)
+        return self.library.power(base, exponent)
+
+    def call(self, name: str, args: list[Any]) -> Any:
+        if self._numbers(*args):
+            return FLOATS.call(name, args)
+        return self.library.functions[name](*args)
+
+    def scalar(self, value: Any) -> float | None:
+        return float(value) if self._numbers(value) else None

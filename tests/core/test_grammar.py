@@ -1,0 +1,190 @@
+"""The whitelist walk without SymPy (:mod:`gamespec.symbolic.grammar`) against the walk into SymPy
+(:mod:`gamespec.symbolic.language`): the same texts refused, the same values built (straight from
+the text with NumPy, or SymPy translated to NumPy), and every shipped ``optimal_control`` file's
+terms equal on both routes, so that a CasADi or Pyomo model built from the text is the model the
+SymPy form describes."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+import sympy as sp
+import yaml
+from hypothesis import HealthCheck, assume, given, settings
+
+from gamespec.errors import ExpressionError
+from gamespec.loader import load, spec_from_dict
+from gamespec.ocp.checks import hamiltonian_end_value
+from gamespec.ocp.symbolic import SymbolicOcp
+from gamespec.ocp.transcription import Transcription
+from gamespec.symbolic.grammar import (
+    NAMES,
+    check,
+    dependencies,
+    expression,
+    numeric_value,
+    relation,
+    used_names,
+)
+from gamespec.symbolic.language import parse, parse_relation, symbol
+from gamespec.symbolic.library import NUMPY, LibraryAlgebra
+from gamespec.symbolic.printer import to_text
+from gamespec.symbolic.translate import numeric, translate
+from tests.conftest import PROBLEMS
+from tests.core.test_printer import MORE_BINARY, MORE_UNARY, REAL_BINARY, REAL_UNARY, representable, trees
+
+ARRAYS = LibraryAlgebra(NUMPY)
+NAMES_XYT = ("x", "y", "t")
+RNG_POINTS = np.random.default_rng(7).uniform(-2.0, 2.0, size=(3, 16))
+ZERMELO = PROBLEMS / "ch6" / "zermelo_min_time.yaml"
+
+
+@pytest.mark.parametrize(
+    "text",
+    [
+        "1/0",
+        "x/0",
+        "x/(1 - 1)",
+        "log(0)",
+        "sqrt(-1)",
+        "(-2)**0.5",
+        "9**9**9",
+        "exp(1000) - exp(1000)",
+        "x*1e300*1e300",
+        "x/1e-300/1e-300",
+        "(x*1e300)**2",
+        "max(exp(exp(exp(9))), x)",
+        "sin(10**400)",
+        "1e400",
+        "x^2",
+        "z",
+        "sin",
+        "f(x)",
+        "x < 1",
+        "[x]",
+    ],
+)
+def test_both_walks_refuse_the_same_texts(text: str) -> None:
+    with pytest.raises(ExpressionError):
+        parse(text, {n: symbol(n) for n in NAMES_XYT})
+    with pytest.raises(ExpressionError):
+        check(text, NAMES_XYT)
+
+
+@pytest.mark.parametrize(
+    "text",
+    ["x*1e300/1e300", "1e300*x + 1e300*y", "exp(x*1e300)", "2**1000*x", "atan2(0, -1)", "heaviside(0)*x"],
+)
+def test_both_walks_accept_the_same_texts(text: str) -> None:
+    parse(text, {n: symbol(n) for n in NAMES_XYT})
+    check(text, NAMES_XYT)
+
+
+@pytest.mark.parametrize(
+    "text", ["2*pi/3 + atan2(1, 2)", "sqrt(2)**2 - heaviside(0)", "min(3, 2**-1) * sign(-4)"]
+)
+def test_numbers_agree_with_sympy(text: str) -> None:
+    assert numeric_value(text, {}) == pytest.approx(numeric(parse(text, {}), {}), rel=1e-15, abs=1e-15)
+
+
+@settings(max_examples=300, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@given(trees(REAL_UNARY + MORE_UNARY, REAL_BINARY + MORE_BINARY))
+def test_building_from_the_text_equals_translating_its_sympy(expr: sp.Expr) -> None:
+    """Two routes from one text to NumPy values: the grammar's walk with NumPy's library, and
+    SymPy (with its simplifications) translated to NumPy; they agree wherever both are finite."""
+    assume(representable(expr))
+    text = to_text(expr)
+    symbols = {n: symbol(n) for n in NAMES_XYT}
+    try:
+        parsed = parse(text, symbols)
+        with np.errstate(all="ignore"):
+            direct = expression(text, dict(zip(NAMES_XYT, RNG_POINTS, strict=True)), ARRAYS)
+    except ExpressionError:
+        return  # refused by a walk: the cases above hold those side by side
+    with np.errstate(all="ignore"):
+        via_sympy = translate(parsed, dict(zip(symbols.values(), RNG_POINTS, strict=True)), NUMPY)
+        a, b = (np.broadcast_to(np.asarray(v, dtype=float), (16,)) for v in (direct, via_sympy))
+    both = np.isfinite(a) & np.isfinite(b) & (np.abs(b) < 1e12)
+    np.testing.assert_allclose(a[both], b[both], rtol=1e-9, atol=1e-9)
+    assert used_names(text, {n: frozenset({n}) for n in NAMES_XYT}) >= {str(s) for s in parsed.free_symbols}
+
+
+def test_relations_carry_the_same_bounds() -> None:
+    for text in ("x <= 2*y", "x >= 1", "x == y", "-1 <= x + y <= 2", "2 >= x >= -pi"):
+        names = relation(text, {n: frozenset({n}) for n in NAMES_XYT}, NAMES)
+        from_sympy = parse_relation(text, {n: symbol(n) for n in NAMES_XYT})
+        assert (names.lower, names.upper) == (from_sympy.lower, from_sympy.upper)
+        assert dependencies(names.expr) == {str(s) for s in from_sympy.expr.free_symbols}
+
+
+OCP_FILES = sorted(p for p in PROBLEMS.rglob("*.yaml") if "kind: optimal_control" in p.read_text())
+
+
+@pytest.mark.parametrize("path", OCP_FILES, ids=lambda p: str(p.relative_to(PROBLEMS)))
+def test_shipped_files_build_the_same_terms_on_both_routes(path) -> None:
+    """Each running and end term of each shipped ``optimal_control`` file, built from the text over
+    NumPy arrays (what CasADi, Pyomo and the checks use) and as SymPy translated to NumPy (what the
+    transforms differentiate), at random points."""
+    ocp = SymbolicOcp(load(path))
+    rng = np.random.default_rng(3)
+    params = ocp.parameter_values()
+    others = params | {n: 0.5 for n in ocp.design}
+    running = {n: rng.uniform(0.1, 1.5, 8) for n in ocp.running_names} | others
+    ends = {n: float(rng.uniform(0.1, 1.5)) for n in ocp.end_names} | others
+    with np.errstate(all="ignore"):
+        direct = ocp.running_terms(running, ARRAYS)
+        direct_ends = ocp.end_terms(ends, ARRAYS)
+        sym_values = {symbol(n): v for n, v in running.items()}
+        sym_ends = {symbol(n): v for n, v in ends.items()}
+        pairs = [
+            *zip(direct.dynamics, ocp.dynamics, strict=True),
+            (direct.lagrange, ocp.lagrange),
+            *((a.expr, b.expr) for a, b in zip(direct.path, ocp.path, strict=True)),
+            *zip(direct.integrands, (r.expr for r in ocp.integrals), strict=True),
+        ]
+        for built, sympy_form in pairs:
+            expected = np.broadcast_to(
+                np.asarray(translate(sympy_form, sym_values, NUMPY), dtype=float), (8,)
+            )
+            np.testing.assert_allclose(np.broadcast_to(built, (8,)), expected, rtol=1e-10, atol=1e-12)
+        end_pairs = [(direct_ends.mayer, ocp.mayer)]
+        end_pairs += [(a.expr, b.expr) for a, b in zip(direct_ends.boundary, ocp.boundary, strict=True)]
+        for built, sympy_form in end_pairs:
+            assert float(built) == pytest.approx(
+                float(translate(sympy_form, sym_ends, NUMPY)), rel=1e-10, abs=1e-12
+            )
+    bounds = [(r.lower, r.upper) for r in ocp.running_structure.path + ocp.end_structure.boundary]
+    assert bounds == [(r.lower, r.upper) for r in ocp.path + ocp.boundary]
+
+
+def test_autonomy_and_inputs_follow_the_definitions() -> None:
+    """``t`` and a grid input reached only through a definition count as used, as in SymPy's
+    substituted form; a chained path constraint keeps its numeric bounds."""
+    data = yaml.safe_load(ZERMELO.read_text())
+    problem = data["problem"]
+    problem["inputs"] = {"gust": {"default": 0.0}, "unused": {"default": 1.0}}
+    problem["definitions"] = {"clock": "t", "push": "gust*clock"}
+    problem["dynamics"] = {"x1": "cos(u) + rho*x2", "x2": "sin(u) + push"}
+    problem["path_constraints"] = ["-1 <= x2 + 0*clock <= 0.5", "x1 >= -pi"]
+    ocp = SymbolicOcp(spec_from_dict(data, source="test"))
+    assert [(r.lower, r.upper) for r in ocp.running_structure.path] == [(-1.0, 0.5), (0.0, math.inf)]
+    assert [(r.lower, r.upper) for r in ocp.path] == [(-1.0, 0.5), (0.0, math.inf)]
+    sympy_free = set().union(*(e.free_symbols for e in [*ocp.dynamics, ocp.lagrange]))
+    assert not ocp.autonomous and symbol("t") in sympy_free
+    assert ocp.inputs_in_hamiltonian == [0]
+    assert [i for i, s in enumerate(ocp.w) if s in sympy_free] == [0]
+
+
+def test_hamiltonian_end_value_is_minus_the_mayer_slope_in_t_f() -> None:
+    """The central difference of the checks against SymPy's exact ``-dPhi/dt_f`` for a Mayer term
+    nonlinear in ``t_f`` (eq. 2.23's transversality value)."""
+    data = yaml.safe_load(ZERMELO.read_text())
+    data["problem"]["objective"]["mayer"] = "t_f**2 + 3*sin(t_f)*x1_f"
+    tr = Transcription(spec_from_dict(data, source="test"))
+    ends = tr.ocp.end_values(([0.0, 0.0], [0.7, 0.2]), ([0.1], [0.3]), 1.3, tr.ocp.parameter_values())
+    exact = -sp.diff(tr.ocp.mayer, tr.ocp.tf)
+    expected = float(translate(exact, {symbol(n): v for n, v in ends.items()}, NUMPY))
+    assert hamiltonian_end_value(tr, ends) == pytest.approx(expected, rel=1e-8)
+    assert not math.isclose(expected, -1.0)

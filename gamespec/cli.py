@@ -10,7 +10,6 @@ saying why; tracebacks are for bugs only.
 
 from __future__ import annotations
 
-import gc
 import json
 import sys
 import warnings
@@ -483,11 +482,5 @@ def _one_line(text: str) -> str:
 
 
 def main() -> None:
-    """Console-script entry point. Once the command has run, the objects that its imports made
-    (pydantic's schemas, NumPy's and CasADi's modules, ...) are moved out of the cyclic garbage
-    collector's reach (:func:`gc.freeze`): the interpreter's exit would otherwise traverse every one
-    of them in its final collections, for memory the operating system takes back with the process.
-    Exit handlers and reference-counted finalizers run as before."""
-    code = run()
-    gc.freeze()
-    sys.exit(code)
+    """Console-script entry point."""
+    sys.exit(run())

@@ -96,7 +96,7 @@ def interval_defects(tr: Transcription, sol: Trajectory, params: Mapping[str, fl
     together)."""
     grid = tr.grid
     gaps = np.empty((tr.n_x, grid.intervals))
-    for degree in np.unique(grid.interval_degrees):
+    for degree in sorted(set(grid.interval_degrees.tolist())):
         chosen = np.flatnonzero(grid.interval_degrees == degree)
         gaps[:, chosen] = _rk4_gaps(tr, sol, params, chosen, int(degree))
     return gaps

@@ -5,8 +5,7 @@ types); ``validate`` of a file whose bounds use no functions neither NumPy, SymP
 whitelist walk in floats); a CasADi solve of an ``optimal_control`` file neither SymPy (its terms
 are built from the text), SciPy nor another backend, and with ``--json`` where stderr is no
 terminal not rich either (no spinner to draw). The plugin registry reads the installed
-distributions' entry points once for all groups, and the console script leaves the objects of a
-finished command frozen out of the exit's garbage collections. The CPU times themselves are
+distributions' entry points once for all groups. The CPU times themselves are
 measured in ``benchmarks/test_bench_startup.py``."""
 
 from __future__ import annotations
@@ -78,18 +77,3 @@ def test_registry_reads_the_installed_entry_points_once_for_all_groups(monkeypat
     assert len(reads) == 1
     assert {"casadi", "pyomo"} <= set(found["gamespec.backends"])
     assert "optimal_control" in found["gamespec.kinds"]
-
-
-FROZEN_AT_EXIT = """
-import atexit, gc, sys
-atexit.register(lambda: print(gc.get_freeze_count()))
-sys.argv = ["gamespec", "validate", sys.argv[1]]
-from gamespec.cli import main
-main()
-"""
-
-
-def test_console_script_freezes_the_collector_before_the_exit() -> None:
-    done = subprocess.run([sys.executable, "-c", FROZEN_AT_EXIT, FILE], capture_output=True, text=True)
-    assert done.returncode == 0, done.stderr
-    assert int(done.stdout.splitlines()[-1]) > 0

@@ -27,7 +27,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from gamespec.symbolic.grammar import Relation
+from gamespec.symbolic.grammar import FLOATS, Relation, dependencies, unknowns
 from gamespec.symbolic.library import NUMPY, LibraryAlgebra
 
 ARRAYS = LibraryAlgebra(NUMPY)
@@ -191,7 +191,7 @@ def max_constraint_violation(tr: Transcription, sol: Trajectory, params: Mapping
     worst.append(_violation(np.array([T]), b.t_lower, b.t_upper))
     worst.append(_violation(np.array([params[n] for n in tr.ocp.design]), b.d_lower, b.d_upper))
     t_eval = tr.t0 + T * tr.grid.eval_tau
-    running = tr.ocp.running_values(X[:, tr.grid.eval_index], U, sol.Win, t_eval, params)
+    running = tr.ocp.running_values(X[:, tr.grid.eval_index], U, sol.Win, t_eval, _arrays(params))
     terms = tr.ocp.running_terms(running, ARRAYS)
     worst += [_relation_violation(r, t_eval.shape) for r in terms.path]
     ends = tr.ocp.end_terms(_end_values(tr, X, U, T, params), ARRAYS)
@@ -206,7 +206,14 @@ def max_constraint_violation(tr: Transcription, sol: Trajectory, params: Mapping
 def _end_values(
     tr: Transcription, X: np.ndarray, U: np.ndarray, T: float, params: Mapping[str, float]
 ) -> dict:
-    return tr.ocp.end_values((X[:, 0], X[:, -1]), tr.end_controls(U), tr.t0 + T, params)
+    return tr.ocp.end_values((X[:, 0], X[:, -1]), tr.end_controls(U), np.float64(tr.t0 + T), _arrays(params))
+
+
+def _arrays(params: Mapping[str, float]) -> dict[str, np.float64]:
+    """The parameter values as NumPy numbers, so that a term over them evaluates in NumPy (an
+    infinity or NaN of a failed solve is a value, not an error as in the floats of
+    :data:`~gamespec.symbolic.grammar.FLOATS`)."""
+    return {n: np.float64(v) for n, v in params.items()}
 
 
 def hamiltonian(
@@ -219,15 +226,27 @@ def hamiltonian(
     return values[-1] + np.sum(lam * values[:-1], axis=0)
 
 
+STEP = float(np.finfo(float).eps) ** (1 / 3)
+"""The relative step of :func:`mayer_slope`'s central difference (the one that balances its
+truncation error, h**2/6 times the third derivative, against its rounding error eps |Phi| / h)."""
+
+
+def mayer_slope(tr: Transcription, ends: Mapping[str, float], name: str) -> float:
+    """``dPhi/d name`` of the minimization form's Mayer term at the end values ``ends`` (by name):
+    exactly 0 when the term does not depend on ``name``, else a central difference with step
+    ``STEP max(1, |value|)`` in NumPy (the term evaluated as the checks evaluate every term)."""
+    if name not in dependencies(tr.ocp.end_terms(unknowns(tr.ocp.end_names), FLOATS).mayer):
+        return 0.0
+    at = float(ends[name])
+    h = STEP * max(1.0, abs(at))
+    mayer = (float(tr.ocp.end_terms({**ends, name: np.float64(at + s)}, ARRAYS).mayer) for s in (h, -h))
+    return (next(mayer) - next(mayer)) / (2 * h)
+
+
 def hamiltonian_end_value(tr: Transcription, ends: Mapping[str, float]) -> float:
-    """``-dPhi/dt_f`` of the minimization form at the solution's end values: the constant value of
-    H on an autonomous, free-final-time problem (transversality, e.g. eq. 2.23), by a central
-    difference with step ``h = 1e-6 max(1, |t_f|)`` (its error, ``h**2/6`` times the third
-    derivative, is far below what the check resolves)."""
-    tf = float(ends["t_f"])
-    h = 1e-6 * max(1.0, abs(tf))
-    upper, lower = (float(tr.ocp.end_terms({**ends, "t_f": tf + s}, ARRAYS).mayer) for s in (h, -h))
-    return -(upper - lower) / (2 * h)
+    """``-dPhi/dt_f`` at the solution's end values: the constant value of H on an autonomous,
+    free-final-time problem (transversality, e.g. eq. 2.23)."""
+    return -mayer_slope(tr, ends, "t_f")
 
 
 def _time_invariant(tr: Transcription, Win: np.ndarray) -> bool:

@@ -23,20 +23,16 @@ the phase times (no explicit ``t``, no ``t_0``/``t_f`` in jumps or boundary cons
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Any
 
 import numpy as np
-import sympy as sp
 
-from gamespec.ocp.checks import Trajectory, hamiltonian, solution_checks
+from gamespec.ocp.checks import Trajectory, hamiltonian, mayer_slope, solution_checks
 from gamespec.ocp.symbolic import SymbolicOcp
 from gamespec.ocp.transcription import Transcription
 from gamespec.result import Result
 from gamespec.specs.ocp import TimeSpec
 from gamespec.specs.phase_lowering import LoweredPhase, Lowering
-from gamespec.symbolic.language import symbol
-from gamespec.symbolic.library import NUMPY
-from gamespec.symbolic.translate import translate
+from gamespec.symbolic.grammar import dependencies
 
 OVERALL_CHECKS = ("max_constraint_violation", "max_defect", "max_defect_relative", "chattering")
 """Checks of the lowered problem that keep their meaning for the whole multi-phase problem."""
@@ -50,15 +46,14 @@ def _phase_transcription(phase: LoweredPhase, start: float, end: float, breaks: 
     return Transcription(spec.model_copy(update={"problem": problem, "method": method}))
 
 
-def _end_value(lowering: Lowering, lowered: Transcription, X: np.ndarray, U: np.ndarray, values: dict) -> Any:
-    """``-dPhi/dt_f`` at the solution (``Phi`` in minimization form), from the lowered Mayer term."""
-    ocp = lowered.ocp
-    first, last = lowered.end_controls(U)
-    ends = {s: X[i, 0] for i, s in enumerate(ocp.x0)} | {s: X[i, -1] for i, s in enumerate(ocp.xf)}
-    ends |= dict(zip(ocp.u0, first, strict=True)) | dict(zip(ocp.uf, last, strict=True))
-    ends |= {symbol(k): v for k, v in values.items()}
-    d_last = symbol(lowering.phases[-1].duration)
-    return float(translate(-sp.diff(ocp.mayer, d_last), ends, NUMPY))
+def _end_value(
+    lowering: Lowering, lowered: Transcription, X: np.ndarray, U: np.ndarray, values: dict, t_final: float
+) -> float:
+    """``-dPhi/dd`` at the solution for the last phase's duration ``d`` (``Phi`` in minimization
+    form), from the lowered Mayer term."""
+    others = {n: np.float64(v) for n, v in values.items()}
+    ends = lowered.ocp.end_values((X[:, 0], X[:, -1]), lowered.end_controls(U), np.float64(t_final), others)
+    return -mayer_slope(lowered, ends, lowering.phases[-1].duration)
 
 
 def _switching_times_free(lowering: Lowering) -> bool:
@@ -68,7 +63,7 @@ def _switching_times_free(lowering: Lowering) -> bool:
         return False
     for ph in lowering.phases:
         ocp = SymbolicOcp(ph.check_spec)
-        if not ocp.autonomous or any(ocp.t in rel.expr.free_symbols for rel in ocp.path):
+        if not ocp.autonomous or any("t" in dependencies(r.expr) for r in ocp.running_structure.path):
             return False
     return True
 
@@ -141,7 +136,7 @@ def split_by_phase(result: Result, lowering: Lowering) -> Result:
     checks = {k: result.checks[k] for k in OVERALL_CHECKS if k in result.checks}
     end_value = None
     if _switching_times_free(lowering):
-        end_value = _end_value(lowering, lowered, X_all, U_all, values)
+        end_value = _end_value(lowering, lowered, X_all, U_all, values, float(s_nodes[-1]))
     for k, ph in enumerate(lowering.phases):
         arrays = phase_arrays(result, ph, grid)
         tr = _phase_transcription(ph, starts[k], starts[k + 1], arrays.breaks)

@@ -20,7 +20,7 @@ import numpy as np
 
 from gamespec.errors import SpecError
 from gamespec.specs.ocp import EvaluatedValues, OptimalControlSpec
-from gamespec.symbolic.grammar import NAMES, Algebra, Relation, dependencies, expression, relation
+from gamespec.symbolic.grammar import FLOATS, Algebra, Relation, dependencies, expression, relation, unknowns
 from gamespec.symbolic.library import NUMPY, LibraryAlgebra
 from gamespec.symbolic.tape import vectorized
 
@@ -116,7 +116,7 @@ class SymbolicOcp:
             values |= {f"{n}_f": v for n, v in zip(names, last, strict=True)}
         return values | {"t_f": t_final}
 
-    def scope(self, values: Mapping[str, Any], algebra: Algebra) -> dict[str, Any]:
+    def _scope(self, values: Mapping[str, Any], algebra: Algebra) -> dict[str, Any]:
         """``values`` (by name) and each definition built over them and the earlier ones."""
         scope = dict(values)
         for name, raw in self.spec.problem.definitions.items():
@@ -126,7 +126,7 @@ class SymbolicOcp:
     def running_terms(self, values: Mapping[str, Any], algebra: Algebra) -> RunningTerms:
         """The running terms over ``values`` (each of :attr:`running_names` by name)."""
         problem = self.spec.problem
-        scope = self.scope(values, algebra)
+        scope = self._scope(values, algebra)
         lagrange = expression(problem.objective.lagrange, scope, algebra)
         path = [relation(c, scope, algebra) for c in problem.path_constraints]
         for name, key, raw in problem.time_varying_bounds():
@@ -150,51 +150,34 @@ class SymbolicOcp:
 
     @cached_property
     def running_structure(self) -> RunningTerms:
-        """The running terms as the sets of names they depend on (:func:`dependencies`), with the
-        constraints' bounds."""
-        return self.running_terms({n: frozenset({n}) for n in self.running_names}, NAMES)
+        """The running terms as :class:`~gamespec.symbolic.grammar.Unknown` values (the names each
+        depends on: :func:`~gamespec.symbolic.grammar.dependencies`), with the constraints' bounds."""
+        return self.running_terms(unknowns(self.running_names), FLOATS)
 
     @cached_property
-    def end_structure(self) -> EndTerms:
-        """The end-point terms as the sets of names they depend on (with the constraints' bounds)."""
-        return self.end_terms({n: frozenset({n}) for n in self.end_names}, NAMES)
-
-    @cached_property
-    def _sympy(self) -> tuple[dict[str, Any], RunningTerms, EndTerms]:
-        """The definitions, running and end terms in SymPy (imported here, at the first use: a
-        CasADi solve never needs it)."""
+    def _sympy(self) -> tuple[RunningTerms, EndTerms]:
+        """The running and end terms in SymPy (imported here, at the first use: loading and
+        solving on CasADi or Pyomo never need it)."""
         from gamespec.symbolic.language import SYMPY
 
         running = {n: self._symbols[n] for n in self.running_names}
         ends = {n: self._symbols[n] for n in self.end_names}
-        return self.scope(running, SYMPY), self.running_terms(running, SYMPY), self.end_terms(ends, SYMPY)
-
-    @property
-    def definitions(self) -> dict[str, Any]:
-        """Each named expression in SymPy with the earlier ones substituted."""
-        return {n: self._sympy[0][n] for n in self.spec.problem.definitions}
+        return self.running_terms(running, SYMPY), self.end_terms(ends, SYMPY)
 
     @property
     def dynamics(self) -> list[Any]:
         """The dynamics in SymPy."""
-        return self._sympy[1].dynamics
+        return self._sympy[0].dynamics
 
     @property
     def lagrange(self) -> Any:
         """The running cost in SymPy, in minimization form (``sign`` applied)."""
-        return self._sympy[1].lagrange
+        return self._sympy[0].lagrange
 
     @property
     def path(self) -> list[Relation]:
         """The path constraints in SymPy (:class:`RunningTerms`)."""
-        return self._sympy[1].path
-
-    @cached_property
-    def integrals(self) -> list[Relation]:
-        """Integral constraints in SymPy: ``lower <= integral of expr dt <= upper`` (integrands not
-        signed), the bounds at the file's parameter values (:meth:`integral_bounds` for others)."""
-        bounds = self.integral_bounds(self.parameter_values())
-        return [Relation(e, lo, hi) for e, (lo, hi) in zip(self._sympy[1].integrands, bounds, strict=True)]
+        return self._sympy[0].path
 
     def integral_bounds(self, params: Mapping[str, float]) -> list[tuple[float, float]]:
         """Per integral constraint ``(lower, upper)`` for these parameter values."""
@@ -203,12 +186,7 @@ class SymbolicOcp:
     @property
     def mayer(self) -> Any:
         """The end cost in SymPy, in minimization form (``sign`` applied)."""
-        return self._sympy[2].mayer
-
-    @property
-    def boundary(self) -> list[Relation]:
-        """The boundary constraints in SymPy."""
-        return self._sympy[2].boundary
+        return self._sympy[1].mayer
 
     @cached_property
     def _symbols(self) -> dict[str, Any]:
@@ -229,10 +207,6 @@ class SymbolicOcp:
         return [self._symbols[n] for n in self.parameters]
 
     @property
-    def d(self) -> list[Any]:
-        return [self._symbols[n] for n in self.design]
-
-    @property
     def w(self) -> list[Any]:
         return [self._symbols[n] for n in self.inputs]
 
@@ -247,19 +221,6 @@ class SymbolicOcp:
     @property
     def xf(self) -> list[Any]:
         return [self._symbols[f"{n}_f"] for n in self.states]
-
-    @property
-    def u0(self) -> list[Any]:
-        """The controls at the initial time (``<control>_0``, in Mayer and boundary terms)."""
-        return [self._symbols[f"{n}_0"] for n in self.controls]
-
-    @property
-    def uf(self) -> list[Any]:
-        return [self._symbols[f"{n}_f"] for n in self.controls]
-
-    @property
-    def tf(self) -> Any:
-        return self._symbols["t_f"]
 
     @property
     def autonomous(self) -> bool:

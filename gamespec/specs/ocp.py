@@ -25,13 +25,14 @@ from gamespec.specs.base import Number, ProblemParameters, SpecBase, StrictModel
 from gamespec.specs.plot import PlotHint
 from gamespec.specs.uncertainty import UncertainParameter
 from gamespec.symbolic.grammar import (
-    NAMES,
+    FLOATS,
     RESERVED,
     check,
     dependencies,
     expression,
     numeric_value,
     relation,
+    unknowns,
 )
 
 INF = math.inf
@@ -252,7 +253,7 @@ class OcpProblem(StrictModel):
             if raw is None or (default in (-INF, INF) and is_time_varying(raw)):
                 return default
             if isinstance(raw, str):
-                raw = numeric_value(raw, values)
+                raw = _evaluated(raw, values, f"problem.{field}")
             if not math.isfinite(raw):
                 raise SpecError(f"evaluates to {raw} (a finite number is needed)", field=f"problem.{field}")
             return float(raw)
@@ -393,13 +394,19 @@ def parameter_values(
     values: dict[str, float] = {}
     for name, raw in parameters.items():
         if isinstance(raw, str):
-            value = numeric_value(raw, values)
-            if not math.isfinite(value):
-                raise SpecError(f"evaluates to {value}", field=f"problem.parameters.{name}")
-            values[name] = value
+            values[name] = _evaluated(raw, values, f"problem.parameters.{name}")
         else:
             values[name] = float(base.get(name, raw))
     return values
+
+
+def _evaluated(text: str, values: Mapping[str, float], field: str) -> float:
+    """The value of a parameter-only expression; a SpecError naming ``field`` when it is not a
+    finite real number (``log(rho - 10)`` at ``rho = 10``)."""
+    try:
+        return numeric_value(text, values)
+    except ExpressionError as err:
+        raise SpecError(str(err), field=field) from None
 
 
 def is_time_varying(raw: float | str | None) -> bool:
@@ -434,9 +441,9 @@ def _inputs_in(constraint: bool, text: str, symbols: dict, inputs: dict) -> list
     """The grid inputs that ``text`` uses, when it parses once they are allowed (else none)."""
     if not inputs or set(inputs) <= set(symbols):
         return []
-    names = {n: frozenset({n}) for n in symbols | inputs}
+    names = unknowns(symbols | inputs)
     try:
-        used = relation(text, names, NAMES).expr if constraint else expression(text, names, NAMES)
+        used = relation(text, names, FLOATS).expr if constraint else expression(text, names, FLOATS)
     except ExpressionError:
         return []
     return sorted(dependencies(used) & set(inputs))

@@ -9,7 +9,7 @@ and the column.
 
 The walk builds its value in an :class:`Algebra`: SymPy (:mod:`gamespec.symbolic.language`, the
 form the transforms differentiate), floats (:data:`FLOATS`, the checks at load and the values of
-bounds and parameters), the names it depends on (:data:`NAMES`) or a backend's own expressions
+bounds and parameters, and the names each term depends on) or a backend's own expressions
 (:class:`gamespec.symbolic.library.LibraryAlgebra`, a CasADi graph built straight from the file),
 so that one walker decides what an expression may be.
 """
@@ -19,7 +19,7 @@ from __future__ import annotations
 import ast
 import math
 import operator
-from collections.abc import Callable, Iterable, Mapping
+from collections.abc import Callable, Hashable, Iterable, Mapping
 from dataclasses import dataclass
 from functools import lru_cache
 from typing import Any, Protocol
@@ -90,6 +90,13 @@ def _checked(value: float) -> float:
     return value
 
 
+def _atan2(y: float, x: float) -> float:
+    """``atan2``, undefined at the origin (SymPy's ``atan2(0, 0)`` is NaN; ``math`` says 0)."""
+    if y == 0 and x == 0:
+        raise ValueError("atan2(0, 0)")
+    return math.atan2(y, x)
+
+
 def _unit_step(x: float) -> float:
     return 0.5 if x == 0 else float(x > 0)
 
@@ -101,7 +108,7 @@ FLOAT_FUNCTIONS: dict[str, Callable[..., float]] = {
     "asin": math.asin,
     "acos": math.acos,
     "atan": math.atan,
-    "atan2": math.atan2,
+    "atan2": _atan2,
     "exp": math.exp,
     "log": math.log,
     "sqrt": math.sqrt,
@@ -117,32 +124,78 @@ FLOAT_FUNCTIONS: dict[str, Callable[..., float]] = {
 
 @dataclass(frozen=True)
 class Unknown:
-    """A value that depends on a name without a number. ``scale`` bounds the numeric coefficient
-    SymPy would fold into it (``x*1e300*1e300`` is ``1e600*x``; terms add their scales), so that
-    a check without SymPy refuses what parsing into SymPy refuses as out of range."""
+    """A value that depends on names without numbers: which ``names`` (through definitions too),
+    a ``key`` that is equal for equal sub-expressions (commutative operands in either order), and
+    a ``scale`` that bounds the numeric coefficient SymPy would fold into it (``x*1e300*1e300`` is
+    ``1e600*x``; terms add their scales). With them a check without SymPy refuses what parsing
+    into SymPy refuses: numbers out of range, and what cancels to a number (``x - x``, ``0*x``,
+    ``x/x``) is that number, so ``1/(x - x)`` and ``log(0*x)`` are undefined."""
 
+    key: Hashable
+    names: frozenset[str]
     scale: float = 1.0
 
 
-UNKNOWN = Unknown()
+def unknown(name: str) -> Unknown:
+    """The :class:`Unknown` of a name."""
+    return Unknown(name, frozenset({name}))
 
 
-def _scale(value: float | Unknown) -> float:
+def dependencies(value: Any) -> frozenset[str]:
+    """The names a value of :data:`FLOATS` depends on (none for a number)."""
+    return value.names if isinstance(value, Unknown) else frozenset()
+
+
+COMMUTATIVE = frozenset({"+", "*", "min", "max"})
+BINARY_TAGS = {operator.add: "+", operator.sub: "-", operator.mul: "*", operator.truediv: "/"}
+
+
+Value = float | Unknown
+"""A value of :class:`FloatAlgebra`."""
+
+
+def _scale(value: Value) -> float:
     return value.scale if isinstance(value, Unknown) else abs(value)
 
 
-def _unknown_result(func: Callable[..., Any], args: tuple[float | Unknown, ...]) -> Unknown:
-    """The :class:`Unknown` that ``func`` of ``args`` (one of them unknown) gives."""
+def _key(value: Value) -> Hashable:
+    return value.key if isinstance(value, Unknown) else value
+
+
+def _cancelled(tag: str, args: tuple[Value, ...]) -> float | None:
+    """The number an operation on an unknown folds to in SymPy's canonical form, if any:
+    ``x - x``, ``x + (-x)``, ``0*x``, ``x/x``, ``0/x``, ``x**0``."""
+    keys = [_key(a) for a in args]
+    if tag == "-" and keys[0] == keys[1]:
+        return 0.0
+    if tag == "+" and (keys[1] == ("neg", keys[0]) or keys[0] == ("neg", keys[1])):
+        return 0.0
+    if tag == "*" and 0.0 in keys:
+        return 0.0
+    if tag == "/" and keys[0] == keys[1]:
+        return 1.0
+    if tag == "/" and keys[0] == 0.0:
+        return 0.0
+    if tag == "**" and keys[1] == 0.0:
+        return 1.0
+    return None
+
+
+def _unknown_result(tag: str, args: tuple[Value, ...]) -> Value:
+    """What ``tag`` (an operator or a function name) of ``args``, one of them unknown, gives."""
+    folded = _cancelled(tag, args)
+    if folded is not None:
+        return folded
     scales = [_scale(a) for a in args]
-    if func is operator.add or func is operator.sub:
+    if tag in ("+", "-"):
         scale = scales[0] + scales[1]
-    elif func is operator.mul:
+    elif tag == "*":
         scale = scales[0] * scales[1]
-    elif func is operator.truediv:
+    elif tag == "/":
         if scales[1] == 0:
             raise Refused("is infinite, undefined or not real")
         scale = scales[0] / scales[1]
-    elif func is operator.pow and not isinstance(args[1], Unknown):
+    elif tag == "**" and not isinstance(args[1], Unknown):
         if scales[0] == 0 and args[1] < 0:
             raise Refused("is infinite, undefined or not real")
         try:
@@ -151,15 +204,20 @@ def _unknown_result(func: Callable[..., Any], args: tuple[float | Unknown, ...])
             raise Refused(f"number out of range (beyond {MAX_MAGNITUDE:g})") from None
     else:
         scale = 1.0
-    return Unknown(_checked(scale))
+    keys = tuple(_key(a) for a in args)
+    if tag in COMMUTATIVE:
+        keys = tuple(sorted(keys, key=repr))
+    names = frozenset().union(*map(dependencies, args))
+    return Unknown((tag, *keys), names, _checked(scale))
 
 
 class FloatAlgebra:
-    """Floats, with an :class:`Unknown` for a value that depends on a name without a number: a
-    walk over ``{name: UNKNOWN}`` checks an expression without computing it (the checks at load),
-    one over ``{name: float}`` computes it (bounds, derived parameters). A number that is
-    infinite, not real or beyond :data:`~gamespec.limits.MAX_MAGNITUDE` (``1/0``, ``log(0)``,
-    ``sqrt(-1)``, ``exp(1000)``, ``x*1e300*1e300``) is refused."""
+    """Floats, with an :class:`Unknown` for a value that depends on names without numbers: a walk
+    over ``{name: unknown(name)}`` checks an expression without computing it (the checks at load)
+    and tells the names each term depends on; one over ``{name: float}`` computes it (bounds,
+    derived parameters). A number that is infinite, not real or beyond
+    :data:`~gamespec.limits.MAX_MAGNITUDE` (``1/0``, ``log(0)``, ``sqrt(-1)``, ``exp(1000)``,
+    ``x*1e300*1e300``, ``1/(x - x)``) is refused."""
 
     def number(self, value: int | float) -> float:
         try:
@@ -170,9 +228,9 @@ class FloatAlgebra:
     def constant(self, name: str) -> float:
         return math.pi
 
-    def _apply(self, func: Callable[..., Any], *args: float | Unknown) -> float | Unknown:
+    def _apply(self, tag: str, func: Callable[..., Any], *args: Value) -> Value:
         if any(isinstance(a, Unknown) for a in args):
-            return _unknown_result(func, args)
+            return _unknown_result(tag, args)
         try:
             value = func(*args)
         except (ZeroDivisionError, ValueError):
@@ -183,68 +241,26 @@ class FloatAlgebra:
             raise Refused("power of a negative number is not real")
         return _checked(float(value))
 
-    def binary(
-        self, op: type[ast.operator], left: float | Unknown, right: float | Unknown
-    ) -> float | Unknown:
-        return self._apply(BINARY[op], left, right)
+    def binary(self, op: type[ast.operator], left: Value, right: Value) -> Value:
+        func = BINARY[op]
+        return self._apply(BINARY_TAGS[func], func, left, right)
 
-    def negate(self, value: float | Unknown) -> float | Unknown:
-        return value if isinstance(value, Unknown) else -value
+    def negate(self, value: Value) -> Value:
+        if isinstance(value, Unknown):
+            return Unknown(("neg", value.key), value.names, value.scale)
+        return -value
 
-    def power(self, base: float | Unknown, exponent: float | Unknown) -> float | Unknown:
-        return self._apply(operator.pow, base, exponent)
+    def power(self, base: Value, exponent: Value) -> Value:
+        return self._apply("**", operator.pow, base, exponent)
 
-    def call(self, name: str, args: list[float | Unknown]) -> float | Unknown:
-        return self._apply(FLOAT_FUNCTIONS[name], *args)
+    def call(self, name: str, args: list[Value]) -> Value:
+        return self._apply(name, FLOAT_FUNCTIONS[name], *args)
 
-    def scalar(self, value: float | Unknown) -> float | None:
+    def scalar(self, value: Value) -> float | None:
         return None if isinstance(value, Unknown) else value
 
 
 FLOATS = FloatAlgebra()
-
-
-def dependencies(value: frozenset[str] | float) -> frozenset[str]:
-    """The names a value of :data:`NAMES` depends on (none for a number)."""
-    return value if isinstance(value, frozenset) else frozenset()
-
-
-class NameAlgebra:
-    """The set of names an expression depends on (through the values given for the names: a
-    definition's set holds the names it is written over); a part without names is its number
-    (:data:`FLOATS`), so that a chained constraint keeps its bounds."""
-
-    def number(self, value: int | float) -> float:
-        return FLOATS.number(value)
-
-    def constant(self, name: str) -> float:
-        return FLOATS.constant(name)
-
-    def _union(self, args: tuple[frozenset[str] | float, ...]) -> frozenset[str]:
-        return frozenset().union(*map(dependencies, args))
-
-    def _numbers(self, *args: frozenset[str] | float) -> bool:
-        return not any(isinstance(a, frozenset) for a in args)
-
-    def binary(self, op: type[ast.operator], left: Any, right: Any) -> frozenset[str] | float:
-        return FLOATS.binary(op, left, right) if self._numbers(left, right) else self._union((left, right))
-
-    def negate(self, value: frozenset[str] | float) -> frozenset[str] | float:
-        return FLOATS.negate(value) if self._numbers(value) else value
-
-    def power(self, base: Any, exponent: Any) -> frozenset[str] | float:
-        return (
-            FLOATS.power(base, exponent) if self._numbers(base, exponent) else self._union((base, exponent))
-        )
-
-    def call(self, name: str, args: list[Any]) -> frozenset[str] | float:
-        return FLOATS.call(name, args) if self._numbers(*args) else self._union(tuple(args))
-
-    def scalar(self, value: frozenset[str] | float) -> float | None:
-        return None if isinstance(value, frozenset) else value
-
-
-NAMES = NameAlgebra()
 
 
 @lru_cache(maxsize=4096, typed=True)
@@ -392,14 +408,18 @@ def relation(text: str, symbols: Mapping[str, Any], algebra: Algebra) -> Relatio
     raise walk.fail(node, "a constraint is one comparison or a chain lo <= expr <= hi")
 
 
+def unknowns(names: Iterable[str]) -> dict[str, Unknown]:
+    """Each name as its :class:`Unknown`: the values of a walk that checks, or finds dependencies."""
+    return {n: unknown(n) for n in names}
+
+
 def check(text: str | float, names: Iterable[str], *, constraint: bool = False) -> None:
     """Refuse ``text`` (an ExpressionError) unless it is an expression (a constraint when
     ``constraint``) over ``names``, its number-only parts finite and real (:class:`FloatAlgebra`)."""
-    unknown = dict.fromkeys(names, UNKNOWN)
     if constraint:
-        relation(str(text), unknown, FLOATS)
+        relation(str(text), unknowns(names), FLOATS)
     else:
-        expression(text, unknown, FLOATS)
+        expression(text, unknowns(names), FLOATS)
 
 
 def numeric_value(text: str | float, values: Mapping[str, float]) -> float:
@@ -408,8 +428,3 @@ def numeric_value(text: str | float, values: Mapping[str, float]) -> float:
     if isinstance(value, Unknown):
         raise ExpressionError(str(text), "is not a number here")
     return value
-
-
-def used_names(text: str | float, names: Mapping[str, frozenset[str]]) -> frozenset[str]:
-    """The names ``text`` depends on, each name of ``names`` standing for its set."""
-    return dependencies(expression(text, names, NAMES))

@@ -72,15 +72,17 @@ NUMPY = Library(_NumpyFunctions(), power=_numpy_power)
 
 class LibraryAlgebra:
     """A backend's own expressions (CasADi, NumPy arrays, a tape), built with ``library`` over the
-    values given for the names; a part without names is computed in floats
-    (:data:`~gamespec.symbolic.grammar.FLOATS`, which refuses ``1/0``)."""
+    values given for the names; a part made of the text's numbers alone is computed in floats
+    (:data:`~gamespec.symbolic.grammar.FLOATS`, which refuses ``1/0`` as the check at load did)."""
 
     def __init__(self, library: Library) -> None:
         self.library = library
 
     @staticmethod
     def _numbers(*args: Any) -> bool:
-        return all(isinstance(a, int | float) for a in args)
+        """Whether every argument is a Python number (the text's own constants): a NumPy number
+        (``np.float64`` is a ``float``) is the backend's value and is computed by the backend."""
+        return all(type(a) in (int, float) for a in args)
 
     def number(self, value: int | float) -> float:
         return FLOATS.number(value)

@@ -14,21 +14,22 @@ import sympy as sp
 import yaml
 from hypothesis import HealthCheck, assume, given, settings
 
+import gamespec
 from gamespec.errors import ExpressionError
 from gamespec.loader import load, spec_from_dict
 from gamespec.ocp.checks import hamiltonian_end_value
 from gamespec.ocp.symbolic import SymbolicOcp
 from gamespec.ocp.transcription import Transcription
 from gamespec.symbolic.grammar import (
-    NAMES,
+    FLOATS,
     check,
     dependencies,
     expression,
     numeric_value,
     relation,
-    used_names,
+    unknowns,
 )
-from gamespec.symbolic.language import parse, parse_relation, symbol
+from gamespec.symbolic.language import SYMPY, parse, parse_relation, symbol
 from gamespec.symbolic.library import NUMPY, LibraryAlgebra
 from gamespec.symbolic.printer import to_text
 from gamespec.symbolic.translate import numeric, translate
@@ -64,6 +65,14 @@ ZERMELO = PROBLEMS / "ch6" / "zermelo_min_time.yaml"
         "f(x)",
         "x < 1",
         "[x]",
+        "1/(x - x)",
+        "x/(x*y - y*x)",
+        "log(x + (-x))",
+        "sqrt(t - t - 1)",
+        "log(0*x)",
+        "exp(log(0*x))",
+        "atan2(0, 0)",
+        "atan2(y - y, 0)",
     ],
 )
 def test_both_walks_refuse_the_same_texts(text: str) -> None:
@@ -75,7 +84,18 @@ def test_both_walks_refuse_the_same_texts(text: str) -> None:
 
 @pytest.mark.parametrize(
     "text",
-    ["x*1e300/1e300", "1e300*x + 1e300*y", "exp(x*1e300)", "2**1000*x", "atan2(0, -1)", "heaviside(0)*x"],
+    [
+        "x*1e300/1e300",
+        "1e300*x + 1e300*y",
+        "exp(x*1e300)",
+        "2**1000*x",
+        "atan2(0, -1)",
+        "heaviside(0)*x",
+        "exp(log(x))",
+        "x - x + 1",
+        "1/(x - y)",
+        "log(x/x)",
+    ],
 )
 def test_both_walks_accept_the_same_texts(text: str) -> None:
     parse(text, {n: symbol(n) for n in NAMES_XYT})
@@ -108,12 +128,16 @@ def test_building_from_the_text_equals_translating_its_sympy(expr: sp.Expr) -> N
         a, b = (np.broadcast_to(np.asarray(v, dtype=float), (16,)) for v in (direct, via_sympy))
     both = np.isfinite(a) & np.isfinite(b) & (np.abs(b) < 1e12)
     np.testing.assert_allclose(a[both], b[both], rtol=1e-9, atol=1e-9)
-    assert used_names(text, {n: frozenset({n}) for n in NAMES_XYT}) >= {str(s) for s in parsed.free_symbols}
+    try:
+        names = dependencies(expression(text, unknowns(NAMES_XYT), FLOATS))
+    except ExpressionError:
+        return  # the check refuses a few texts SymPy takes (terms whose scales add past 1e308)
+    assert names >= {str(s) for s in parsed.free_symbols}
 
 
 def test_relations_carry_the_same_bounds() -> None:
     for text in ("x <= 2*y", "x >= 1", "x == y", "-1 <= x + y <= 2", "2 >= x >= -pi"):
-        names = relation(text, {n: frozenset({n}) for n in NAMES_XYT}, NAMES)
+        names = relation(text, unknowns(NAMES_XYT), FLOATS)
         from_sympy = parse_relation(text, {n: symbol(n) for n in NAMES_XYT})
         assert (names.lower, names.upper) == (from_sympy.lower, from_sympy.upper)
         assert dependencies(names.expr) == {str(s) for s in from_sympy.expr.free_symbols}
@@ -125,38 +149,39 @@ OCP_FILES = sorted(p for p in PROBLEMS.rglob("*.yaml") if "kind: optimal_control
 @pytest.mark.parametrize("path", OCP_FILES, ids=lambda p: str(p.relative_to(PROBLEMS)))
 def test_shipped_files_build_the_same_terms_on_both_routes(path) -> None:
     """Each running and end term of each shipped ``optimal_control`` file, built from the text over
-    NumPy arrays (what CasADi, Pyomo and the checks use) and as SymPy translated to NumPy (what the
-    transforms differentiate), at random points."""
+    NumPy arrays (what CasADi, Pyomo and the checks use) and built in SymPy then translated to
+    NumPy (what the transforms differentiate), at random points."""
     ocp = SymbolicOcp(load(path))
     rng = np.random.default_rng(3)
     params = ocp.parameter_values()
     others = params | {n: 0.5 for n in ocp.design}
     running = {n: rng.uniform(0.1, 1.5, 8) for n in ocp.running_names} | others
     ends = {n: float(rng.uniform(0.1, 1.5)) for n in ocp.end_names} | others
+    symbols = {n: symbol(n) for n in [*ocp.running_names, *ocp.end_names]}
+    sym_running = ocp.running_terms({n: symbols[n] for n in ocp.running_names}, SYMPY)
+    sym_ends = ocp.end_terms({n: symbols[n] for n in ocp.end_names}, SYMPY)
     with np.errstate(all="ignore"):
         direct = ocp.running_terms(running, ARRAYS)
         direct_ends = ocp.end_terms(ends, ARRAYS)
-        sym_values = {symbol(n): v for n, v in running.items()}
-        sym_ends = {symbol(n): v for n, v in ends.items()}
         pairs = [
-            *zip(direct.dynamics, ocp.dynamics, strict=True),
-            (direct.lagrange, ocp.lagrange),
-            *((a.expr, b.expr) for a, b in zip(direct.path, ocp.path, strict=True)),
-            *zip(direct.integrands, (r.expr for r in ocp.integrals), strict=True),
+            *zip(direct.dynamics, sym_running.dynamics, strict=True),
+            (direct.lagrange, sym_running.lagrange),
+            *((a.expr, b.expr) for a, b in zip(direct.path, sym_running.path, strict=True)),
+            *zip(direct.integrands, sym_running.integrands, strict=True),
         ]
+        values = {symbols[n]: v for n, v in running.items()}
         for built, sympy_form in pairs:
-            expected = np.broadcast_to(
-                np.asarray(translate(sympy_form, sym_values, NUMPY), dtype=float), (8,)
-            )
-            np.testing.assert_allclose(np.broadcast_to(built, (8,)), expected, rtol=1e-10, atol=1e-12)
-        end_pairs = [(direct_ends.mayer, ocp.mayer)]
-        end_pairs += [(a.expr, b.expr) for a, b in zip(direct_ends.boundary, ocp.boundary, strict=True)]
+            expected = np.asarray(translate(sympy_form, values, NUMPY), dtype=float)
+            np.testing.assert_allclose(*np.broadcast_arrays(built, expected), rtol=1e-10, atol=1e-12)
+        end_pairs = [(direct_ends.mayer, sym_ends.mayer)]
+        end_pairs += [(a.expr, b.expr) for a, b in zip(direct_ends.boundary, sym_ends.boundary, strict=True)]
+        values = {symbols[n]: v for n, v in ends.items()}
         for built, sympy_form in end_pairs:
-            assert float(built) == pytest.approx(
-                float(translate(sympy_form, sym_ends, NUMPY)), rel=1e-10, abs=1e-12
-            )
-    bounds = [(r.lower, r.upper) for r in ocp.running_structure.path + ocp.end_structure.boundary]
-    assert bounds == [(r.lower, r.upper) for r in ocp.path + ocp.boundary]
+            expected = float(translate(sympy_form, values, NUMPY))
+            assert float(built) == pytest.approx(expected, rel=1e-10, abs=1e-12)
+    structure = ocp.end_terms(unknowns(ocp.end_names), FLOATS)
+    bounds = [(r.lower, r.upper) for r in ocp.running_structure.path + structure.boundary]
+    assert bounds == [(r.lower, r.upper) for r in sym_running.path + sym_ends.boundary]
 
 
 def test_autonomy_and_inputs_follow_the_definitions() -> None:
@@ -184,7 +209,22 @@ def test_hamiltonian_end_value_is_minus_the_mayer_slope_in_t_f() -> None:
     data["problem"]["objective"]["mayer"] = "t_f**2 + 3*sin(t_f)*x1_f"
     tr = Transcription(spec_from_dict(data, source="test"))
     ends = tr.ocp.end_values(([0.0, 0.0], [0.7, 0.2]), ([0.1], [0.3]), 1.3, tr.ocp.parameter_values())
-    exact = -sp.diff(tr.ocp.mayer, tr.ocp.tf)
+    exact = -sp.diff(tr.ocp.mayer, symbol("t_f"))
     expected = float(translate(exact, {symbol(n): v for n, v in ends.items()}, NUMPY))
     assert hamiltonian_end_value(tr, ends) == pytest.approx(expected, rel=1e-8)
     assert not math.isclose(expected, -1.0)
+
+
+def test_checks_of_a_failed_solve_evaluate_to_nan_not_an_error() -> None:
+    """A solve that stops at ``log(x1_f)`` with ``x1_f = 0`` (the guess) is a Result with its
+    status (exit 1), not an expression error (exit 2): its checks are NaN where a term is not a
+    number, as NumPy computes them."""
+    data = yaml.safe_load(ZERMELO.read_text())
+    problem = data["problem"]
+    problem["states"]["x1"] = {"initial": 0.0}
+    problem["objective"]["mayer"] = "t_f - log(x1_f)"
+    problem["boundary_constraints"] = ["x1_f >= 0.5"]
+    data["solver"] = {"options": {"casadi": {"max_iter": 3}}}
+    result = gamespec.solve(spec_from_dict(data, source="test"), "casadi")
+    assert result.status.value != "optimal"
+    assert math.isnan(result.checks["hamiltonian_end_error"])

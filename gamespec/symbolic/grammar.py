@@ -293,18 +293,20 @@ class _Walker:
     def fail(self, node: ast.AST, reason: str) -> ExpressionError:
         return ExpressionError(self.text, reason, getattr(node, "col_offset", None))
 
-    def __call__(self, node: ast.AST) -> Any:
+    def apply(self, node: ast.AST, build: Callable[..., Any], *args: Any) -> Any:
+        """``build(*args)`` in the algebra, a refusal named at ``node``'s column."""
         try:
-            return self.value(node)
+            return build(*args)
         except Refused as err:
             raise self.fail(node, str(err)) from None
 
-    def value(self, node: ast.AST) -> Any:
+    def __call__(self, node: ast.AST) -> Any:
+        """The value of ``node`` (one frame per level of the tree, as deep sums need)."""
         algebra = self.algebra
         if isinstance(node, ast.Constant):
             if isinstance(node.value, bool) or not isinstance(node.value, int | float):
                 raise self.fail(node, f"only numbers are allowed as literals, not {node.value!r}")
-            return algebra.number(node.value)
+            return self.apply(node, algebra.number, node.value)
         if isinstance(node, ast.Name):
             if node.id in self.symbols:
                 return self.symbols[node.id]
@@ -315,15 +317,15 @@ class _Walker:
             known = ", ".join(sorted(self.symbols)) or "none"
             raise self.fail(node, f"undefined symbol {node.id!r} (declared: {known})")
         if isinstance(node, ast.BinOp) and isinstance(node.op, ast.Pow):
-            return algebra.power(self(node.left), self(node.right))
+            return self.apply(node, algebra.power, self(node.left), self(node.right))
         if isinstance(node, ast.BinOp) and isinstance(node.op, ast.BitXor):
             column = self.text.find("^", getattr(node.left, "end_col_offset", 0) or 0)
             raise ExpressionError(self.text, "'^' is not a power: use ** for powers", column)
         if isinstance(node, ast.BinOp) and type(node.op) in BINARY:
-            return algebra.binary(type(node.op), self(node.left), self(node.right))
+            return self.apply(node, algebra.binary, type(node.op), self(node.left), self(node.right))
         if isinstance(node, ast.UnaryOp) and isinstance(node.op, ast.USub | ast.UAdd):
             value = self(node.operand)
-            return algebra.negate(value) if isinstance(node.op, ast.USub) else value
+            return self.apply(node, algebra.negate, value) if isinstance(node.op, ast.USub) else value
         if isinstance(node, ast.Call):
             return self.call(node)
         if isinstance(node, ast.Compare):
@@ -340,7 +342,7 @@ class _Walker:
         arity = FUNCTION_ARITY[node.func.id]
         if len(node.args) != arity:
             raise self.fail(node, f"{node.func.id} takes {arity} argument(s), got {len(node.args)}")
-        return self.algebra.call(node.func.id, [self(a) for a in node.args])
+        return self.apply(node, self.algebra.call, node.func.id, [self(a) for a in node.args])
 
 
 def expression(text: str | float, symbols: Mapping[str, Any], algebra: Algebra) -> Any:
@@ -386,10 +388,7 @@ def relation(text: str, symbols: Mapping[str, Any], algebra: Algebra) -> Relatio
         raise ExpressionError(text[:40] + "...", "expression nested too deeply") from None
     inf = math.inf
     if len(ops) == 1:
-        try:
-            diff = algebra.binary(ast.Sub, terms[0], terms[1])
-        except Refused as err:
-            raise walk.fail(node, str(err)) from None
+        diff = walk.apply(node, algebra.binary, ast.Sub, terms[0], terms[1])
         if ops[0] is ast.Eq:
             return Relation(diff, 0.0, 0.0)
         if ops[0] in (ast.LtE, ast.Lt):

@@ -98,6 +98,7 @@ def test_both_walks_refuse_the_same_texts(text: str) -> None:
         "+".join(["x"] * 400),
         "-" * 300 + "x",
     ],
+    ids=lambda text: text if len(text) < 40 else f"{text[:20]}...({len(text)} characters)",
 )
 def test_both_walks_accept_the_same_texts(text: str) -> None:
     parse(text, {n: symbol(n) for n in NAMES_XYT})

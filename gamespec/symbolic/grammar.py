@@ -63,19 +63,26 @@ class Refused(ValueError):
 
 
 class Algebra(Protocol):
-    """Where a walk builds its value: what a number, ``pi``, an operator and a function become."""
+    """Where a walk builds its value: what a number, ``pi``, an operator and a function become.
+    A method raises :class:`Refused` for a value it will not build."""
 
-    def number(self, value: int | float) -> Any: ...
+    def number(self, value: int | float) -> Any:
+        """A literal of the text."""
 
-    def constant(self, name: str) -> Any: ...
+    def constant(self, name: str) -> Any:
+        """A named constant (``pi``)."""
 
-    def binary(self, op: type[ast.operator], left: Any, right: Any) -> Any: ...
+    def binary(self, op: type[ast.operator], left: Any, right: Any) -> Any:
+        """``left op right`` for ``op`` one of :data:`BINARY`."""
 
-    def negate(self, value: Any) -> Any: ...
+    def negate(self, value: Any) -> Any:
+        """``-value``."""
 
-    def power(self, base: Any, exponent: Any) -> Any: ...
+    def power(self, base: Any, exponent: Any) -> Any:
+        """``base ** exponent``."""
 
-    def call(self, name: str, args: list[Any]) -> Any: ...
+    def call(self, name: str, args: list[Any]) -> Any:
+        """The whitelisted function ``name`` (:data:`FUNCTION_ARITY`) of ``args``."""
 
     def scalar(self, value: Any) -> float | None:
         """``value`` as a float when it is a number (no symbols), else None."""

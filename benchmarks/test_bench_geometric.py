@@ -14,12 +14,16 @@ in each group.
 
 from __future__ import annotations
 
+import statistics
+import time
+
 import numpy as np
 import pytest
 import yaml
 from gamespec_geometric import active_pursuers, allocation, simulation
 from gamespec_geometric.simulation import simulate
 
+import gamespec
 from gamespec.loader import spec_from_dict
 from tests.conftest import PROBLEMS
 
@@ -105,3 +109,32 @@ def test_mpme_copy_steps(benchmark, monkeypatch, case: str) -> None:
         monkeypatch.setattr(simulation, "allocate", _one_evader_at_a_time)
     run = benchmark.pedantic(simulate, (spec,), rounds=3, warmup_rounds=1)
     np.testing.assert_array_equal(run.allocation, expected)
+
+
+def _cpu_per_step(spec) -> float:
+    """CPU seconds per simulation step of a whole ``gamespec.solve`` of ``spec`` (the chain the
+    command line runs: load excluded, the simulation to its end included)."""
+    start = time.process_time()
+    result = gamespec.solve(spec)
+    assert result.status == "simulated"
+    return (time.process_time() - start) / result.iterations
+
+
+def test_mpme_whole_run_per_step(benchmark) -> None:
+    """Issue 29: the whole run of the 100 × 50 copy of the ten-on-five file (every evader captured)
+    at ≤ 6× the per-step CPU of the 10 × 5 file itself, both run to their end, interleaved (median
+    of 3)."""
+    benchmark.group = "MPME whole runs, CPU per step"
+    small = spec_from_dict(_ten_on_five_copy(10, 5, steps=6000))
+    large = spec_from_dict(_ten_on_five_copy(100, 50, steps=6000))
+
+    def interleaved() -> tuple[float, float]:
+        pairs = [(_cpu_per_step(small), _cpu_per_step(large)) for _ in range(3)]
+        return statistics.median(p[0] for p in pairs), statistics.median(p[1] for p in pairs)
+
+    per_small, per_large = benchmark.pedantic(interleaved, rounds=1, iterations=1)
+    ratio = per_large / per_small
+    benchmark.extra_info |= {"ms_per_step_10x5": 1e3 * per_small, "ms_per_step_100x50": 1e3 * per_large}
+    benchmark.extra_info["ratio"] = ratio
+    print(f"\n10 x 5: {1e3 * per_small:.2f} ms/step, 100 x 50: {1e3 * per_large:.2f} ms/step, {ratio:.1f}x")
+    assert ratio <= 6.0

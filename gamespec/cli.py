@@ -15,7 +15,6 @@ import sys
 import warnings
 from collections.abc import Iterator
 from contextlib import AbstractContextManager, contextmanager, nullcontext
-from functools import cache
 from pathlib import Path
 from typing import TYPE_CHECKING, Annotated
 
@@ -39,12 +38,12 @@ app = typer.Typer(
 _MOUNTED: set[str] = set()
 
 
-@cache
 def _console(stderr: bool = False) -> Console:
-    """rich's console on stdout (or stderr), made on first use: rich is imported only to print."""
-    from rich.console import Console
+    """rich's console on stdout (or stderr), made on first use (:func:`gamespec.terminal.console`:
+    unwrapped off a terminal); rich is imported only to print."""
+    from gamespec.terminal import console
 
-    return Console(stderr=stderr)
+    return console(stderr)
 
 
 def _spinner(text: str) -> AbstractContextManager[object]:
@@ -95,8 +94,14 @@ def _main(
     version: Annotated[
         bool, typer.Option("--version", callback=_version, is_eager=True, help="Print the version and exit.")
     ] = False,
+    quiet: Annotated[
+        bool, typer.Option("--quiet", "-q", help="No progress on stderr (results and errors still print).")
+    ] = False,
 ) -> None:
     """gamespec: declarative optimal control and differential games on interchangeable backends."""
+    from gamespec.terminal import set_quiet
+
+    set_quiet(quiet)
 
 
 def _fmt(value: object) -> str:

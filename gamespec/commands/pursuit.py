@@ -45,13 +45,13 @@ def study(
 
     Resumes from the file's ``store`` (or OUT/points); the Result is the one `gamespec solve` gives.
     """
-    from rich.console import Console
     from rich.table import Table
 
     from gamespec.errors import SpecError
     from gamespec.loader import load
     from gamespec.plotting import plot_result
     from gamespec.solving import solve
+    from gamespec.terminal import console
 
     overrides = [*(set_ or []), *([f"store={out / 'points'}"] if out is not None else [])]
     spec = load(file, overrides)
@@ -65,7 +65,7 @@ def study(
         result.save(out)
         for path in plot_result(result, out):
             if not json_:
-                Console().print(f"wrote {out / 'result.json'} and {path}", highlight=False)
+                console().print(f"wrote {out / 'result.json'} and {path}", highlight=False)
     table = result.metrics.get("table", [])
     if json_:
         sys.stdout.write(json.dumps(table, indent=2) + "\n")
@@ -75,7 +75,7 @@ def study(
             view.add_column(col.replace("_variation_percent", " [%]"), justify="right")
         for row in table:
             view.add_row(*(_cell(row[c]) for c in TABLE_COLUMNS))
-        Console().print(view)
+        console().print(view)
     if not result.ok:
         print(
             f"error: {spec.name}: study ended with status {result.status.value}: {result.message}",
@@ -83,4 +83,4 @@ def study(
         )
         raise typer.Exit(1)
     if not json_:
-        Console().print(f"{result.status.value}: {result.message}", highlight=False)
+        console().print(f"{result.status.value}: {result.message}", highlight=False)

@@ -21,9 +21,8 @@ from collections.abc import Mapping
 from dataclasses import dataclass, field
 
 import numpy as np
-from rich.console import Console
-from rich.progress import BarColumn, Progress, TextColumn, TimeElapsedColumn
 
+from gamespec import terminal
 from gamespec.errors import SpecError
 from gamespec.games.backend import true_parameters
 from gamespec.games.equilibrium import GameModel, GameSolution
@@ -216,8 +215,7 @@ class RecedingHorizon:
         intervals = game.method.intervals
         stop, captured_at = "time_limit", None
         total = round((end - t) / rh.step)
-        with _progress(progress) as bar:
-            task = bar.add_task(game.name, total=total, info="")
+        with terminal.progress(f"{game.name} (receding horizon)", total, enabled=progress) as tracker:
             for _ in range(total):
                 model = self._model(intervals, t) if rh.horizon == "shrinking" else self.model
                 solutions = {}
@@ -254,7 +252,7 @@ class RecedingHorizon:
                 if rh.horizon == "shrinking":
                     intervals -= self.intervals_per_step
                 iterations = ", ".join(f"{v}: {s.run.iterations}" for v, s in solutions.items())
-                bar.update(task, advance=1, info=f"t = {t:.2f}  iterations {iterations}")
+                tracker.advance(info=f"t = {t:.2f}, iterations {iterations}")
                 captured_at = self._captured(record)
                 if captured_at is not None:
                     stop = "captured"
@@ -394,19 +392,6 @@ def _padded(rows: list[np.ndarray]) -> np.ndarray:
     for i, r in enumerate(rows):
         out[i, : len(r)] = r
     return out
-
-
-def _progress(enabled: bool) -> Progress:
-    return Progress(
-        TextColumn("[bold]{task.description}"),
-        BarColumn(),
-        TextColumn("{task.completed}/{task.total} steps"),
-        TimeElapsedColumn(),
-        TextColumn("{task.fields[info]}"),
-        console=Console(stderr=True),
-        transient=True,
-        disable=not enabled,
-    )
 
 
 def receding_horizon(model: GameModel, progress: bool = True) -> Result:

@@ -19,11 +19,9 @@ from functools import cache
 from importlib.metadata import PackageNotFoundError, version
 from typing import Any
 
-from rich.console import Console
-from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeRemainingColumn
-
 from gamespec.studies.executors import Executor, SerialExecutor
 from gamespec.studies.store import ResultStore
+from gamespec.terminal import progress
 
 PROVENANCE_PACKAGES = ("gamespec", "numpy", "scipy", "casadi", "pyomo", "cvxpy")
 
@@ -86,9 +84,9 @@ def run_study(
     ``fn`` must return JSON-able data. Values already stored are reused (those ``accept`` takes,
     when given; the others are computed again), so an interrupted study resumes where it stopped;
     damaged records are reported and computed again. ``report`` gets one line for each damaged
-    record and, on a resumed run, the number of points reused (default: stderr). The progress bar
-    goes to stderr too, so stdout stays clean for ``--json``, and only to a terminal, so that an
-    error is the one line a script reads there.
+    record and, on a resumed run, the number of points reused (default: stderr). Progress goes to
+    stderr too, so stdout stays clean for ``--json``: a bar on a terminal, a plain line every few
+    seconds elsewhere (:func:`gamespec.terminal.progress`; ``--quiet`` silences it).
     """
     say = report or (lambda line: print(line, file=sys.stderr))
     saved = store.items()
@@ -100,16 +98,13 @@ def run_study(
     if reused:
         say(f"resuming: {reused} of {len(points)} points reused from {store.path}")
     runner = executor or SerialExecutor()
-    columns = (TextColumn("{task.description}"), BarColumn(), MofNCompleteColumn(), TimeRemainingColumn())
-    console = Console(stderr=True)
-    progress_bar = Progress(*columns, disable=not (show_progress and console.is_terminal), console=console)
-    with runner, progress_bar as progress:
+    with runner, progress(description, total=len(points), enabled=show_progress) as tracker:
+        tracker.advance(reused)
         size = chunk_size(len(todo), runner.workers)
         jobs = [(fn, todo[i : i + size]) for i in range(0, len(todo), size)]
-        task = progress.add_task(description, total=len(points), completed=reused)
         for _job, records in runner.imap(_evaluate_chunk, jobs):
             store.put_many((key, value, spec_hash, versions) for key, value, versions in records)
-            progress.advance(task, len(records))
+            tracker.advance(len(records))
     saved = store.items()
     values = {key: saved[key] for key in points if key in saved}
     return StudyRun(values, computed=len(todo), reused=reused)

@@ -315,16 +315,41 @@ RESULT_COLUMNS = (
 """Columns ``gamespec results`` shows after the swept parameters, where the rows have them."""
 
 
+def _result_trajectories(folder: Path, csv: Path | None, parquet: Path | None, json_: bool) -> None:
+    """``gamespec results`` on one Result's folder: its summary (or JSON), its trajectories exported."""
+    from gamespec.result import Result
+    from gamespec.studies.export import write_csv, write_parquet
+    from gamespec.studies.trajectories import trajectory_rows
+
+    result = Result.load(folder)
+    rows = trajectory_rows(result)
+    if (csv or parquet) and not rows:
+        raise GamespecError(f"{folder}: the Result has no trajectories to export")
+    if json_:
+        sys.stdout.write(result.to_json() + "\n")
+    else:
+        _print_summary(result)
+    for path in (write_csv(rows, csv) if csv else None, write_parquet(rows, parquet) if parquet else None):
+        if path is not None:
+            print(f"wrote {path} ({len(rows)} rows)", file=sys.stderr)
+
+
 @app.command()
 def results(
-    folder: Annotated[Path, typer.Argument(help="A study folder (a sweep's or compare's --out).")],
+    folder: Annotated[
+        Path, typer.Argument(help="A study folder (a sweep's or compare's --out), or one Result's folder.")
+    ],
     csv: Annotated[Path | None, typer.Option("--csv", help="Write every column as CSV here.")] = None,
     parquet: Annotated[Path | None, typer.Option("--parquet", help="Write a typed Parquet file.")] = None,
     json_: JsonOpt = False,
 ) -> None:
-    """Print a study's table (sweep, compare, Table 2.1) and export it as CSV or Parquet."""
+    """Print a study's table (sweep, compare, Table 2.1) and export it as CSV or Parquet; for one
+    Result's folder, its summary, and its trajectories as the exported table."""
     from gamespec.studies.export import find_store, study_rows, write_csv, write_parquet
 
+    if (folder / "result.json").is_file():
+        _result_trajectories(folder, csv, parquet, json_)
+        return
     store = find_store(folder)
     rows = study_rows(store)
     for line in store.damaged:

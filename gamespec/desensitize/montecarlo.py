@@ -12,9 +12,10 @@ from typing import Any
 import numpy as np
 
 from gamespec.desensitize.augment import initial_values
-from gamespec.desensitize.simulate import Signal, Trajectories, cost, evaluate, open_loop, rk4
+from gamespec.desensitize.simulate import Trajectories, cost, evaluate, open_loop, rk4
 from gamespec.desensitize.tracking import linearization, riccati_gains
 from gamespec.montecarlo import Distribution, Normal, Uniform, proportion, sample, summarize
+from gamespec.ocp.control_signal import TranscribedSignal
 from gamespec.ocp.symbolic import SymbolicOcp
 from gamespec.result import Result
 from gamespec.specs.desensitize import MonteCarloOptions
@@ -112,7 +113,7 @@ def _tracking(
     result: Result,
     params: Mapping[Any, Any],
     nominal: Mapping[str, float],
-    signals: tuple[Signal, Signal | None],
+    signals: tuple[TranscribedSignal, TranscribedSignal | None],
     options: MonteCarloOptions,
     x0: np.ndarray,
 ) -> tuple[dict[str, Any], Trajectories]:

@@ -1,8 +1,10 @@
 """Vectorized re-simulation of a solved open-loop control under many parameter values at once.
 
-Classical RK4 on a uniform grid of ``steps`` steps over ``[t0, t_f]``, every sample in one NumPy
-array (samples along the last axis), the control interpolated linearly between the Result's control
-points, and the running cost integrated as one more state. The dynamics are the file's SymPy
+Classical RK4 with about ``steps`` steps over ``[t0, t_f]``, each mesh interval of the transcription
+cut into equal steps (:func:`gamespec.ocp.control_signal.step_edges`), every sample in one NumPy
+array (samples along the last axis), the control applied exactly as the transcription holds it (the
+polynomial of each mesh interval, :mod:`gamespec.ocp.control_signal`), and the running cost
+integrated as one more state. The dynamics are the file's SymPy
 expressions evaluated on arrays by :func:`gamespec.symbolic.calculus.numeric_function` (no code is
 generated, no Python call per sample).
 """
@@ -14,16 +16,14 @@ from dataclasses import dataclass
 
 import numpy as np
 import sympy as sp
-from scipy.interpolate import PchipInterpolator
 
+from gamespec.ocp.control_signal import TranscribedSignal, step_edges, transcribed_signal
 from gamespec.ocp.symbolic import SymbolicOcp
 from gamespec.result import Result
 from gamespec.symbolic.calculus import numeric_function
 from gamespec.symbolic.language import TIME, symbol
 
 Values = Mapping[sp.Symbol, np.ndarray | float]
-Signal = Callable[[np.ndarray], np.ndarray]
-"""Times ``(k,)`` → values ``(rows, k)``: an open-loop control or a grid input."""
 Feedback = Callable[[int, np.ndarray], np.ndarray]
 """``(step, x (n, samples)) -> Δu (m, samples)``: a correction added to the open-loop control."""
 
@@ -44,17 +44,10 @@ class Trajectories:
     violation: np.ndarray
 
 
-def open_loop(result: Result, names: list[str]) -> Signal:
-    """The Result's controls (or grid inputs, ``arrays["input/<name>"]``) of these names as a function
-    of time: the piecewise-cubic Hermite interpolant of the control points (shape-preserving, so it
-    does not overshoot between them), its end pieces continued to the ends of the horizon (Radau
-    collocation has no control point at t0)."""
-    tc = np.asarray(result.control_time if result.control_time is not None else result.time)
-    rows = [result.controls[n] if n in result.controls else result.arrays[f"input/{n}"] for n in names]
-    table = np.array(rows, dtype=float).reshape(len(names), -1)
-    if tc.size < 2:
-        return lambda t: np.repeat(table, np.size(t), axis=1)
-    return PchipInterpolator(tc, table, axis=1, extrapolate=True)
+def open_loop(result: Result, names: list[str]) -> TranscribedSignal:
+    """The Result's controls (or grid inputs) of these names as the transcription holds them
+    (:func:`gamespec.ocp.control_signal.transcribed_signal`)."""
+    return transcribed_signal(result, names)
 
 
 def evaluate(exprs: list[sp.Expr], values: Values, shape: tuple[int, ...]) -> np.ndarray:
@@ -66,32 +59,34 @@ def evaluate(exprs: list[sp.Expr], values: Values, shape: tuple[int, ...]) -> np
 def rk4(
     ocp: SymbolicOcp,
     x0: np.ndarray,
-    controls: Signal,
+    controls: TranscribedSignal,
     params: Values,
     t0: float,
     tf: float,
     steps: int,
     keep: int | None = None,
-    inputs: Signal | None = None,
+    inputs: TranscribedSignal | None = None,
     feedback: Feedback | None = None,
 ) -> Trajectories:
     """Integrate the file's dynamics from ``x0`` (n, samples) under the open-loop ``controls`` (plus
     ``feedback``, when given) and the grid ``inputs`` (when the problem has some); keep the
     trajectories of the first ``keep`` samples (all when None).
 
-    The open-loop signals are tabulated once at the RK4 stage times (every half step); the feedback
-    sees the state at the start of each step and is held over it (a zero-order hold).
+    The steps follow the controls' mesh (about ``steps`` of them, none across a mesh point); the
+    open-loop signals are tabulated once at each step's RK4 stage times, from the step's own mesh
+    interval; the feedback sees the state at the start of each step and is held over it (a
+    zero-order hold).
     """
     samples = x0.shape[1]
     keep = samples if keep is None else min(keep, samples)
     n, m = len(ocp.x), len(ocp.u)
-    h = (tf - t0) / steps
-    t = t0 + h * np.arange(steps + 1)
-    stages = t0 + h / 2 * np.arange(2 * steps + 1)
-    u_open = np.asarray(controls(stages), dtype=float).reshape(m, -1)
-    w_open = np.asarray(inputs(stages), dtype=float).reshape(len(ocp.w), -1) if inputs else np.empty((0, 0))
-    X = np.empty((steps + 1, n, keep))
-    U = np.empty((steps + 1, m, keep))
+    t = step_edges(controls.mesh, t0, tf, steps)
+    h = np.diff(t)
+    stages = np.stack([t[:-1], t[:-1] + h / 2, t[1:]], axis=1)
+    u_open = controls.on_steps(t).reshape(m, len(h), 3)
+    w_open = inputs.on_steps(t) if inputs else np.empty((0, len(h), 3))
+    X = np.empty((len(t), n, keep))
+    U = np.empty((len(t), m, keep))
     running, energy, violation = np.zeros(samples), np.zeros(samples), np.zeros(samples)
     args = [*ocp.p, *ocp.w, *ocp.x, *ocp.u, TIME]
     flow = numeric_function([*ocp.dynamics, ocp.sign * ocp.lagrange], args)
@@ -101,42 +96,37 @@ def rk4(
     fixed = [params[p] for p in ocp.p]
 
     def at(
-        function: Callable[..., np.ndarray], rows: int, j: int, x: np.ndarray, u: np.ndarray
+        function: Callable[..., np.ndarray], rows: int, k: int, stage: int, x: np.ndarray, u: np.ndarray
     ) -> np.ndarray:
-        signals = list(w_open[:, j]) if inputs else []
-        return np.broadcast_to(function(*fixed, *signals, *x, *u, stages[j]), (rows, samples))
+        signals = list(w_open[:, k, stage])
+        return np.broadcast_to(function(*fixed, *signals, *x, *u, stages[k, stage]), (rows, samples))
 
-    def rhs(j: int, x: np.ndarray, u: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        values = at(flow, n + 1, j, x, u)
+    def rhs(k: int, stage: int, x: np.ndarray, u: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        values = at(flow, n + 1, k, stage, x, u)
         return values[:n], values[n], np.sum(u**2, axis=0)
 
-    def control(j: int, correction: np.ndarray) -> np.ndarray:
-        return u_open[:, j, None] + correction
-
-    def record(k: int, x: np.ndarray, u: np.ndarray) -> None:
-        X[k], U[k] = x[:, :keep], np.broadcast_to(u, (m, samples))[:, :keep]
+    def record(index: int, k: int, stage: int, x: np.ndarray, u: np.ndarray) -> None:
+        X[index], U[index] = x[:, :keep], np.broadcast_to(u, (m, samples))[:, :keep]
         if ocp.path:
-            g = at(path, len(ocp.path), 2 * k, x, u)
+            g = at(path, len(ocp.path), k, stage, x, u)
             excess = np.maximum(lower - g, 0.0) + np.maximum(g - upper, 0.0)
             np.maximum(violation, excess.max(axis=0), out=violation)
 
     x = x0
-    for k in range(steps):
+    for k, hk in enumerate(h):
         correction = np.zeros((m, 1)) if feedback is None else feedback(k, x)
-        u1, u2, u4 = (
-            control(2 * k, correction),
-            control(2 * k + 1, correction),
-            control(2 * k + 2, correction),
-        )
-        record(k, x, u1)
-        k1, c1, e1 = rhs(2 * k, x, u1)
-        k2, c2, e2 = rhs(2 * k + 1, x + h / 2 * k1, u2)
-        k3, c3, e3 = rhs(2 * k + 1, x + h / 2 * k2, u2)
-        k4, c4, e4 = rhs(2 * k + 2, x + h * k3, u4)
-        x = x + h / 6 * (k1 + 2 * k2 + 2 * k3 + k4)
-        running += h / 6 * (c1 + 2 * c2 + 2 * c3 + c4)
-        energy += h / 6 * (e1 + 2 * e2 + 2 * e3 + e4)
-    record(steps, x, control(2 * steps, np.zeros((m, 1)) if feedback is None else feedback(steps, x)))
+        u1, u2, u4 = (u_open[:, k, stage, None] + correction for stage in range(3))
+        record(k, k, 0, x, u1)
+        k1, c1, e1 = rhs(k, 0, x, u1)
+        k2, c2, e2 = rhs(k, 1, x + hk / 2 * k1, u2)
+        k3, c3, e3 = rhs(k, 1, x + hk / 2 * k2, u2)
+        k4, c4, e4 = rhs(k, 2, x + hk * k3, u4)
+        x = x + hk / 6 * (k1 + 2 * k2 + 2 * k3 + k4)
+        running += hk / 6 * (c1 + 2 * c2 + 2 * c3 + c4)
+        energy += hk / 6 * (e1 + 2 * e2 + 2 * e3 + e4)
+    last = len(h) - 1
+    correction = np.zeros((m, 1)) if feedback is None else feedback(len(h), x)
+    record(len(h), last, 2, x, u_open[:, last, 2, None] + correction)
     return Trajectories(t, X, U, x, running, energy, violation)
 
 

@@ -283,7 +283,8 @@ class Transcription:
         solver_stats: dict | None = None,
     ) -> Result:
         """A Result from a solution, with costates from the defect multipliers, the checks, the
-        grid inputs used (``arrays["input/<name>"]``, on ``control_time``), the optimized design
+        grid inputs used (``arrays["input/<name>"]``, on ``control_time``), the mesh the controls
+        are held on (``arrays["control_mesh"]``, :mod:`gamespec.ocp.control_signal`), the optimized design
         variables (``metrics["design"]``) and a pass/fail verdict per check against its tolerance
         (``metrics["checks_passed"]``, see :func:`~gamespec.ocp.checks.verdicts`)."""
         if objective is not None:
@@ -294,6 +295,7 @@ class Transcription:
         t_eval = self.t0 + T * self.grid.eval_tau
         costates: dict[str, np.ndarray] = {}
         arrays = {f"input/{n}": inputs[i] for i, n in enumerate(self.ocp.inputs)}
+        arrays["control_mesh"] = self.t0 + T * self.grid.breaks
         lam = None
         if defect_multipliers is not None and self.grid.scheme == "radau":
             lam = defect_multipliers * self.costate_rows[None, :]

@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from gamespec.ocp.control_signal import transcribed_signal
 from gamespec.pursuit.reduced import Reduction
 from gamespec.pursuit.relay import detect_arcs
 from gamespec.pursuit.report import engagement_report
@@ -22,13 +23,13 @@ ARC_TOL = 1e-5
 
 
 def heading_law(red: Reduction, result: Result) -> HeadingLaw:
-    """The OCP's evader heading as a law for re-simulation: θ_E(t) interpolated in the fixed frame;
-    θ(t) + φ_1 in the line-of-sight frame, φ_1 read from the simulated positions."""
-    tc = np.asarray(result.control_time if result.control_time is not None else result.time)
-    control = np.asarray(result.controls[red.control])
+    """The OCP's evader heading as a law for re-simulation, as the transcription holds it
+    (:mod:`gamespec.ocp.control_signal`): θ_E(t) in the fixed frame; θ(t) + φ_1 in the
+    line-of-sight frame, φ_1 read from the simulated positions."""
+    signal = transcribed_signal(result, [red.control])
     if red.frame == "fixed":
-        return lambda t, P, E: float(np.interp(t, tc, control))
-    return lambda t, P, E: float(np.interp(t, tc, control) + np.arctan2(*(E - P[0])[::-1]))
+        return lambda t, P, E: signal.at(t)[0]
+    return lambda t, P, E: signal.at(t)[0] + float(np.arctan2(*(E - P[0])[::-1]))
 
 
 def relay_arcs(red: Reduction, players: Players, result: Result) -> dict[str, float]:
@@ -39,8 +40,7 @@ def relay_arcs(red: Reduction, players: Players, result: Result) -> dict[str, fl
     r_a, r_s = s[red.distance[active]], s[red.distance[guard]]
     u, v = players.speeds[active], players.v
     t = np.asarray(result.time)
-    tc = np.asarray(result.control_time if result.control_time is not None else t)
-    control = np.interp(t, tc, result.controls[red.control])
+    control = transcribed_signal(result, [red.control])(t)[0]
     if red.frame == "fixed":
         name = red.angle[active]
         phi_a = s[name] if name in s else np.full_like(t, red.parameters[name])

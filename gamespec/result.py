@@ -106,6 +106,8 @@ class Result(BaseModel):
     objective: float | None = None
     t_final: float | None = None
     solve_time_s: float = 0.0
+    """Wall-clock seconds the caller waited for the solve (set by the chain: the backend's solve,
+    the checks, the inverse maps and any multi-start)."""
     build_time_s: float = 0.0
     iterations: int | None = None
     time: np.ndarray | None = None

@@ -13,7 +13,7 @@ from typing import ClassVar
 import numpy as np
 
 from gamespec.backend import Backend, CompiledModel, Inputs, refuse_inputs
-from gamespec.games.equilibrium import GameModel, GameSolution, status_of
+from gamespec.games.equilibrium import GameModel, GameSolution, equilibrium_report, status_of
 from gamespec.games.problems import initial_state
 from gamespec.games.simulate import TrueSystem, control_signal, grid_of
 from gamespec.result import Result
@@ -39,9 +39,7 @@ def open_loop(model: GameModel) -> Result:
     own = {name: _own(solutions, name) for name in game.problem.players}
     first = solutions[0].states
     tc = first.control_time + t0
-    controls = {
-        c: own[p].results[p].controls[c] for p, pl in game.problem.players.items() for c in pl.controls
-    }
+    controls = {c: own[p].states.controls[c] for p, pl in game.problem.players.items() for c in pl.controls}
     arrays = {}
     if len(solutions) == 1:
         time, states = first.time + t0, dict(first.states)
@@ -49,10 +47,13 @@ def open_loop(model: GameModel) -> Result:
         for s in solutions:
             arrays |= {f"game/{s.view}/{k}": v for k, v in s.states.states.items()}
         time, states = _simulated(model, first, controls, t0)
-    metrics = {"best_response": _runs(solutions), "builds": model.builds}
+    report = equilibrium_report(model, solutions)
+    metrics = {"best_response": _runs(solutions), "builds": model.builds} | report.metrics
     return Result(
         status=status_of(solutions),
-        message="; ".join(s.run.message for s in solutions if s.run.message),
+        message="; ".join(
+            [s.run.message for s in solutions if s.run.message] + [report.message] * bool(report.message)
+        ),
         objective=first.objective,
         t_final=float(time[-1]),
         time=time,
@@ -61,6 +62,7 @@ def open_loop(model: GameModel) -> Result:
         controls=controls,
         arrays=arrays,
         iterations=sum(s.run.iterations for s in solutions),
+        checks=report.checks,
         metrics=metrics,
     )
 

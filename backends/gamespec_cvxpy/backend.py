@@ -218,6 +218,12 @@ class CovariancePlayers:
         report = StepReport(status, f"step {self.steps}: {'; '.join(notes)}" if notes else "")
         return (self.gains.unscale(np.asarray(self.zeta.value)) if status.ok else None), report
 
+    def controller_value(self, ell: np.ndarray) -> float | None:
+        """``J_Σ`` of the controller's constrained best response to ``ℓ`` (one more step, for the
+        Nash gap), None when the step fails."""
+        kappa, report = self.controller_step(ell)
+        return self.model.covariance.payoff(kappa, ell) if kappa is not None and report.status.ok else None
+
     def smallest_scaling(self) -> float | None:
         """``min_K ‖W‖₂²`` for the current parameters: the least ``γ`` with ``Σ_N(K) ⪯ γ Σ_N``."""
         status = self.scaling.solve()
@@ -251,6 +257,8 @@ class CovariancePlayers:
             history=list(zip(run.changes(CONTROLLER), run.changes(STOPPER), strict=True)),
             best_response=run.as_metrics(),
         )
+        if run.status.ok:
+            outcome.controller_value = self.controller_value(run.strategies[STOPPER])
         if run.status is Status.INFEASIBLE and run.failed_player == CONTROLLER:
             gamma = self.smallest_scaling()
             outcome.min_covariance_scaling = gamma

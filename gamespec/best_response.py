@@ -216,6 +216,9 @@ class BestResponseRun:
     players: dict[str, PlayerRecord] = field(default_factory=dict)
     failed_player: str = ""
     best: int | None = None
+    rate: float | None = None
+    """The observed factor of the largest change per sweep over the last window (below 1: still
+    converging), None with too short a history."""
 
     @property
     def residual(self) -> float:
@@ -247,6 +250,7 @@ class BestResponseRun:
             "failed_player": self.failed_player or None,
             "best_iteration": self.best,
             "residual": self.residual,
+            "observed_rate": self.rate,
             "players": {
                 name: {"status": r.status.value, "message": r.message, "responses": r.responses}
                 for name, r in self.players.items()
@@ -541,4 +545,5 @@ def iterate(
         players=it.records,
         failed_player=it.failed,
         best=it.best,
+        rate=it.rate(),
     )

@@ -73,4 +73,4 @@ def game_summary(result: Result) -> Rows:
         for key, value in m.items()
         if key.endswith("_min_obstacle_distance")
     ]
-    return rows
+    return [*rows, *_solution(m)]

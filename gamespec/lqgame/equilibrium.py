@@ -18,7 +18,8 @@ point of Algorithm 2. The Result's concept is ``upper_value`` when the mean part
 ``nash`` when the covariance part is, else ``saddle``. A saddle or Nash point is checked by its gap
 (``checks.saddle_gap``); an upper value by the follower's improvement alone (``checks.follower_gap``),
 the leader's improvement against a fixed follower being no defect of it (it is reported). Both
-tolerances are ``method.tolerance · max(1, |J|)``.
+tolerances are ``method.tolerance · max(1, |J|)``. ``upper_value`` (and ``lower_value`` for a
+saddle) is ``J`` where the covariance part is the UCSG saddle; under ``Σ_N`` neither is claimed.
 """
 
 from __future__ import annotations
@@ -116,6 +117,10 @@ def report(
         "improvements_by_part": {"mean": mean, "covariance": cov},
         "saddle_gap": gap,
     }
+    if found and kinds["covariance"] == "saddle":
+        metrics["upper_value"] = float(J)
+        if kinds["mean"] == "saddle":
+            metrics["lower_value"] = float(J)
     if kinds["game"] == "upper_value":
         name, value = "follower_gap", improvements[STOPPER]
     else:

@@ -35,6 +35,7 @@ def test_without_targets_the_game_is_a_saddle_with_no_gain():
     assert m["payoffs"] == {"controller": result.objective, "stopper": result.objective}
     assert abs(result.checks["saddle_gap"]) <= 1e-10 * abs(result.objective)
     assert m["checks_passed"]["saddle_gap"]
+    assert m["lower_value"] == m["upper_value"] == result.objective
 
 
 def _controller_value(model: GameModel, V: np.ndarray) -> float:

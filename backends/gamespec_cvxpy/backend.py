@@ -6,7 +6,7 @@ and the controller's best response under the relaxed terminal constraint eq. 4.6
 eq. 4.62 (``W Wᵀ ⪯ I``, an SDP in whitened gains, :mod:`gamespec.lqgame.scaling`, with one small
 cone per column of ``W``: :meth:`CovariancePlayers.terminal_cone`), built once with
 ``cp.Parameter``s and re-solved every iteration. A step the solver fails on numerically is retried
-on ``fallback_solver`` when the options name one, and otherwise stops the run with the last iterate
+on ``fallback_solver`` when the options name one, and otherwise stops the run with the best iterate
 and the status ``numerical_error``. When the controller's problem is infeasible, a second problem
 on the same parameters, ``min γ`` subject to ``W Wᵀ ⪯ γ I``, gives the smallest achievable scaling
 ``γ* = σ_max(W)²`` of ``Σ_N``. Without a terminal covariance the covariance game is the UCSG closed
@@ -269,7 +269,7 @@ class CovariancePlayers:
             )
             outcome.message = (
                 f"terminal covariance cannot be met at Jacobi iteration {run.iterations + 1}: {scaling}; "
-                "gains shown are the last iterate"
+                "gains shown are the best iterate (smallest residual)"
             )
         outcome.solve_time_s = self.seconds - start
         return outcome

@@ -75,7 +75,8 @@ class Existence:
 
     @property
     def refused(self) -> bool:
-        return self.escape_time is not None or (self.checked and self.riccati is not None)
+        """A Riccati equation escaped or a player's problem is not strictly convex: no saddle."""
+        return self.riccati is not None
 
     def as_metrics(self) -> dict:
         return {
@@ -116,10 +117,10 @@ def _skip(game: DifferentialGameSpec) -> str:
 def _quadratic(expr: sp.Expr, variables: list[sp.Symbol]) -> tuple[np.ndarray, np.ndarray, float] | None:
     """``(H, g, c)`` with ``expr = ½ zᵀHz + gᵀz + c`` in ``variables``, or None when ``expr`` is not
     a polynomial of degree ≤ 2 with numeric coefficients."""
-    if expr.free_symbols - set(variables):
+    expr = sp.expand(expr)
+    if expr.free_symbols - set(variables) or not expr.is_polynomial(*variables):
         return None
-    poly = sp.Poly(sp.expand(expr), *variables) if variables else None
-    if poly is not None and poly.total_degree() > 2:
+    if variables and sp.Poly(expr, *variables).total_degree() > 2:
         return None
     zero = dict.fromkeys(variables, 0)
     H = np.array([[float(sp.diff(expr, a, b).subs(zero)) for b in variables] for a in variables], dtype=float)

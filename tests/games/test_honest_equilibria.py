@@ -210,3 +210,28 @@ def test_damped_jacobi_down_to_the_solvers_accuracy_is_not_cycling(scalar):
     if run["outcome"] == "iteration_limit":
         assert "converging slowly" in result.message
     assert result.metrics["payoffs"]["pursuer"] == pytest.approx(3 / 7, abs=1e-10)
+
+
+@pytest.mark.parametrize(
+    ("change", "reason"),
+    [
+        ("problem.dynamics.x=sin(x) + u + v", "not linear"),
+        ("problem.dynamics.x=x*u + v", "not linear"),
+        ("problem.payoff.lagrange=abs(u) - g2*v**2", "not quadratic"),
+        ("problem.payoff.lagrange=t*u**2 - g2*v**2", "not quadratic"),
+        ("problem.payoff.mayer=x_f**4", "not quadratic"),
+        ("problem.players.evader.payoff={mayer: 0, lagrange: v**2}", "not zero-sum"),
+    ],
+)
+def test_the_riccati_test_skips_what_is_not_linear_quadratic(scalar, change, reason):
+    from gamespec.games.existence import existence
+
+    spec = scalar(change)
+    verdict = existence(spec, spec.problem.parameters)
+    assert not verdict.checked and not verdict.refused and reason in verdict.reason
+
+
+def test_a_payoff_convex_in_the_maximizer_is_refused(scalar):
+    """``+γ² v²`` in the integrand: the maximizer's problem is unbounded whatever the horizon."""
+    result = compile_spec(scalar("problem.payoff.lagrange=(u**2 + g2*v**2)/2")).solve()
+    assert result.status is Status.UNBOUNDED and "not strictly concave" in result.message

@@ -49,7 +49,7 @@ def open_loop(model: GameModel) -> Result:
     own = {name: _own(solutions, name) for name in game.problem.players}
     first = solutions[0].states
     tc = first.control_time + t0
-    controls = {c: own[p].states.controls[c] for p, pl in game.problem.players.items() for c in pl.controls}
+    controls = {c: own[p].controls_of(p)[c] for p, pl in game.problem.players.items() for c in pl.controls}
     arrays = {}
     if len(solutions) == 1:
         time, states = first.time + t0, dict(first.states)

@@ -132,6 +132,12 @@ class GameSolution:
             return self.equilibrium.point
         return self.results[self.last_player]
 
+    def controls_of(self, player: str) -> dict[str, np.ndarray]:
+        """``player``'s controls at the returned point (its last response's when not verified)."""
+        if self.equilibrium is not None and self.equilibrium.point is not None:
+            return self.equilibrium.point.controls
+        return self.results[player].controls
+
 
 @dataclass
 class GameModel:
@@ -198,10 +204,9 @@ class GameModel:
         time: float,
         start: Mapping[str, np.ndarray] | None = None,
         sensitivities: Mapping[str, float] | None = None,
-        verify: bool = True,
     ) -> GameSolution:
-        """Iterate best responses of game ``view`` from ``state`` at ``time``; with ``verify``, one
-        more best response per player at the returned point says what it is (see module doc)."""
+        """Iterate best responses of game ``view`` from ``state`` at ``time``; then one more best
+        response per player at the returned point says what it is (see module doc)."""
         settings = self.game.game
         order = [r for (v, _), r in self.responders.items() if v == view]
         for r in order:
@@ -223,7 +228,7 @@ class GameModel:
             Settings(settings.scheme, settings.tolerance, settings.max_iterations, settings.damping),
             payoff=lambda _: _objective(self.responders[(view, last[0])].last),
         )
-        equilibrium = self._verify(order, run) if verify and run.best is not None else None
+        equilibrium = self._verify(order, run) if run.best is not None else None
         results = {r.name: r.last for r in order if r.last is not None}
         return GameSolution(view, run, results, last[0], equilibrium)
 
@@ -237,8 +242,15 @@ class GameModel:
         return "saddle" if len({p.objective for p in players}) > 1 else "nash"
 
     def _verify(self, order: list[BestResponder], run: BestResponseRun) -> Equilibrium:
-        """Every player's payoff at the returned point and its best response's improvement there."""
+        """Every player's payoff at the returned point and its best response's improvement there
+        (none when a player's problem goes through transforms: its states and payoff are not the
+        game's)."""
         point = run.strategies
+        concept = self.concept() if run.outcome is Outcome.CONVERGED else "none"
+        if any(r.solver.steps or not hasattr(r.solver.compiled, "tr") for r in order):
+            missing = dict.fromkeys((r.name for r in order), None)
+            note = "a player's problem goes through transforms: no payoffs or gap at the returned point"
+            return Equilibrium(concept, missing, dict(missing), dict(missing), None, note)
         responses = {r.name: r.respond({o: point[o] for o in r.opponents})[1] for r in order}
         payoffs: dict[str, float | None] = {}
         best: dict[str, float | None] = {}
@@ -261,9 +273,8 @@ class GameModel:
             b = best[r.name]
             improvements[r.name] = None if b is None else sense * (payoffs[r.name] - b)
         first = order[0].name
-        found = run.outcome is Outcome.CONVERGED
         return Equilibrium(
-            concept=self.concept() if found else "none",
+            concept=concept,
             payoffs=payoffs,
             best_values=best,
             improvements=improvements,
@@ -273,11 +284,11 @@ class GameModel:
 
     @staticmethod
     def _states_at(r: BestResponder, result: Result, strategy: np.ndarray) -> np.ndarray | None:
-        """The states of the returned point on ``r``'s model (None when its problem went through
-        transforms, whose states and payoff are not the game's, or its best response failed)."""
-        tr = getattr(r.solver.compiled, "tr", None)
-        if tr is None or r.solver.steps or not result.ok:
+        """The states of the returned point on ``r``'s model (None when its best response failed or
+        the collocation equations were not met)."""
+        if not result.ok:
             return None
+        tr = r.solver.compiled.tr
         start = np.array([result.states[n] for n in tr.ocp.states])
         return states_at(tr, result.parameters, np.asarray(strategy, dtype=float), _inputs(tr, result), start)
 

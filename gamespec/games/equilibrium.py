@@ -376,7 +376,7 @@ def equilibrium_report(model: GameModel, solutions: list[GameSolution]) -> Equil
     tolerance = model.game.game.tolerance
     notes = [s.equilibrium.note for s in verified if s.equilibrium.note]
     if gap is None:
-        return EquilibriumReport(metrics, {}, "; ".join([*notes, "the saddle gap could not be computed"]))
+        return EquilibriumReport(metrics, {}, "; ".join(notes or ["the saddle gap could not be computed"]))
     passed = bool(gap <= tolerance)
     metrics |= {"checks_passed": {"saddle_gap": passed}, "check_tolerances": {"saddle_gap": tolerance}}
     message = (

@@ -36,7 +36,7 @@ def open_loop(model: GameModel) -> Result:
     whose Riccati test (:mod:`gamespec.games.existence`) finds no saddle is refused as ``unbounded``.
     """
     game = model.game
-    exists = existence(game, model.parameters)
+    exists = existence(model.lq, model.parameters)
     if exists.refused:
         metrics = {
             "existence": exists.as_metrics(),
@@ -62,9 +62,7 @@ def open_loop(model: GameModel) -> Result:
     metrics |= report.metrics
     return Result(
         status=status_of(solutions),
-        message="; ".join(
-            [s.run.message for s in solutions if s.run.message] + [report.message] * bool(report.message)
-        ),
+        message="; ".join(m for m in [*(s.run.message for s in solutions), report.message] if m),
         objective=first.objective,
         t_final=float(time[-1]),
         time=time,

@@ -35,6 +35,7 @@ import numpy as np
 
 from gamespec.best_response import BestResponseRun, Outcome, Settings, VectorPlayer, iterate
 from gamespec.games.evaluation import payoff_at, states_at
+from gamespec.games.existence import LQForm, lq_form
 from gamespec.games.problems import parameter_values, player_problem, views
 from gamespec.loader import with_values
 from gamespec.result import Result, Status
@@ -147,9 +148,13 @@ class GameModel:
     responders: dict[tuple[str, str], BestResponder] = field(default_factory=dict)
     parameters: dict[str, float] = field(default_factory=dict)
     """The game's runtime parameter values (``problem.parameters``, updated by a re-solve)."""
+    lq: LQForm | str = ""
+    """The game's expressions for the Riccati existence test (:mod:`gamespec.games.existence`),
+    parsed once, or why the test does not apply."""
 
     def __post_init__(self) -> None:
         self.parameters = dict(self.game.problem.parameters) | self.parameters
+        self.lq = lq_form(self.game)
         names = list(self.game.problem.players)
         for view in views(self.game):
             for player in names:

@@ -128,36 +128,66 @@ def _quadratic(expr: sp.Expr, variables: list[sp.Symbol]) -> tuple[np.ndarray, n
     return H.reshape(len(variables), len(variables)), g, float(expr.subs(zero))
 
 
-def lq_data(game: DifferentialGameSpec, parameters: Mapping[str, float]) -> LQData | str:
-    """The game's LQ matrices at ``parameters``, or the reason it is not a game the test covers."""
+@dataclass(frozen=True)
+class LQForm:
+    """A zero-sum game's expressions parsed once into SymPy (in the parameters' symbols): the
+    dynamics, the Lagrange and Mayer terms and the horizon, over ``z = (x, u, v)`` and ``x_f``."""
+
+    dynamics: list[sp.Expr]
+    lagrange: sp.Expr
+    mayer: sp.Expr
+    horizon: sp.Expr
+    z: list[sp.Symbol]
+    ends: list[sp.Symbol]
+    parameters: dict[str, sp.Symbol]
+    states: list[str]
+    m: int
+    x0: np.ndarray
+    t0: float
+
+
+def lq_form(game: DifferentialGameSpec) -> LQForm | str:
+    """The game's expressions for the test, or the reason it is not a game the test covers."""
     why = _skip(game)
     if why:
         return why
     p = game.problem
     sym = symbols_of(game)
-    values = {sym.running[n]: float(v) for n, v in parameters.items() if n in sym.running}
-    minimizers = [c for pl in p.players.values() if pl.objective == "minimize" for c in pl.controls]
-    maximizers = [c for pl in p.players.values() if pl.objective == "maximize" for c in pl.controls]
-    x = [sym.running[n] for n in p.states]
-    u = [sym.running[c] for c in minimizers]
-    v = [sym.running[c] for c in maximizers]
-    z = x + u + v
+    senses = {c: pl.objective for pl in p.players.values() for c in pl.controls}
+    u = [sym.running[c] for c, sense in senses.items() if sense == "minimize"]
+    v = [sym.running[c] for c, sense in senses.items() if sense == "maximize"]
+    return LQForm(
+        dynamics=[sp.sympify(parse(p.dynamics[name], sym.running)) for name in p.states],
+        lagrange=sp.sympify(parse(p.payoff.lagrange, sym.running)),
+        mayer=sp.sympify(parse(p.payoff.mayer, sym.ends)),
+        horizon=sp.sympify(parse(p.time.final, sym.running)),
+        z=[sym.running[n] for n in p.states] + u + v,
+        ends=[sym.ends[f"{s}_f"] for s in p.states],
+        parameters={n: sym.running[n] for n in p.parameters},
+        states=list(p.states),
+        m=len(u),
+        x0=np.array([*(float(s.initial) for s in p.states.values()), 1.0]),
+        t0=float(p.time.initial),
+    )
+
+
+def lq_data(form: LQForm, parameters: Mapping[str, float]) -> LQData | str:
+    """The game's LQ matrices at ``parameters``, or the reason the expressions are not LQ."""
+    values = {form.parameters[n]: float(v) for n, v in parameters.items() if n in form.parameters}
     rows = []
-    for name in p.states:
-        term = _quadratic(sp.sympify(parse(p.dynamics[name], sym.running)).subs(values), z)
+    for name, f in zip(form.states, form.dynamics, strict=True):
+        term = _quadratic(f.subs(values), form.z)
         if term is None or np.any(term[0]):
             return f"the dynamics of {name} are not linear in the states and controls (or depend on t)"
         rows.append((term[1], term[2]))
-    n, nu = len(x), len(u)
-    running = _quadratic(sp.sympify(parse(p.payoff.lagrange, sym.running)).subs(values), z)
-    ends_values = {sym.ends[k]: float(v) for k, v in parameters.items() if k in sym.ends}
-    xf = [sym.ends[f"{s}_f"] for s in p.states]
-    mayer = _quadratic(sp.sympify(parse(p.payoff.mayer, sym.ends)).subs(ends_values), xf)
+    running = _quadratic(form.lagrange.subs(values), form.z)
+    mayer = _quadratic(form.mayer.subs(values), form.ends)
     if running is None or mayer is None:
         return "the payoff is not quadratic in the states and controls (or depends on t or t_f)"
-    horizon = sp.sympify(parse(p.time.final, sym.running)).subs(values)
+    horizon = form.horizon.subs(values)
     if horizon.free_symbols:
         return "the final time depends on more than the parameters"
+    n, nu = len(form.states), form.m
     G = np.array([g for g, _ in rows])
     c = np.array([k for _, k in rows])
     A = np.block([[G[:, :n], c[:, None]], [np.zeros((1, n + 1))]])
@@ -167,19 +197,8 @@ def lq_data(game: DifferentialGameSpec, parameters: Mapping[str, float]) -> LQDa
     N = np.vstack([H[:n, n:], g[None, n:]])
     Hf, gf, kf = mayer
     S = np.block([[Hf, gf[:, None]], [gf[None, :], np.array([[2 * kf]])]])
-    x0 = np.array([*(float(s.initial) for s in p.states.values()), 1.0])
     return LQData(
-        A,
-        B[:, :nu],
-        B[:, nu:],
-        Q,
-        N[:, :nu],
-        N[:, nu:],
-        H[n:, n:],
-        S,
-        x0,
-        float(p.time.initial),
-        float(horizon),
+        A, B[:, :nu], B[:, nu:], Q, N[:, :nu], N[:, nu:], H[n:, n:], S, form.x0, form.t0, float(horizon)
     )
 
 
@@ -204,9 +223,10 @@ def escape(A, B, Q, N, R, S, duration: float) -> tuple[float | None, np.ndarray]
     return (float(sol.t_events[0][0]) if sol.t_events[0].size else None), P
 
 
-def existence(game: DifferentialGameSpec, parameters: Mapping[str, float]) -> Existence:
-    """The Riccati test of the module docstring at ``parameters``."""
-    data = lq_data(game, parameters)
+def existence(form: LQForm | str, parameters: Mapping[str, float]) -> Existence:
+    """The Riccati test of the module docstring at ``parameters`` on the game's parsed ``form``
+    (:func:`lq_form`; a string: why the test does not apply)."""
+    data = form if isinstance(form, str) else lq_data(form, parameters)
     if isinstance(data, str):
         return Existence(False, f"existence test skipped: {data}")
     m = data.m

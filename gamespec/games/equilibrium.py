@@ -13,8 +13,9 @@ as a zero change. Each player's NLP ``tol`` is therefore tied to the game's:
 ``min(configured tol, TOLERANCE_RATIO · game.tolerance)`` (not below ``SOLVER_TOL_FLOOR``).
 
 What was found (:class:`Equilibrium`). From the returned point ``s`` (the engine's best iterate)
-every player answers once more, ``b_p = J_p(BR_p(s_{-p}), s_{-p})``, and its payoff at ``s`` itself,
-``J_p(s)``, is evaluated on its own transcription (:mod:`gamespec.games.evaluation`); the
+every player answers once more, ``b_p = J_p(BR_p(s_{-p}), s_{-p})``, and both ``b_p`` and its payoff
+at ``s`` itself, ``J_p(s)``, are evaluated on its own transcription (:mod:`gamespec.games.evaluation`:
+the collocation states of the controls, not IPOPT's states within its tolerance); the
 improvement ``J_p(s) − b_p`` (minimizer) or ``b_p − J_p(s)`` (maximizer) is what a best response
 gains, and the largest is the Nash gap (``metrics.saddle_gap``; for a zero-sum game the open-loop
 saddle gap). ``b`` of a zero-sum game's minimizer and maximizer bracket its lower and upper values
@@ -264,7 +265,7 @@ class GameModel:
         notes = []
         for r in order:
             result = responses[r.name]
-            best[r.name] = float(result.objective) if result.ok and result.objective is not None else None
+            best[r.name] = self._response_value(r, result)
             states = self._states_at(r, result, point[r.name])
             if states is None:
                 payoffs[r.name] = improvements[r.name] = None
@@ -286,6 +287,19 @@ class GameModel:
             point=self._point(trajectory, point, payoffs[first]) if trajectory else None,
             note="; ".join(notes),
         )
+
+    def _response_value(self, r: BestResponder, result: Result) -> float | None:
+        """The best response's payoff evaluated as the returned point's is (on the collocation
+        states of its controls), so that the improvement compares like with like and not IPOPT's
+        objective at states within its tolerance of the defects; IPOPT's when they are not met."""
+        if not result.ok or result.objective is None:
+            return None
+        tr = r.solver.compiled.tr
+        U = np.array([result.controls[c] for c in tr.ocp.controls])
+        states = self._states_at(r, result, U)
+        if states is None:
+            return float(result.objective)
+        return payoff_at(tr, result.parameters, states, U, _inputs(tr, result))
 
     @staticmethod
     def _states_at(r: BestResponder, result: Result, strategy: np.ndarray) -> np.ndarray | None:
@@ -374,9 +388,9 @@ def equilibrium_report(model: GameModel, solutions: list[GameSolution]) -> Equil
         "payoffs": {p: g["payoffs"].get(p) for p, g in own.items()},
         "saddle_gap": gap,
     }
-    if len(games) == 1 and "value_bounds" in first:
-        metrics["value_bounds"] = first["value_bounds"]
-    if len(games) > 1:
+    if len(games) == 1:
+        metrics = first | metrics
+    else:
         metrics["equilibria"] = games
     tolerance = model.game.game.tolerance
     notes = [s.equilibrium.note for s in verified if s.equilibrium.note]

@@ -1,7 +1,12 @@
 """One best-response engine for n players (Algorithm 2 of section 4.4 and its Gauss–Seidel form).
 
 Each player answers the others' current strategies with a best response; the engine iterates until
-no player's strategy moves by more than ``tolerance``:
+the fixed-point residual is within ``tolerance``: every player's best response lies within
+``tolerance`` of the strategy it answered, ``distance(BR_p(view), s_p) ≤ tolerance`` (the undamped
+response, so damping does not shrink the test). The residual is only as true as the responses are
+exact: a player that solves to a tolerance of its own must solve well below the engine's (the
+differential-game drivers tie each player's IPOPT ``tol`` to it), or a response that merely accepts
+its warm start reads as a zero residual.
 
 - **Jacobi** (Algorithm 2): every player answers the strategies of the previous iterate,
   ``s_p^{i+1} = BR_p(s_{-p}^i)``;
@@ -10,7 +15,8 @@ no player's strategy moves by more than ``tolerance``:
 
 With ``damping`` ``w < 1`` a player that supports it keeps ``(1 − w) s_p^i + w BR_p`` (relaxation, which
 turns a Jacobi map whose eigenvalues lie outside the unit disc into a contraction when their real
-parts are below 1); a player without ``blend`` takes its plain response.
+parts are below 1); a player without ``blend`` takes its plain response. The residual recorded is
+the undamped one, ``distance(BR_p, s_p)``, not the step ``w · distance(BR_p, s_p)``.
 
 With ``acceleration="anderson"`` the next point the players answer is not the last sweep's
 responses ``g_i = G(x_i)`` but Anderson's extrapolation (type II, Walker & Ni 2011) from the last
@@ -19,19 +25,25 @@ residuals and ``ΔF``, ``ΔG`` the differences of successive residuals and respo
 sweep map its iterates are GMRES's, so it converges, in at most as many sweeps as the joint
 strategy has entries, where the plain iteration spirals outwards. The stopping rule does not
 change: a player's change is still ``distance(G_p(x_i), x_{i,p})``, the distance from the point it
-answered to its best response there, and the run returns the last sweep's responses. A response
+answered to its best response there. A response
 that fails at an extrapolated point drops the memory and is asked again at the last responses
 (a plain step); only a failure there stops the run. Acceleration needs players whose strategies
 are vectors (:class:`VectorSpacePlayer`).
 
+The run returns the **best iterate**: the strategies produced by the sweep whose residual was the
+smallest (the last one when it converged), not merely the last.
+
 The engine knows nothing of a strategy beyond the player's ``distance``. It stops with an honest
-outcome: ``converged``; ``iteration_limit``; ``cycling`` (the joint strategy returns to an earlier
+outcome: ``converged``; ``iteration_limit`` (with the observed rate when the residual was still
+falling: slow convergence is not a cycle); ``cycling`` (the joint strategy returns to an earlier
 iterate, within tolerance and much closer to it than to the previous one; or a period-k cycle,
 ``2 ≤ k ≤ window``: each of the last k iterates lies within ``cycle_ratio`` times the smallest change
 of the last 2k iterations of the iterate k before it, and the change has not shrunk over the period;
 or the largest change over the last ``window`` iterations is no smaller than over the ``window``
-before); ``diverged`` (a non-finite change, or
-that largest change at least ``growth`` times the one before); or ``player_failed`` (a response
+before); ``diverged`` (a non-finite change, the largest change grown at least ``growth`` times in
+each of the last ``growth_sweeps`` sweeps — so a geometric blow-up stops before a player's solver
+fails on huge iterates — or the largest change over the last ``window`` at least ``growth`` times
+the one before); or ``player_failed`` (a response
 whose status carries no solution). :class:`BestResponseRun` maps the outcome to a
 :class:`~gamespec.result.Status` and packs the history for ``Result.metrics["best_response"]``.
 
@@ -48,6 +60,7 @@ from __future__ import annotations
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field
 from enum import StrEnum
+from itertools import pairwise
 from typing import Any, Literal, Protocol, runtime_checkable
 
 import numpy as np
@@ -149,6 +162,7 @@ class Settings:
     damping: float = 1.0
     window: int = 10
     growth: float = 2.0
+    growth_sweeps: int = 3
     cycle_ratio: float = 1e-2
     acceleration: Literal["none", "anderson"] = "none"
     memory: int = 5
@@ -158,6 +172,8 @@ class Settings:
             raise ValueError(f"damping must lie in (0, 1], got {self.damping}")
         if self.tolerance <= 0 or self.max_iterations < 1 or self.window < 1 or self.growth <= 1:
             raise ValueError("tolerance > 0, max_iterations ≥ 1, window ≥ 1 and growth > 1 are required")
+        if self.growth_sweeps < 1:
+            raise ValueError(f"growth_sweeps must be at least 1, got {self.growth_sweeps}")
         if not 0 < self.cycle_ratio < 1:
             raise ValueError(f"cycle_ratio must lie in (0, 1), got {self.cycle_ratio}")
         if self.memory < 1:
@@ -175,7 +191,8 @@ class PlayerRecord:
 
 @dataclass
 class Iteration:
-    """One sweep: each player's change ``distance(s_p^{i+1}, s_p^i)`` and the payoff after it."""
+    """One sweep: each player's change — its fixed-point residual ``distance(BR_p, s_p^i)``, the
+    undamped best response's distance from the strategy it answered — and the payoff after it."""
 
     changes: dict[str, float]
     payoff: float | None = None
@@ -187,7 +204,8 @@ class Iteration:
 
 @dataclass
 class BestResponseRun:
-    """The last strategies, why the iteration stopped, its history and each player's record."""
+    """The best iterate (the strategies of the sweep with the smallest residual), why the iteration
+    stopped, its history and each player's record; ``best`` is that sweep's index in ``history``."""
 
     strategies: Strategies
     outcome: Outcome
@@ -197,6 +215,15 @@ class BestResponseRun:
     history: list[Iteration] = field(default_factory=list)
     players: dict[str, PlayerRecord] = field(default_factory=dict)
     failed_player: str = ""
+    best: int | None = None
+    rate: float | None = None
+    """The observed factor of the largest change per sweep over the last window (below 1: still
+    converging), None with too short a history."""
+
+    @property
+    def residual(self) -> float:
+        """The largest player's residual of the best sweep (NaN when no sweep finished)."""
+        return self.history[self.best].largest if self.best is not None else float("nan")
 
     @property
     def converged(self) -> bool:
@@ -221,6 +248,9 @@ class BestResponseRun:
             "damping": self.settings.damping,
             "acceleration": self.settings.acceleration,
             "failed_player": self.failed_player or None,
+            "best_iteration": self.best,
+            "residual": self.residual,
+            "observed_rate": self.rate,
             "players": {
                 name: {"status": r.status.value, "message": r.message, "responses": r.responses}
                 for name, r in self.players.items()
@@ -298,33 +328,38 @@ class _Iterator:
         self.history: list[Iteration] = []
         self.recent: list[Strategies] = [dict(self.current)]
         self.failed = ""
+        self.best: int | None = None
+        self.best_strategies: Strategies = dict(self.current)
 
-    def _respond(self, player: Player, view: Strategies) -> Any:
-        """``player``'s (damped) response to ``view``, or None when it failed."""
+    def _respond(self, player: Player, view: Strategies) -> tuple[Any, float]:
+        """``player``'s (damped) response to ``view`` (None when it failed) and its residual, the
+        undamped response's distance from ``view``'s strategy of the player."""
         others = {k: v for k, v in view.items() if k != player.name}
         strategy, report = player.respond(others)
         record = self.records[player.name]
         record.status, record.message = report.status, report.message
         record.responses += 1
         if strategy is None or not report.status.ok:
-            return None
+            return None, float("nan")
+        residual = float(player.distance(strategy, view[player.name]))
         w = self.settings.damping
         if w < 1 and isinstance(player, BlendingPlayer):
-            return player.blend(view[player.name], strategy, w)
-        return strategy
+            return player.blend(view[player.name], strategy, w), residual
+        return strategy, residual
 
-    def sweep(self) -> tuple[Strategies, str]:
-        """One Jacobi or Gauss–Seidel sweep answering ``self.point``; the failed player's name ('' when
-        none failed)."""
+    def sweep(self) -> tuple[Strategies, dict[str, float], str]:
+        """One Jacobi or Gauss–Seidel sweep answering ``self.point``: the new strategies, each
+        player's residual and the failed player's name ('' when none failed)."""
         gauss_seidel = self.settings.scheme == "gauss_seidel"
         previous = dict(self.point)
         following = dict(self.point)
+        residuals: dict[str, float] = {}
         for player in self.players:
-            strategy = self._respond(player, following if gauss_seidel else previous)
+            strategy, residuals[player.name] = self._respond(player, following if gauss_seidel else previous)
             if strategy is None:
-                return following, player.name
+                return following, residuals, player.name
             following[player.name] = strategy
-        return following, ""
+        return following, residuals, ""
 
     def _returned_to_earlier(self, strategies: Strategies, change: float) -> bool:
         """The joint strategy is back at an iterate before the previous one: within tolerance of it
@@ -355,6 +390,23 @@ class _Iterator:
         bound = ratio * min(changes)
         return all(self._distance(recent[-1 - j], recent[-1 - j - period]) <= bound for j in range(period))
 
+    def _growing(self) -> bool:
+        """The largest change grew at least ``growth`` times in each of the last ``growth_sweeps``
+        sweeps: a geometric blow-up, stopped while the players can still answer."""
+        k = self.settings.growth_sweeps
+        if len(self.history) < k + 1:
+            return False
+        largest = [it.largest for it in self.history[-k - 1 :]]
+        return all(b >= self.settings.growth * a for a, b in pairwise(largest))
+
+    def rate(self) -> float | None:
+        """The observed factor by which the largest change shrinks per sweep over the last window
+        (geometric mean), or None with fewer than two sweeps or a zero change."""
+        largest = [it.largest for it in self.history[-self.settings.window - 1 :]]
+        if len(largest) < 2 or largest[0] <= 0 or largest[-1] <= 0:
+            return None
+        return float((largest[-1] / largest[0]) ** (1 / (len(largest) - 1)))
+
     def _trend(self) -> Outcome | None:
         """Cycling or divergence from the largest changes of the last two windows."""
         w = self.settings.window
@@ -370,21 +422,24 @@ class _Iterator:
 
     def step(self) -> Outcome | None:
         """One iteration; the outcome when the iteration stops here."""
-        following, failed = self.sweep()
+        following, changes, failed = self.sweep()
         if failed and self.extrapolated:
             self._plain_point()
-            following, failed = self.sweep()
+            following, changes, failed = self.sweep()
         if failed:
             self.failed = failed
             return Outcome.PLAYER_FAILED
-        changes = {p.name: float(p.distance(following[p.name], self.point[p.name])) for p in self.players}
         payoff = float(self.payoff(following)) if self.payoff is not None else None
         self.history.append(Iteration(changes, payoff))
         if not np.isfinite(list(changes.values())).all():
             return Outcome.DIVERGED
         self.current = following
+        if self.best is None or max(changes.values()) < self.history[self.best].largest:
+            self.best, self.best_strategies = len(self.history) - 1, following
         if max(changes.values()) <= self.settings.tolerance:
             return Outcome.CONVERGED
+        if self._growing():
+            return Outcome.DIVERGED
         if self._returned_to_earlier(following, max(changes.values())):
             return Outcome.CYCLING
         self.recent = [*self.recent[-2 * self.settings.window :], dict(following)]
@@ -418,6 +473,20 @@ _STATUS = {
 }
 
 
+def _slow(it: _Iterator) -> str:
+    """How fast a run stopped at its limit was still converging: the observed rate and the sweeps
+    it would need at that rate ('' when the residual was not falling)."""
+    rate = it.rate()
+    if rate is None or rate >= 1:
+        return ""
+    last = it.history[-1].largest
+    more = int(np.ceil(np.log(it.settings.tolerance / last) / np.log(rate)))
+    return (
+        f"; converging slowly: the residual falls ×{rate:.3g} per sweep, "
+        f"about {more} more sweeps to reach {it.settings.tolerance:.3g}"
+    )
+
+
 def _message(outcome: Outcome, it: _Iterator, failed: str) -> str:
     n = len(it.history)
     last = it.history[-1].largest if it.history else float("nan")
@@ -429,10 +498,12 @@ def _message(outcome: Outcome, it: _Iterator, failed: str) -> str:
         reason = f": {record.message}" if record.message else ""
         return f"best responses stopped at iteration {n + 1}: {failed} failed ({record.status.value}){reason}"
     if outcome is Outcome.ITERATION_LIMIT:
-        return f"best responses did not converge in {n} iterations (last change {last:.3g})"
+        return f"best responses did not converge in {n} iterations (last change {last:.3g}){_slow(it)}"
     if outcome is Outcome.CYCLING:
         return f"best responses cycle: no progress after {n} iterations (last change {last:.3g})"
-    return f"best responses diverge: the change grew to {last:.3g} after {n} iterations"
+    rate = it.rate()
+    speed = f" (diverging: ×{rate:.3g} per sweep)" if rate is not None and rate > 1 else ""
+    return f"best responses diverge: the change grew to {last:.3g} after {n} iterations{speed}"
 
 
 def iterate(
@@ -445,7 +516,8 @@ def iterate(
 
     A converged run is ``optimal`` when every player's last response was, else ``feasible``; a run
     stopped by a player's failure has that player's status; the others map as in ``_STATUS``. The
-    strategies returned are the last iterate every player accepted.
+    strategies returned are the best iterate (see the module docstring), the start when no sweep
+    finished.
     """
     settings = settings or Settings()
     it = _Iterator(players, start, settings, payoff)
@@ -464,7 +536,7 @@ def iterate(
     else:
         status = _STATUS[outcome]
     return BestResponseRun(
-        strategies=it.current,
+        strategies=it.best_strategies,
         outcome=outcome,
         status=status,
         message=_message(outcome, it, it.failed),
@@ -472,4 +544,6 @@ def iterate(
         history=it.history,
         players=it.records,
         failed_player=it.failed,
+        best=it.best,
+        rate=it.rate(),
     )

@@ -6,7 +6,7 @@ and the controller's best response under the relaxed terminal constraint eq. 4.6
 eq. 4.62 (``W Wᵀ ⪯ I``, an SDP in whitened gains, :mod:`gamespec.lqgame.scaling`, with one small
 cone per column of ``W``: :meth:`CovariancePlayers.terminal_cone`), built once with
 ``cp.Parameter``s and re-solved every iteration. A step the solver fails on numerically is retried
-on ``fallback_solver`` when the options name one, and otherwise stops the run with the last iterate
+on ``fallback_solver`` when the options name one, and otherwise stops the run with the best iterate
 and the status ``numerical_error``. When the controller's problem is infeasible, a second problem
 on the same parameters, ``min γ`` subject to ``W Wᵀ ⪯ γ I``, gives the smallest achievable scaling
 ``γ* = σ_max(W)²`` of ``Σ_N``. Without a terminal covariance the covariance game is the UCSG closed
@@ -218,6 +218,12 @@ class CovariancePlayers:
         report = StepReport(status, f"step {self.steps}: {'; '.join(notes)}" if notes else "")
         return (self.gains.unscale(np.asarray(self.zeta.value)) if status.ok else None), report
 
+    def controller_value(self, ell: np.ndarray) -> float | None:
+        """``J_Σ`` of the controller's constrained best response to ``ℓ`` (one more step, for the
+        Nash gap), None when the step fails."""
+        kappa, report = self.controller_step(ell)
+        return self.model.covariance.payoff(kappa, ell) if kappa is not None and report.status.ok else None
+
     def smallest_scaling(self) -> float | None:
         """``min_K ‖W‖₂²`` for the current parameters: the least ``γ`` with ``Σ_N(K) ⪯ γ Σ_N``."""
         status = self.scaling.solve()
@@ -251,6 +257,8 @@ class CovariancePlayers:
             history=list(zip(run.changes(CONTROLLER), run.changes(STOPPER), strict=True)),
             best_response=run.as_metrics(),
         )
+        if run.status.ok:
+            outcome.controller_value = self.controller_value(run.strategies[STOPPER])
         if run.status is Status.INFEASIBLE and run.failed_player == CONTROLLER:
             gamma = self.smallest_scaling()
             outcome.min_covariance_scaling = gamma
@@ -261,7 +269,7 @@ class CovariancePlayers:
             )
             outcome.message = (
                 f"terminal covariance cannot be met at Jacobi iteration {run.iterations + 1}: {scaling}; "
-                "gains shown are the last iterate"
+                "gains shown are the best iterate (smallest residual)"
             )
         outcome.solve_time_s = self.seconds - start
         return outcome

@@ -100,7 +100,15 @@ class LQCompiledModel(CompiledModel):
         else:
             carlo = self.spec.method.monte_carlo
             mean, cov = self.solve_mean(guess), self._solve_covariance(guess)
-            result = assemble(self.model, mean, cov, self.spec.state_names, carlo.samples, carlo.seed)
+            result = assemble(
+                self.model,
+                mean,
+                cov,
+                self.spec.state_names,
+                carlo.samples,
+                carlo.seed,
+                tolerance=self.spec.method.tolerance,
+            )
         return result.model_copy(
             update={"parameters": values, "solver_stats": {"solver": self.options.solver}}
         )

@@ -13,10 +13,11 @@ from typing import ClassVar
 import numpy as np
 
 from gamespec.backend import Backend, CompiledModel, Inputs, refuse_inputs
-from gamespec.games.equilibrium import GameModel, GameSolution, status_of
+from gamespec.games.equilibrium import GameModel, GameSolution, equilibrium_report, status_of
+from gamespec.games.existence import existence
 from gamespec.games.problems import initial_state
 from gamespec.games.simulate import TrueSystem, control_signal, grid_of
-from gamespec.result import Result
+from gamespec.result import Result, Status
 from gamespec.specs.base import SpecBase, StrictModel
 from gamespec.specs.differential_game import DifferentialGameSpec
 
@@ -31,17 +32,24 @@ def open_loop(model: GameModel) -> Result:
 
     One game (no private beliefs or transforms): its trajectories. Several (``G^i`` per player):
     each player applies the controls of its own game and the true system is integrated with them;
-    each game's own trajectories are in ``arrays["game/<player>/<state>"]``.
+    each game's own trajectories are in ``arrays["game/<player>/<state>"]``. A zero-sum LQ game
+    whose Riccati test (:mod:`gamespec.games.existence`) finds no saddle is refused as ``unbounded``.
     """
     game = model.game
+    exists = existence(model.lq, model.parameters)
+    if exists.refused:
+        metrics = {
+            "existence": exists.as_metrics(),
+            "solution_concept": "none",
+            "sought_concept": model.concept(),
+        }
+        return Result(status=Status.UNBOUNDED, message=exists.reason, metrics=metrics)
     x0, t0 = initial_state(game), game.problem.time.initial
     solutions = [model.solve(view, x0, t0) for view in model.views]
     own = {name: _own(solutions, name) for name in game.problem.players}
     first = solutions[0].states
     tc = first.control_time + t0
-    controls = {
-        c: own[p].results[p].controls[c] for p, pl in game.problem.players.items() for c in pl.controls
-    }
+    controls = {c: own[p].controls_of(p)[c] for p, pl in game.problem.players.items() for c in pl.controls}
     arrays = {}
     if len(solutions) == 1:
         time, states = first.time + t0, dict(first.states)
@@ -49,10 +57,12 @@ def open_loop(model: GameModel) -> Result:
         for s in solutions:
             arrays |= {f"game/{s.view}/{k}": v for k, v in s.states.states.items()}
         time, states = _simulated(model, first, controls, t0)
-    metrics = {"best_response": _runs(solutions), "builds": model.builds}
+    report = equilibrium_report(model, solutions)
+    metrics = {"best_response": _runs(solutions), "builds": model.builds, "existence": exists.as_metrics()}
+    metrics |= report.metrics
     return Result(
         status=status_of(solutions),
-        message="; ".join(s.run.message for s in solutions if s.run.message),
+        message="; ".join(m for m in [*(s.run.message for s in solutions), report.message] if m),
         objective=first.objective,
         t_final=float(time[-1]),
         time=time,
@@ -61,6 +71,7 @@ def open_loop(model: GameModel) -> Result:
         controls=controls,
         arrays=arrays,
         iterations=sum(s.run.iterations for s in solutions),
+        checks=report.checks,
         metrics=metrics,
     )
 

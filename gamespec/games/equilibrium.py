@@ -6,6 +6,25 @@
 (warm-started from its previous solution) and is a player of :func:`gamespec.best_response.iterate`
 (Gauss–Seidel as Algorithm 4, or Jacobi). A strategy is the array of a player's controls at the
 evaluation points (rows: its controls), compared in the Euclidean norm as in section 7.3.2.
+
+Honest convergence. The engine's residual ``‖BR_p(s) − s_p‖`` is only as true as each response is
+exact: a player's IPOPT that accepts its warm start (its KKT test passes at its own ``tol``) reads
+as a zero change. Each player's NLP ``tol`` is therefore tied to the game's:
+``min(configured tol, TOLERANCE_RATIO · game.tolerance)`` (not below ``SOLVER_TOL_FLOOR``).
+
+What was found (:class:`Equilibrium`). From the returned point ``s`` (the engine's best iterate)
+every player answers once more, ``b_p = J_p(BR_p(s_{-p}), s_{-p})``, and both ``b_p`` and its payoff
+at ``s`` itself, ``J_p(s)``, are evaluated on its own transcription (:mod:`gamespec.games.evaluation`:
+the collocation states of the controls, not IPOPT's states within its tolerance); the
+improvement ``J_p(s) − b_p`` (minimizer) or ``b_p − J_p(s)`` (maximizer) is what a best response
+gains, and the largest is the Nash gap (``metrics.saddle_gap``; for a zero-sum game the open-loop
+saddle gap). ``b`` of a zero-sum game's minimizer and maximizer bracket its lower and upper values
+(``metrics.value_bounds``). The Result's trajectory is the one of ``s`` (the collocation equations
+solved for the returned controls), so states, controls and payoffs belong to one point.
+
+``objective``: for a zero-sum game, the payoff ``J(s)`` every player shares (the game value at the
+returned point); for a non-zero-sum game, where there is no single value, the payoff of the first
+player the file lists, every player's being in ``metrics.payoffs``.
 """
 
 from __future__ import annotations
@@ -15,13 +34,32 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from gamespec.best_response import BestResponseRun, Settings, VectorPlayer, iterate
+from gamespec.best_response import BestResponseRun, Outcome, Settings, VectorPlayer, iterate
+from gamespec.games.evaluation import payoff_at, states_at
+from gamespec.games.existence import LQForm, lq_form
 from gamespec.games.problems import parameter_values, player_problem, views
 from gamespec.loader import with_values
 from gamespec.result import Result, Status
-from gamespec.solving import Solver, compile_spec
+from gamespec.solving import Solver, compile_spec, get_backend
 from gamespec.specs.differential_game import INITIAL_PREFIX, NOMINAL_PREFIX, START_TIME, DifferentialGameSpec
 from gamespec.specs.ocp import OptimalControlSpec
+
+TOLERANCE_RATIO = 1e-2
+"""A player's NLP ``tol`` is at most this fraction of ``game.tolerance``: IPOPT's error in a response
+(its KKT residual over the problem's curvature) then stays well inside the residual the game tests."""
+SOLVER_TOL_FLOOR = 1e-14
+"""The tightest NLP ``tol`` asked for (roundoff of IPOPT's own linear algebra lies near it)."""
+
+
+def with_tied_tolerance(spec: OptimalControlSpec, tolerance: float) -> OptimalControlSpec:
+    """``spec`` whose backend's ``tol`` is ``min(configured, TOLERANCE_RATIO · tolerance)``, floored at
+    ``SOLVER_TOL_FLOOR`` (the configured one when it is tighter)."""
+    backend = get_backend(spec.solver.backend or spec.default_backend)
+    configured = float(backend.options(spec).tol)
+    tol = min(configured, max(TOLERANCE_RATIO * tolerance, SOLVER_TOL_FLOOR))
+    options = dict(spec.solver.options)
+    options[backend.name] = {**options.get(backend.name, {}), "tol": tol}
+    return spec.model_copy(update={"solver": spec.solver.model_copy(update={"options": options})})
 
 
 @dataclass
@@ -43,7 +81,9 @@ class BestResponder:
         self.spec = with_values(self.solver.spec, dict(values))
 
     def respond(self, others: Mapping[str, np.ndarray]) -> tuple[np.ndarray | None, Result]:
-        inputs = {c: others[o][row] for o, cs in self.opponents.items() for row, c in enumerate(cs)}
+        inputs = {
+            c: np.asarray(others[o])[row] for o, cs in self.opponents.items() for row, c in enumerate(cs)
+        }
         result = self.solver.solve_spec(self.spec, inputs=inputs)
         self.solves += 1
         self.last = result
@@ -57,18 +97,48 @@ class BestResponder:
 
 
 @dataclass
+class Equilibrium:
+    """What the returned point ``s`` is (see module doc): each player's payoff ``J_p(s)``, its best
+    response's value ``b_p`` and improvement, the largest improvement (``gap``), and the Result of
+    ``s`` itself (``point``: its trajectory, every player's controls, ``objective`` as the module
+    says); a value is None where it could not be computed, ``note`` says why."""
+
+    concept: str
+    payoffs: dict[str, float | None]
+    best_values: dict[str, float | None]
+    improvements: dict[str, float | None]
+    point: Result | None
+    note: str = ""
+
+    @property
+    def gap(self) -> float | None:
+        values = list(self.improvements.values())
+        return None if not values or any(v is None for v in values) else max(values)
+
+
+@dataclass
 class GameSolution:
-    """One game's best-response run and each player's last Result (the last responder's states are
-    consistent with every player's final strategy)."""
+    """One game's best-response run, each player's last Result and, when verified, what the
+    returned point is (:class:`Equilibrium`; else the last responder's Result stands for it)."""
 
     view: str
     run: BestResponseRun
     results: dict[str, Result]
     last_player: str
+    equilibrium: Equilibrium | None = None
 
     @property
     def states(self) -> Result:
+        """The Result of the returned point (its trajectory and every player's controls)."""
+        if self.equilibrium is not None and self.equilibrium.point is not None:
+            return self.equilibrium.point
         return self.results[self.last_player]
+
+    def controls_of(self, player: str) -> dict[str, np.ndarray]:
+        """``player``'s controls at the returned point (its last response's when not verified)."""
+        if self.equilibrium is not None and self.equilibrium.point is not None:
+            return self.equilibrium.point.controls
+        return self.results[player].controls
 
 
 @dataclass
@@ -79,13 +149,17 @@ class GameModel:
     responders: dict[tuple[str, str], BestResponder] = field(default_factory=dict)
     parameters: dict[str, float] = field(default_factory=dict)
     """The game's runtime parameter values (``problem.parameters``, updated by a re-solve)."""
+    lq: LQForm | str = ""
+    """The game's expressions for the Riccati existence test (:mod:`gamespec.games.existence`),
+    parsed once, or why the test does not apply."""
 
     def __post_init__(self) -> None:
         self.parameters = dict(self.game.problem.parameters) | self.parameters
+        self.lq = lq_form(self.game)
         names = list(self.game.problem.players)
         for view in views(self.game):
             for player in names:
-                spec = player_problem(self.game, player, view)
+                spec = with_tied_tolerance(player_problem(self.game, player, view), self.game.game.tolerance)
                 opponents = {o: list(self.game.problem.players[o].controls) for o in names if o != player}
                 self.responders[(view, player)] = BestResponder(
                     player, view, compile_spec(spec), list(spec.problem.controls), opponents, spec
@@ -137,7 +211,8 @@ class GameModel:
         start: Mapping[str, np.ndarray] | None = None,
         sensitivities: Mapping[str, float] | None = None,
     ) -> GameSolution:
-        """Iterate best responses of game ``view`` from ``state`` at ``time`` (see module doc)."""
+        """Iterate best responses of game ``view`` from ``state`` at ``time``; then one more best
+        response per player at the returned point says what it is (see module doc)."""
         settings = self.game.game
         order = [r for (v, _), r in self.responders.items() if v == view]
         for r in order:
@@ -159,8 +234,95 @@ class GameModel:
             Settings(settings.scheme, settings.tolerance, settings.max_iterations, settings.damping),
             payoff=lambda _: _objective(self.responders[(view, last[0])].last),
         )
+        equilibrium = self._verify(order, run) if run.best is not None else None
         results = {r.name: r.last for r in order if r.last is not None}
-        return GameSolution(view, run, results, last[0])
+        return GameSolution(view, run, results, last[0], equilibrium)
+
+    def concept(self) -> str:
+        """The solution concept the best responses seek: ``saddle`` (zero-sum, players of both
+        senses), ``nash`` (one shared payoff, one sense: a team's person-by-person optimum) or
+        ``open_loop_nash`` (players with payoffs of their own)."""
+        players = self.game.problem.players.values()
+        if any(p.payoff is not None for p in players):
+            return "open_loop_nash"
+        return "saddle" if len({p.objective for p in players}) > 1 else "nash"
+
+    def _verify(self, order: list[BestResponder], run: BestResponseRun) -> Equilibrium:
+        """Every player's payoff at the returned point and its best response's improvement there
+        (none when a player's problem goes through transforms: its states and payoff are not the
+        game's)."""
+        point = run.strategies
+        concept = self.concept() if run.outcome is Outcome.CONVERGED else "none"
+        if any(r.solver.steps or not hasattr(r.solver.compiled, "tr") for r in order):
+            missing = dict.fromkeys((r.name for r in order), None)
+            note = "a player's problem goes through transforms: no payoffs or gap at the returned point"
+            return Equilibrium(concept, missing, dict(missing), dict(missing), None, note)
+        responses = {r.name: r.respond({o: point[o] for o in r.opponents})[1] for r in order}
+        payoffs: dict[str, float | None] = {}
+        best: dict[str, float | None] = {}
+        improvements: dict[str, float | None] = {}
+        trajectory: tuple[Result, np.ndarray] | None = None
+        notes = []
+        for r in order:
+            result = responses[r.name]
+            best[r.name] = self._response_value(r, result)
+            states = self._states_at(r, result, point[r.name])
+            if states is None:
+                payoffs[r.name] = improvements[r.name] = None
+                notes.append(f"{r.name}'s payoff at the returned point could not be evaluated")
+                continue
+            tr = r.solver.compiled.tr
+            U = np.asarray(point[r.name], dtype=float)
+            payoffs[r.name] = payoff_at(tr, result.parameters, states, U, _inputs(tr, result))
+            trajectory = trajectory or (result, states)
+            sense = 1.0 if self.game.problem.players[r.name].objective == "minimize" else -1.0
+            b = best[r.name]
+            improvements[r.name] = None if b is None else sense * (payoffs[r.name] - b)
+        first = order[0].name
+        return Equilibrium(
+            concept=concept,
+            payoffs=payoffs,
+            best_values=best,
+            improvements=improvements,
+            point=self._point(trajectory, point, payoffs[first]) if trajectory else None,
+            note="; ".join(notes),
+        )
+
+    def _response_value(self, r: BestResponder, result: Result) -> float | None:
+        """The best response's payoff evaluated as the returned point's is (on the collocation
+        states of its controls), so that the improvement compares like with like and not IPOPT's
+        objective at states within its tolerance of the defects; IPOPT's when they are not met."""
+        if not result.ok or result.objective is None:
+            return None
+        tr = r.solver.compiled.tr
+        U = np.array([result.controls[c] for c in tr.ocp.controls])
+        states = self._states_at(r, result, U)
+        if states is None:
+            return float(result.objective)
+        return payoff_at(tr, result.parameters, states, U, _inputs(tr, result))
+
+    @staticmethod
+    def _states_at(r: BestResponder, result: Result, strategy: np.ndarray) -> np.ndarray | None:
+        """The states of the returned point on ``r``'s model (None when its best response failed or
+        the collocation equations were not met)."""
+        if not result.ok:
+            return None
+        tr = r.solver.compiled.tr
+        start = np.array([result.states[n] for n in tr.ocp.states])
+        return states_at(tr, result.parameters, np.asarray(strategy, dtype=float), _inputs(tr, result), start)
+
+    def _point(self, trajectory: tuple[Result, np.ndarray], point: dict, objective: float | None) -> Result:
+        result, X = trajectory
+        names = self.game.problem.players
+        controls = {c: np.asarray(point[p])[row] for p in point for row, c in enumerate(names[p].controls)}
+        states = {n: X[i] for i, n in enumerate(self.game.problem.states)}
+        return result.model_copy(update={"states": states, "controls": controls, "objective": objective})
+
+
+def _inputs(tr, result: Result) -> np.ndarray:
+    """The grid inputs a response was solved with (n_w × evaluation points)."""
+    rows = [np.asarray(result.arrays[f"input/{n}"], dtype=float) for n in tr.ocp.inputs]
+    return np.array(rows) if rows else np.zeros((0, tr.grid.eval_tau.size))
 
 
 def _objective(result: Result | None) -> float:
@@ -174,3 +336,74 @@ def status_of(solutions: list[GameSolution]) -> Status:
     if bad:
         return bad[0]
     return Status.FEASIBLE if Status.FEASIBLE in statuses else Status.OPTIMAL
+
+
+@dataclass
+class EquilibriumReport:
+    """What the games of one solve found, for the Result: ``metrics`` (``solution_concept``,
+    ``information``, ``payoffs``, ``saddle_gap``, ``value_bounds``; per game under ``equilibria``
+    when each player solves its own), the ``saddle_gap`` check (value, verdict, tolerance in
+    ``metrics.checks_passed`` and ``metrics.check_tolerances``) and a message when the gap exceeds
+    the tolerance or could not be computed."""
+
+    metrics: dict
+    checks: dict[str, float | None]
+    message: str
+
+
+def _game_metrics(model: GameModel, e: Equilibrium) -> dict:
+    out: dict = {
+        "solution_concept": e.concept,
+        "sought_concept": model.concept(),
+        "information": "open_loop",
+        "payoffs": e.payoffs,
+        "best_response_values": e.best_values,
+        "improvements": e.improvements,
+        "saddle_gap": e.gap,
+    }
+    senses = {n: p.objective for n, p in model.game.problem.players.items()}
+    if model.concept() == "saddle":
+        lows = [e.best_values[n] for n, s in senses.items() if s == "minimize"]
+        highs = [e.best_values[n] for n, s in senses.items() if s == "maximize"]
+        if None not in lows + highs:
+            out["value_bounds"] = {"lower": max(lows), "upper": min(highs)}
+    return out
+
+
+def equilibrium_report(model: GameModel, solutions: list[GameSolution]) -> EquilibriumReport:
+    """The report of an open-loop solve's games (see :class:`EquilibriumReport`): each player's
+    payoff is the one in the game it solves itself; the gap is the largest of the games'."""
+    verified = [s for s in solutions if s.equilibrium is not None]
+    if not verified:
+        return EquilibriumReport({"solution_concept": "none", "sought_concept": model.concept()}, {}, "")
+    games = {s.view: _game_metrics(model, s.equilibrium) for s in verified}
+    own = {p: games.get(p, next(iter(games.values()))) for p in model.game.problem.players}
+    gaps = [g["saddle_gap"] for g in games.values()]
+    gap = None if None in gaps else max(gaps)
+    first = next(iter(games.values()))
+    metrics = {
+        "solution_concept": first["solution_concept"],
+        "sought_concept": first["sought_concept"],
+        "information": "open_loop",
+        "payoffs": {p: g["payoffs"].get(p) for p, g in own.items()},
+        "saddle_gap": gap,
+    }
+    if len(games) == 1:
+        metrics = first | metrics
+    else:
+        metrics["equilibria"] = games
+    tolerance = model.game.game.tolerance
+    notes = [s.equilibrium.note for s in verified if s.equilibrium.note]
+    if gap is None:
+        return EquilibriumReport(metrics, {}, "; ".join(notes or ["the saddle gap could not be computed"]))
+    passed = bool(gap <= tolerance)
+    metrics |= {"checks_passed": {"saddle_gap": passed}, "check_tolerances": {"saddle_gap": tolerance}}
+    message = (
+        ""
+        if passed
+        else (
+            f"saddle gap {gap:.3g} exceeds the tolerance {tolerance:.3g}: a player gains that much by a "
+            "best response at the returned point"
+        )
+    )
+    return EquilibriumReport(metrics, {"saddle_gap": gap}, "; ".join([*notes, message] if message else notes))

@@ -13,6 +13,12 @@ collision with the obstacle (when ``stop_at_collision``) or at the time limit.
 The horizon is ``N Δt`` ahead at every step (``receding``), or reaches the game's final time
 (``shrinking``: each remaining length has its own compiled models); with a shrinking horizon and a
 time-consistent open-loop equilibrium the run reproduces the open-loop solution.
+
+The Result's ``solution_concept`` is ``receding_horizon_<concept>`` (each step's open-loop game's
+concept, :meth:`~gamespec.games.equilibrium.GameModel.concept`; ``none`` when a step's game did not
+converge) and ``saddle_gap`` the largest of the step games' gaps at their returned points (a check
+against ``game.tolerance``; not computed when a player's problem has transforms). No payoff of the
+realized trajectory is computed: the run's figure is the capture time.
 """
 
 from __future__ import annotations
@@ -286,6 +292,7 @@ class RecedingHorizon:
                     "iterations": s.run.iterations,
                     "converged": s.run.converged,
                     "outcome": s.run.outcome.value,
+                    "saddle_gap": s.equilibrium.gap if s.equilibrium is not None else None,
                 }
                 for v, s in solutions.items()
             },
@@ -368,8 +375,25 @@ class RecedingHorizon:
                 "lookahead_players": {v: list(self.rh.positions) for v in record.lookahead},
             },
         }
+        gaps = [g["saddle_gap"] for s in record.steps for g in s["games"].values()]
+        gap = None if not gaps or None in gaps else max(gaps)
+        concept = self.model.concept()
+        metrics |= {
+            "solution_concept": f"receding_horizon_{concept}" if converged else "none",
+            "sought_concept": f"receding_horizon_{concept}",
+            "information": "receding_horizon (each step's open-loop game, its first step applied)",
+            "saddle_gap": gap,
+        }
+        checks: dict[str, float | None] = {}
+        tolerance = self.model.game.game.tolerance
+        if gap is not None:
+            checks["saddle_gap"] = gap
+            metrics["checks_passed"] = {"saddle_gap": bool(gap <= tolerance)}
+            metrics["check_tolerances"] = {"saddle_gap": tolerance}
         failed = sum(not g["converged"] for s in record.steps for g in s["games"].values())
         message = f"stopped: {stop}" + (f"; {failed} game(s) did not converge" if failed else "")
+        if gap is not None and gap > tolerance:
+            message += f"; saddle gap {gap:.3g} of a step's game exceeds the tolerance {tolerance:.3g}"
         return Result(
             status=Status.OPTIMAL if converged else Status.FEASIBLE,
             message=message,
@@ -381,6 +405,7 @@ class RecedingHorizon:
             controls={c: np.array(v) for c, v in record.controls.items()},
             arrays=arrays,
             iterations=sum(g["iterations"] for s in record.steps for g in s["games"].values()),
+            checks=checks,
             metrics=metrics,
         )
 

@@ -156,7 +156,7 @@ def algorithm_2(
     and ``ε_ℓ = ‖L_{i+1} − L_i‖`` are both at most the tolerance (section 4.5). Jacobi is the
     thesis' scheme; Gauss–Seidel lets the controller answer ``L_{i+1}``. A step that fails (e.g.
     the controller's set ``𝒦(L_i)`` is empty) stops the run with that step's status, keeping the
-    last iterate; a run that cycles or diverges says so (``settings``' stopping rule).
+    best iterate (the smallest residual); a run that cycles or diverges says so (``settings``' stopping rule).
     """
     players = [
         VectorPlayer(STOPPER, lambda others: stopper_step(others[CONTROLLER])),

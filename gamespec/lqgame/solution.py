@@ -14,6 +14,7 @@ import numpy as np
 
 from gamespec.lqgame.checks import Assumptions, check_assumptions
 from gamespec.lqgame.covariance import CovarianceGame, vector_to_gains
+from gamespec.lqgame.equilibrium import report
 from gamespec.lqgame.lifting import Lifted, lift
 from gamespec.lqgame.mean_steering import MeanGame
 from gamespec.lqgame.montecarlo import agreement, simulate
@@ -90,6 +91,9 @@ class CovarianceOutcome:
     min_covariance_scaling: float | None = None
     solve_time_s: float = 0.0
     best_response: dict[str, object] | None = None
+    controller_value: float | None = None
+    """``J_Σ`` of the controller's constrained best response (eq. 4.62) to the returned ``ℓ``, when
+    the backend solved it (the saddle/Nash gap needs it under ``Σ_N``)."""
 
 
 def unconstrained_covariance(model: GameModel, note: str = "") -> CovarianceOutcome:
@@ -119,8 +123,11 @@ def assemble(
     state_names: list[str],
     samples: int,
     seed: int,
+    tolerance: float = 1e-5,
 ) -> Result:
-    """The Result of one solve, with checks recomputed from the strategies (not from the solver).
+    """The Result of one solve, with checks recomputed from the strategies (not from the solver),
+    and which solution it is (:mod:`gamespec.lqgame.equilibrium`, gap tolerance ``tolerance``
+    relative to ``max(1, |J|)``).
 
     ``iterations`` is Algorithm 2's count when it ran, else the mean QP solver's count (None when
     the solver does not say); ``metrics.iterations`` is Algorithm 2's count alone.
@@ -148,6 +155,10 @@ def assemble(
         "covariance_payoff": model.covariance.payoff(cov.kappa, cov.ell),
         **model.assumptions.as_metrics(),
     }
+    found = mean.status.ok and cov.status.ok
+    solution = report(model, (mean.U, mean.V, cov.kappa, cov.ell), cov.controller_value, tolerance, found)
+    metrics |= solution.metrics
+    checks |= solution.checks
     arrays: dict[str, np.ndarray] = {"mean": means, "covariance": covariances, "K": K, "L": L}
     if game.muN is not None:
         given = ~np.isnan(game.muN)
@@ -180,7 +191,7 @@ def assemble(
     controls |= {f"v{i + 1}": strategies.V[:, i] for i in range(game.ell)}
     return Result(
         status=_combined_status(mean, cov),
-        message="; ".join(m for m in (mean.message, cov.message) if m),
+        message="; ".join(m for m in (mean.message, cov.message, solution.message) if m),
         objective=metrics["mean_payoff"] + metrics["covariance_payoff"],
         t_final=float(time[-1]),
         solve_time_s=mean.solve_time_s + cov.solve_time_s,

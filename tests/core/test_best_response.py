@@ -320,3 +320,51 @@ def test_anderson_needs_vector_strategies():
     game = QuadraticGame(sigma=0.6)
     with pytest.raises(ValueError, match="vector strategies"):
         iterate([*game.players(), Opaque()], {**game.start(), "w": "x"}, Settings(acceleration="anderson"))
+
+
+def _true_residual(game: QuadraticGame, s: dict[str, np.ndarray]) -> float:
+    """``max_p ‖BR_p(s_{-p}) − s_p‖`` at ``s``, from the closed-form best responses."""
+    u = -np.linalg.solve(game.A, game.C @ s["v"] + game.a)
+    v = np.linalg.solve(game.B, game.C.T @ s["u"] + game.b)
+    return max(float(np.linalg.norm(u - s["u"])), float(np.linalg.norm(v - s["v"])))
+
+
+def test_a_damped_run_stops_on_the_undamped_residual():
+    """With damping w = 0.2 the step is w times the best response's distance; the stopping test
+    is on the distance itself, so the returned point's true fixed-point residual (closed-form best
+    responses) is within a small multiple of the tolerance, not tol/w."""
+    game = QuadraticGame(sigma=2.0, seed=1)
+    tol = 1e-8
+    run = iterate(game.players(), game.start(), Settings(damping=0.2, tolerance=tol, max_iterations=500))
+    assert run.converged and run.best == run.iterations - 1
+    assert _true_residual(game, run.strategies) <= 2 * tol
+
+
+def test_geometric_growth_is_divergence_before_the_window_fills():
+    """A Gauss–Seidel map that multiplies the change by 50 per sweep: diverging after
+    ``growth_sweeps + 1`` sweeps (the window of 10 would need 20), returning the best iterate —
+    the first sweep's responses."""
+    ok = StepReport(Status.OPTIMAL)
+    players = [
+        VectorPlayer("u", lambda o: (50.0 * o["v"] + 1.0, ok)),
+        VectorPlayer("v", lambda o: (o["u"].copy(), ok)),
+    ]
+    run = iterate(players, {"u": np.zeros(1), "v": np.zeros(1)}, Settings(scheme="gauss_seidel"))
+    assert run.outcome is Outcome.DIVERGED and run.status is Status.NOT_CONVERGED
+    assert run.iterations == Settings().growth_sweeps + 1 and "diverging" in run.message
+    assert run.best == 0
+    np.testing.assert_array_equal(run.strategies["u"], [1.0])
+    np.testing.assert_array_equal(run.strategies["v"], [1.0])
+
+
+def test_slow_damped_convergence_reports_its_rate_not_a_cycle():
+    """Damped Jacobi (w = 0.1) on σ = 2: the map's eigenvalues are ``1 − w ± iwσ_k`` (module
+    docstring), so the change falls by ``√((1 − w)² + w²σ_max²)`` ≈ 0.92 per sweep: at the limit
+    the run says it is converging slowly at that observed rate."""
+    game = QuadraticGame(sigma=2.0, seed=1)
+    w = 0.1
+    run = iterate(game.players(), game.start(), Settings(damping=w, tolerance=1e-12, max_iterations=120))
+    assert run.outcome is Outcome.ITERATION_LIMIT and "converging slowly" in run.message
+    radius = np.sqrt((1 - w) ** 2 + (w * 2.0) ** 2)
+    assert run.rate == pytest.approx(radius, rel=0.02)
+    assert run.as_metrics()["observed_rate"] == run.rate

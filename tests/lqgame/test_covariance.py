@@ -168,7 +168,7 @@ alternate and each grows by about 1.4 every two iterations."""
 
 def test_jacobi_that_diverges_says_so():
     """Algorithm 2 on the engine with a window of three periods of the alternation: the run stops
-    as ``diverged`` (status not_converged) with the history, keeping the last iterate; it is not a
+    as ``diverged`` (status not_converged) with the history, keeping the best iterate; it is not a
     solution."""
     spec = gamespec.load(EXAMPLE, HORIZON_25)
     players = CovariancePlayers(GameModel.build(spec.game()), CvxpyOptions())

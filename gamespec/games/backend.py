@@ -3,7 +3,9 @@
 Compiling builds a :class:`~gamespec.games.equilibrium.GameModel` (each player's problem of each game
 compiled once on ``game.backend``); solving runs the receding horizon of Algorithm 4 when the file
 has a ``receding_horizon`` section (:mod:`gamespec.games.receding_horizon`), else the open-loop game
-over the whole horizon. Runtime parameters are the game's ``problem.parameters``.
+over the whole horizon. With ``game.information: feedback`` it parses the linear-quadratic game
+instead and solves its coupled Riccati equations (:mod:`gamespec.games.feedback_game`). Runtime
+parameters are the game's ``problem.parameters``.
 """
 
 from __future__ import annotations
@@ -15,6 +17,7 @@ import numpy as np
 from gamespec.backend import Backend, CompiledModel, Inputs, refuse_inputs
 from gamespec.games.equilibrium import GameModel, GameSolution, equilibrium_report, status_of
 from gamespec.games.existence import existence
+from gamespec.games.feedback_game import feedback_equilibrium, feedback_form
 from gamespec.games.problems import initial_state
 from gamespec.games.simulate import TrueSystem, control_signal, grid_of
 from gamespec.result import Result, Status
@@ -102,14 +105,18 @@ class GameCompiled(CompiledModel):
 
     def __init__(self, game: DifferentialGameSpec) -> None:
         self.game = game
-        self.model = GameModel(game)
+        self.feedback = feedback_form(game) if game.game.information == "feedback" else None
+        self.model = GameModel(game) if self.feedback is None else None
+        self.parameters = dict(game.problem.parameters)
 
     def solve(
         self, parameters: dict[str, float] | None = None, guess: Result | None = None, inputs: Inputs = None
     ) -> Result:
         refuse_inputs(inputs, self.game.kind)
-        if parameters:
-            self.model.parameters = {**self.model.parameters, **parameters}
+        self.parameters |= parameters or {}
+        if self.feedback is not None:
+            return feedback_equilibrium(self.game, self.feedback, self.parameters)
+        self.model.parameters = {**self.model.parameters, **self.parameters}
         if self.game.receding_horizon is not None:
             from gamespec.games.receding_horizon import receding_horizon
 

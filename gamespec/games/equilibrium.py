@@ -36,7 +36,7 @@ import numpy as np
 
 from gamespec.best_response import BestResponseRun, Outcome, Settings, VectorPlayer, iterate
 from gamespec.games.evaluation import payoff_at, states_at
-from gamespec.games.existence import LQForm, lq_form
+from gamespec.games.lq_structure import LQForm, lq_form
 from gamespec.games.problems import parameter_values, player_problem, views
 from gamespec.loader import with_values
 from gamespec.result import Result, Status

@@ -30,36 +30,13 @@ from collections.abc import Mapping
 from dataclasses import dataclass
 
 import numpy as np
-import sympy as sp
 from scipy.integrate import solve_ivp
 
-from gamespec.games.problems import symbols_of
-from gamespec.specs.differential_game import DifferentialGameSpec
-from gamespec.symbolic.language import parse
+from gamespec.games.feedback import LQGame
+from gamespec.games.lq_structure import LQForm, lq_game
 
 ESCAPE = 1e8
 """``‖P‖`` beyond this multiple of ``max(1, ‖P(T)‖, ‖Q‖)`` counts as a finite escape."""
-
-
-@dataclass(frozen=True)
-class LQData:
-    """The homogeneous (constant state appended) matrices of a zero-sum LQ game."""
-
-    A: np.ndarray
-    B_u: np.ndarray
-    B_v: np.ndarray
-    Q: np.ndarray
-    N_u: np.ndarray
-    N_v: np.ndarray
-    R: np.ndarray
-    S: np.ndarray
-    x0: np.ndarray
-    t0: float
-    T: float
-
-    @property
-    def m(self) -> int:
-        return self.B_u.shape[1]
 
 
 @dataclass(frozen=True)
@@ -88,118 +65,21 @@ class Existence:
         }
 
 
-def _skip(game: DifferentialGameSpec) -> str:
-    """Why the game is not one the test covers ('' when it is)."""
-    p = game.problem
-    players = p.players.values()
-    reasons = [
-        (any(pl.payoff is not None for pl in players), "a player has a payoff of its own (not zero-sum)"),
-        (len({pl.objective for pl in players}) < 2, "every player has the same sense"),
-        (bool(p.uncertain), "uncertain parameters (the players' games differ)"),
-        (
-            any(pl.transforms or pl.path_constraints for pl in players),
-            "a player's transforms or path constraints",
-        ),
-        (bool(p.terminal_constraints), "terminal constraints"),
-        (
-            any(c.lower is not None or c.upper is not None for pl in players for c in pl.controls.values()),
-            "control bounds",
-        ),
-        (
-            any(s.lower is not None or s.upper is not None or s.final is not None for s in p.states.values()),
-            "state bounds or fixed final states",
-        ),
-        (any(s.initial is None for s in p.states.values()), "a free initial state"),
+def _not_zero_sum(form: LQForm) -> str:
+    """Why the LQ game is not a zero-sum game of minimizers against maximizers ('' when it is)."""
+    if not form.zero_sum:
+        return "a player has a payoff of its own (not zero-sum)"
+    if len(set(form.senses)) < 2:
+        return "every player has the same sense"
+    return ""
+
+
+def _columns(form: LQForm, sense: str) -> np.ndarray:
+    """The stacked-control columns of the players of ``sense``."""
+    spans = [
+        np.arange(s.start, s.stop) for s, pl in zip(form.controls, form.senses, strict=True) if pl == sense
     ]
-    return next((why for hit, why in reasons if hit), "")
-
-
-def _quadratic(expr: sp.Expr, variables: list[sp.Symbol]) -> tuple[np.ndarray, np.ndarray, float] | None:
-    """``(H, g, c)`` with ``expr = ½ zᵀHz + gᵀz + c`` in ``variables``, or None when ``expr`` is not
-    a polynomial of degree ≤ 2 with numeric coefficients."""
-    expr = sp.expand(expr)
-    if expr.free_symbols - set(variables) or not expr.is_polynomial(*variables):
-        return None
-    if variables and sp.Poly(expr, *variables).total_degree() > 2:
-        return None
-    zero = dict.fromkeys(variables, 0)
-    H = np.array([[float(sp.diff(expr, a, b).subs(zero)) for b in variables] for a in variables], dtype=float)
-    g = np.array([float(sp.diff(expr, a).subs(zero)) for a in variables], dtype=float)
-    return H.reshape(len(variables), len(variables)), g, float(expr.subs(zero))
-
-
-@dataclass(frozen=True)
-class LQForm:
-    """A zero-sum game's expressions parsed once into SymPy (in the parameters' symbols): the
-    dynamics, the Lagrange and Mayer terms and the horizon, over ``z = (x, u, v)`` and ``x_f``."""
-
-    dynamics: list[sp.Expr]
-    lagrange: sp.Expr
-    mayer: sp.Expr
-    horizon: sp.Expr
-    z: list[sp.Symbol]
-    ends: list[sp.Symbol]
-    parameters: dict[str, sp.Symbol]
-    states: list[str]
-    m: int
-    x0: np.ndarray
-    t0: float
-
-
-def lq_form(game: DifferentialGameSpec) -> LQForm | str:
-    """The game's expressions for the test, or the reason it is not a game the test covers."""
-    why = _skip(game)
-    if why:
-        return why
-    p = game.problem
-    sym = symbols_of(game)
-    senses = {c: pl.objective for pl in p.players.values() for c in pl.controls}
-    u = [sym.running[c] for c, sense in senses.items() if sense == "minimize"]
-    v = [sym.running[c] for c, sense in senses.items() if sense == "maximize"]
-    return LQForm(
-        dynamics=[sp.sympify(parse(p.dynamics[name], sym.running)) for name in p.states],
-        lagrange=sp.sympify(parse(p.payoff.lagrange, sym.running)),
-        mayer=sp.sympify(parse(p.payoff.mayer, sym.ends)),
-        horizon=sp.sympify(parse(p.time.final, sym.running)),
-        z=[sym.running[n] for n in p.states] + u + v,
-        ends=[sym.ends[f"{s}_f"] for s in p.states],
-        parameters={n: sym.running[n] for n in p.parameters},
-        states=list(p.states),
-        m=len(u),
-        x0=np.array([*(float(s.initial) for s in p.states.values()), 1.0]),
-        t0=float(p.time.initial),
-    )
-
-
-def lq_data(form: LQForm, parameters: Mapping[str, float]) -> LQData | str:
-    """The game's LQ matrices at ``parameters``, or the reason the expressions are not LQ."""
-    values = {form.parameters[n]: float(v) for n, v in parameters.items() if n in form.parameters}
-    rows = []
-    for name, f in zip(form.states, form.dynamics, strict=True):
-        term = _quadratic(f.subs(values), form.z)
-        if term is None or np.any(term[0]):
-            return f"the dynamics of {name} are not linear in the states and controls (or depend on t)"
-        rows.append((term[1], term[2]))
-    running = _quadratic(form.lagrange.subs(values), form.z)
-    mayer = _quadratic(form.mayer.subs(values), form.ends)
-    if running is None or mayer is None:
-        return "the payoff is not quadratic in the states and controls (or depends on t or t_f)"
-    horizon = form.horizon.subs(values)
-    if horizon.free_symbols:
-        return "the final time depends on more than the parameters"
-    n, nu = len(form.states), form.m
-    G = np.array([g for g, _ in rows])
-    c = np.array([k for _, k in rows])
-    A = np.block([[G[:, :n], c[:, None]], [np.zeros((1, n + 1))]])
-    B = np.vstack([G[:, n:], np.zeros((1, G.shape[1] - n))])
-    H, g, k = running
-    Q = np.block([[H[:n, :n], g[:n, None]], [g[None, :n], np.array([[2 * k]])]])
-    N = np.vstack([H[:n, n:], g[None, n:]])
-    Hf, gf, kf = mayer
-    S = np.block([[Hf, gf[:, None]], [gf[None, :], np.array([[2 * kf]])]])
-    return LQData(
-        A, B[:, :nu], B[:, nu:], Q, N[:, :nu], N[:, nu:], H[n:, n:], S, form.x0, form.t0, float(horizon)
-    )
+    return np.concatenate(spans)
 
 
 def escape(A, B, Q, N, R, S, duration: float) -> tuple[float | None, np.ndarray]:
@@ -225,12 +105,15 @@ def escape(A, B, Q, N, R, S, duration: float) -> tuple[float | None, np.ndarray]
 
 def existence(form: LQForm | str, parameters: Mapping[str, float]) -> Existence:
     """The Riccati test of the module docstring at ``parameters`` on the game's parsed ``form``
-    (:func:`lq_form`; a string: why the test does not apply)."""
-    data = form if isinstance(form, str) else lq_data(form, parameters)
+    (:func:`~gamespec.games.lq_structure.lq_form`; a string: why the test does not apply)."""
+    why = form if isinstance(form, str) else _not_zero_sum(form)
+    data: LQGame | str = why or lq_game(form, parameters)
     if isinstance(data, str):
         return Existence(False, f"existence test skipped: {data}")
-    m = data.m
-    R_uu, R_vv = data.R[:m, :m], data.R[m:, m:]
+    u, v = _columns(form, "minimize"), _columns(form, "maximize")
+    payoff = data.players[form.senses.index("minimize")]
+    Q, N, R, S = payoff.Q, payoff.N, payoff.R, payoff.S
+    R_uu, R_vv = R[np.ix_(u, u)], R[np.ix_(v, v)]
     if np.linalg.eigvalsh(R_uu).min() <= 0:
         return Existence(
             True, "no saddle: the payoff is not strictly convex in the minimizer's controls", "minimizer"
@@ -239,15 +122,16 @@ def existence(form: LQForm | str, parameters: Mapping[str, float]) -> Existence:
         return Existence(
             True, "no saddle: the payoff is not strictly concave in the maximizer's controls", "maximizer"
         )
+    both = np.concatenate([u, v])
     duration = data.T - data.t0
     players = {
-        "minimizer": (data.B_u, data.Q, data.N_u, R_uu, data.S),
-        "maximizer": (data.B_v, -data.Q, -data.N_v, -R_vv, -data.S),
-        "game": (np.hstack([data.B_u, data.B_v]), data.Q, np.hstack([data.N_u, data.N_v]), data.R, data.S),
+        "minimizer": (data.B[:, u], Q, N[:, u], R_uu, S),
+        "maximizer": (data.B[:, v], -Q, -N[:, v], -R_vv, -S),
+        "game": (data.B[:, both], Q, N[:, both], R[np.ix_(both, both)], S),
     }
     P = None
-    for name, (B, Q, N, R, S) in players.items():
-        backward, P = escape(data.A, B, Q, N, R, S, duration)
+    for name, (B, Qi, Ni, Ri, Si) in players.items():
+        backward, P = escape(data.A, B, Qi, Ni, Ri, Si, duration)
         if backward is not None:
             when = data.T - backward
             return Existence(

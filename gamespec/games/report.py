@@ -37,7 +37,7 @@ def _solution(m: dict) -> Rows:
         verdict = "not computed" if gap is None else f"{gap:.3g}"
         if passed is False:
             verdict += f" — exceeds the tolerance {tolerance:.3g}"
-        rows.append(("saddle gap" if sought == "saddle" else "Nash gap", verdict))
+        rows.append(("saddle gap" if "saddle" in (sought or "") else "Nash gap", verdict))
     bounds = m.get("value_bounds")
     if bounds:
         rows.append(("value bounds (best responses)", f"[{bounds['lower']:.10g}, {bounds['upper']:.10g}]"))
@@ -46,10 +46,22 @@ def _solution(m: dict) -> Rows:
 
 def game_summary(result: Result) -> Rows:
     """Open-loop game: the equilibrium's outcome per game, the game value and the solution found
-    (refused by the Riccati test: the reason). Receding horizon:
+    (refused by the Riccati test: the reason). Feedback game (``game.information: feedback``): the
+    method, the value and the solution found. Receding horizon:
     captured or not, the capture time, the number of steps, whether every step's game converged,
     and each avoiding player's smallest distance to the obstacle (negative: it collided)."""
     m = result.metrics
+    if m.get("information") == "feedback" and "payoffs" in m:
+        label = (
+            "game value"
+            if m["solution_concept"] == "feedback_saddle"
+            else "objective (first player's payoff)"
+        )
+        return [
+            ("equilibrium", "feedback laws, coupled Riccati equations"),
+            (label, result.objective),
+            *_solution(m),
+        ]
     runs = m.get("best_response")
     if runs is not None:
         rows = [_equilibrium(view, run, len(runs) > 1) for view, run in runs.items()]

@@ -199,8 +199,16 @@ def _check_transforms(name: str, player: PlayerSpec) -> None:
 class GameSettings(StrictModel):
     """The best-response iteration (:mod:`gamespec.best_response`): Gauss–Seidel (Algorithm 4) or
     Jacobi, the tolerance on each player's change ‖[ǔ]_i − [ǔ]_{i−1}‖ (section 7.3.2), the
-    iteration limit and the damping."""
+    iteration limit and the damping; or, with ``information: feedback``, the feedback (closed-loop)
+    equilibrium of a linear-quadratic game by coupled Riccati equations
+    (:mod:`gamespec.games.feedback_game`)."""
 
+    information: Literal["open_loop", "feedback"] = Field(
+        "open_loop",
+        description="open_loop: each player's strategy is a control signal of time (best responses); "
+        "feedback: a law of the state, the feedback Nash (saddle, zero-sum) equilibrium of a "
+        "linear-quadratic game by coupled Riccati equations.",
+    )
     scheme: Literal["gauss_seidel", "jacobi"] = "gauss_seidel"
     tolerance: float = Field(1e-6, gt=0)
     max_iterations: int = Field(100, ge=1)
@@ -273,6 +281,8 @@ class DifferentialGameSpec(ProblemParameters, SpecBase):
         rh = self.receding_horizon
         if rh is None:
             return self
+        if self.game.information == "feedback":
+            raise ValueError("game.information: feedback solves the whole horizon; drop receding_horizon")
         players = self.problem.players
         states = set(self.problem.states)
         pairs = dict(rh.positions) | (dict(rh.obstacle.avoided_by) if rh.obstacle else {})

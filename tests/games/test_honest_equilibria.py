@@ -224,7 +224,8 @@ def test_damped_jacobi_down_to_the_solvers_accuracy_is_not_cycling(scalar):
     ],
 )
 def test_the_riccati_test_skips_what_is_not_linear_quadratic(scalar, change, reason):
-    from gamespec.games.existence import existence, lq_form
+    from gamespec.games.existence import existence
+    from gamespec.games.lq_structure import lq_form
 
     spec = scalar(change)
     verdict = existence(lq_form(spec), spec.problem.parameters)

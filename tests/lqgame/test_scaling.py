@@ -1,0 +1,116 @@
+"""The scaled mean QP (:class:`~gamespec.lqgame.scaling.QPScaling`) is the same problem, and the
+missile endgame (§4.5.2) gives the same answer whatever the rounding: its data perturbed at the
+level of a different machine's arithmetic, and Clarabel on other numerical paths."""
+
+from __future__ import annotations
+
+import dataclasses
+
+import numpy as np
+import pytest
+
+import gamespec
+from gamespec.lqgame.mean_steering import QPData
+from gamespec.lqgame.scaling import QPScaling
+from gamespec.lqgame.solution import GameModel
+from gamespec.result import Status
+from gamespec.specs.lq_game import LQGameSpec
+from gamespec.specs.lq_model import LQGame
+from tests.conftest import PROBLEMS
+
+CH4 = PROBLEMS / "ch4"
+MISSILE = CH4 / "missile_endgame.yaml"
+
+PERTURBATION = 1e-10
+"""Relative noise on every datum, far above double rounding (1.1e-16), as if the file's products and
+matrix exponentials had been rounded on another machine (the noise multiplies, so structural zeros,
+such as the target acceleration's row of ``B``, stay zero as they do in any rounding)."""
+
+
+def _kkt_solution(qp: QPData) -> np.ndarray:
+    """The minimizer of ``½zᵀPz + qᵀz`` s.t. ``Az = b`` from the KKT system (dense solve)."""
+    k = qp.A.shape[0]
+    kkt = np.block([[qp.P, qp.A.T], [qp.A, np.zeros((k, k))]])
+    return np.linalg.solve(kkt, np.concatenate([-qp.q, qp.b]))[: qp.q.size]
+
+
+@pytest.mark.parametrize("name", ["missile_endgame", "test_example"])
+def test_the_scaled_mean_qp_is_the_same_problem_of_order_one(name: str):
+    """Unit Hessian, unit rows, a right-hand side and linear term of norm at most one, and its
+    minimizer mapped back is the original's; the value is the original's divided by ``(ρ s)²``."""
+    model = GameModel.build(gamespec.load(CH4 / f"{name}.yaml").game())
+    original = model.mean.upper_game_qp()
+    scaling = QPScaling.of(original)
+    scaled = scaling.scaled(original)
+    np.testing.assert_array_equal(scaled.P, 2 * np.eye(original.q.size))
+    np.testing.assert_allclose(np.linalg.norm(scaled.A, axis=1), 1, rtol=1e-12)
+    assert np.linalg.norm(scaled.b) <= 1 + 1e-12 and np.linalg.norm(scaled.q) <= 2 + 1e-12
+    xi = _kkt_solution(scaled)
+    U = _kkt_solution(original)
+    np.testing.assert_allclose(scaling.unscale(xi), U, rtol=1e-9, atol=1e-9 * np.abs(U).max())
+
+    def value(qp: QPData, z: np.ndarray) -> float:
+        return 0.5 * z @ qp.P @ z + qp.q @ z
+
+    factor = (scaling.magnitude * scaling.whitening.step) ** 2
+    assert value(original, U) == pytest.approx(factor * value(scaled, xi), rel=1e-9)
+
+
+def _perturbed(game: LQGame, seed: int) -> LQGame:
+    rng = np.random.default_rng(seed)
+    noisy = {
+        k: getattr(game, k) * (1 + PERTURBATION * rng.standard_normal(getattr(game, k).shape))
+        for k in ("A", "B", "C", "D", "Q", "R", "S")
+    }
+    return dataclasses.replace(game, **noisy)
+
+
+@pytest.fixture(scope="module")
+def missile() -> gamespec.Result:
+    return gamespec.solve(MISSILE)
+
+
+def _assert_meets_the_file_test(result: gamespec.Result, n: int) -> None:
+    """The checks of test_problem_files.py::test_missile_endgame and its rank test."""
+    assert result.status is Status.OPTIMAL, result.message
+    assert result.metrics["best_response"]["converged"]
+    assert result.checks["terminal_mean_error"] < 1e-6
+    assert result.checks["terminal_covariance_violation"] < 1e-6
+    assert result.metrics["relative_controllability_rank"] == n - 1
+
+
+@pytest.mark.parametrize("seed", range(3))
+def test_the_missile_endgame_survives_a_rounding_level_change_of_its_data(monkeypatch, missile, seed: int):
+    """The same status and checks, and the same answer: the mean (a KKT solve) to the relative
+    perturbation's order times the KKT system's condition number of the scaled QP (below 10²), the
+    gains to the Jacobi tolerance (the accuracy at which Algorithm 2 stops)."""
+    spec = gamespec.load(MISSILE)
+    game = _perturbed(spec.game(), seed)
+    monkeypatch.setattr(LQGameSpec, "game", lambda self, values=None: game)
+    result = gamespec.solve(spec)
+    _assert_meets_the_file_test(result, game.n)
+    mean = missile.arrays["mean"]
+    np.testing.assert_allclose(result.arrays["mean"], mean, atol=1e2 * PERTURBATION * np.abs(mean).max())
+    np.testing.assert_allclose(result.arrays["K"], missile.arrays["K"], atol=spec.method.tolerance)
+
+
+@pytest.mark.parametrize(
+    "path",
+    [
+        {"direct_solve_method": "faer"},
+        {"iterative_refinement_max_iter": 1},
+        {"iterative_refinement_max_iter": 2},
+    ],
+    ids=["faer", "one_refinement", "two_refinements"],
+)
+def test_the_missile_endgame_is_the_same_on_another_numerical_path(missile, path: dict):
+    """Clarabel with another factorization or fewer refinement steps of its KKT solves (what a
+    different BLAS or rounding changes): the same verdicts, the mean to rounding, the gains to the
+    Jacobi tolerance. Before the mean QP was scaled (its KKT condition number 2.6·10⁷), two
+    refinement steps left the terminal mean 9.8·10⁻⁷ off, at the file test's 10⁻⁶."""
+    spec = gamespec.load(MISSILE)
+    result = gamespec.solve(MISSILE, "cvxpy", options={"solver": "CLARABEL", "solver_options": path})
+    _assert_meets_the_file_test(result, spec.game().n)
+    mean = missile.arrays["mean"]
+    np.testing.assert_allclose(result.arrays["mean"], mean, atol=1e-12 * np.abs(mean).max())
+    np.testing.assert_allclose(result.arrays["K"], missile.arrays["K"], atol=spec.method.tolerance)

@@ -10,6 +10,7 @@ import numpy as np
 import pytest
 
 import gamespec
+from gamespec.lqgame.checks import numerical_rank
 from gamespec.lqgame.mean_steering import QPData
 from gamespec.lqgame.scaling import QPScaling
 from gamespec.lqgame.solution import GameModel
@@ -77,6 +78,7 @@ def _assert_meets_the_file_test(result: gamespec.Result, n: int) -> None:
     assert result.checks["terminal_mean_error"] < 1e-6
     assert result.checks["terminal_covariance_violation"] < 1e-6
     assert result.metrics["relative_controllability_rank"] == n - 1
+    assert result.metrics["relative_controllability_rank_margin"] > 10
 
 
 @pytest.mark.parametrize("seed", range(3))
@@ -114,3 +116,15 @@ def test_the_missile_endgame_is_the_same_on_another_numerical_path(missile, path
     mean = missile.arrays["mean"]
     np.testing.assert_allclose(result.arrays["mean"], mean, atol=1e-12 * np.abs(mean).max())
     np.testing.assert_allclose(result.arrays["K"], missile.arrays["K"], atol=spec.method.tolerance)
+
+
+@pytest.mark.parametrize("small", [1e-20, 1e-16, 1e-14, 1e-9])
+def test_a_rank_decision_reports_its_distance_from_numpys_tolerance(small: float):
+    """``diag(1, 0.5, small)``: numpy's rank, and the margin ``min(σ_r/τ, τ/σ_{r+1})`` with
+    ``τ = 3 eps`` (σ_max = 1), small when ``small`` sits near ``τ``."""
+    sv = np.array([1.0, 0.5, small])
+    rank, margin = numerical_rank(sv, (3, 3))
+    tolerance = 3 * np.finfo(float).eps
+    assert rank == np.linalg.matrix_rank(np.diag(sv))
+    expected = min(0.5 / tolerance, tolerance / small) if small <= tolerance else small / tolerance
+    assert margin == pytest.approx(expected)

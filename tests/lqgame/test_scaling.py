@@ -128,3 +128,24 @@ def test_a_rank_decision_reports_its_distance_from_numpys_tolerance(small: float
     assert rank == np.linalg.matrix_rank(np.diag(sv))
     expected = min(0.5 / tolerance, tolerance / small) if small <= tolerance else small / tolerance
     assert margin == pytest.approx(expected)
+
+
+@pytest.mark.parametrize("name", ["test_example", "test_example_large_noise"])
+def test_the_other_covariance_files_survive_a_rounding_level_change_of_their_data(monkeypatch, name: str):
+    """§4.5.1 (Fig. 4.2 and 4.3) with the same noise: the same status, the mean to the
+    perturbation's order, and, where the Jacobi run converges, the gains to its tolerance; the
+    infeasible file's smallest scaling γ* to the perturbation's order."""
+    path = CH4 / f"{name}.yaml"
+    reference = gamespec.solve(path)
+    spec = gamespec.load(path)
+    game = _perturbed(spec.game(), 0)
+    monkeypatch.setattr(LQGameSpec, "game", lambda self, values=None: game)
+    result = gamespec.solve(spec)
+    assert result.status is reference.status
+    mean = reference.arrays["mean"]
+    np.testing.assert_allclose(result.arrays["mean"], mean, atol=1e2 * PERTURBATION * np.abs(mean).max())
+    if reference.status is Status.OPTIMAL:
+        np.testing.assert_allclose(result.arrays["K"], reference.arrays["K"], atol=spec.method.tolerance)
+    else:
+        gamma = reference.metrics["min_covariance_scaling"]
+        assert result.metrics["min_covariance_scaling"] == pytest.approx(gamma, rel=1e2 * PERTURBATION)

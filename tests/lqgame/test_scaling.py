@@ -57,6 +57,19 @@ def test_the_scaled_mean_qp_is_the_same_problem_of_order_one(name: str):
     assert value(original, U) == pytest.approx(factor * value(scaled, xi), rel=1e-9)
 
 
+def test_the_scaled_mean_qp_without_a_terminal_mean_is_the_saddle_point():
+    """Without ``μ_N`` (Prop. 9) the scaled QP has no equality, and its minimizer ``−q̂/2`` maps back
+    to the saddle point's ``Ū``."""
+    spec = gamespec.load(CH4 / "test_example_mean_steering.yaml", ["problem.terminal.mean=null"])
+    model = GameModel.build(spec.game())
+    original = model.mean.upper_game_qp()
+    scaling = QPScaling.of(original)
+    scaled = scaling.scaled(original)
+    assert scaled.A is None and np.linalg.norm(scaled.q) == pytest.approx(2)
+    U, _ = model.mean.saddle_point()
+    np.testing.assert_allclose(scaling.unscale(-scaled.q / 2), U, rtol=1e-9, atol=1e-12)
+
+
 def _perturbed(game: LQGame, seed: int) -> LQGame:
     rng = np.random.default_rng(seed)
     noisy = {

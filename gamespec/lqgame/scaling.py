@@ -23,9 +23,11 @@ equality is divided by its norm (every component of ``μ_N`` is met to the same 
 whatever its unit), and the variable by its magnitude ``ρ = max(‖ĥ‖, ‖ĉ‖)``, the size of the
 constrained and of the unconstrained minimizer in whitened units, so ``Ū = ρ s R⁻¹ ξ`` with
 ``‖ξ‖`` of order one. Without it the missile endgame's QP has an optimal value near 9·10⁸ and
-multipliers near 10⁶ (``R = 100``, a closing speed of 350 m/s to null in 0.7 s), so the KKT system's
-static regularization (1e-8 in Clarabel) moves the terminal mean by 3·10⁻⁷ when iterative refinement
-does not repair it, a third of the test's 10⁻⁶; scaled, the same solve meets it to rounding.
+multipliers near 10⁷ (``R = 100``, a closing speed of 350 m/s to null in 0.7 s) and a KKT condition
+number of 2.6·10⁷, so the terminal mean depends on how Clarabel's iterative refinement of its
+regularized KKT solves ends (off by 6·10⁻⁸, 9.8·10⁻⁷ and 1.5·10⁻⁹ after one, two and three steps, at
+the test's 10⁻⁶): on another machine's rounding, another answer. Scaled, the condition number is 74
+and one step gives 7·10⁻¹³.
 """
 
 from __future__ import annotations

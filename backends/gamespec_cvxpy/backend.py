@@ -26,7 +26,7 @@ from gamespec.backend.lq import LQBackend, LQCompiledModel, LQSolverOptions
 from gamespec.best_response import Settings, StepReport
 from gamespec.errors import BackendError
 from gamespec.lqgame.covariance import CONTROLLER, STOPPER, algorithm_2, gains_to_vector
-from gamespec.lqgame.scaling import ControllerScaling
+from gamespec.lqgame.scaling import ControllerScaling, QPScaling
 from gamespec.lqgame.solution import CovarianceOutcome, GameModel, MeanOutcome, fallback_mean
 from gamespec.result import Result, Status
 from gamespec.specs.base import StrictModel
@@ -124,16 +124,18 @@ class _Problem:
 
 
 class MeanProblem:
-    """The controller's upper game eq. 4.43 as a CVXPY QP in ``Ū``."""
+    """The controller's upper game eq. 4.43 as a CVXPY QP in the scaled inputs ``ξ`` of
+    :class:`~gamespec.lqgame.scaling.QPScaling` (``Ū = ρ s R⁻¹ ξ``)."""
 
     def __init__(self, model: GameModel, options: CvxpyOptions) -> None:
         import cvxpy as cp
 
-        qp = model.mean.upper_game_qp()
-        self.U = cp.Variable(qp.q.size)
-        root = np.linalg.cholesky(qp.P / 2).T
-        constraints = [] if qp.A is None else [qp.A @ self.U - qp.b == 0]
-        objective = cp.Minimize(cp.sum_squares(root @ self.U) + qp.q @ self.U)
+        original = model.mean.upper_game_qp()
+        self.scaling = QPScaling.of(original)
+        qp = self.scaling.scaled(original)
+        self.xi = cp.Variable(qp.q.size)
+        constraints = [] if qp.A is None else [qp.A @ self.xi - qp.b == 0]
+        objective = cp.Minimize(cp.sum_squares(self.xi) + qp.q @ self.xi)
         self.problem = _Problem(cp.Problem(objective, constraints), options)
 
     def solve(self, model: GameModel) -> MeanOutcome:
@@ -142,9 +144,9 @@ class MeanProblem:
         reported = f"mean QP: solver reported {self.problem.reported}"
         if self.problem.note:
             reported += f" ({self.problem.note})"
-        if self.U.value is None or not status.ok:
+        if self.xi.value is None or not status.ok:
             return fallback_mean(model, status, reported)
-        U = np.asarray(self.U.value)
+        U = self.scaling.unscale(np.asarray(self.xi.value))
         return MeanOutcome(
             U,
             model.mean.stopper_response(U),

@@ -9,6 +9,13 @@
 
 Extreme eigenvalues within roundoff of zero are reported as zero, so a singular matrix (the
 boundary case of a strict inequality) fails its check rather than passing on a rounding error.
+
+A numerical rank is decided against numpy's tolerance ``τ = σ_max · max(shape) · eps``, an estimate
+of the rounding error on the singular values; ``rank_margin = min(σ_r / τ, τ / σ_{r+1})`` says how
+far the decision is from that threshold. By Weyl's inequality another machine's rounding moves each
+σ by at most ``‖ΔG‖₂``, of the order of ``τ``, so a decision with a margin above 10 is the same on
+any machine and one below it is the rounding's (the missile endgame's rank 3 of 𝒢 has a margin
+above 10⁵: ``σ_4 ≈ 10⁻²⁰`` against ``τ ≈ 1.6·10⁻¹⁵``, ``σ_3 ≈ 0.04``).
 Without eq. 4.27 the stopper has no best response (eq. 4.39b), so ``𝒢`` and Lemma 11 are not
 computed.
 """
@@ -31,6 +38,7 @@ class Reachability:
     singular_values: list[float]
     reachable: bool
     residual: float
+    rank_margin: float
     unreachable_directions: list[list[float]] = field(default_factory=list)
     unreachable_components: list[int] = field(default_factory=list)
 
@@ -63,6 +71,7 @@ class Assumptions:
             metrics |= {
                 "relative_controllability_rank": reach.rank,
                 "relative_controllability_singular_values": reach.singular_values,
+                "relative_controllability_rank_margin": reach.rank_margin,
                 "mean_target_reachable": reach.reachable,
                 "mean_target_residual": reach.residual,
                 "unreachable_directions": reach.unreachable_directions,
@@ -75,6 +84,17 @@ def _rank_tolerance(singular_values: np.ndarray, shape: tuple[int, int]) -> floa
     """numpy's default rank tolerance: ``σ_max · max(shape) · eps``."""
     top = singular_values.max() if singular_values.size else 0.0
     return top * max(shape) * np.finfo(float).eps
+
+
+def numerical_rank(singular_values: np.ndarray, shape: tuple[int, int]) -> tuple[int, float]:
+    """The rank at numpy's tolerance ``τ`` and its margin ``min(σ_r / τ, τ / σ_{r+1})`` (infinite
+    for a zero matrix or where no σ lies on that side)."""
+    tolerance = _rank_tolerance(singular_values, shape)
+    kept = singular_values[singular_values > tolerance]
+    dropped = singular_values[singular_values <= tolerance]
+    above = kept.min() / tolerance if kept.size else np.inf
+    below = tolerance / dropped.max() if dropped.size and dropped.max() > 0 else np.inf
+    return int(kept.size), float(min(above, below))
 
 
 def extreme_eigenvalue(M: np.ndarray, largest: bool = False) -> float:
@@ -90,16 +110,17 @@ def reachability(mean: MeanGame) -> Reachability:
 
     ``rank`` and the singular values are those of the full ``𝒢`` (eq. 4.44); reachability is tested
     on the rows of ``μ_N`` that are given, and unreachable components are state indices.
+    ``rank_margin`` is the smaller of the two rank decisions' margins (:func:`numerical_rank`).
     """
     G_full, _ = mean.relative_controllability
     sv = np.linalg.svd(G_full, compute_uv=False)
-    rank = int((sv > _rank_tolerance(sv, G_full.shape)).sum())
+    rank, margin = numerical_rank(sv, G_full.shape)
     if mean.game.muN is None:
-        return Reachability(rank, sv.tolist(), True, 0.0)
+        return Reachability(rank, sv.tolist(), True, 0.0, margin)
     G, target = mean.target_equation()
     rows = np.flatnonzero(~np.isnan(mean.game.muN))
     U_, sv_rows, _ = np.linalg.svd(G)
-    row_rank = int((sv_rows > _rank_tolerance(sv_rows, G.shape)).sum())
+    row_rank, row_margin = numerical_rank(sv_rows, G.shape)
     left_null = U_[:, row_rank:]
     missed = left_null.T @ target
     scale = max(np.linalg.norm(target), 1.0)
@@ -113,6 +134,7 @@ def reachability(mean: MeanGame) -> Reachability:
         singular_values=sv.tolist(),
         reachable=not significant.any(),
         residual=residual,
+        rank_margin=min(margin, row_margin),
         unreachable_directions=directions.T.tolist(),
         unreachable_components=components,
     )

@@ -29,9 +29,11 @@ from gamespec.plotting import LEGEND_RIGHT, headline
 from gamespec.result import Result
 
 COLORS = ("tab:red", "tab:blue")
-LOOPS = (("open_loop", "o"), ("closed_loop", "s"), ("pursuer_feedback", "^"))
-"""Eq. 5.39 in open loop, at the game's solution, and with the pursuer's feedback against the
-open-loop evader."""
+LOOPS = (("open_loop", "o"), ("lower_value", "^"), ("minimax_mixed", "s"), ("gauss_seidel", "v"))
+"""Eq. 5.39 in open loop, at the lower value (the pursuer's feedback answers the evader's committed
+gains: the thesis' closed loop), at the mixed minimax (a worst-case evader) and at Algorithm 3's
+last iterate (:mod:`gamespec.flowfield.concepts`); whichever the file chose is also
+``closed_loop``."""
 
 
 def _level(result: Result) -> str:

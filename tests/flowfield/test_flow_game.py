@@ -31,7 +31,7 @@ SPEC = {
     },
     "method": {
         "grid": {"lower": [-2.5, -3.0], "upper": [4.0, 3.0], "nodes": [53, 49]},
-        "game": {"scheme": "minimax", "max_iterations": 12},
+        "game": {"scheme": "minimax_mixed", "max_iterations": 12},
         "monte_carlo": {"samples": 20000, "seed": 1},
     },
 }
@@ -68,7 +68,7 @@ def test_monte_carlo_agrees_with_eq_5_39(result) -> None:
 def test_result_reports_the_game_honestly(result) -> None:
     assert isinstance(result.metrics["game_converged"], bool)
     history = result.metrics["best_response"]["history"]
-    assert history and result.metrics["game_scheme"] == "minimax"
+    assert history and result.metrics["game_scheme"] == "minimax_mixed"
     assert result.ok == result.metrics["game_converged"]
     mixture = result.metrics["evader_mixture"]
     assert sum(mixture["weights"]) == pytest.approx(1.0)

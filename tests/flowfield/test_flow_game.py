@@ -151,9 +151,56 @@ def test_fig_5_2_from_a_sweep(tmp_path: Path, cli) -> None:
 
 
 def test_summary_leads_with_the_capture(result) -> None:
+    """The summary shows open loop, both closed-loop figures, the saddle gap and the concept."""
     from gamespec.summaries import outcome
 
     rows = dict(outcome(result))
-    assert rows["capture time T̂"] == result.metrics["capture_time"]
-    assert rows["P(capture at T̂), closed loop"] == result.metrics["capture_probability_closed_loop"]
-    assert rows["game converged"].startswith(str(result.metrics["game_converged"]))
+    m = result.metrics
+    assert rows["capture time T̂"] == m["capture_time"]
+    assert rows["P(capture at T̂), open loop"] == m["capture_probability_open_loop"]
+    lower = "P(capture at T̂), lower value (evader commits, pursuer answers: the thesis)"
+    assert rows[lower] == m["capture_probability_lower_value"]
+    assert (
+        rows["P(capture at T̂), mixed minimax (worst-case evader)"] == m["capture_probability_minimax_mixed"]
+    )
+    assert rows["saddle gap v₊ − v₋ (payoff)"].startswith(f"{m['saddle_gap']:.4g}")
+    assert rows["solution concept (closed loop)"].startswith(m["solution_concept"])
+    assert rows["game converged"] == m["game_converged"]
+
+
+@pytest.fixture(scope="module")
+def lower() -> object:
+    data = copy.deepcopy(SPEC)
+    data["method"]["game"]["scheme"] = "lower_value"
+    data["method"]["monte_carlo"]["samples"] = 0
+    return solve(spec_from_dict(data), options={"cross_check": False})
+
+
+def test_both_solution_concepts_are_reported(result, lower) -> None:
+    """Each scheme reports the figure of its concept as the closed loop and the other beside it, the
+    same values ``v₋ ≤ v₊`` and saddle gap (:mod:`gamespec.flowfield.concepts`), and no pure saddle
+    point in this uniform flow: the gap is far beyond the tolerance."""
+    for run, scheme in ((result, "minimax_mixed"), (lower, "lower_value")):
+        m = run.metrics
+        assert m["solution_concept"] == scheme, run.message
+        assert m["capture_probability_closed_loop"] == m[f"capture_probability_{scheme}"]
+        assert m["lower_value"] < m["upper_value"]
+        assert m["saddle_gap"] == pytest.approx(m["upper_value"] - m["lower_value"])
+        assert m["saddle_gap"] > 10 * 1e-3 * m["upper_value"]  # ten times the default method.game.gap
+        assert "no pure saddle point" in run.message
+        assert m["payoffs"]["pursuer"] == pytest.approx(run.objective) == -m["payoffs"]["evader"]
+        assert set(m["check_tolerances"]) == set(m["checks_passed"]) <= set(run.checks)
+    assert all(result.metrics["checks_passed"].values()), result.metrics["checks_passed"]
+    assert lower.metrics["lower_value"] == pytest.approx(result.metrics["lower_value"], rel=1e-9)
+    assert lower.objective == pytest.approx(lower.metrics["lower_value"])
+    # here the pursuer's answer to the open-loop evader uses more than ρᵖ − ρᵉ of its spread: no room
+    # to copy, so the evader's commitment beats open loop and the lower value is not certified
+    ascent = lower.metrics["lower_value_ascent"]
+    assert ascent["copy_room"] > 1 and ascent["bound"] is None
+    assert ascent["payoffs"][-1] > ascent["payoffs"][0]
+    assert lower.checks["lower_value_bracket"] is None
+    assert not lower.metrics["checks_passed"]["lower_value_bracket"]
+    # the thesis' reading captures more than open loop, a worst-case evader less than the thesis
+    m = lower.metrics
+    assert m["capture_probability_lower_value"] > m["capture_probability_open_loop"]
+    assert m["capture_probability_minimax_mixed"] < m["capture_probability_lower_value"]

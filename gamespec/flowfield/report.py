@@ -11,7 +11,7 @@ from gamespec.result import Result
 
 LOOPS = (
     ("open_loop", "open loop"),
-    ("lower_value", "lower value (evader commits, pursuer answers: the thesis)"),
+    ("lower_value", "lower value (thesis: the pursuer answers)"),
     ("minimax_mixed", "mixed minimax (worst-case evader)"),
     ("gauss_seidel", "Algorithm 3's last iterate"),
 )

@@ -158,7 +158,7 @@ def test_summary_leads_with_the_capture(result) -> None:
     m = result.metrics
     assert rows["capture time T̂"] == m["capture_time"]
     assert rows["P(capture at T̂), open loop"] == m["capture_probability_open_loop"]
-    lower = "P(capture at T̂), lower value (evader commits, pursuer answers: the thesis)"
+    lower = "P(capture at T̂), lower value (thesis: the pursuer answers)"
     assert rows[lower] == m["capture_probability_lower_value"]
     assert (
         rows["P(capture at T̂), mixed minimax (worst-case evader)"] == m["capture_probability_minimax_mixed"]

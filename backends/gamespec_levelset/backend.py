@@ -24,7 +24,7 @@ import numpy as np
 from pydantic import Field
 
 from gamespec.backend import Availability, Backend, CompiledModel, Inputs, refuse_inputs
-from gamespec.best_response import Settings, iterate
+from gamespec.best_response import Outcome, Settings, iterate
 from gamespec.flowfield.capture_probability import capture_probabilities
 from gamespec.flowfield.concepts import saddle_gap, solution_concept
 from gamespec.flowfield.covariance_game import PLAYERS, CovarianceGame, Strategy
@@ -342,8 +342,9 @@ def _concepts(spec: FlowGameSpec, game: CovarianceGame, cast: Players) -> tuple[
     plays: dict[str, Plays] = {
         iteration: [(w, (p_star, e)) for w, e in _evader_mixture(cast.pursuer, run.strategies["evader"])]
     }
-    answered = cast.evader.log.responses
-    upper = game.value((p_star, answered[-1])) if answered and run.status.ok else None
+    answered = cast.evader.log.responses  # the last answered the run's last pursuer unless a step failed
+    failed = run.outcome is Outcome.PLAYER_FAILED
+    upper = game.value((p_star, answered[-1])) if answered and not failed else None
     lower_point = lower_value(cast.answer, cast.evader, open_loop[1], m.gap, m.max_iterations)
     lower = None
     metrics: dict[str, Any] = {"best_response": run.as_metrics(), "minimax_lower_bound": None}
@@ -369,8 +370,8 @@ def _concepts(spec: FlowGameSpec, game: CovarianceGame, cast: Players) -> tuple[
             checks["lower_value_bracket"] = (width, m.gap)
     concept = solution_concept(lower, upper, m.gap, m.scheme)
     gap = None if lower is None or upper is None else saddle_gap(lower, upper)
-    if concept == "saddle" and m.scheme == "gauss_seidel":
-        checks["saddle_gap"] = (None if gap is None else gap / upper, m.gap)
+    if m.scheme == "gauss_seidel":
+        checks["saddle_gap"] = (None if gap is None else gap / max(upper, 1e-300), m.gap)
     metrics |= {
         "solution_concept": concept,
         "lower_value": lower,
@@ -391,8 +392,8 @@ def _concepts(spec: FlowGameSpec, game: CovarianceGame, cast: Players) -> tuple[
     if gap is not None and concept != "saddle":
         message = (
             f"{message}; " * bool(message)
-            + f"{concept}: no pure saddle point (v₊ − v₋ = {gap:.4g}, {gap / upper:.1%} of v₊); "
-            + "capture_probability_lower_value and capture_probability_minimax_mixed differ"
+            + f"{m.scheme}: no pure saddle point (v₊ − v₋ = {gap:.4g}, {gap / upper:.1%} of v₊): the "
+            + "lower value (the pursuer answers) and a worst-case evader give different closed loops"
         )
     metrics["game_converged"] = converged
     chosen = "lower_value" if m.scheme == "lower_value" and "lower_value" in plays else iteration

@@ -70,7 +70,8 @@ def saddle_gap(lower: float, upper: float) -> float:
 
 def solution_concept(lower: float | None, upper: float | None, tolerance: float, scheme: Scheme) -> str:
     """``saddle`` when both values are known and ``v₊ − v₋ ≤ tolerance · |v₊|`` (a pure saddle point:
-    every concept gives it), else the concept of ``scheme`` (:data:`SCHEME_CONCEPT`)."""
+    every concept gives it), else the concept of ``scheme`` (:data:`SCHEME_CONCEPT`; for
+    ``gauss_seidel`` the saddle it seeks, its ``checks.saddle_gap`` failing)."""
     if lower is not None and upper is not None and saddle_gap(lower, upper) <= tolerance * abs(upper):
         return "saddle"
     return SCHEME_CONCEPT[scheme]

@@ -351,7 +351,7 @@ class GamePlayer:
 class LowerValue:
     """The lower value's point: the evader's committed strategy and the pursuer's answer, the
     payoffs ``φ(e)/scale`` along the ascent, whether it stopped (one more step gains at most the
-    tolerance), the relative gain of that last step, the report of the last step, and — when the
+    tolerance), the relative gain of that last step, and — when the
     pursuer's first answer can copy every evader gain (``room`` ≤ 1, ``V = Û``) — the certified
     upper ``bound`` of ``v₋/scale`` and the copy ``defect`` ``max_e ‖(Tᵖ + Tᵉ)κᵉ‖`` it uses."""
 
@@ -360,7 +360,6 @@ class LowerValue:
     values: list[float]
     converged: bool
     residual: float
-    report: StepReport
     room: float | None
     defect: float | None
     bound: float | None
@@ -416,4 +415,4 @@ def lower_value(
             break
         point = (answer, committed)
         values.append(value)
-    return LowerValue(point[1], point[0], values, converged, residual, report, room, defect, bound)
+    return LowerValue(point[1], point[0], values, converged, residual, room, defect, bound)

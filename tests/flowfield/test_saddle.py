@@ -13,6 +13,8 @@ Karlin and Shapley 1950); the ``minimax`` scheme computes it by outer approximat
 
 from __future__ import annotations
 
+from dataclasses import replace
+
 import numpy as np
 import pytest
 from gamespec_levelset.backend import REACHABILITY, linearized_game
@@ -29,7 +31,7 @@ from gamespec_levelset.players import (
 import gamespec
 from gamespec.best_response import Outcome, Settings, iterate
 from gamespec.flowfield.concepts import copy_room, saddle_gap, solution_concept
-from gamespec.flowfield.covariance_game import CovarianceGame
+from gamespec.flowfield.covariance_game import CovarianceGame, PlayerBounds, Strategy
 from gamespec.flowfield.problem import evaluate
 from tests.conftest import PROBLEMS
 from tests.flowfield.conftest import linear_field, small_game, vortex_field
@@ -163,3 +165,35 @@ def test_the_feasibility_condition_holds_on_the_shipped_files(name):
     answer = evader.respond(found.pursuer)[0]
     mirror = found.values[0] + float(np.sum((Te @ answer.kappa.reshape(-1)) ** 2)) / scale
     assert mirror > found.bound * (1 + GAP)
+
+
+@pytest.mark.parametrize("payoff", ["trace", "frobenius"])
+def test_the_copy_bracket_bounds_every_evader_commitment(payoff):
+    """In a nonlinear field (``Tᵖ + Tᵉ ≠ 0``) with room to copy, every evader commitment ``e`` (drawn
+    on the boundary of its set) meets a pursuer answer ``p₀ + κᵉ`` that is feasible and keeps
+    ``J`` below the bracket of :func:`~gamespec.flowfield.concepts.lower_value_bound`, and the
+    pursuer's own best answer does at least as well: ``min_p J(p, e) ≤ bound`` (so ``v₋ ≤ bound``)."""
+    game, _ = small_game(vortex_field(), payoff, feedforward="nominal")
+    game = replace(game, bounds=(PlayerBounds(4.0, 0.1, 0.8, 0.01), game.bounds[1]))  # room to copy
+    open_loop = game.nominal()
+    scale = game.value(open_loop)
+    pursuer = PursuerStep(game, "CLARABEL", {}, scale)
+    evader = EvaderStep(game, "CLARABEL", {}, scale, 1e-6, 50, open_loop[1])
+    found = lower_value(pursuer, evader, open_loop[1], GAP, 5)
+    assert isinstance(found, LowerValue) and found.room <= 1 and found.defect > 0
+    p0 = pursuer.respond(open_loop[1])[0]
+    rng = np.random.default_rng(0)
+    for _ in range(20):
+        z = rng.standard_normal((game.N - 1, 8))
+        z *= (evader.radii / np.linalg.norm(z, axis=1))[:, None]
+        kappa = np.zeros((game.N, 2, 4))
+        kappa[1:] = np.einsum("kij,kj->ki", evader.inverse_maps, z).reshape(-1, 2, 4)
+        committed = Strategy(open_loop[1].V, kappa)
+        copy = Strategy(p0.V, p0.kappa + kappa)
+        spread = np.linalg.norm(
+            np.einsum("kij,kj->ki", pursuer.spread_maps, copy.kappa[1:].reshape(-1, 8)), axis=1
+        )
+        assert np.all(spread <= pursuer.radii * (1 + 1e-9))
+        assert game.value((copy, committed)) / scale <= found.bound * (1 + 1e-9)
+        answer = pursuer.respond(committed)[0]
+        assert game.value((answer, committed)) / scale <= found.bound * (1 + 1e-6)

@@ -31,6 +31,7 @@ SPEC = {
     },
     "method": {
         "grid": {"lower": [-2.5, -3.0], "upper": [4.0, 3.0], "nodes": [53, 49]},
+        "levels": [0.4, 0.8],
         "game": {"scheme": "minimax_mixed", "max_iterations": 12},
         "monte_carlo": {"samples": 20000, "seed": 1},
     },

@@ -5,11 +5,12 @@ eq. 5.22 on the grid (:mod:`gamespec.flowfield.levelset`) and integrates the nom
 along ∇φ (eqs. 5.23–5.26); ``extremals`` shoots the characteristics (:mod:`gamespec.flowfield.
 extremals`) and takes the extremals through ``x_f`` as the nominal paths. Then: ``N = round(T̂/step)``
 steps, the zero-order hold of the linearized dynamics (eqs. 5.5–5.8), the lifting (eq. 5.10),
-the game on the best-response engine with the players of :mod:`.players` (Gauss–Seidel,
-Algorithm 3, or the ``minimax`` scheme), the capture probability (eq. 5.39) per step in open loop,
-closed loop (the game's solution: the pursuer's strategy against the evader's, mixed for
-``minimax``) and with the pursuer's strategy against the open-loop evader, and a Monte Carlo of
-the nonlinear SDE in open and closed loop (the samples split among the evader's mixture). The
+the game on the best-response engine with the players of :mod:`.players` (the mixed minimax, or
+Gauss–Seidel, Algorithm 3, for ``gauss_seidel``) and the lower value (the evader commits, the
+pursuer answers; :mod:`gamespec.flowfield.concepts`), the capture probability (eq. 5.39) per step
+in open loop and under each solution, the closed loop being the one of ``method.game.scheme``,
+and a Monte Carlo of the nonlinear SDE in open and closed loop (the samples split among the
+evader's mixture for the minimax). The
 reachability and nominal paths depend on the drift only, so a re-solve with new values of
 parameters that enter only the diffusion (α) reuses them.
 """

@@ -309,7 +309,7 @@ class EvaderStep(_PlayerProblem):
 
 @dataclass
 class MinimaxEvader:
-    """The evader of the ``minimax`` scheme: its step's answer to the pursuer's security strategy
+    """The evader of the mixed minimax: its step's answer to the pursuer's security strategy
     when that answer raises ``J`` above the restricted value ``t`` by more than ``gap · t`` (a new
     strategy the pursuer has not guarded against), else its previous answer. At a mixed
     equilibrium the evader is indifferent among its support, so its plain best response may jump

@@ -1,8 +1,9 @@
 """Which solution of the covariance game (section 5.3) a Result reports, and when the game has a
 pure saddle point.
 
-The pursuer minimizes ``J(p, e)`` (eq. 5.34 or 5.17) over its set ``𝒫`` of gains, the evader
-maximizes it over ``ℰ`` (eqs. 5.35–5.36). Two values bracket every solution:
+The pursuer minimizes the payoff ``𝒥(V, K)`` (eq. 5.34, or eq. 5.17) by its part
+``p = (EᵖV, EᵖK) ∈ 𝒫``, the evader maximizes it by ``e = (EᵉV, EᵉK) ∈ ℰ``, the sets of section 5.3
+cut out by eqs. 5.35–5.36 for each player; write ``J(p, e)``. Two values bracket every solution:
 
 - the **lower value** ``v₋ = max_{e∈ℰ} min_{p∈𝒫} J(p, e)``: the evader commits to its gains and the
   pursuer's feedback answers them. This is the thesis' reading: Algorithm 3 lets the pursuer answer
@@ -28,9 +29,10 @@ open-loop evader (``e = 0``) leaves room to copy any evader gain: ``p₀ + ℰ �
 ``e``, so ``v₋ = J(p₀, 0) = min_p ‖c(p)‖²`` and ``v₊ − v₋ ≥ max_e ‖Tᵉκᵉ‖² > 0``. In a nonlinear flow
 ``Tᵖ + Tᵉ`` is small but not zero, and the copy gives the bracket of :func:`lower_value_bound`.
 
-Both per-step sets are balls of one shape, ``‖S_k κ_k‖ ≤ ρⁱ_k`` with ``ρⁱ_k = (vⁱ_max − ‖vⁱ_k‖)/√(2
-log 1/βⁱ)`` (eq. 5.36; ``S_k`` from the noise ``y_k`` both players observe), so ``p₀ + ℰ ⊆ 𝒫`` iff
-``‖S_k κᵖ_k‖ + ρᵉ_k ≤ ρᵖ_k`` at every step.
+With ``V = Û`` (``feedforward: nominal``) both players' gains range over per-step balls of one
+shape, ``‖S_k κ_k‖ ≤ ρⁱ_k`` with ``ρⁱ_k = (vⁱ_max − ‖ûⁱ_k‖)/√(2 log 1/βⁱ)`` (eq. 5.36 in its SOC form;
+``S_k`` from the noise ``y_k`` both players observe), so ``p₀ + ℰ ⊆ 𝒫`` iff
+``‖S_k κᵖ_k‖ + ρᵉ_k ≤ ρᵖ_k`` at every step; with ``free`` feedforward the condition is not checked.
 """
 
 from __future__ import annotations

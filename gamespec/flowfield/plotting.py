@@ -110,9 +110,9 @@ def capture_rows(values: Iterable[Mapping[str, Any]]) -> list[Mapping[str, Any]]
 
 
 def plot_capture_sweep(points: Sequence[tuple[float, Mapping[str, Any]]], parameter: str, path: Path) -> Path:
-    """Capture probability at ``T̂`` against ``parameter`` — ``points`` are (value, metrics) — open
-    loop, closed loop and the pursuer's feedback against a passive evader, eq. 5.39 and the Monte
-    Carlo with its interval (Fig. 5.2)."""
+    """Capture probability at ``T̂`` against ``parameter`` — ``points`` are (value, metrics) — in
+    open loop and under each solution concept of :data:`LOOPS`, eq. 5.39 and the Monte Carlo with its
+    interval (Fig. 5.2)."""
     points = sorted(points, key=lambda p: p[0])
     x = np.array([value for value, _ in points])
     fig, ax = plt.subplots(figsize=(6, 4))

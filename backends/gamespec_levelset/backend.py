@@ -75,7 +75,8 @@ class FlowGameOptions(StrictModel):
 @dataclass(frozen=True)
 class Reachability:
     """Stage 1's outcome: ``T̂``, ``x_f`` and the nominal paths, or why there are none; the arrays
-    and metrics it contributes to the Result."""
+    and metrics it contributes to the Result; the grid-error estimate where one was made (None
+    inside: the coarser grid found no capture)."""
 
     capture_time: float | None
     capture_point: np.ndarray | None
@@ -83,6 +84,7 @@ class Reachability:
     message: str
     arrays: dict[str, np.ndarray]
     metrics: dict[str, Any]
+    grid_error: dict[str, Any] | None = None
 
 
 def _level_set_reach(
@@ -116,10 +118,11 @@ def _level_set_reach(
     if reach.capture_time is None:
         return Reachability(None, None, None, reach.message, arrays, metrics)
     paths = from_level_sets(reach, data.field, speeds, data.origins) if nominal else None
+    grid_error = None
     if nominal and engine == "numpy":
         coarse_solver = numpy_solver(coarser_grid(data.grid))
         coarse = capture_by_level_sets(coarse_solver, data.origins, m.max_time, levels=m.read_levels)
-        metrics["grid_error_estimate"] = grid_error_estimate(reach, coarse)
+        grid_error = {"estimate": grid_error_estimate(reach, coarse)}
     metrics |= {
         "levels": reach.levels.tolist(),
         "level_capture_times": reach.level_times.tolist(),
@@ -130,7 +133,7 @@ def _level_set_reach(
         "grid_y": data.grid.axes[1],
         "phi_final": reach.snapshots[-1].astype(float),
     }
-    return Reachability(reach.capture_time, reach.capture_point, paths, "", arrays, metrics)
+    return Reachability(reach.capture_time, reach.capture_point, paths, "", arrays, metrics, grid_error)
 
 
 def _extremal_reach(spec: FlowGameSpec, data: FlowGameData, nominal: bool = True) -> Reachability:
@@ -216,8 +219,8 @@ class FlowGameModel(CompiledModel):
             f"closure_error_{n}": float(e) for n, e in zip(PLAYERS, reach.paths.closure_error, strict=True)
         }
         metrics = result.metrics
-        if "grid_error_estimate" in reach.metrics:
-            estimate = reach.metrics["grid_error_estimate"]
+        if reach.grid_error is not None:
+            estimate = reach.grid_error["estimate"]
             graded = {
                 "capture_time_grid_error": (
                     None if estimate is None else estimate["capture_time"],
@@ -227,6 +230,7 @@ class FlowGameModel(CompiledModel):
             checks |= {name: value for name, (value, _) in graded.items()}
             verdicts = _verdicts(graded)
             metrics = metrics | {key: metrics[key] | verdicts[key] for key in verdicts}
+            metrics["grid_error_estimate"] = estimate
         return result.model_copy(
             update={
                 "parameters": values,

@@ -37,7 +37,7 @@ def flow_game_summary(result: Result) -> list[tuple[str, object]]:
         ("capture time T̂", m["capture_time"]),
         ("capture point x_f", "[" + ", ".join(f"{v:.4g}" for v in m["capture_point"]) + "]"),
     ]
-    estimate = m.get("reachability", {}).get("grid_error_estimate")
+    estimate = m.get("grid_error_estimate")
     if estimate:
         rows.append(
             (

@@ -52,6 +52,12 @@ def test_capture_time_and_point(result) -> None:
     assert np.linalg.norm(np.array(result.metrics["capture_point"]) - x_f) < dx
     assert result.checks["capture_time_difference"] < 0.1 * dx / 1.6
     assert max(result.checks["closure_error_pursuer"], result.checks["closure_error_evader"]) < dx
+    # the grid-error estimate (the same levels on a grid twice as coarse) is of the true error's size
+    estimate = result.metrics["grid_error_estimate"]
+    true_error = abs(result.metrics["capture_time"] - T_EXACT)
+    assert 0.1 * true_error <= estimate["capture_time"] <= 10 * true_error
+    assert result.checks["capture_time_grid_error"] == estimate["capture_time"]
+    assert result.metrics["check_tolerances"]["capture_time_grid_error"] == pytest.approx(0.05 * 0.2, rel=0.1)
 
 
 def test_monte_carlo_agrees_with_eq_5_39(result) -> None:

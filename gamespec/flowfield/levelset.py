@@ -17,9 +17,14 @@ starting points, where φ is smooth and the scheme keeps its order), so a refine
 cells between the smeared edge and the levels, and finds the capture time ``T(c)`` and point
 ``x_f(c)`` of each. Both are extrapolated linearly to ``c = 0``: in a uniform or linear flow
 ``A = σI + ωJ`` both sets grow by the same ``c e^{σt}``, so ``T(c) = T(0)`` and ``x_f(c)`` is affine
-in ``c``, and the extrapolation is exact; in a general flow it leaves ``O(c₁c₂)``. Measured in a
-uniform flow with ``c = (0.4, 0.8)``: errors 5.6e-3, 6.4e-4, 6.0e-5 in ``T̂`` for dx = 0.2, 0.1,
-0.05 (orders 3.1, 3.4; ``tests/flowfield/test_levelset.py``).
+in ``c``, and the extrapolation is exact; in a general flow it leaves ``O(c₁c₂)``. The
+extrapolation weighs the lower level's error twice (``c₂ = 2c₁``), so ``c₁`` should be several
+cells out (6 on the shipped files: at 4 cells it was 5e-4 off on ``linear_flow.yaml``). Measured in
+a uniform flow with ``c = (0.4, 0.8)``: errors 5.6e-3, 6.4e-4, 6.0e-5 in ``T̂`` for dx = 0.2, 0.1,
+0.05 (orders 3.1, 3.4; ``tests/flowfield/test_levelset.py``); in rotating and spiral flows with
+``c = (0.8, 1.6)`` orders 3.3 and 2.8 over dx = 0.2 → 0.05, with a step-to-step scatter of about
+1e-4 from reading the fronts (contour and bilinear interpolation), which is also the floor on the
+chapter-5 fields (about 6e-5 against extremal shooting at twice the files' resolution).
 """
 
 from __future__ import annotations

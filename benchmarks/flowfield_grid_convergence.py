@@ -51,7 +51,7 @@ def table(path: str, scale: list[float]) -> list[str]:
         )
         start = time.perf_counter()
         reach = capture_by_level_sets(
-            solver, data.origins, spec.method.max_time, level_cells=spec.method.level_cells
+            solver, data.origins, spec.method.max_time, levels=spec.method.read_levels
         )
         seconds = time.perf_counter() - start
         if reach.capture_time is None:

@@ -43,7 +43,7 @@ def capture(n: int, engine: str = "numpy") -> LevelSetReach:
     else:
         hamiltonian = FlowHamiltonian(data.nominal_speeds, data.field.drift(grid.points))
         solver = LevelSetSolver(grid, hamiltonian, m.scheme, m.cfl)
-    return capture_by_level_sets(solver, data.origins, m.max_time, level_cells=m.level_cells)
+    return capture_by_level_sets(solver, data.origins, m.max_time, levels=m.read_levels)
 
 
 def timed(run: Callable[[], LevelSetReach]) -> tuple[LevelSetReach, float, float]:

@@ -208,7 +208,11 @@ def test_capture_search_memory_at_the_finest_grid(benchmark) -> None:
     )
     tracemalloc.start()
     reach = benchmark.pedantic(
-        capture_by_level_sets, args=(solver, data.origins, 10.0), rounds=1, warmup_rounds=0
+        capture_by_level_sets,
+        args=(solver, data.origins, 10.0),
+        kwargs={"levels": gamespec.load(HUGO).method.read_levels},
+        rounds=1,
+        warmup_rounds=0,
     )
     peak = tracemalloc.get_traced_memory()[1]
     tracemalloc.stop()

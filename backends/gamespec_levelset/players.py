@@ -15,9 +15,11 @@ form of Theorem 5's ``σ_max``). ``V`` does not enter ``J`` (eq. 5.34 depends on
 ties toward the nominal control (a player still moves ``V`` where that frees speed for its gains).
 Problems are scaled so that the open-loop payoff is 1.
 
-Algorithm 3 pairs :class:`PursuerStep` with :class:`EvaderStep`; the ``minimax`` scheme pairs
+Algorithm 3 pairs :class:`PursuerStep` with :class:`EvaderStep`; the mixed minimax pairs
 :class:`MinimaxPursuerStep` (the pursuer's security strategy over the evader strategies seen) with
-:class:`MinimaxEvader` (the evader's step, kept only when it beats the restricted value).
+:class:`MinimaxEvader` (the evader's step, kept only when it beats the restricted value);
+:func:`lower_value` lets the evader commit and the pursuer answer (the thesis' reading,
+:mod:`gamespec.flowfield.concepts`).
 """
 
 from __future__ import annotations
@@ -30,6 +32,7 @@ import numpy as np
 from gamespec_cvxpy.backend import STATUS_MAP
 
 from gamespec.best_response import StepReport
+from gamespec.flowfield.concepts import copy_room, lower_value_bound
 from gamespec.flowfield.covariance_game import PLAYERS, CovarianceGame, Strategy
 from gamespec.result import Status
 
@@ -76,6 +79,9 @@ class _PlayerProblem:
         self.proximal = (
             PROXIMAL * cp.sum_squares(self.V - self.U_hat) / max(1.0, float(self.U_hat @ self.U_hat))
         )
+        # with V = Û the gains' set of eq. 5.36 is ‖S_k κ_k‖ ≤ ρ_k (S_k = spread_maps[k − 1], k ≥ 1)
+        speeds = np.linalg.norm(self.U_hat.reshape(N, 2)[1:], axis=1)
+        self.radii = (b.max_speed - speeds) / b.chance_factor
 
     def strategy(self) -> Strategy:
         kappa = np.zeros((self.game.N, 2, 4))
@@ -237,9 +243,6 @@ class EvaderStep(_PlayerProblem):
         self.problem = cp.Problem(cp.Maximize(linear - self.proximal), self.constraints)
         self.current = start
         self.log = ConvexConcaveLog()
-        b = game.bounds[1]
-        speeds = np.linalg.norm(self.U_hat.reshape(game.N, 2)[1:], axis=1)
-        self.radii = (b.max_speed - speeds) / b.chance_factor
         self.inverse_maps = np.linalg.pinv(self.spread_maps) if game.N > 1 else None
 
     def tangent_step(self, slope: np.ndarray) -> tuple[Strategy | None, StepReport]:
@@ -306,7 +309,7 @@ class EvaderStep(_PlayerProblem):
 
 @dataclass
 class MinimaxEvader:
-    """The evader of the ``minimax`` scheme: its step's answer to the pursuer's security strategy
+    """The evader of the mixed minimax: its step's answer to the pursuer's security strategy
     when that answer raises ``J`` above the restricted value ``t`` by more than ``gap · t`` (a new
     strategy the pursuer has not guarded against), else its previous answer. At a mixed
     equilibrium the evader is indifferent among its support, so its plain best response may jump
@@ -342,3 +345,74 @@ class GamePlayer:
 
     def distance(self, a: Strategy, b: Strategy) -> float:
         return _distance(a, b)
+
+
+@dataclass(frozen=True)
+class LowerValue:
+    """The lower value's point: the evader's committed strategy and the pursuer's answer, the
+    payoffs ``φ(e)/scale`` along the ascent, whether it stopped (one more step gains at most the
+    tolerance), the relative gain of that last step, and — when the
+    pursuer's first answer can copy every evader gain (``room`` ≤ 1, ``V = Û``) — the certified
+    upper ``bound`` of ``v₋/scale`` and the copy ``defect`` ``max_e ‖(Tᵖ + Tᵉ)κᵉ‖`` it uses."""
+
+    evader: Strategy
+    pursuer: Strategy
+    values: list[float]
+    converged: bool
+    residual: float
+    room: float | None
+    defect: float | None
+    bound: float | None
+
+
+def lower_value(
+    pursuer: PursuerStep, evader: EvaderStep, start: Strategy, tolerance: float, max_iterations: int
+) -> LowerValue | StepReport:
+    """``v₋ = max_e min_p J(p, e)``: the evader commits, the pursuer's feedback answers (the thesis'
+    reading of Algorithm 3 and Fig. 5.2). ``φ(e) = min_p J(p, e)`` is convex in ``e`` (``J`` is jointly
+    convex, the pursuer's set does not depend on ``e``), so, as in the evader's step, the
+    convex–concave procedure: from the open-loop evader ``start``, step to the maximizer of the
+    tangent ``∇φ(e)·e'`` (``∇φ(e) = ∇_e J(p(e), e)``, Danskin; ``p(e)`` the pursuer's answer) over the
+    evader's set, and stop when ``φ`` rises by at most ``tolerance · φ``. The first point certifies
+    itself when :func:`~gamespec.flowfield.concepts.copy_room` ≤ 1: then ``φ(start) ≤ v₋ ≤ bound``
+    (:func:`~gamespec.flowfield.concepts.lower_value_bound`). A failed pursuer or tangent step
+    returns its report."""
+    game, scale = pursuer.game, pursuer.scale
+    answer, report = pursuer.respond(start)
+    if answer is None:
+        return report
+    point, values = (answer, start), [game.value((answer, start)) / scale]
+    room = defect = bound = None
+    if game.feedforward == "nominal" and game.N > 1 and not np.any(start.kappa):
+        used = np.linalg.norm(
+            np.einsum("kij,kj->ki", pursuer.spread_maps, answer.kappa[1:].reshape(-1, 8)), axis=1
+        )
+        room = copy_room(used, pursuer.radii, evader.radii)
+        if room <= 1:
+            T = game.gain_maps[0][:, 8:] + game.gain_maps[1][:, 8:]
+            blocks = T.reshape(T.shape[0], -1, 8)
+            defect = float(
+                sum(
+                    r * np.linalg.norm(blocks[:, k] @ inverse, 2)
+                    for k, (r, inverse) in enumerate(zip(evader.radii, evader.inverse_maps, strict=True))
+                )
+            )
+            factor = game.factor((answer, start))
+            bound = lower_value_bound(factor, defect, game.payoff) / scale
+    residual, converged = 0.0, False
+    for _ in range(max_iterations):
+        slope = game.gradient(point, 1)[1:].reshape(-1)
+        committed, report = evader.tangent_step(slope)
+        if committed is None:
+            return report
+        answer, report = pursuer.respond(committed)
+        if answer is None:
+            return report
+        value = game.value((answer, committed)) / scale
+        gain = (value - values[-1]) / max(abs(values[-1]), 1e-300)
+        if gain <= tolerance:
+            residual, converged = max(gain, 0.0), True
+            break
+        point = (answer, committed)
+        values.append(value)
+    return LowerValue(point[1], point[0], values, converged, residual, room, defect, bound)

@@ -18,6 +18,9 @@ import numpy as np
 from gamespec.flowfield.band import band_window
 from gamespec.flowfield.grid import Grid
 
+PEAK_CELLS = 4.0
+"""Half-width, in cells, of the front's arc over which the capture point is fitted."""
+
 
 def contours(grid: Grid, phi: np.ndarray, level: float = 0.0) -> list[np.ndarray]:
     """The ``level`` contours of node values ``phi`` (nx, ny), each an array (M, 2) of points, traced
@@ -50,6 +53,22 @@ def refined_peak(values: np.ndarray, points: np.ndarray, k: int) -> tuple[float,
     return y0 + (c1 + c2 * peak) * peak, point
 
 
+def smoothed_peak_point(values: np.ndarray, points: np.ndarray, k: int, width: float) -> np.ndarray | None:
+    """Where the least-squares parabola (by arc length) through the samples within ``width`` of
+    sample k peaks; None with fewer than five samples or no peak. A flat maximum locates poorly from
+    three samples (the interpolation's scatter along the front moves the peak by about its square
+    root); a wider fit averages that scatter out."""
+    s = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(points, axis=0), axis=1))])
+    near = np.abs(s - s[k]) <= width
+    if near.sum() < 5:
+        return None
+    c2, c1, _ = np.polyfit(s[near] - s[k], values[near], 2)
+    if c2 >= 0:
+        return None
+    peak = float(np.clip(-c1 / (2 * c2), s[near].min() - s[k], s[near].max() - s[k])) + s[k]
+    return np.array([np.interp(peak, s, points[:, 0]), np.interp(peak, s, points[:, 1])])
+
+
 @dataclass(frozen=True)
 class Margin:
     """``m(t)``: the largest pursuer level on the evader's front, and where it is."""
@@ -65,6 +84,8 @@ def margin(grid: Grid, phi_pursuer: np.ndarray, phi_evader: np.ndarray, level: f
         values = grid.interpolate(phi_pursuer, line) - level
         k = int(np.argmax(values))
         value, point = refined_peak(values, line, k)
+        smoothed = smoothed_peak_point(values, line, k, PEAK_CELLS * float(np.max(grid.spacing)))
+        point = point if smoothed is None else smoothed
         if best is None or value > best.value:
             best = Margin(value, point)
     return best

@@ -8,16 +8,23 @@ capture search the box of :mod:`~gamespec.flowfield.band` around the levels read
 
 The initial zero level set is a single point, and the viscosity solution from the cone is flat
 inside the set: in still air ``φ(x, t) = max(|x − x₀| − v̂t, 0)`` (Hopf–Lax), so the zero level set
-is the whole reachable set, not a curve, and its contour is numerical noise. The capture search
-therefore reads two positive levels ``c₁ < c₂`` (a few cells; the sets reached from the disks of
-radius ``c`` about the starting points, where φ is smooth and the scheme keeps its order) and finds
-the capture time ``T(c)`` and point ``x_f(c)`` of each. Both sets grow by the same ``c``, so the
-offset cancels in the time to first order (exactly in a uniform flow; extremal shooting from disks
-gives ``|T(c) − T(0)| < 1e-4 c`` on both chapter-5 fields), while the touching point moves out by
-about ``c`` along the normal. So ``T̂ = T(c₂)``, read at the upper level, clear of the smeared
-edge of the flat region (about three cells wide; the lower level lags by up to 1e-3 of T̂ on the
-chapter-5 fields) — extrapolating the time would only double the grid error — and ``x_f`` is
-extrapolated linearly to ``c = 0``; ``T(c₂) − T(c₁)`` is reported as the measured level offset.
+is the whole reachable set, not a curve, and its contour is numerical noise: the edge of the flat
+region is smeared over a few cells, and a level read a fixed number of cells above it keeps an
+error of fixed size under refinement (read at 4 cells, ``T̂`` stayed about 1e-3 off in uniform,
+rotating and spiral flows for dx = 0.2, 0.1, 0.05). The capture search therefore reads two positive
+levels ``c₁ < c₂`` fixed as *lengths* (the sets reached from the disks of radius ``c`` about the
+starting points, where φ is smooth and the scheme keeps its order), so a refined grid puts more
+cells between the smeared edge and the levels, and finds the capture time ``T(c)`` and point
+``x_f(c)`` of each. Both are extrapolated linearly to ``c = 0``: in a uniform or linear flow
+``A = σI + ωJ`` both sets grow by the same ``c e^{σt}``, so ``T(c) = T(0)`` and ``x_f(c)`` is affine
+in ``c``, and the extrapolation is exact; in a general flow it leaves ``O(c₁c₂)``. The
+extrapolation weighs the lower level's error twice (``c₂ = 2c₁``), so ``c₁`` should be several
+cells out (6 on the shipped files: at 4 cells it was 5e-4 off on ``linear_flow.yaml``). Measured in
+a uniform flow with ``c = (0.4, 0.8)``: errors 5.6e-3, 6.4e-4, 6.0e-5 in ``T̂`` for dx = 0.2, 0.1,
+0.05 (orders 3.1, 3.4; ``tests/flowfield/test_levelset.py``); in rotating and spiral flows with
+``c = (0.8, 1.6)`` orders 3.3 and 2.8 over dx = 0.2 → 0.05, with a step-to-step scatter of about
+1e-4 from reading the fronts (contour and bilinear interpolation), which is also the floor on the
+chapter-5 fields (about 6e-5 against extremal shooting at twice the files' resolution).
 """
 
 from __future__ import annotations
@@ -144,7 +151,7 @@ class LevelSetSolver:
 @dataclass
 class LevelSetReach:
     """What the level-set capture search found: ``capture_time`` (None if none before ``t_max`` or
-    the front left the grid) at the upper level and ``capture_point`` extrapolated to level 0, the
+    the front left the grid) and ``capture_point``, both extrapolated to level 0, the
     capture time and point of each level read (``level_times``, ``level_points``), the margin
     history ``m(t)`` of the upper level (section 5.2), the snapshots of φ (``snapshot_times``,
     (S, 2, nx, ny), capped at the ``band`` level above which φ was not kept exact) ending with φ at
@@ -203,26 +210,52 @@ class _LevelWatch:
             self.crossing = zero[1], (1 - w) * self.points[-2] + w * self.points[-1]
 
 
+GRID_ERROR_ORDER = 2
+"""The order the grid-error estimate assumes: the least the tests observe for ``T̂`` (about 3 in
+uniform flows, ``tests/flowfield/test_levelset.py``), so the estimate errs on the large side."""
+
+
+def coarser_grid(grid: Grid) -> Grid:
+    """The same box with every other node (about twice the spacing)."""
+    return Grid(grid.lower, grid.upper, tuple((n - 1) // 2 + 1 for n in grid.shape))
+
+
+def grid_error_estimate(fine: LevelSetReach, coarse: LevelSetReach) -> dict[str, float] | None:
+    """Richardson's estimate of the error of ``T̂`` and ``x_f`` on the fine grid from the same levels
+    read on a coarser one: ``|q_h − q_H| / (r^p − 1)`` with ``r = H/h`` and ``p`` =
+    :data:`GRID_ERROR_ORDER`; None when either search found no capture."""
+    if fine.capture_time is None or coarse.capture_time is None:
+        return None
+    ratio = float(coarse.grid.spacing.max() / fine.grid.spacing.max())
+    scale = ratio**GRID_ERROR_ORDER - 1
+    return {
+        "capture_time": abs(fine.capture_time - coarse.capture_time) / scale,
+        "capture_point": float(np.linalg.norm(fine.capture_point - coarse.capture_point)) / scale,
+        "coarse_nodes": list(coarse.grid.shape),
+        "order": GRID_ERROR_ORDER,
+    }
+
+
 def capture_by_level_sets(
     solver: LevelSetSolver,
     origins: np.ndarray,
     t_max: float,
     *,
-    level_cells: tuple[float, float] = (2.0, 4.0),
+    levels: tuple[float, float],
     snapshot_interval: float = 0.02,
     banded: bool = True,
 ) -> LevelSetReach:
     """Advance both sets until the margins of both levels have vanished (capture, Theorem 6), a
     set reaches the box's edge or ``t_max`` passes; then re-advance from the last snapshot to land
-    exactly on ``T̂``. ``banded``: update only the box around the nodes below :data:`BAND_CELLS`
-    cells above the upper level (:mod:`~gamespec.flowfield.band`), else the whole grid."""
+    exactly on ``T̂``. ``levels``: the two levels read, as lengths ``c₁ < c₂``. ``banded``: update
+    only the box around the nodes below :data:`BAND_CELLS` cells above the upper level
+    (:mod:`~gamespec.flowfield.band`), else the whole grid."""
     grid = solver.grid
-    levels = np.asarray(level_cells, dtype=float) * grid.spacing.max()
+    levels = np.asarray(levels, dtype=float)
     band = float(levels.max() + BAND_CELLS * grid.spacing.max()) if banded else np.inf
     step_band = band if banded else None
     watches = [_LevelWatch(c) for c in levels]
     phi = initial_cones(grid, origins)
-    t_read = float(levels.max() / np.min(solver.hamiltonian.speeds))
     dt = solver.max_step
     snap_t, snaps = [0.0], [np.minimum(phi, band, dtype=np.float32)]
     t, steps = 0.0, 0
@@ -237,9 +270,8 @@ def capture_by_level_sets(
         if t - snap_t[-1] >= snapshot_interval - 1e-12:
             snap_t.append(t)
             snaps.append(exact.astype(np.float32))
-        if t >= t_read:
-            for watch in watches:
-                watch.observe(grid, exact, t)
+        for watch in watches:
+            watch.observe(grid, exact, t)
     upper = watches[1]
     history = {"times": np.array(upper.times), "margins": np.array(upper.margins)}
     if any(w.crossing is None for w in watches):
@@ -255,7 +287,7 @@ def capture_by_level_sets(
         )
     level_times = np.array([w.crossing[0] for w in watches])
     level_points = np.array([w.crossing[1] for w in watches])
-    capture_time = float(level_times[1])
+    capture_time = float(extrapolate_to_zero(levels, level_times))
     keep = int(np.searchsorted(snap_t, capture_time, side="right"))
     snap_t, snaps = snap_t[:keep], snaps[:keep]
     final = np.minimum(solver.propagate(snaps[-1].astype(float), capture_time - snap_t[-1], step_band), band)

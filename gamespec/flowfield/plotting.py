@@ -29,9 +29,11 @@ from gamespec.plotting import LEGEND_RIGHT, headline
 from gamespec.result import Result
 
 COLORS = ("tab:red", "tab:blue")
-LOOPS = (("open_loop", "o"), ("closed_loop", "s"), ("pursuer_feedback", "^"))
-"""Eq. 5.39 in open loop, at the game's solution, and with the pursuer's feedback against the
-open-loop evader."""
+LOOPS = (("open_loop", "o"), ("lower_value", "^"), ("minimax_mixed", "s"), ("gauss_seidel", "v"))
+"""Eq. 5.39 in open loop, at the lower value (the pursuer's feedback answers the evader's committed
+gains: the thesis' closed loop), at the mixed minimax (a worst-case evader) and at Algorithm 3's
+last iterate (:mod:`gamespec.flowfield.concepts`); whichever the file chose is also
+``closed_loop``."""
 
 
 def _level(result: Result) -> str:
@@ -108,9 +110,9 @@ def capture_rows(values: Iterable[Mapping[str, Any]]) -> list[Mapping[str, Any]]
 
 
 def plot_capture_sweep(points: Sequence[tuple[float, Mapping[str, Any]]], parameter: str, path: Path) -> Path:
-    """Capture probability at ``T̂`` against ``parameter`` — ``points`` are (value, metrics) — open
-    loop, closed loop and the pursuer's feedback against a passive evader, eq. 5.39 and the Monte
-    Carlo with its interval (Fig. 5.2)."""
+    """Capture probability at ``T̂`` against ``parameter`` — ``points`` are (value, metrics) — in
+    open loop and under each solution concept of :data:`LOOPS`, eq. 5.39 and the Monte Carlo with its
+    interval (Fig. 5.2)."""
     points = sorted(points, key=lambda p: p[0])
     x = np.array([value for value, _ in points])
     fig, ax = plt.subplots(figsize=(6, 4))

@@ -7,9 +7,10 @@ names, e.g. eq. 5.37 or eq. 5.40) and the diffusion ``g(x)`` (a 2 × 2 matrix of
 the step ``T̂/N``, the payoff (``trace``: eq. 5.34; ``frobenius``: eq. 5.17) and the feedforward
 (``free``: ``V`` within eq. 5.35; ``nominal``: ``V = Û``, the means on the nominal paths). Any
 number may be an expression over ``parameters``; the flow's expressions may use the position names
-as well. ``method`` sets the reachability grid and scheme, the game's iteration (``gauss_seidel``,
-Algorithm 3, or ``minimax``, the pursuer's security strategy against the evader's mixed strategy)
-and its stopping rule, the evader's convex–concave procedure and the Monte Carlo.
+as well. ``method`` sets the reachability grid, scheme and the levels read, the game's solution
+concept (``lower_value``, the thesis' reading; ``minimax_mixed``, the robust value; or
+``gauss_seidel``, Algorithm 3 as written) and its stopping rule, the evader's convex–concave
+procedure and the Monte Carlo.
 
 Validation at load evaluates every entry through the symbolic layer only (SymPy and
 :func:`gamespec.symbolic.calculus.numeric_function` at a probe point) into
@@ -25,12 +26,15 @@ from typing import Literal
 
 import numpy as np
 import sympy as sp
-from pydantic import Field, FiniteFloat, model_validator
+from pydantic import Field, FiniteFloat, PositiveFloat, model_validator
 
 from gamespec.errors import ExpressionError, SpecError
 from gamespec.specs.base import ProblemParameters, SpecBase, StrictModel, Value
 from gamespec.symbolic.calculus import jacobian, numeric_function
 from gamespec.symbolic.language import RESERVED, parse, symbol
+
+LEVEL_FRACTIONS = (0.06, 0.12)
+"""The default levels read by the capture search, as fractions of the grid box's longer side."""
 
 
 class Identity(StrictModel):
@@ -104,19 +108,28 @@ class GridSpec(StrictModel):
 
 
 class GameMethod(StrictModel):
-    """The iteration and its stopping rule ``max(‖ΔV‖, ‖ΔK‖) ≤ tolerance`` (ε_v = ε_k): ``gauss_seidel``
-    is Algorithm 3 (it converges only to a pure saddle point, which this game need not have);
-    ``minimax`` keeps Gauss–Seidel's evader step and lets the pursuer answer every evader strategy
-    seen so far (its security strategy, the evader's answer a mixed strategy)."""
+    """The solution concept of the covariance game and its iteration's stopping rule
+    ``max(‖ΔV‖, ‖ΔK‖) ≤ tolerance`` (ε_v = ε_k, section 5.4); :mod:`gamespec.flowfield.concepts`."""
 
-    scheme: Literal["gauss_seidel", "minimax"] = "gauss_seidel"
+    scheme: Literal["lower_value", "minimax_mixed", "gauss_seidel"] = Field(
+        "lower_value",
+        description="lower_value (the thesis' reading, Algorithm 3 and Fig. 5.2): the evader commits to "
+        "its gains and the pursuer's feedback answers them, v₋ = max_e min_p J; minimax_mixed: the "
+        "robust value v₊ = min_p max_e J, the pursuer's security strategy against the evader's mixed "
+        "strategy (what a worst-case evader achieves); gauss_seidel: Algorithm 3 as written, which "
+        "converges only to a pure saddle point (this game has none when the pursuer can copy the "
+        "evader's gains). Every scheme also reports the other closed-loop figure, both values and "
+        "the saddle gap v₊ − v₋.",
+    )
     gap: float = Field(
         1e-3,
         gt=0,
-        description="minimax: an evader answer counts as new when it raises J above the pursuer's "
-        "restricted value t by more than gap·t; the stop certifies J(p, BR_e(p)) ≤ (1 + gap) t.",
+        description="Relative tolerance of the values: minimax_mixed counts an evader answer as new when "
+        "it raises J above the pursuer's restricted value t by more than gap·t, and stops when "
+        "J(p, BR_e(p)) ≤ (1 + gap) t; lower_value stops when a step of the evader's commitment raises "
+        "min_p J by at most gap; a saddle gap v₊ − v₋ ≤ gap·v₊ is a pure saddle point.",
     )
-    tolerance: float = Field(5e-3, gt=0)
+    tolerance: float = Field(5e-3, gt=0, description="ε_v = ε_k of the iteration's stopping rule.")
     max_iterations: int = Field(30, ge=1, le=1000)
 
 
@@ -149,8 +162,13 @@ class FlowGameMethod(StrictModel):
     scheme: Literal["weno5", "eno2", "first_order"] = "weno5"
     cfl: float = Field(0.5, gt=0, le=1)
     max_time: float = Field(20.0, gt=0)
-    level_cells: tuple[float, float] = Field(
-        (2.0, 4.0), description="The two positive levels read, in cells."
+    levels: tuple[PositiveFloat, PositiveFloat] | None = Field(
+        None,
+        description="The two levels c₁ < c₂ the capture search reads, as lengths (the sets reached from "
+        "the disks of radius c about the starts; T̂ and x_f are extrapolated to c = 0): fixed under grid "
+        "refinement, and clear of the smeared edge of φ's flat zero region (on linear_flow.yaml at dx = "
+        "0.2 the level 4 cells out was 5e-4 off in T̂, 6 cells out 5e-5). Default: 6 % and 12 % of the "
+        "box's longer side (6 and 12 cells of a 101-node axis).",
     )
     extremals: ExtremalMethod = Field(default_factory=ExtremalMethod)
     game: GameMethod = Field(default_factory=GameMethod)
@@ -159,10 +177,17 @@ class FlowGameMethod(StrictModel):
 
     @model_validator(mode="after")
     def _levels(self) -> FlowGameMethod:
-        low, high = self.level_cells
-        if not 0 < low < high:
-            raise ValueError("level_cells must be two increasing positive numbers")
+        if self.levels is not None and not self.levels[0] < self.levels[1]:
+            raise ValueError("levels must be two increasing positive lengths")
         return self
+
+    @property
+    def read_levels(self) -> tuple[float, float]:
+        """``levels``, or its default from the box (fixed under refinement of ``grid.nodes``)."""
+        if self.levels is not None:
+            return self.levels
+        side = max(hi - lo for lo, hi in zip(self.grid.lower, self.grid.upper, strict=True))
+        return (LEVEL_FRACTIONS[0] * side, LEVEL_FRACTIONS[1] * side)
 
 
 class FlowGameSpec(ProblemParameters, SpecBase):

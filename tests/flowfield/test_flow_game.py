@@ -31,7 +31,8 @@ SPEC = {
     },
     "method": {
         "grid": {"lower": [-2.5, -3.0], "upper": [4.0, 3.0], "nodes": [53, 49]},
-        "game": {"scheme": "minimax", "max_iterations": 12},
+        "levels": [0.4, 0.8],
+        "game": {"scheme": "minimax_mixed", "max_iterations": 12},
         "monte_carlo": {"samples": 20000, "seed": 1},
     },
 }
@@ -51,6 +52,12 @@ def test_capture_time_and_point(result) -> None:
     assert np.linalg.norm(np.array(result.metrics["capture_point"]) - x_f) < dx
     assert result.checks["capture_time_difference"] < 0.1 * dx / 1.6
     assert max(result.checks["closure_error_pursuer"], result.checks["closure_error_evader"]) < dx
+    # the grid-error estimate (the same levels on a grid twice as coarse) is of the true error's size
+    estimate = result.metrics["grid_error_estimate"]
+    true_error = abs(result.metrics["capture_time"] - T_EXACT)
+    assert 0.1 * true_error <= estimate["capture_time"] <= 10 * true_error
+    assert result.checks["capture_time_grid_error"] == estimate["capture_time"]
+    assert result.metrics["check_tolerances"]["capture_time_grid_error"] == pytest.approx(0.05 * 0.2, rel=0.1)
 
 
 def test_monte_carlo_agrees_with_eq_5_39(result) -> None:
@@ -68,7 +75,7 @@ def test_monte_carlo_agrees_with_eq_5_39(result) -> None:
 def test_result_reports_the_game_honestly(result) -> None:
     assert isinstance(result.metrics["game_converged"], bool)
     history = result.metrics["best_response"]["history"]
-    assert history and result.metrics["game_scheme"] == "minimax"
+    assert history and result.metrics["game_scheme"] == "minimax_mixed"
     assert result.ok == result.metrics["game_converged"]
     mixture = result.metrics["evader_mixture"]
     assert sum(mixture["weights"]) == pytest.approx(1.0)
@@ -151,9 +158,56 @@ def test_fig_5_2_from_a_sweep(tmp_path: Path, cli) -> None:
 
 
 def test_summary_leads_with_the_capture(result) -> None:
+    """The summary shows open loop, both closed-loop figures, the saddle gap and the concept."""
     from gamespec.summaries import outcome
 
     rows = dict(outcome(result))
-    assert rows["capture time T̂"] == result.metrics["capture_time"]
-    assert rows["P(capture at T̂), closed loop"] == result.metrics["capture_probability_closed_loop"]
-    assert rows["game converged"].startswith(str(result.metrics["game_converged"]))
+    m = result.metrics
+    assert rows["capture time T̂"] == m["capture_time"]
+    assert rows["P(capture at T̂), open loop"] == m["capture_probability_open_loop"]
+    lower = "P(capture at T̂), lower value (thesis: the pursuer answers)"
+    assert rows[lower] == m["capture_probability_lower_value"]
+    assert (
+        rows["P(capture at T̂), mixed minimax (worst-case evader)"] == m["capture_probability_minimax_mixed"]
+    )
+    assert rows["saddle gap v₊ − v₋ (payoff)"].startswith(f"{m['saddle_gap']:.4g}")
+    assert rows["solution concept (closed loop)"].startswith(m["solution_concept"])
+    assert rows["game converged"] == m["game_converged"]
+
+
+@pytest.fixture(scope="module")
+def lower() -> object:
+    data = copy.deepcopy(SPEC)
+    data["method"]["game"]["scheme"] = "lower_value"
+    data["method"]["monte_carlo"]["samples"] = 0
+    return solve(spec_from_dict(data), options={"cross_check": False})
+
+
+def test_both_solution_concepts_are_reported(result, lower) -> None:
+    """Each scheme reports the figure of its concept as the closed loop and the other beside it, the
+    same values ``v₋ ≤ v₊`` and saddle gap (:mod:`gamespec.flowfield.concepts`), and no pure saddle
+    point in this uniform flow: the gap is far beyond the tolerance."""
+    for run, scheme in ((result, "minimax_mixed"), (lower, "lower_value")):
+        m = run.metrics
+        assert m["solution_concept"] == scheme, run.message
+        assert m["capture_probability_closed_loop"] == m[f"capture_probability_{scheme}"]
+        assert m["lower_value"] < m["upper_value"]
+        assert m["saddle_gap"] == pytest.approx(m["upper_value"] - m["lower_value"])
+        assert m["saddle_gap"] > 10 * 1e-3 * m["upper_value"]  # ten times the default method.game.gap
+        assert "no pure saddle point" in run.message
+        assert m["payoffs"]["pursuer"] == pytest.approx(run.objective) == -m["payoffs"]["evader"]
+        assert set(m["check_tolerances"]) == set(m["checks_passed"]) <= set(run.checks)
+    assert all(result.metrics["checks_passed"].values()), result.metrics["checks_passed"]
+    assert lower.metrics["lower_value"] == pytest.approx(result.metrics["lower_value"], rel=1e-9)
+    assert lower.objective == pytest.approx(lower.metrics["lower_value"])
+    # here the pursuer's answer to the open-loop evader uses more than ρᵖ − ρᵉ of its spread: no room
+    # to copy, so the evader's commitment beats open loop and the lower value is not certified
+    ascent = lower.metrics["lower_value_ascent"]
+    assert ascent["copy_room"] > 1 and ascent["bound"] is None
+    assert ascent["payoffs"][-1] > ascent["payoffs"][0]
+    assert lower.checks["lower_value_bracket"] is None
+    assert not lower.metrics["checks_passed"]["lower_value_bracket"]
+    # the thesis' reading captures more than open loop, a worst-case evader less than the thesis
+    m = lower.metrics
+    assert m["capture_probability_lower_value"] > m["capture_probability_open_loop"]
+    assert m["capture_probability_minimax_mixed"] < m["capture_probability_lower_value"]

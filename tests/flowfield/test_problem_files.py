@@ -27,9 +27,11 @@ def test_alpha_is_a_parameter(cli) -> None:
 @pytest.mark.parametrize("path", FILES, ids=lambda p: p.stem)
 def test_files_solve(path) -> None:
     """Each file reaches capture, the two reachability methods agree to a fraction of a cell, the
-    minimax game converges (the file solves, exit 0), and the Monte Carlo of the SDE agrees with
-    eq. 5.39 in both loops (the nonlinear drift is close to its linearization over the dispersion:
-    a 0.01 allowance)."""
+    game solves (exit 0) with every check passed, and the Monte Carlo of the SDE agrees with eq. 5.39
+    in both loops (the nonlinear drift is close to its linearization over the dispersion: a 0.01
+    allowance). Both report the thesis' reading (``lower_value``, the closed loop) and the mixed
+    minimax beside it, and the saddle gap between them: the lower value captures more than open loop
+    (Fig. 5.2, section 5.4), a worst-case evader less than the lower value."""
     result = gamespec.solve(gamespec.load(path))
     m = result.metrics
     spec = gamespec.load(path)
@@ -37,6 +39,12 @@ def test_files_solve(path) -> None:
     assert m["capture_time"] > 0
     assert result.checks["capture_time_difference"] < 0.25 * dx / evaluate(spec).nominal_speeds[0]
     assert result.ok and m["game_converged"], result.message
+    assert all(m["checks_passed"].values()), m["checks_passed"]
+    assert m["solution_concept"] == "lower_value"
+    assert m["capture_probability_closed_loop"] == m["capture_probability_lower_value"]
+    assert m["capture_probability_lower_value"] > m["capture_probability_open_loop"]
+    assert m["capture_probability_minimax_mixed"] < m["capture_probability_lower_value"]
+    assert m["saddle_gap"] > spec.method.game.gap * m["upper_value"]
     for loop in ("open_loop", "closed_loop"):
         carlo = m["monte_carlo_capture_probability"][loop]
         assert carlo["low"] - 0.01 <= m[f"capture_probability_{loop}"] <= carlo["high"] + 0.01

@@ -1,7 +1,7 @@
 """Adaptive refinement of a collocation mesh on the solver-independent defect estimate (the loop of
 GPOPS-II and dymos): solve, refine every interval whose defect relative to the state scale exceeds
-``method.refine.tolerance``, re-solve on the new mesh from the last solution, until no interval does
-or ``max_iterations`` refinements were made.
+``method.refine.tolerance`` or is not finite, re-solve on the new mesh from the last solution, until
+no interval does or ``max_iterations`` refinements were made.
 
 ``h`` splits each such interval into two halves of its degree. ``hp`` follows the ph rule of
 Patterson, Hager & Rao (2015): on a smooth solution the LGR error of an interval of N points falls
@@ -9,6 +9,11 @@ by about a factor N per added point, so ``P = ceil(log(e / tol) / log(N))`` more
 the tolerance; the interval gets degree N + P when that is at most ``max_degree``, and otherwise (the
 defect falls too slowly for a polynomial: a corner, a switch) is split into ``max(2, ceil((N + P) /
 d0))`` equal intervals of the file's degree d0.
+
+A defect that is NaN or infinite (the RK4 re-integration of :func:`~gamespec.ocp.checks.
+interval_defects` overflows: an interval too long for the stiffness of its dynamics, as on the
+hyper-sensitive problem's boundary layers at t_f = 1e4) says only that the interval is too long:
+it is split in two, under either strategy, and no degree is raised on it.
 
 The model is rebuilt for each mesh (its NLP changes size) by the backend's own model class, so the
 loop is the same for every collocation backend; the history goes to ``metrics["refinement"]``.
@@ -34,8 +39,9 @@ if TYPE_CHECKING:
 def trajectory_of(tr: Transcription, result: Result) -> tuple[Trajectory, dict[str, float]]:
     """The transcribed solution in a Result, and the parameter values with the design variables."""
     X = np.array([result.states[n] for n in tr.ocp.states])
-    U = np.array([result.controls[n] for n in tr.ocp.controls]).reshape(tr.n_u, -1)
-    Win = np.array([result.arrays[f"input/{n}"] for n in tr.ocp.inputs]).reshape(tr.n_w, U.shape[1])
+    k = len(tr.grid.eval_index)
+    U = np.array([result.controls[n] for n in tr.ocp.controls]).reshape(tr.n_u, k)
+    Win = np.array([result.arrays[f"input/{n}"] for n in tr.ocp.inputs]).reshape(tr.n_w, k)
     values = dict(result.parameters) | result.metrics.get("design", {})
     return Trajectory(X, U, Win, float(result.t_final) - tr.t0), values
 
@@ -43,11 +49,12 @@ def trajectory_of(tr: Transcription, result: Result) -> tuple[Trajectory, dict[s
 def refined_mesh(
     breaks: np.ndarray, degrees: np.ndarray, defects: np.ndarray, options: RefineSpec, base_degree: int
 ) -> tuple[list[float], list[int]]:
-    """The next mesh: interval boundaries and per-interval degrees (see the module docstring)."""
+    """The next mesh: interval boundaries and per-interval degrees (see the module docstring; a
+    non-finite defect halves its interval)."""
     mesh, new_degrees = [0.0], []
     for a, b, d, e in zip(breaks[:-1], breaks[1:], degrees.tolist(), defects, strict=True):
         pieces, degree = 1, d
-        if e > options.tolerance and options.strategy == "h":
+        if not np.isfinite(e) or (e > options.tolerance and options.strategy == "h"):
             pieces = 2
         elif e > options.tolerance:
             wanted = d + math.ceil(math.log(e / options.tolerance) / math.log(max(d, 2)))
@@ -91,7 +98,7 @@ def refined(
             break
         sol, values = trajectory_of(current.tr, result)
         defects = relative_defects(current.tr, sol, values)
-        if not (defects > options.tolerance).any():
+        if (defects <= options.tolerance).all():
             break
         grid = current.tr.grid
         mesh, degrees = refined_mesh(

@@ -11,12 +11,19 @@
 - ``control_swings/<control>``: total variation of the control over the range it spans; ``chattering``
   is 1 when one sweeps its range more than ``CHATTERING_SWINGS`` times (regularize it with
   ``method.control_rate_penalty``), else 0.
-- ``hamiltonian_variation``: ``max |H - mean H|`` along the solution for autonomous problems, with
-  ``H = sign*L + lambda^T f`` from the costate estimates (constant on an optimal arc). A grid input
-  that enters f or L and varies along the grid makes the problem non-autonomous
-  (``dH/dt = dH/dw * dw/dt``): both Hamiltonian checks are then left out.
-- ``hamiltonian_end_error``: ``max |H + dPhi/dt_f|`` on free-final-time autonomous problems, where
-  the transversality condition fixes the constant (``H = 0`` for minimum time, eqs. 2.22–2.23).
+- ``hamiltonian_variation``: ``max |H - mean H|`` along the solution, with ``H = sign*L + lambda^T f
+  + nu^T g`` from the costate estimates and the integral constraints' multipliers ``nu`` (integrands
+  ``g``: the isoperimetric problem's augmented Hamiltonian, constant on an optimal arc). Left out,
+  with the reason in ``metrics["checks_skipped"]``, where H need not be constant: explicit time in
+  f, L, a path constraint or an integrand (``dH/dt = dH/dt|explicit``, e.g. a time-dependent obstacle),
+  a grid input that enters f or L and varies along the grid (``dH/dt = dH/dw * dw/dt``), or no
+  costate estimates (the trapezoidal scheme).
+- ``hamiltonian_end_error``: ``max |H + dPhi/dt_f|`` on free-final-time problems where H is constant,
+  since the transversality condition fixes the constant (``H = 0`` for minimum time, eqs. 2.22–2.23).
+
+Each check with a tolerance (:data:`DEFAULT_TOLERANCES`, ``method.refine.tolerance`` for the relative
+defect) gets a verdict (:func:`verdicts`); a NaN or infinite value (an overflowing re-integration)
+fails, and mesh refinement splits the intervals where it occurs.
 """
 
 from __future__ import annotations
@@ -146,16 +153,21 @@ DEFAULT_TOLERANCES = {"max_constraint_violation": 1e-6, "max_defect_relative": 1
 defect at the level of IPOPT's default tolerance, and no chattering control."""
 
 
-def verdicts(checks: Mapping[str, float | None], defect_tolerance: float | None) -> dict[str, bool]:
-    """Pass (True) or fail per check that has a tolerance (``method.refine.tolerance`` for the
-    relative defect when the file sets one); a check that could not be computed fails."""
+def check_tolerances(checks: Mapping[str, float | None], defect_tolerance: float | None) -> dict[str, float]:
+    """The tolerance of each check present that has one (``method.refine.tolerance`` for the
+    relative defect when the file sets one)."""
     tolerances = DEFAULT_TOLERANCES | (
         {"max_defect_relative": defect_tolerance} if defect_tolerance is not None else {}
     )
+    return {name: float(tol) for name, tol in tolerances.items() if name in checks}
+
+
+def verdicts(checks: Mapping[str, float | None], tolerances: Mapping[str, float]) -> dict[str, bool]:
+    """Pass (True) or fail per check in ``tolerances``: its value is at most its tolerance; a value
+    that could not be computed (None, NaN, an overflow) fails."""
     return {
-        name: checks[name] is not None and bool(checks[name] <= tol)
+        name: checks[name] is not None and bool(np.isfinite(checks[name]) and checks[name] <= tol)
         for name, tol in tolerances.items()
-        if name in checks
     }
 
 
@@ -217,13 +229,23 @@ def _arrays(params: Mapping[str, float]) -> dict[str, np.float64]:
 
 
 def hamiltonian(
-    tr: Transcription, sol: Trajectory, params: Mapping[str, float], lam: np.ndarray
+    tr: Transcription,
+    sol: Trajectory,
+    params: Mapping[str, float],
+    lam: np.ndarray,
+    integral_multipliers: np.ndarray | None = None,
 ) -> np.ndarray:
-    """``H = sign*L + lambda^T f`` at the collocation points (eq. 2.22 in general form)."""
+    """``H = sign*L + lambda^T f + nu^T g`` at the collocation points (eq. 2.22 in general form,
+    augmented by the integral constraints' integrands ``g`` and their multipliers ``nu``)."""
     t_eval = tr.t0 + sol.T * tr.grid.eval_tau
     xe = sol.X[:, tr.grid.eval_index]
     values = _running(tr, xe, sol.U, sol.Win, t_eval, params)
-    return values[-1] + np.sum(lam * values[:-1], axis=0)
+    H = values[-1] + np.sum(lam * values[:-1], axis=0)
+    if integral_multipliers is not None and len(integral_multipliers):
+        running = tr.ocp.running_values(xe, sol.U, sol.Win, t_eval, _arrays(params))
+        for nu, g in zip(integral_multipliers, tr.ocp.running_terms(running, ARRAYS).integrands, strict=True):
+            H = H + float(nu) * np.broadcast_to(np.asarray(g, dtype=float), t_eval.shape)
+    return H
 
 
 STEP = float(np.finfo(float).eps) ** (1 / 3)
@@ -249,18 +271,39 @@ def hamiltonian_end_value(tr: Transcription, ends: Mapping[str, float]) -> float
     return -mayer_slope(tr, ends, "t_f")
 
 
-def _time_invariant(tr: Transcription, Win: np.ndarray) -> bool:
-    """No explicit time in f and L, and every grid input that enters them constant on the grid."""
+def varying_hamiltonian(tr: Transcription, Win: np.ndarray) -> str | None:
+    """Why H need not be constant along this solution (None when it must be): explicit time in the
+    dynamics, the running cost, a path constraint or an integrand, or a grid input that enters f or
+    L and varies on the grid."""
+    if not tr.ocp.autonomous:
+        return "the dynamics or the running cost depend on t explicitly"
+    structure = tr.ocp.running_structure
+    for kind, terms in (
+        ("path constraint", [r.expr for r in structure.path]),
+        ("integrand", structure.integrands),
+    ):
+        for number, term in enumerate(terms):
+            if "t" in dependencies(term):
+                return f"{kind} {number} depends on t explicitly (its multiplier makes H vary)"
     used = Win[tr.ocp.inputs_in_hamiltonian]
-    return tr.ocp.autonomous and bool(np.all(used == used[:, :1]))
+    if not np.all(used == used[:, :1]):
+        return "a grid input that enters the dynamics or the running cost varies along the grid"
+    return None
+
+
+HAMILTONIAN_CHECKS = ("hamiltonian_variation", "hamiltonian_end_error")
 
 
 @np.errstate(all="ignore")
 def solution_checks(
-    tr: Transcription, sol: Trajectory, params: Mapping[str, float], lam: np.ndarray | None
-) -> dict[str, float | None]:
+    tr: Transcription,
+    sol: Trajectory,
+    params: Mapping[str, float],
+    lam: np.ndarray | None,
+    integral_multipliers: np.ndarray | None = None,
+) -> tuple[dict[str, float | None], dict[str, str]]:
     """All checks that apply to this problem and solution (NaN where a value cannot be computed,
-    e.g. a diverging re-integration of a failed solve)."""
+    e.g. a diverging re-integration of a failed solve), and the checks left out with the reason."""
     checks: dict[str, float | None] = {
         "max_constraint_violation": max_constraint_violation(tr, sol, params),
     }
@@ -271,10 +314,16 @@ def solution_checks(
         swings = control_swings(sol.U)
         checks |= {f"control_swings/{n}": float(v) for n, v in zip(tr.ocp.controls, swings, strict=True)}
         checks["chattering"] = float(np.max(swings) > CHATTERING_SWINGS)
-    if lam is not None and _time_invariant(tr, sol.Win):
-        H = hamiltonian(tr, sol, params, lam)
-        checks["hamiltonian_variation"] = float(np.max(np.abs(H - H.mean())))
-        if tr.free_time:
-            end = hamiltonian_end_value(tr, _end_values(tr, sol.X, sol.U, sol.T, params))
-            checks["hamiltonian_end_error"] = float(np.max(np.abs(H - end)))
-    return checks
+    applicable = HAMILTONIAN_CHECKS if tr.free_time else HAMILTONIAN_CHECKS[:1]
+    if lam is None:
+        reason = "no costate estimates (the trapezoidal scheme, or no multipliers from the solver)"
+        return checks, dict.fromkeys(applicable, reason)
+    varying = varying_hamiltonian(tr, sol.Win)
+    if varying is not None:
+        return checks, dict.fromkeys(applicable, f"H need not be constant: {varying}")
+    H = hamiltonian(tr, sol, params, lam, integral_multipliers)
+    checks["hamiltonian_variation"] = float(np.max(np.abs(H - H.mean())))
+    if tr.free_time:
+        end = hamiltonian_end_value(tr, _end_values(tr, sol.X, sol.U, sol.T, params))
+        checks["hamiltonian_end_error"] = float(np.max(np.abs(H - end)))
+    return checks, {}

@@ -97,6 +97,7 @@ def _per_interval(tr: Transcription, V: np.ndarray, chosen: np.ndarray) -> np.nd
     return np.stack([V[:, chosen], V[:, chosen + 1]], axis=2)
 
 
+@np.errstate(all="ignore")
 def interval_defects(tr: Transcription, sol: Trajectory, params: Mapping[str, float]) -> np.ndarray:
     """Per state and interval (n_x × intervals), the gap between an RK4 re-integration of the
     interval from its first node and the collocated state at its end (the intervals of each degree

@@ -209,7 +209,8 @@ class Transcription:
         design = previous.metrics.get("design", {})
         defaults = [g for *_, g in self.ocp.design_bounds(previous.parameters or self.ocp.parameter_values())]
         d = np.array([design.get(n, g) for n, g in zip(self.ocp.design, defaults, strict=True)], dtype=float)
-        return Guess(X.reshape(self.n_x, -1), U.reshape(self.n_u, -1), float(span), d)
+        k = len(self.grid.eval_index)
+        return Guess(X.reshape(self.n_x, self.grid.n_nodes), U.reshape(self.n_u, k), float(span), d)
 
     @cached_property
     def start_weights(self) -> np.ndarray:

@@ -150,3 +150,14 @@ def test_refinement_works_without_controls() -> None:
     assert result.ok and result.metrics["refinement_converged"]
     assert len(result.metrics["refinement"]) > 1
     assert result.metrics["design"]["k"] == pytest.approx(2.0, rel=1e-6)
+
+
+def test_hp_raises_the_degree_only_where_the_defect_decays_as_the_ph_rule_assumes() -> None:
+    """Both intervals went from degree 3 to 5 (the ph rule predicts a factor 3**2 = 9, so at least
+    3 is needed): the first fell by 100 and gets a higher degree, the second by 2 and is split."""
+    options = RefineSpec(strategy="hp", tolerance=1e-8, max_degree=10)
+    breaks, degrees = np.array([0.0, 0.5, 1.0]), np.array([5, 5])
+    before = {(0.0, 0.5): (3, 1e-3), (0.5, 1.0): (3, 1e-3)}
+    mesh, new_degrees = refined_mesh(breaks, degrees, np.array([1e-5, 5e-4]), options, 3, before)
+    assert mesh[:2] == [0.0, 0.5] and new_degrees[0] > 5
+    assert len(mesh) > 3 and new_degrees[1:] == [3] * (len(mesh) - 2)

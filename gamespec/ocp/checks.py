@@ -7,7 +7,9 @@
   (trapezoidal), so the check measures the discretization, not how a signal was tabulated.
 - ``max_defect_relative``: the same gap divided by the state's scale ``max(1, max |x|)`` (what
   ``method.refine.tolerance`` is compared with).
-- ``max_constraint_violation``: bounds, fixed end values, path, boundary and integral constraints.
+- ``max_constraint_violation``: bounds, fixed end values, path, boundary and integral constraints,
+  the integrals re-integrated with the states (RK4, as the defects) rather than by the
+  transcription's own quadrature, which cannot see an integrand between its points.
 - ``control_swings/<control>``: total variation of the control over the range it spans; ``chattering``
   is 1 when one sweeps its range more than ``CHATTERING_SWINGS`` times (regularize it with
   ``method.control_rate_penalty``), else 0.
@@ -65,8 +67,9 @@ class Trajectory:
 
 
 def _running(tr: Transcription, x, u, w, t: np.ndarray, params: Mapping[str, float]) -> np.ndarray:
-    """The dynamics (first ``n_x`` rows) and the Lagrange integrand (last row) along ``t``
-    (``params`` holds the design variables' values too)."""
+    """The dynamics (first ``n_x`` rows), the Lagrange integrand (row ``n_x``) and the integral
+    constraints' integrands (the rows after it) along ``t`` (``params`` holds the design variables'
+    values too)."""
     p = [params[n] for n in [*tr.ocp.parameters, *tr.ocp.design]]
     return tr.ocp.running_function(*x, *u, *w, *p, t)
 
@@ -98,44 +101,60 @@ def _per_interval(tr: Transcription, V: np.ndarray, chosen: np.ndarray) -> np.nd
 
 
 @np.errstate(all="ignore")
-def interval_defects(tr: Transcription, sol: Trajectory, params: Mapping[str, float]) -> np.ndarray:
-    """Per state and interval (n_x × intervals), the gap between an RK4 re-integration of the
-    interval from its first node and the collocated state at its end (the intervals of each degree
-    together)."""
+def reintegration(
+    tr: Transcription, sol: Trajectory, params: Mapping[str, float]
+) -> tuple[np.ndarray, np.ndarray]:
+    """Each interval re-integrated with RK4 from its first node, the integral constraints'
+    integrands along with the states: per state and interval (n_x × intervals) the gap to the
+    collocated state at the interval's end, and the integrals over the horizon (NaN where the
+    re-integration overflows; the intervals of each degree together)."""
     grid = tr.grid
+    n_int = len(tr.ocp.running_structure.integrands)
     gaps = np.empty((tr.n_x, grid.intervals))
+    integrals = np.zeros(n_int)
     for degree in sorted(set(grid.interval_degrees.tolist())):
         chosen = np.flatnonzero(grid.interval_degrees == degree)
-        gaps[:, chosen] = _rk4_gaps(tr, sol, params, chosen, int(degree))
-    return gaps
+        gaps[:, chosen], pieces = _rk4(tr, sol, params, chosen, int(degree))
+        integrals += np.sum(pieces, axis=1)
+    return gaps, integrals
 
 
-def _rk4_gaps(
+def interval_defects(tr: Transcription, sol: Trajectory, params: Mapping[str, float]) -> np.ndarray:
+    """The gaps of :func:`reintegration` (what mesh refinement reads)."""
+    return reintegration(tr, sol, params)[0]
+
+
+def _rk4(
     tr: Transcription, sol: Trajectory, params: Mapping[str, float], chosen: np.ndarray, degree: int
-) -> np.ndarray:
+) -> tuple[np.ndarray, np.ndarray]:
+    """The gaps at the ends of the ``chosen`` intervals (all of ``degree``) and the integrals of the
+    integrands over each of them (n_integrals × chosen)."""
     X, T = sol.X, sol.T
     grid = tr.grid
     starts = grid.interval_start_index
     h = np.diff(grid.breaks)[chosen] * T
     t0 = tr.t0 + T * grid.breaks[chosen]
     Ui, Wi = _per_interval(tr, sol.U, chosen), _per_interval(tr, sol.Win, chosen)
-    x = X[:, starts[chosen]].astype(float)
+    nx = tr.n_x
+    n_int = len(tr.ocp.running_structure.integrands)
+    y = np.vstack([X[:, starts[chosen]].astype(float), np.zeros((n_int, len(chosen)))])
     ds = 1.0 / RK4_STEPS
     halves = np.arange(2 * RK4_STEPS + 1) * ds / 2
     bases = control_basis(tr, halves, degree)
 
-    def f(x: np.ndarray, half: int) -> np.ndarray:
-        """The dynamics at local time ``half * ds / 2``."""
+    def f(y: np.ndarray, half: int) -> np.ndarray:
+        """The dynamics and the integrands at local time ``half * ds / 2``."""
         basis = bases[half]
-        return _running(tr, x, Ui @ basis, Wi @ basis, t0 + halves[half] * h, params)[:-1]
+        values = _running(tr, y[:nx], Ui @ basis, Wi @ basis, t0 + halves[half] * h, params)
+        return np.delete(values, nx, axis=0)
 
     for step in range(RK4_STEPS):
-        k1 = f(x, 2 * step)
-        k2 = f(x + 0.5 * ds * h * k1, 2 * step + 1)
-        k3 = f(x + 0.5 * ds * h * k2, 2 * step + 1)
-        k4 = f(x + ds * h * k3, 2 * step + 2)
-        x = x + ds * h / 6.0 * (k1 + 2 * k2 + 2 * k3 + k4)
-    return np.abs(x - X[:, starts[chosen + 1]])
+        k1 = f(y, 2 * step)
+        k2 = f(y + 0.5 * ds * h * k1, 2 * step + 1)
+        k3 = f(y + 0.5 * ds * h * k2, 2 * step + 1)
+        k4 = f(y + ds * h * k3, 2 * step + 2)
+        y = y + ds * h / 6.0 * (k1 + 2 * k2 + 2 * k3 + k4)
+    return np.abs(y[:nx] - X[:, starts[chosen + 1]]), y[nx:]
 
 
 def state_scale(X: np.ndarray) -> np.ndarray:
@@ -195,9 +214,13 @@ def _relation_violation(rel: Relation, shape: tuple[int, ...]) -> float:
     return _violation(v, rel.lower, rel.upper)
 
 
-def max_constraint_violation(tr: Transcription, sol: Trajectory, params: Mapping[str, float]) -> float:
+def max_constraint_violation(
+    tr: Transcription, sol: Trajectory, params: Mapping[str, float], integrals: np.ndarray | None = None
+) -> float:
     """Largest violation of bounds (the design variables' too), fixed end values, path, boundary
-    and integral constraints (by the transcription's quadrature)."""
+    and integral constraints: the ``integrals`` given (re-integrated, :func:`reintegration`), else
+    by the transcription's quadrature, which only sees the integrand at the collocation points (a
+    hanging chain may bend steeply between them, its length uncounted)."""
     X, U, T = sol.X, sol.U, sol.T
     b = tr.bounds(params)
     worst = [_violation(X, b.x_lower, b.x_upper), _violation(U, b.u_lower, b.u_upper)]
@@ -210,9 +233,12 @@ def max_constraint_violation(tr: Transcription, sol: Trajectory, params: Mapping
     ends = tr.ocp.end_terms(_end_values(tr, X, U, T, params), ARRAYS)
     worst += [_relation_violation(r, ()) for r in ends.boundary]
     q = tr.grid.triplets[2]
-    for integrand, (lo, hi) in zip(terms.integrands, tr.ocp.integral_bounds(params), strict=True):
-        g = np.broadcast_to(np.asarray(integrand, dtype=float), t_eval.shape)
-        worst.append(_violation(np.array([T * q @ g]), lo, hi))
+    if integrals is None:
+        integrals = [
+            T * q @ np.broadcast_to(np.asarray(g, dtype=float), t_eval.shape) for g in terms.integrands
+        ]
+    for value, (lo, hi) in zip(integrals, tr.ocp.integral_bounds(params), strict=True):
+        worst.append(_violation(np.array([value]), lo, hi))
     return float(np.max(worst))
 
 
@@ -241,11 +267,10 @@ def hamiltonian(
     t_eval = tr.t0 + sol.T * tr.grid.eval_tau
     xe = sol.X[:, tr.grid.eval_index]
     values = _running(tr, xe, sol.U, sol.Win, t_eval, params)
-    H = values[-1] + np.sum(lam * values[:-1], axis=0)
+    nx = tr.n_x
+    H = values[nx] + np.sum(lam * values[:nx], axis=0)
     if integral_multipliers is not None and len(integral_multipliers):
-        running = tr.ocp.running_values(xe, sol.U, sol.Win, t_eval, _arrays(params))
-        for nu, g in zip(integral_multipliers, tr.ocp.running_terms(running, ARRAYS).integrands, strict=True):
-            H = H + float(nu) * np.broadcast_to(np.asarray(g, dtype=float), t_eval.shape)
+        H = H + np.asarray(integral_multipliers, dtype=float) @ values[nx + 1 :]
     return H
 
 
@@ -305,10 +330,10 @@ def solution_checks(
 ) -> tuple[dict[str, float | None], dict[str, str]]:
     """All checks that apply to this problem and solution (NaN where a value cannot be computed,
     e.g. a diverging re-integration of a failed solve), and the checks left out with the reason."""
+    gaps, integrals = reintegration(tr, sol, params)
     checks: dict[str, float | None] = {
-        "max_constraint_violation": max_constraint_violation(tr, sol, params),
+        "max_constraint_violation": max_constraint_violation(tr, sol, params, integrals),
     }
-    gaps = interval_defects(tr, sol, params)
     checks["max_defect"] = float(np.max(gaps, initial=0.0))
     checks["max_defect_relative"] = float(np.max(gaps / state_scale(sol.X)[:, None], initial=0.0))
     if tr.n_u:

@@ -161,3 +161,20 @@ def test_hp_raises_the_degree_only_where_the_defect_decays_as_the_ph_rule_assume
     mesh, new_degrees = refined_mesh(breaks, degrees, np.array([1e-5, 5e-4]), options, 3, before)
     assert mesh[:2] == [0.0, 0.5] and new_degrees[0] > 5
     assert len(mesh) > 3 and new_degrees[1:] == [3] * (len(mesh) - 2)
+
+
+def test_a_chain_that_bends_between_quadrature_points_is_not_optimal() -> None:
+    """From a deeper parabola on 50 intervals IPOPT stops at a spurious NLP minimum below the
+    catenary's energy (the chain drops steeply inside its first interval, between the Radau points,
+    so the quadrature counts little of that length). The re-integrated length is not L: the
+    constraint violation check fails and the status says so."""
+    *_, energy = _catenary()
+    deep = [
+        "method.intervals=50",
+        "guess.states.x=1 + 2*tau - 6*tau*(1 - tau)",
+        "guess.controls.u=2 - 6*(1 - 2*tau)",
+    ]
+    result = gamespec.solve(gamespec.load(HANGING_CHAIN, deep), "casadi")
+    assert result.objective < energy - 0.1  # below the optimum: not a chain of length L
+    assert result.checks["max_constraint_violation"] > 0.1
+    assert result.status is gamespec.Status.FEASIBLE and "max_constraint_violation" in result.message

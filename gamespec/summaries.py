@@ -26,6 +26,14 @@ def outcome(result: Result) -> Rows:
     return rows + check_rows(result)
 
 
+def headline(result: Result) -> str:
+    """The one-line summary over the solve table: problem, backend, status, and the checks that kept
+    the Result from ``optimal`` where there are any."""
+    line = f"{result.problem} on {result.backend}: {result.status.value}"
+    failed = [f.name for f in result.failed_checks()]
+    return f"{line} (failed: {', '.join(failed)})" if failed else line
+
+
 def check_rows(result: Result) -> Rows:
     """One ``failed check`` row per failed check (value against tolerance), one ``check left out``
     row per check that does not apply (name: reason)."""

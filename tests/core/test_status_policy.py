@@ -120,3 +120,10 @@ def test_optimal_means_every_check_passed_on_the_shipped_files(path) -> None:
         assert all(f.name in shown for f in result.failed_checks())  # the summary names each one
         if "not optimal: failed check(s)" in result.message:  # downgraded by the policy
             assert all(f.name in result.message for f in result.failed_checks())
+
+
+def test_the_solve_table_names_the_failed_check_in_its_title_and_rows(cli) -> None:
+    code, out, _ = cli("solve", PROBLEMS / "ocp" / "hang_glider.yaml", "--set", "method.intervals=10")
+    assert code == 0
+    assert "hang_glider on casadi: feasible (failed: max_defect_relative)" in out
+    assert "failed check" in out and "tolerance 1e-06" in out

@@ -179,9 +179,9 @@ def _print_summary(result: Result) -> None:
     the other scalar metrics; each key once."""
     from rich.table import Table
 
-    from gamespec.summaries import outcome
+    from gamespec.summaries import headline, outcome
 
-    table = Table(title=f"{result.problem} on {result.backend}: {result.status.value}", show_header=False)
+    table = Table(title=headline(result), show_header=False)
     lead = outcome(result)
     for key, value in lead:
         table.add_row(_escape(key), _escape(_fmt(value)), style="bold")

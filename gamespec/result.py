@@ -11,6 +11,7 @@ import json
 import math
 import zipfile
 import zlib
+from dataclasses import dataclass
 from enum import StrEnum
 from pathlib import Path
 from typing import Any
@@ -71,6 +72,25 @@ OK_STATUSES = frozenset({Status.OPTIMAL, Status.FEASIBLE, Status.SIMULATED})
 def status_ok(value: str) -> bool:
     """Whether a status written as text (a table row, a JSON Result) carries a usable solution."""
     return value in {s.value for s in OK_STATUSES}
+
+
+@dataclass(frozen=True)
+class FailedCheck:
+    """A check with a tolerance that did not pass: its value (None where it could not be computed)
+    and its tolerance (None where the Result gives none)."""
+
+    name: str
+    value: float | None
+    tolerance: float | None
+
+    def __str__(self) -> str:
+        value = "not computable" if _missing(self.value) else f"{self.value:.3g}"
+        bound = "" if self.tolerance is None else f" > tolerance {self.tolerance:.3g}"
+        return f"{self.name} = {value}{bound}"
+
+
+def _missing(value: Any) -> bool:
+    return value is None or (isinstance(value, float) and not math.isfinite(value))
 
 
 class Provenance(BaseModel):
@@ -146,6 +166,24 @@ class Result(BaseModel):
     def ok(self) -> bool:
         """True when the status carries a usable solution."""
         return self.status.ok
+
+    def failed_checks(self) -> list[FailedCheck]:
+        """The checks with a verdict or a tolerance that did not pass (the status policy's input,
+        see :func:`gamespec.solving.status_policy`): a verdict ``metrics["checks_passed"][name]``
+        that is False; a check whose value ``checks[name]`` is NaN or None (not computable); or,
+        with no verdict, a value above its tolerance ``metrics["check_tolerances"][name]``."""
+        verdicts = self.metrics.get("checks_passed", {})
+        tolerances = self.metrics.get("check_tolerances", {})
+        failed = []
+        for name in sorted(set(verdicts) | set(tolerances)):
+            value, tolerance = self.checks.get(name), tolerances.get(name)
+            if name in verdicts:
+                passed = bool(verdicts[name]) and not (name in self.checks and _missing(value))
+            else:
+                passed = not _missing(value) and value <= tolerance
+            if not passed:
+                failed.append(FailedCheck(name, value, tolerance))
+        return failed
 
     def summary(self) -> dict[str, Any]:
         """The scalar fields: what ``--json`` always shows and what tables are made of."""

@@ -146,6 +146,19 @@ def _first_difference(a: Any, b: Any, path: tuple[str, ...] = ()) -> str | None:
     return None if a == b else ".".join(path) or "<root>"
 
 
+def status_policy(result: Result) -> Result:
+    """The one status policy (DESIGN.md stage 4; README "Statuses and exit codes"): ``optimal``
+    only when the solver says so *and* every check with a verdict or a tolerance passes
+    (:meth:`Result.failed_checks`); otherwise ``feasible``, the message naming each failed check,
+    its value and its tolerance. Applied by the chain to every Result it returns, of every kind."""
+    failed = result.failed_checks()
+    if result.status is not Status.OPTIMAL or not failed:
+        return result
+    note = "not optimal: failed check(s) " + "; ".join(str(f) for f in failed)
+    message = f"{result.message}; {note}" if result.message else note
+    return result.model_copy(update={"status": Status.FEASIBLE, "message": message})
+
+
 def _better(candidate: Result, best: Result | None, sense: str) -> bool:
     if best is None or best.objective is None:
         return True
@@ -239,7 +252,7 @@ class Solver:
             versions=_versions(self.backend),
             created=_dt.datetime.now(_dt.UTC).isoformat(timespec="seconds"),
         )
-        return result.model_copy(
+        return status_policy(result).model_copy(
             update={
                 "backend": self.backend.name,
                 "problem": spec.name,

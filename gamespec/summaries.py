@@ -3,7 +3,10 @@
 A kind registers a summary function in the ``gamespec.summaries`` entry-point group:
 ``summary(result) -> list[tuple[str, object]]``, rows that lead the solve table (capture time and
 capturing set, arcs, per-evader captures, terminal statistics against the target) and ``hint``
-rows that point to a better backend where one exists. It reads the Result only.
+rows that point to a better backend where one exists. It reads the Result only. Every kind's rows
+end with one ``failed check`` row per check that kept the Result from ``optimal`` (its value and
+tolerance, :meth:`~gamespec.result.Result.failed_checks`) and one ``check left out`` row per check
+that does not apply, with the reason (``metrics["checks_skipped"]``).
 """
 
 from __future__ import annotations
@@ -15,10 +18,28 @@ Rows = list[tuple[str, object]]
 
 
 def outcome(result: Result) -> Rows:
-    """The kind's summary rows of ``result`` (none when the kind registers no summary)."""
-    if result.kind not in registry.names("gamespec.summaries"):
-        return []
-    return registry.load("gamespec.summaries", result.kind)(result)
+    """The kind's summary rows of ``result`` (none when the kind registers no summary), then the
+    failed and the left-out checks."""
+    rows = []
+    if result.kind in registry.names("gamespec.summaries"):
+        rows = registry.load("gamespec.summaries", result.kind)(result)
+    return rows + check_rows(result)
+
+
+def headline(result: Result) -> str:
+    """The one-line summary over the solve table: problem, backend, status, and the checks that kept
+    the Result from ``optimal`` where there are any."""
+    line = f"{result.problem} on {result.backend}: {result.status.value}"
+    failed = [f.name for f in result.failed_checks()]
+    return f"{line} (failed: {', '.join(failed)})" if failed else line
+
+
+def check_rows(result: Result) -> Rows:
+    """One ``failed check`` row per failed check (value against tolerance), one ``check left out``
+    row per check that does not apply (name: reason)."""
+    failed = [("failed check", str(f)) for f in result.failed_checks()]
+    skipped = result.metrics.get("checks_skipped", {})
+    return failed + [("check left out", f"{name}: {why}") for name, why in skipped.items()]
 
 
 def optimal_control_summary(result: Result) -> Rows:

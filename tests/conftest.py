@@ -1,4 +1,5 @@
-"""Shared fixtures: paths of the shipped problem files and a CLI runner."""
+"""Shared fixtures: paths of the shipped problem files, a CLI runner, and the status policy's
+invariant asserted on every Result the solving chain returns anywhere in the suite."""
 
 from __future__ import annotations
 
@@ -21,3 +22,38 @@ def cli(capsys):
         return code, captured.out, captured.err
 
     return invoke
+
+
+def assert_optimal_means_checked(result) -> None:
+    """The status policy's invariant (README "Statuses and exit codes"): an ``optimal`` Result has
+    every verdict in ``metrics["checks_passed"]`` True, every value with a verdict or a tolerance
+    finite, and every value at most its ``metrics["check_tolerances"]`` entry."""
+    import math
+
+    if result.status.value != "optimal":
+        return
+    verdicts = result.metrics.get("checks_passed", {})
+    tolerances = result.metrics.get("check_tolerances", {})
+    assert all(verdicts.values()), f"optimal with failed verdicts {verdicts}"
+    for name in set(verdicts) | set(tolerances):
+        if name in result.checks:
+            value = result.checks[name]
+            assert value is not None and math.isfinite(value), f"optimal with {name} = {value}"
+            if name in tolerances:
+                assert value <= tolerances[name], f"optimal with {name} = {value} > {tolerances[name]}"
+
+
+@pytest.fixture(autouse=True)
+def _optimal_means_checked(monkeypatch):
+    """Wrap the chain (:meth:`gamespec.solving.Solver._solve`, behind every ``solve``) so that every
+    Result it returns in any test satisfies :func:`assert_optimal_means_checked`."""
+    from gamespec import solving
+
+    chain = solving.Solver._solve
+
+    def checked(self, *args, **kwargs):
+        result = chain(self, *args, **kwargs)
+        assert_optimal_means_checked(result)
+        return result
+
+    monkeypatch.setattr(solving.Solver, "_solve", checked)

@@ -172,7 +172,9 @@ class CasadiModel(CollocationModel):
             self._last = w
         X, U, d, T = self._unpack(w, b.t_lower)
         nx = self.shape[0]
-        nu_def = np.asarray(sol["lam_g"]).ravel()[: self.n_defects].reshape((nx, -1), order="F")
+        lam_g = np.asarray(sol["lam_g"]).ravel()
+        nu_def = lam_g[: self.n_defects].reshape((nx, -1), order="F")
+        n_int = len(tr.ocp.running_structure.integrands)
         return tr.result(
             X=X,
             U=U,
@@ -186,6 +188,7 @@ class CasadiModel(CollocationModel):
             solve_time_s=elapsed,
             iterations=int(stats.get("iter_count", 0)),
             defect_multipliers=nu_def,
+            integral_multipliers=lam_g[len(lam_g) - n_int :],
             solver_stats={"return_status": native, "solver": self.options.solver},
         )
 

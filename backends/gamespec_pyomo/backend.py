@@ -149,6 +149,14 @@ class PyomoModel(CollocationModel):
         rows = len(m.defect) // self.tr.n_x
         return np.array([[m.dual[m.defect[i, r]] for r in range(rows)] for i in range(self.tr.n_x)])
 
+    def _integral_multipliers(self) -> np.ndarray | None:
+        """The multipliers of the integral constraints as the CasADi backend has them (of the row
+        ``T q^T g``: Pyomo's constraint reads ``value - T q^T g == 0``, hence the sign)."""
+        m = self.model
+        if not all(con in m.dual for con in m.integral.values()):
+            return None
+        return np.array([-m.dual[m.integral[r]] for r in range(len(m.integral))], dtype=float)
+
     def _solver_options(self) -> dict[str, Any]:
         name = self.executable.name
         opts = {"tol": self.options.tol, "max_iter": self.options.max_iter, "print_level": PRINT_LEVEL[name]}
@@ -202,6 +210,7 @@ class PyomoModel(CollocationModel):
             solve_time_s=elapsed,
             iterations=iterations_in(log),
             defect_multipliers=self._defect_multipliers() if loaded else None,
+            integral_multipliers=self._integral_multipliers() if loaded else None,
             solver_stats={
                 "solver": self.executable.name,
                 "executable": self.executable.path,

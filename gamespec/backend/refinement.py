@@ -1,14 +1,23 @@
 """Adaptive refinement of a collocation mesh on the solver-independent defect estimate (the loop of
 GPOPS-II and dymos): solve, refine every interval whose defect relative to the state scale exceeds
-``method.refine.tolerance``, re-solve on the new mesh from the last solution, until no interval does
-or ``max_iterations`` refinements were made.
+``method.refine.tolerance`` or is not finite, re-solve on the new mesh from the last solution, until
+no interval does or ``max_iterations`` refinements were made.
 
 ``h`` splits each such interval into two halves of its degree. ``hp`` follows the ph rule of
 Patterson, Hager & Rao (2015): on a smooth solution the LGR error of an interval of N points falls
 by about a factor N per added point, so ``P = ceil(log(e / tol) / log(N))`` more points should meet
 the tolerance; the interval gets degree N + P when that is at most ``max_degree``, and otherwise (the
 defect falls too slowly for a polynomial: a corner, a switch) is split into ``max(2, ceil((N + P) /
-d0))`` equal intervals of the file's degree d0.
+d0))`` equal intervals of the file's degree d0. The degree is raised only where the error decays
+as fast as that rule assumes: an interval whose degree was raised on the previous mesh and whose
+defect fell by less than the square root of the predicted factor (``e > e_prev *
+N_prev**(-(N - N_prev) / 2)``: a layer or a corner inside it, which more points do not resolve) is
+split instead, as GPOPS-II's ph method splits where the predicted degree is out of reach.
+
+A defect that is NaN or infinite (the RK4 re-integration of :func:`~gamespec.ocp.checks.
+interval_defects` overflows: an interval too long for the stiffness of its dynamics, as on the
+hyper-sensitive problem's boundary layers at t_f = 1e4) says only that the interval is too long:
+it is split in two, under either strategy, and no degree is raised on it.
 
 The model is rebuilt for each mesh (its NLP changes size) by the backend's own model class, so the
 loop is the same for every collocation backend; the history goes to ``metrics["refinement"]``.
@@ -34,24 +43,48 @@ if TYPE_CHECKING:
 def trajectory_of(tr: Transcription, result: Result) -> tuple[Trajectory, dict[str, float]]:
     """The transcribed solution in a Result, and the parameter values with the design variables."""
     X = np.array([result.states[n] for n in tr.ocp.states])
-    U = np.array([result.controls[n] for n in tr.ocp.controls]).reshape(tr.n_u, -1)
-    Win = np.array([result.arrays[f"input/{n}"] for n in tr.ocp.inputs]).reshape(tr.n_w, U.shape[1])
+    k = len(tr.grid.eval_index)
+    U = np.array([result.controls[n] for n in tr.ocp.controls]).reshape(tr.n_u, k)
+    Win = np.array([result.arrays[f"input/{n}"] for n in tr.ocp.inputs]).reshape(tr.n_w, k)
     values = dict(result.parameters) | result.metrics.get("design", {})
     return Trajectory(X, U, Win, float(result.t_final) - tr.t0), values
 
 
+Interval = tuple[float, float]
+"""An interval of the normalized mesh by its ends (exact floats: an interval left whole keeps them)."""
+
+
+def _decays_too_slowly(degree: int, defect: float, before: tuple[int, float] | None) -> bool:
+    """Whether raising this interval's degree from ``before = (N_prev, e_prev)`` to ``degree`` cut
+    its defect by less than the square root of the ph rule's factor ``N_prev**(degree - N_prev)``."""
+    if before is None or before[0] >= degree or not np.isfinite(before[1]):
+        return False
+    previous_degree, previous_defect = before
+    predicted = max(previous_degree, 2) ** (-(degree - previous_degree) / 2)
+    return defect > previous_defect * predicted
+
+
 def refined_mesh(
-    breaks: np.ndarray, degrees: np.ndarray, defects: np.ndarray, options: RefineSpec, base_degree: int
+    breaks: np.ndarray,
+    degrees: np.ndarray,
+    defects: np.ndarray,
+    options: RefineSpec,
+    base_degree: int,
+    previous: Mapping[Interval, tuple[int, float]] | None = None,
 ) -> tuple[list[float], list[int]]:
-    """The next mesh: interval boundaries and per-interval degrees (see the module docstring)."""
+    """The next mesh: interval boundaries and per-interval degrees (see the module docstring; a
+    non-finite defect halves its interval). ``previous``: the degree and defect each interval had
+    on the mesh before, by its ends, where it had one."""
     mesh, new_degrees = [0.0], []
     for a, b, d, e in zip(breaks[:-1], breaks[1:], degrees.tolist(), defects, strict=True):
         pieces, degree = 1, d
-        if e > options.tolerance and options.strategy == "h":
+        if not np.isfinite(e) or (e > options.tolerance and options.strategy == "h"):
             pieces = 2
         elif e > options.tolerance:
             wanted = d + math.ceil(math.log(e / options.tolerance) / math.log(max(d, 2)))
-            if wanted <= options.max_degree:
+            if _decays_too_slowly(d, e, (previous or {}).get((float(a), float(b)))):
+                pieces, degree = max(2, math.ceil(wanted / base_degree)), base_degree
+            elif wanted <= options.max_degree:
                 degree = wanted
             else:
                 pieces, degree = max(2, math.ceil(wanted / base_degree)), base_degree
@@ -86,17 +119,22 @@ def refined(
     options = model.tr.spec.method.refine
     current, result = model, first
     history = [_entry(current.tr, result)]
+    before: dict[Interval, tuple[int, float]] = {}
     for _ in range(options.max_iterations):
         if not result.ok:
             break
         sol, values = trajectory_of(current.tr, result)
         defects = relative_defects(current.tr, sol, values)
-        if not (defects > options.tolerance).any():
+        if (defects <= options.tolerance).all():
             break
         grid = current.tr.grid
         mesh, degrees = refined_mesh(
-            grid.breaks, grid.interval_degrees, defects, options, model.tr.spec.method.degree
+            grid.breaks, grid.interval_degrees, defects, options, model.tr.spec.method.degree, before
         )
+        ends = zip(grid.breaks[:-1].tolist(), grid.breaks[1:].tolist(), strict=True)
+        before = {
+            end: (int(d), float(e)) for end, d, e in zip(ends, grid.interval_degrees, defects, strict=True)
+        }
         update = {"mesh": mesh, "intervals": len(mesh) - 1}
         if options.strategy == "hp":
             update["degrees"] = degrees

@@ -7,16 +7,25 @@
   (trapezoidal), so the check measures the discretization, not how a signal was tabulated.
 - ``max_defect_relative``: the same gap divided by the state's scale ``max(1, max |x|)`` (what
   ``method.refine.tolerance`` is compared with).
-- ``max_constraint_violation``: bounds, fixed end values, path, boundary and integral constraints.
+- ``max_constraint_violation``: bounds, fixed end values, path, boundary and integral constraints,
+  the integrals re-integrated with the states (RK4, as the defects) rather than by the
+  transcription's own quadrature, which cannot see an integrand between its points.
 - ``control_swings/<control>``: total variation of the control over the range it spans; ``chattering``
   is 1 when one sweeps its range more than ``CHATTERING_SWINGS`` times (regularize it with
   ``method.control_rate_penalty``), else 0.
-- ``hamiltonian_variation``: ``max |H - mean H|`` along the solution for autonomous problems, with
-  ``H = sign*L + lambda^T f`` from the costate estimates (constant on an optimal arc). A grid input
-  that enters f or L and varies along the grid makes the problem non-autonomous
-  (``dH/dt = dH/dw * dw/dt``): both Hamiltonian checks are then left out.
-- ``hamiltonian_end_error``: ``max |H + dPhi/dt_f|`` on free-final-time autonomous problems, where
-  the transversality condition fixes the constant (``H = 0`` for minimum time, eqs. 2.22–2.23).
+- ``hamiltonian_variation``: ``max |H - mean H|`` along the solution, with ``H = sign*L + lambda^T f
+  + nu^T g`` from the costate estimates and the integral constraints' multipliers ``nu`` (integrands
+  ``g``: the isoperimetric problem's augmented Hamiltonian, constant on an optimal arc). Left out,
+  with the reason in ``metrics["checks_skipped"]``, where H need not be constant: explicit time in
+  f, L, a path constraint or an integrand (``dH/dt = dH/dt|explicit``, e.g. a time-dependent obstacle),
+  a grid input that enters f or L and varies along the grid (``dH/dt = dH/dw * dw/dt``), or no
+  costate estimates (the trapezoidal scheme).
+- ``hamiltonian_end_error``: ``max |H + dPhi/dt_f|`` on free-final-time problems where H is constant,
+  since the transversality condition fixes the constant (``H = 0`` for minimum time, eqs. 2.22–2.23).
+
+Each check with a tolerance (:data:`DEFAULT_TOLERANCES`, ``method.refine.tolerance`` for the relative
+defect) gets a verdict (:func:`verdicts`); a NaN or infinite value (an overflowing re-integration)
+fails, and mesh refinement splits the intervals where it occurs.
 """
 
 from __future__ import annotations
@@ -58,8 +67,9 @@ class Trajectory:
 
 
 def _running(tr: Transcription, x, u, w, t: np.ndarray, params: Mapping[str, float]) -> np.ndarray:
-    """The dynamics (first ``n_x`` rows) and the Lagrange integrand (last row) along ``t``
-    (``params`` holds the design variables' values too)."""
+    """The dynamics (first ``n_x`` rows), the Lagrange integrand (row ``n_x``) and the integral
+    constraints' integrands (the rows after it) along ``t`` (``params`` holds the design variables'
+    values too)."""
     p = [params[n] for n in [*tr.ocp.parameters, *tr.ocp.design]]
     return tr.ocp.running_function(*x, *u, *w, *p, t)
 
@@ -90,44 +100,61 @@ def _per_interval(tr: Transcription, V: np.ndarray, chosen: np.ndarray) -> np.nd
     return np.stack([V[:, chosen], V[:, chosen + 1]], axis=2)
 
 
-def interval_defects(tr: Transcription, sol: Trajectory, params: Mapping[str, float]) -> np.ndarray:
-    """Per state and interval (n_x × intervals), the gap between an RK4 re-integration of the
-    interval from its first node and the collocated state at its end (the intervals of each degree
-    together)."""
+@np.errstate(all="ignore")
+def reintegration(
+    tr: Transcription, sol: Trajectory, params: Mapping[str, float]
+) -> tuple[np.ndarray, np.ndarray]:
+    """Each interval re-integrated with RK4 from its first node, the integral constraints'
+    integrands along with the states: per state and interval (n_x × intervals) the gap to the
+    collocated state at the interval's end, and the integrals over the horizon (NaN where the
+    re-integration overflows; the intervals of each degree together)."""
     grid = tr.grid
+    n_int = len(tr.ocp.running_structure.integrands)
     gaps = np.empty((tr.n_x, grid.intervals))
+    integrals = np.zeros(n_int)
     for degree in sorted(set(grid.interval_degrees.tolist())):
         chosen = np.flatnonzero(grid.interval_degrees == degree)
-        gaps[:, chosen] = _rk4_gaps(tr, sol, params, chosen, int(degree))
-    return gaps
+        gaps[:, chosen], pieces = _rk4(tr, sol, params, chosen, int(degree))
+        integrals += np.sum(pieces, axis=1)
+    return gaps, integrals
 
 
-def _rk4_gaps(
+def interval_defects(tr: Transcription, sol: Trajectory, params: Mapping[str, float]) -> np.ndarray:
+    """The gaps of :func:`reintegration` (what mesh refinement reads)."""
+    return reintegration(tr, sol, params)[0]
+
+
+def _rk4(
     tr: Transcription, sol: Trajectory, params: Mapping[str, float], chosen: np.ndarray, degree: int
-) -> np.ndarray:
+) -> tuple[np.ndarray, np.ndarray]:
+    """The gaps at the ends of the ``chosen`` intervals (all of ``degree``) and the integrals of the
+    integrands over each of them (n_integrals × chosen)."""
     X, T = sol.X, sol.T
     grid = tr.grid
     starts = grid.interval_start_index
     h = np.diff(grid.breaks)[chosen] * T
     t0 = tr.t0 + T * grid.breaks[chosen]
     Ui, Wi = _per_interval(tr, sol.U, chosen), _per_interval(tr, sol.Win, chosen)
-    x = X[:, starts[chosen]].astype(float)
+    nx = tr.n_x
+    n_int = len(tr.ocp.running_structure.integrands)
+    y = np.vstack([X[:, starts[chosen]].astype(float), np.zeros((n_int, len(chosen)))])
     ds = 1.0 / RK4_STEPS
     halves = np.arange(2 * RK4_STEPS + 1) * ds / 2
     bases = control_basis(tr, halves, degree)
 
-    def f(x: np.ndarray, half: int) -> np.ndarray:
-        """The dynamics at local time ``half * ds / 2``."""
+    def f(y: np.ndarray, half: int) -> np.ndarray:
+        """The dynamics and the integrands at local time ``half * ds / 2``."""
         basis = bases[half]
-        return _running(tr, x, Ui @ basis, Wi @ basis, t0 + halves[half] * h, params)[:-1]
+        values = _running(tr, y[:nx], Ui @ basis, Wi @ basis, t0 + halves[half] * h, params)
+        return np.delete(values, nx, axis=0)
 
     for step in range(RK4_STEPS):
-        k1 = f(x, 2 * step)
-        k2 = f(x + 0.5 * ds * h * k1, 2 * step + 1)
-        k3 = f(x + 0.5 * ds * h * k2, 2 * step + 1)
-        k4 = f(x + ds * h * k3, 2 * step + 2)
-        x = x + ds * h / 6.0 * (k1 + 2 * k2 + 2 * k3 + k4)
-    return np.abs(x - X[:, starts[chosen + 1]])
+        k1 = f(y, 2 * step)
+        k2 = f(y + 0.5 * ds * h * k1, 2 * step + 1)
+        k3 = f(y + 0.5 * ds * h * k2, 2 * step + 1)
+        k4 = f(y + ds * h * k3, 2 * step + 2)
+        y = y + ds * h / 6.0 * (k1 + 2 * k2 + 2 * k3 + k4)
+    return np.abs(y[:nx] - X[:, starts[chosen + 1]]), y[nx:]
 
 
 def state_scale(X: np.ndarray) -> np.ndarray:
@@ -146,16 +173,21 @@ DEFAULT_TOLERANCES = {"max_constraint_violation": 1e-6, "max_defect_relative": 1
 defect at the level of IPOPT's default tolerance, and no chattering control."""
 
 
-def verdicts(checks: Mapping[str, float | None], defect_tolerance: float | None) -> dict[str, bool]:
-    """Pass (True) or fail per check that has a tolerance (``method.refine.tolerance`` for the
-    relative defect when the file sets one); a check that could not be computed fails."""
+def check_tolerances(checks: Mapping[str, float | None], defect_tolerance: float | None) -> dict[str, float]:
+    """The tolerance of each check present that has one (``method.refine.tolerance`` for the
+    relative defect when the file sets one)."""
     tolerances = DEFAULT_TOLERANCES | (
         {"max_defect_relative": defect_tolerance} if defect_tolerance is not None else {}
     )
+    return {name: float(tol) for name, tol in tolerances.items() if name in checks}
+
+
+def verdicts(checks: Mapping[str, float | None], tolerances: Mapping[str, float]) -> dict[str, bool]:
+    """Pass (True) or fail per check in ``tolerances``: its value is at most its tolerance; a value
+    that could not be computed (None, NaN, an overflow) fails."""
     return {
-        name: checks[name] is not None and bool(checks[name] <= tol)
+        name: checks[name] is not None and bool(np.isfinite(checks[name]) and checks[name] <= tol)
         for name, tol in tolerances.items()
-        if name in checks
     }
 
 
@@ -182,9 +214,13 @@ def _relation_violation(rel: Relation, shape: tuple[int, ...]) -> float:
     return _violation(v, rel.lower, rel.upper)
 
 
-def max_constraint_violation(tr: Transcription, sol: Trajectory, params: Mapping[str, float]) -> float:
+def max_constraint_violation(
+    tr: Transcription, sol: Trajectory, params: Mapping[str, float], integrals: np.ndarray | None = None
+) -> float:
     """Largest violation of bounds (the design variables' too), fixed end values, path, boundary
-    and integral constraints (by the transcription's quadrature)."""
+    and integral constraints: the ``integrals`` given (re-integrated, :func:`reintegration`), else
+    by the transcription's quadrature, which only sees the integrand at the collocation points (a
+    hanging chain may bend steeply between them, its length uncounted)."""
     X, U, T = sol.X, sol.U, sol.T
     b = tr.bounds(params)
     worst = [_violation(X, b.x_lower, b.x_upper), _violation(U, b.u_lower, b.u_upper)]
@@ -197,9 +233,12 @@ def max_constraint_violation(tr: Transcription, sol: Trajectory, params: Mapping
     ends = tr.ocp.end_terms(_end_values(tr, X, U, T, params), ARRAYS)
     worst += [_relation_violation(r, ()) for r in ends.boundary]
     q = tr.grid.triplets[2]
-    for integrand, (lo, hi) in zip(terms.integrands, tr.ocp.integral_bounds(params), strict=True):
-        g = np.broadcast_to(np.asarray(integrand, dtype=float), t_eval.shape)
-        worst.append(_violation(np.array([T * q @ g]), lo, hi))
+    if integrals is None:
+        integrals = [
+            T * q @ np.broadcast_to(np.asarray(g, dtype=float), t_eval.shape) for g in terms.integrands
+        ]
+    for value, (lo, hi) in zip(integrals, tr.ocp.integral_bounds(params), strict=True):
+        worst.append(_violation(np.array([value]), lo, hi))
     return float(np.max(worst))
 
 
@@ -217,13 +256,22 @@ def _arrays(params: Mapping[str, float]) -> dict[str, np.float64]:
 
 
 def hamiltonian(
-    tr: Transcription, sol: Trajectory, params: Mapping[str, float], lam: np.ndarray
+    tr: Transcription,
+    sol: Trajectory,
+    params: Mapping[str, float],
+    lam: np.ndarray,
+    integral_multipliers: np.ndarray | None = None,
 ) -> np.ndarray:
-    """``H = sign*L + lambda^T f`` at the collocation points (eq. 2.22 in general form)."""
+    """``H = sign*L + lambda^T f + nu^T g`` at the collocation points (eq. 2.22 in general form,
+    augmented by the integral constraints' integrands ``g`` and their multipliers ``nu``)."""
     t_eval = tr.t0 + sol.T * tr.grid.eval_tau
     xe = sol.X[:, tr.grid.eval_index]
     values = _running(tr, xe, sol.U, sol.Win, t_eval, params)
-    return values[-1] + np.sum(lam * values[:-1], axis=0)
+    nx = tr.n_x
+    H = values[nx] + np.sum(lam * values[:nx], axis=0)
+    if integral_multipliers is not None and len(integral_multipliers):
+        H = H + np.asarray(integral_multipliers, dtype=float) @ values[nx + 1 :]
+    return H
 
 
 STEP = float(np.finfo(float).eps) ** (1 / 3)
@@ -249,32 +297,59 @@ def hamiltonian_end_value(tr: Transcription, ends: Mapping[str, float]) -> float
     return -mayer_slope(tr, ends, "t_f")
 
 
-def _time_invariant(tr: Transcription, Win: np.ndarray) -> bool:
-    """No explicit time in f and L, and every grid input that enters them constant on the grid."""
+def varying_hamiltonian(tr: Transcription, Win: np.ndarray) -> str | None:
+    """Why H need not be constant along this solution (None when it must be): explicit time in the
+    dynamics, the running cost, a path constraint or an integrand, or a grid input that enters f or
+    L and varies on the grid."""
+    if not tr.ocp.autonomous:
+        return "the dynamics or the running cost depend on t explicitly"
+    structure = tr.ocp.running_structure
+    for kind, terms in (
+        ("path constraint", [r.expr for r in structure.path]),
+        ("integrand", structure.integrands),
+    ):
+        for number, term in enumerate(terms):
+            if "t" in dependencies(term):
+                return f"{kind} {number} depends on t explicitly (its multiplier makes H vary)"
     used = Win[tr.ocp.inputs_in_hamiltonian]
-    return tr.ocp.autonomous and bool(np.all(used == used[:, :1]))
+    if not np.all(used == used[:, :1]):
+        return "a grid input that enters the dynamics or the running cost varies along the grid"
+    return None
+
+
+HAMILTONIAN_CHECKS = ("hamiltonian_variation", "hamiltonian_end_error")
 
 
 @np.errstate(all="ignore")
 def solution_checks(
-    tr: Transcription, sol: Trajectory, params: Mapping[str, float], lam: np.ndarray | None
-) -> dict[str, float | None]:
+    tr: Transcription,
+    sol: Trajectory,
+    params: Mapping[str, float],
+    lam: np.ndarray | None,
+    integral_multipliers: np.ndarray | None = None,
+) -> tuple[dict[str, float | None], dict[str, str]]:
     """All checks that apply to this problem and solution (NaN where a value cannot be computed,
-    e.g. a diverging re-integration of a failed solve)."""
+    e.g. a diverging re-integration of a failed solve), and the checks left out with the reason."""
+    gaps, integrals = reintegration(tr, sol, params)
     checks: dict[str, float | None] = {
-        "max_constraint_violation": max_constraint_violation(tr, sol, params),
+        "max_constraint_violation": max_constraint_violation(tr, sol, params, integrals),
     }
-    gaps = interval_defects(tr, sol, params)
     checks["max_defect"] = float(np.max(gaps, initial=0.0))
     checks["max_defect_relative"] = float(np.max(gaps / state_scale(sol.X)[:, None], initial=0.0))
     if tr.n_u:
         swings = control_swings(sol.U)
         checks |= {f"control_swings/{n}": float(v) for n, v in zip(tr.ocp.controls, swings, strict=True)}
         checks["chattering"] = float(np.max(swings) > CHATTERING_SWINGS)
-    if lam is not None and _time_invariant(tr, sol.Win):
-        H = hamiltonian(tr, sol, params, lam)
-        checks["hamiltonian_variation"] = float(np.max(np.abs(H - H.mean())))
-        if tr.free_time:
-            end = hamiltonian_end_value(tr, _end_values(tr, sol.X, sol.U, sol.T, params))
-            checks["hamiltonian_end_error"] = float(np.max(np.abs(H - end)))
-    return checks
+    applicable = HAMILTONIAN_CHECKS if tr.free_time else HAMILTONIAN_CHECKS[:1]
+    if lam is None:
+        reason = "no costate estimates (the trapezoidal scheme, or no multipliers from the solver)"
+        return checks, dict.fromkeys(applicable, reason)
+    varying = varying_hamiltonian(tr, sol.Win)
+    if varying is not None:
+        return checks, dict.fromkeys(applicable, f"H need not be constant: {varying}")
+    H = hamiltonian(tr, sol, params, lam, integral_multipliers)
+    checks["hamiltonian_variation"] = float(np.max(np.abs(H - H.mean())))
+    if tr.free_time:
+        end = hamiltonian_end_value(tr, _end_values(tr, sol.X, sol.U, sol.T, params))
+        checks["hamiltonian_end_error"] = float(np.max(np.abs(H - end)))
+    return checks, {}

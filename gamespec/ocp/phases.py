@@ -134,6 +134,7 @@ def split_by_phase(result: Result, lowering: Lowering) -> Result:
     controls = {n: [] for n in control_names}
     costates: dict[str, list[np.ndarray]] = {f"lambda_{n}": [] for n in state_names}
     checks = {k: result.checks[k] for k in OVERALL_CHECKS if k in result.checks}
+    skipped: dict[str, str] = {}
     end_value = None
     if _switching_times_free(lowering):
         end_value = _end_value(lowering, lowered, X_all, U_all, values, float(s_nodes[-1]))
@@ -153,11 +154,12 @@ def split_by_phase(result: Result, lowering: Lowering) -> Result:
             costates[f"lambda_{n}"].append(lam[i])
         U = np.array([arrays.controls[n] for n in tr.ocp.controls]).reshape(tr.n_u, len(arrays.s_eval))
         sol = Trajectory(arrays.X, U, np.zeros((0, U.shape[1])), float(durations[k]))
-        own = solution_checks(tr, sol, values, lam)
+        own, left_out = solution_checks(tr, sol, values, lam)
         if lam is not None and ph.free and end_value is not None and "hamiltonian_variation" in own:
             H = hamiltonian(tr, sol, values, lam)
             own["hamiltonian_end_error"] = float(np.max(np.abs(H - end_value)))
         checks |= {f"{name}/{ph.name}": value for name, value in own.items()}
+        skipped |= {f"{name}/{ph.name}": reason for name, reason in left_out.items()}
     has_costates = all(len(v) == len(lowering.phases) for v in costates.values())
     extra = {k: v for k, v in result.arrays.items() if k != "costate_time"}
     extra |= {
@@ -178,7 +180,8 @@ def split_by_phase(result: Result, lowering: Lowering) -> Result:
         }
         for k, ph in enumerate(lowering.phases)
     ]
-    metrics = {k: v for k, v in result.metrics.items() if k != "design"} | {"phases": phases}
+    metrics = {k: v for k, v in result.metrics.items() if k not in ("design", "checks_skipped")}
+    metrics |= {"phases": phases} | ({"checks_skipped": skipped} if skipped else {})
     if design:
         metrics["design"] = design
     return result.model_copy(

@@ -235,13 +235,14 @@ class SymbolicOcp:
 
     @cached_property
     def running_function(self) -> Callable[..., np.ndarray]:
-        """The dynamics and the Lagrange integrand, recorded once: called with one array per
-        :attr:`running_names` it returns ``(n_x + 1, *shape)`` (the checks evaluate them often)."""
+        """The dynamics, the Lagrange integrand and the integral constraints' integrands, recorded
+        once: called with one array per :attr:`running_names` it returns ``(n_x + 1 + n_integrals,
+        *shape)`` (the checks evaluate them often)."""
         names = self.running_names
 
         def build(slots: list[Any], library: Any) -> list[Any]:
             terms = self.running_terms(dict(zip(names, slots, strict=True)), LibraryAlgebra(library))
-            return [*terms.dynamics, terms.lagrange]
+            return [*terms.dynamics, terms.lagrange, *terms.integrands]
 
         return vectorized(build, len(names), NUMPY)
 

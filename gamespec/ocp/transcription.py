@@ -16,7 +16,7 @@ from typing import Any
 import numpy as np
 
 from gamespec.errors import ExpressionError, SpecError
-from gamespec.ocp.checks import Trajectory, control_basis, solution_checks, verdicts
+from gamespec.ocp.checks import Trajectory, check_tolerances, control_basis, solution_checks, verdicts
 from gamespec.ocp.collocation import Grid
 from gamespec.ocp.inputs import InputGrid, InputValue, on_grid
 from gamespec.ocp.symbolic import SymbolicOcp
@@ -209,7 +209,8 @@ class Transcription:
         design = previous.metrics.get("design", {})
         defaults = [g for *_, g in self.ocp.design_bounds(previous.parameters or self.ocp.parameter_values())]
         d = np.array([design.get(n, g) for n, g in zip(self.ocp.design, defaults, strict=True)], dtype=float)
-        return Guess(X.reshape(self.n_x, -1), U.reshape(self.n_u, -1), float(span), d)
+        k = len(self.grid.eval_index)
+        return Guess(X.reshape(self.n_x, self.grid.n_nodes), U.reshape(self.n_u, k), float(span), d)
 
     @cached_property
     def start_weights(self) -> np.ndarray:
@@ -280,13 +281,17 @@ class Transcription:
         inputs: np.ndarray,
         design: np.ndarray | None = None,
         defect_multipliers: np.ndarray | None = None,
+        integral_multipliers: np.ndarray | None = None,
         solver_stats: dict | None = None,
     ) -> Result:
         """A Result from a solution, with costates from the defect multipliers, the checks, the
         grid inputs used (``arrays["input/<name>"]``, on ``control_time``), the mesh the controls
-        are held on (``arrays["control_mesh"]``, :mod:`gamespec.ocp.control_signal`), the optimized design
-        variables (``metrics["design"]``) and a pass/fail verdict per check against its tolerance
-        (``metrics["checks_passed"]``, see :func:`~gamespec.ocp.checks.verdicts`)."""
+        are held on (``arrays["control_mesh"]``, :mod:`gamespec.ocp.control_signal`), the optimized
+        design variables (``metrics["design"]``), a pass/fail verdict per check against its
+        tolerance (``metrics["checks_passed"]`` and ``metrics["check_tolerances"]``, see
+        :func:`~gamespec.ocp.checks.verdicts`) and the checks left out with the reason
+        (``metrics["checks_skipped"]``). ``integral_multipliers``: the NLP multipliers of the
+        integral constraints' rows, which enter the Hamiltonian check."""
         if objective is not None:
             objective -= self.ocp.sign * float(self.rate_penalty(U))
         values = np.zeros(self.n_d) if design is None else np.asarray(design, dtype=float)
@@ -300,8 +305,11 @@ class Transcription:
         if defect_multipliers is not None and self.grid.scheme == "radau":
             lam = defect_multipliers * self.costate_rows[None, :]
             costates = {f"lambda_{n}": lam[i] for i, n in enumerate(self.ocp.states)}
-        checks = solution_checks(self, Trajectory(X, U, inputs, T), {**params, **optimized}, lam)
+        checks, skipped = solution_checks(
+            self, Trajectory(X, U, inputs, T), {**params, **optimized}, lam, integral_multipliers
+        )
         refine = self.spec.method.refine
+        tolerances = check_tolerances(checks, refine.tolerance if refine else None)
         if lam is not None:
             arrays["costate_time"] = t_eval
         return Result(
@@ -320,7 +328,8 @@ class Transcription:
             parameters=dict(params),
             checks=checks,
             metrics=({"design": optimized} if optimized else {})
-            | {"checks_passed": verdicts(checks, refine.tolerance if refine else None)}
+            | {"checks_passed": verdicts(checks, tolerances), "check_tolerances": tolerances}
+            | ({"checks_skipped": skipped} if skipped else {})
             | {
                 "plot": {
                     **self.spec.plot.as_metrics(),

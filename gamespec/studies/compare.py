@@ -42,8 +42,9 @@ def compare_backends(
     out: Path | None = None,
     progress: Console | None = None,
 ) -> list[dict[str, Any]]:
-    """Solve ``spec`` on each ``(backend, solver)``; rows with status, objective, times, checks and
-    the relative objective gap to the best optimal row."""
+    """Solve ``spec`` on each ``(backend, solver)``; rows with status, objective, times, checks, the
+    checks that failed (``failed_checks``: each value against its tolerance) and the relative
+    objective gap to the best optimal row."""
     from gamespec.solving import solve
 
     rows: list[dict[str, Any]] = []
@@ -64,7 +65,8 @@ def compare_backends(
             continue
         if out is not None:
             result.save(Path(out) / label.replace(":", "_"))
-        rows.append({**result.summary(), "backend": label})
+        failed = "; ".join(str(f) for f in result.failed_checks())
+        rows.append({**result.summary(), "backend": label} | ({"failed_checks": failed} if failed else {}))
     best = [r["objective"] for r in rows if _trusted(r)]
     if best:
         ref = reference_objective(best, spec.objective_sense)
@@ -166,10 +168,14 @@ def comparison_table(rows: list[dict[str, Any]], title: str) -> Table:
 
 
 def row_notes(rows: list[dict[str, Any]]) -> list[str]:
-    """One line per row that is not optimal: the backend's reason, or the solver's message."""
+    """One line per row that is not optimal: the checks that failed (value against tolerance, the
+    status policy's reason), else the backend's reason or the solver's message."""
     notes = []
     for row in rows:
         if row.get("status") != "optimal":
-            why = row.get("reason") or row.get("message") or "no message"
+            if row.get("failed_checks"):
+                why = f"failed check(s) {row['failed_checks']}"
+            else:
+                why = row.get("reason") or row.get("message") or "no message"
             notes.append(f"{row['backend']}: {why}")
     return notes

@@ -91,7 +91,10 @@ def test_a_saved_result_file_seeds_pyomo(tmp_path) -> None:
 def test_trapezoidal_scheme_agrees_with_casadi() -> None:
     spec = gamespec.load(MIN_TIME, ["method.scheme=trapezoidal", "method.intervals=60"])
     casadi, pyomo = gamespec.solve(spec, "casadi"), gamespec.solve(spec, "pyomo")
-    assert pyomo.status is Status.OPTIMAL
+    # a second-order scheme on 60 intervals: both converge, the relative defect fails on both
+    assert pyomo.status is casadi.status is Status.FEASIBLE
+    assert [f.name for f in pyomo.failed_checks()] == [f.name for f in casadi.failed_checks()]
+    assert [f.name for f in pyomo.failed_checks()] == ["max_defect_relative"]
     assert pyomo.objective == pytest.approx(casadi.objective, rel=1e-6)
     assert len(pyomo.controls["u"]) == 61
 

@@ -77,7 +77,9 @@ def test_a_backend_that_cannot_take_the_problem_gets_a_row(cli, tmp_path) -> Non
     assert code == 0
     pyomo, casadi = json.loads(out)
     assert pyomo["status"] == "unsupported" and "atan2" in pyomo["reason"]
-    assert casadi["status"] == "optimal"
+    # casadi solves it; its coarse mesh's relative defect (1e-4) keeps it from optimal, and the row
+    # names that check
+    assert casadi["status"] == "feasible" and "max_defect_relative" in casadi["failed_checks"]
 
 
 def test_out_saves_each_result(cli, tmp_path) -> None:

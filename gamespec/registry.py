@@ -61,8 +61,14 @@ def distribution(group: str, name: str) -> str:
     """The distribution (and version) that registered ``name`` in ``group``."""
     if name in _IN_PROCESS.get(group, {}):
         return "registered in this process"
-    ep = _entry_points(group)[name]
-    dist = ep.dist
+    return _installed_distribution(group, name)
+
+
+@cache
+def _installed_distribution(group: str, name: str) -> str:
+    """An entry point's distribution and version, read once: reading a distribution's version
+    parses its metadata file, and every Result's provenance asks for it."""
+    dist = _entry_points(group)[name].dist
     return f"{dist.name} {dist.version}" if dist is not None else "?"
 
 

@@ -25,7 +25,7 @@ from gamespec.ocp.transcription import Guess, Transcription
 from gamespec.result import Result, Status
 from gamespec.specs.base import StrictModel
 from gamespec.specs.ocp import OptimalControlSpec
-from gamespec.symbolic.library import Library
+from gamespec.symbolic.library import casadi_library
 
 STATUS_MAP = {
     "Solve_Succeeded": Status.OPTIMAL,
@@ -72,14 +72,6 @@ class CasadiOptions(StrictModel):
 
             check_ipopt_options(ipopt)
         return ipopt
-
-
-def casadi_library(ca: Any) -> Library:
-    """CasADi's functions by gamespec's names; ``heaviside(x) = (1 + sign(x))/2``, which is 1/2 at 0
-    as SymPy's ``Heaviside`` (CasADi's ``sign(0) = 0``)."""
-    return Library.from_namespace(
-        ca, abs=ca.fabs, min=ca.fmin, max=ca.fmax, heaviside=lambda x: 0.5 * (1 + ca.sign(x))
-    )
 
 
 def nlp_solver(nlp: Any, options: CasadiOptions) -> Any:

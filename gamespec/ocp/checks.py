@@ -36,6 +36,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
+from gamespec.ocp.compiled_checks import reintegrate
 from gamespec.symbolic.grammar import FLOATS, Relation, dependencies, unknowns
 from gamespec.symbolic.library import NUMPY, LibraryAlgebra
 
@@ -128,7 +129,8 @@ def _rk4(
     tr: Transcription, sol: Trajectory, params: Mapping[str, float], chosen: np.ndarray, degree: int
 ) -> tuple[np.ndarray, np.ndarray]:
     """The gaps at the ends of the ``chosen`` intervals (all of ``degree``) and the integrals of the
-    integrands over each of them (n_integrals × chosen)."""
+    integrands over each of them (n_integrals × chosen): ``RK4_STEPS`` classical RK4 steps per
+    interval, compiled once (:mod:`gamespec.ocp.compiled_checks`)."""
     X, T = sol.X, sol.T
     grid = tr.grid
     starts = grid.interval_start_index
@@ -138,22 +140,10 @@ def _rk4(
     nx = tr.n_x
     n_int = len(tr.ocp.running_structure.integrands)
     y = np.vstack([X[:, starts[chosen]].astype(float), np.zeros((n_int, len(chosen)))])
-    ds = 1.0 / RK4_STEPS
-    halves = np.arange(2 * RK4_STEPS + 1) * ds / 2
+    halves = np.arange(2 * RK4_STEPS + 1) / (2 * RK4_STEPS)
     bases = control_basis(tr, halves, degree)
-
-    def f(y: np.ndarray, half: int) -> np.ndarray:
-        """The dynamics and the integrands at local time ``half * ds / 2``."""
-        basis = bases[half]
-        values = _running(tr, y[:nx], Ui @ basis, Wi @ basis, t0 + halves[half] * h, params)
-        return np.delete(values, nx, axis=0)
-
-    for step in range(RK4_STEPS):
-        k1 = f(y, 2 * step)
-        k2 = f(y + 0.5 * ds * h * k1, 2 * step + 1)
-        k3 = f(y + 0.5 * ds * h * k2, 2 * step + 1)
-        k4 = f(y + ds * h * k3, 2 * step + 2)
-        y = y + ds * h / 6.0 * (k1 + 2 * k2 + 2 * k3 + k4)
+    p = np.array([params[n] for n in [*tr.ocp.parameters, *tr.ocp.design]], dtype=float)
+    y = reintegrate(tr, degree, RK4_STEPS, bases, y, Ui, Wi, h, t0, p)
     return np.abs(y[:nx] - X[:, starts[chosen + 1]]), y[nx:]
 
 

@@ -1,6 +1,7 @@
 """A backend's elementary functions (:class:`Library`) and the walk of
 :mod:`gamespec.symbolic.grammar` building that backend's expressions (:class:`LibraryAlgebra`)
-straight from a file's text, without SymPy; :data:`NUMPY` is NumPy's library.
+straight from a file's text, without SymPy; :data:`NUMPY` is NumPy's library and
+:func:`casadi_library` CasADi's (for the casadi backend's NLP and the compiled checks).
 """
 
 from __future__ import annotations
@@ -68,6 +69,14 @@ class _NumpyFunctions(Mapping[str, Callable[..., Any]]):
 
 
 NUMPY = Library(_NumpyFunctions(), power=_numpy_power)
+
+
+def casadi_library(ca: Any) -> Library:
+    """CasADi's functions by gamespec's names; ``heaviside(x) = (1 + sign(x))/2``, which is 1/2 at 0
+    as SymPy's ``Heaviside`` (CasADi's ``sign(0) = 0``)."""
+    return Library.from_namespace(
+        ca, abs=ca.fabs, min=ca.fmin, max=ca.fmax, heaviside=lambda x: 0.5 * (1 + ca.sign(x))
+    )
 
 
 class LibraryAlgebra:

@@ -10,13 +10,13 @@ import casadi as ca
 import numpy as np
 import pytest
 from gamespec_casadi.assembly import assembled_nlp
-from gamespec_casadi.backend import casadi_library
 from gamespec_casadi.nlp import collocation_nlp
 
 import gamespec
 from gamespec.loader import spec_from_dict
 from gamespec.ocp.transcription import Transcription
 from gamespec.solving import get_backend
+from gamespec.symbolic.library import casadi_library
 from tests.conftest import PROBLEMS
 from tests.core.test_ocp_modelling import (
     _bounded_in_time,

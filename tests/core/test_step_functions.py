@@ -8,12 +8,11 @@ import numpy as np
 import pyomo.environ as pyo
 import pytest
 import sympy as sp
-from gamespec_casadi.backend import casadi_library
 from gamespec_pyomo.model import pyomo_library
 
 from gamespec.errors import UnsupportedFeature
 from gamespec.symbolic.language import parse, symbol
-from gamespec.symbolic.library import NUMPY
+from gamespec.symbolic.library import NUMPY, casadi_library
 from gamespec.symbolic.translate import translate
 
 X = symbol("x")

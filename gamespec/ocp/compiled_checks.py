@@ -1,0 +1,106 @@
+"""The checks' per-interval RK4 re-integration compiled once as a CasADi ``Function``.
+
+:func:`gamespec.ocp.checks.reintegration` integrates each mesh interval from its first node with
+``RK4_STEPS`` classical RK4 steps under the interval's control polynomial (and its grid inputs),
+the integral constraints' integrands along with the states. Evaluated by a tape of NumPy calls,
+each of the ``4 · RK4_STEPS`` stages costs one pass over every operation of the dynamics — on
+small problems re-solved often (a receding-horizon game's thousand NLPs) that was most of a
+solve's time. Here the whole re-integration of one interval is one CasADi SX function of the
+interval's start ``y0``, its control and input points, its length ``h``, its start time ``t0``
+and the parameter values, built once per transcription and interval degree from the file's text
+(:class:`~gamespec.symbolic.library.LibraryAlgebra` over CasADi), and mapped over the intervals:
+one call of compiled code per check. The arithmetic is the same as the NumPy route's, so the
+numbers agree to rounding.
+"""
+
+from __future__ import annotations
+
+import weakref
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+
+from gamespec.symbolic.library import LibraryAlgebra, casadi_library
+
+if TYPE_CHECKING:
+    from gamespec.ocp.transcription import Transcription
+
+
+_FUNCTIONS: weakref.WeakKeyDictionary[Transcription, dict[tuple[int, int], Any]] = weakref.WeakKeyDictionary()
+"""Each live transcription's compiled re-integrations by (degree, steps): a compiled model keeps
+one transcription, so one build serves every re-solve."""
+
+
+def rk4_function(tr: Transcription, degree: int, steps: int, bases: np.ndarray) -> Any:
+    """``(y0, U, W, h, t0, p) → y(t0 + h)`` for one interval of ``degree`` (``steps`` RK4 steps;
+    ``bases[half]`` weights the interval's control points at local time ``half / (2 steps)``, the
+    same for every call with this degree and step count), built on first use."""
+    functions = _FUNCTIONS.setdefault(tr, {})
+    if (degree, steps) not in functions:
+        functions[degree, steps] = _build(tr, degree, steps, bases)
+    return functions[degree, steps]
+
+
+def _build(tr: Transcription, degree: int, steps: int, bases: np.ndarray) -> Any:
+    import casadi as ca
+
+    ocp = tr.ocp
+    algebra = LibraryAlgebra(casadi_library(ca))
+    names = ocp.running_names
+    nx, nu, nw = len(ocp.states), len(ocp.controls), len(ocp.inputs)
+    n_p = len(ocp.parameters) + len(ocp.design)
+    n_int = len(ocp.running_structure.integrands)
+    points = bases.shape[1]
+    y0 = ca.SX.sym("y0", nx + n_int)
+    U, W = ca.SX.sym("U", nu, points), ca.SX.sym("W", nw, points)
+    h, t0, p = ca.SX.sym("h"), ca.SX.sym("t0"), ca.SX.sym("p", n_p)
+    ds = 1.0 / steps
+
+    def f(y: Any, half: int) -> Any:
+        u = U @ bases[half] if nu else []
+        w = W @ bases[half] if nw else []
+        slots = [
+            *ca.vertsplit(y[:nx]),
+            *_split(u, nu),
+            *_split(w, nw),
+            *ca.vertsplit(p),
+            t0 + half * ds / 2 * h,
+        ]
+        terms = ocp.running_terms(dict(zip(names, slots, strict=True)), algebra)
+        return ca.vertcat(*terms.dynamics, *terms.integrands)
+
+    y = y0
+    for step in range(steps):
+        k1 = f(y, 2 * step)
+        k2 = f(y + 0.5 * ds * h * k1, 2 * step + 1)
+        k3 = f(y + 0.5 * ds * h * k2, 2 * step + 1)
+        k4 = f(y + ds * h * k3, 2 * step + 2)
+        y = y + ds * h / 6.0 * (k1 + 2 * k2 + 2 * k3 + k4)
+    return ca.Function(f"rk4_degree_{degree}", [y0, U, W, h, t0, p], [y])
+
+
+def _split(v: Any, rows: int) -> list[Any]:
+    import casadi as ca
+
+    return ca.vertsplit(v) if rows else []
+
+
+def reintegrate(
+    tr: Transcription,
+    degree: int,
+    steps: int,
+    bases: np.ndarray,
+    y0: np.ndarray,
+    U: np.ndarray,
+    W: np.ndarray,
+    h: np.ndarray,
+    t0: np.ndarray,
+    p: np.ndarray,
+) -> np.ndarray:
+    """The ends ``(n_y, k)`` of the ``k`` intervals' re-integrations from ``y0`` (n_y, k) under their
+    control and input points ``U`` (n_u, k, d), ``W`` (n_w, k, d), lengths ``h`` and starts ``t0``."""
+    k = y0.shape[1]
+    mapped = rk4_function(tr, degree, steps, bases).map(k)
+    d = bases.shape[1]
+    out = mapped(y0, U.reshape(U.shape[0], k * d), W.reshape(W.shape[0], k * d), h[None, :], t0[None, :], p)
+    return np.asarray(out, dtype=float).reshape(y0.shape[0], k)

@@ -82,6 +82,24 @@ JsonOpt = Annotated[bool, typer.Option("--json", help="Print the result as JSON 
 OutOpt = Annotated[Path | None, typer.Option("--out", help="Folder to save results into.")]
 
 
+SchedulerOpt = Annotated[
+    str | None,
+    typer.Option(
+        "--scheduler",
+        envvar="GAMESPEC_SCHEDULER",
+        help="Address of a running Dask scheduler, e.g. tcp://host:8786 (env GAMESPEC_SCHEDULER).",
+    ),
+]
+InsecureOpt = Annotated[
+    bool,
+    typer.Option(
+        "--insecure-scheduler",
+        help="Reach a --scheduler on another machine without verified TLS: a scheduler can run code "
+        "in this process (README, Security).",
+    ),
+]
+
+
 def _version(value: bool) -> None:
     if value:
         from importlib.metadata import version
@@ -122,8 +140,11 @@ def solve(
     out: OutOpt = None,
     json_: JsonOpt = False,
     plot: Annotated[bool, typer.Option("--plot", help="Also write plots (into --out or .).")] = False,
+    scheduler: SchedulerOpt = None,
+    insecure_scheduler: InsecureOpt = False,
 ) -> None:
-    """Solve a problem file and print a summary (or the Result as JSON)."""
+    """Solve a problem file and print a summary (or the Result as JSON); a study kind runs on the
+    Dask ``--scheduler`` when one is given."""
     from gamespec.loader import load
     from gamespec.result import writable_folder
     from gamespec.solving import solve as run_solve
@@ -131,8 +152,9 @@ def solve(
     spec = load(file, set_ or [])
     if out is not None:
         writable_folder(out)
+    options = _where_it_runs(spec, backend, scheduler, insecure_scheduler)
     with _spinner(f"solving {spec.name} ..."):
-        result = run_solve(spec, backend)
+        result = run_solve(spec, backend, options=options)
     if out is not None:
         _remove_previous_figures(out)
         result.save(out)
@@ -154,6 +176,22 @@ def solve(
             file=sys.stderr,
         )
         raise typer.Exit(1)
+
+
+def _where_it_runs(spec, backend: str | None, scheduler: str | None, insecure: bool) -> dict | None:
+    """The study options ``--scheduler`` and ``--insecure-scheduler`` give, for a backend that runs
+    a study (None when neither is given); a GamespecError for any other backend."""
+    if not scheduler and not insecure:
+        return None
+    from gamespec.solving import backend_name
+    from gamespec.studies.point_study import PointStudyBackend
+
+    name = backend_name(spec, backend)
+    if not issubclass(registry.backend_class(name), PointStudyBackend):
+        raise GamespecError(
+            f"--scheduler: backend {name!r} runs no study (a sweep takes --scheduler: gamespec sweep)"
+        )
+    return {"scheduler": scheduler, "insecure_scheduler": insecure}
 
 
 FIGURE_SUFFIXES = (".png", ".gif", ".mp4")
@@ -236,14 +274,6 @@ ExecutorOpt = Annotated[
     ),
 ]
 WorkersOpt = Annotated[int, typer.Option(min=1, help="Worker processes (a LocalCluster's size for dask).")]
-SchedulerOpt = Annotated[
-    str | None,
-    typer.Option(
-        "--scheduler",
-        envvar="GAMESPEC_SCHEDULER",
-        help="Address of a running Dask scheduler, e.g. tcp://host:8786 (env GAMESPEC_SCHEDULER).",
-    ),
-]
 
 SWEEP_COLUMNS = ("status", "objective", "t_final", "solve_time_s")
 
@@ -257,6 +287,7 @@ def sweep(
     executor: ExecutorOpt = None,
     workers: WorkersOpt = 1,
     scheduler: SchedulerOpt = None,
+    insecure_scheduler: InsecureOpt = False,
     set_: SetOpt = None,
     json_: JsonOpt = False,
 ) -> None:
@@ -270,7 +301,7 @@ def sweep(
     load(file, set_ or [])
     ranges = [parse_range(p) for p in param]
     writable_folder(out)
-    runner = make_executor(executor, workers, scheduler)
+    runner = make_executor(executor, workers, scheduler, insecure=insecure_scheduler)
     run = run_sweep(file, ranges, out=out, overrides=tuple(set_ or []), backend=backend, executor=runner)
     rows = list(run.values.values())
     if json_:

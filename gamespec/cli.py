@@ -11,6 +11,7 @@ saying why; tracebacks are for bugs only.
 from __future__ import annotations
 
 import json
+import logging
 import sys
 import warnings
 from collections.abc import Iterator
@@ -478,9 +479,15 @@ def _quiet() -> Iterator[None]:
     already; where a command imports it later, they reach the same filter as warnings. NumPy is
     not imported for it: ``--help`` and ``validate`` of most files never need it."""
     numpy = sys.modules.get("numpy")
-    with warnings.catch_warnings(), numpy.errstate(all="ignore") if numpy else nullcontext():
-        warnings.simplefilter("ignore")
-        yield
+    matplotlib_log = logging.getLogger("matplotlib")
+    level = matplotlib_log.level
+    matplotlib_log.setLevel(logging.ERROR)  # its notes on axis limits are warnings too
+    try:
+        with warnings.catch_warnings(), numpy.errstate(all="ignore") if numpy else nullcontext():
+            warnings.simplefilter("ignore")
+            yield
+    finally:
+        matplotlib_log.setLevel(level)
 
 
 def run(argv: list[str] | None = None) -> int:

@@ -351,18 +351,19 @@ def results(
 ) -> None:
     """Print a study's table (sweep, compare, Table 2.1) and export it as CSV or Parquet."""
     from gamespec.studies.export import find_store, study_rows, write_csv, write_parquet
+    from gamespec.studies.rows import study_meta
 
     store = find_store(folder)
     rows = study_rows(store)
+    study = study_meta(store)
     for line in store.damaged:
         print(line, file=sys.stderr)
     if json_:
         sys.stdout.write(json.dumps(rows, indent=2) + "\n")
     else:
-        study = store.meta("study") or {}
         present = {name for row in rows for name in row}
-        shown = [c for c in [*study.get("parameters", []), *RESULT_COLUMNS] if c in present]
-        title = f"{study.get('type', 'study')} {study.get('problem', '')}: {len(rows)} points".strip()
+        shown = [c for c in [*study.parameters, *RESULT_COLUMNS] if c in present]
+        title = f"{study.type or 'study'} {study.problem}: {len(rows)} points".strip()
         _console().print(_rows_table(rows, shown or ["key"], title))
     for path in (write_csv(rows, csv) if csv else None, write_parquet(rows, parquet) if parquet else None):
         if path is not None:

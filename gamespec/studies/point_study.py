@@ -11,7 +11,7 @@ from abc import abstractmethod
 from collections.abc import Callable, Mapping
 from typing import Any, ClassVar
 
-from pydantic import Field, ValidationError
+from pydantic import BaseModel, Field, ValidationError
 
 from gamespec.backend import Backend, CompiledModel, Inputs, refuse_inputs
 from gamespec.errors import SpecError, UnsupportedFeature
@@ -81,6 +81,18 @@ class PointStudyModel(CompiledModel):
     def result(self, rows: list[dict[str, Any]], run: StudyRun) -> Result:
         """The Result of all rows (in the order of :meth:`points`)."""
 
+    row_model: ClassVar[type[BaseModel]]
+    """What a stored row must be to be reused (a store is untrusted input): one that does not
+    validate is computed again."""
+
+    def reusable(self, row: Any) -> bool:
+        """Whether a stored row validates as :attr:`row_model`."""
+        try:
+            self.row_model.model_validate(row)
+        except ValidationError:
+            return False
+        return True
+
     def prepare(self, store: ResultStore) -> None:
         """Record what the store holds before the run (nothing by default)."""
 
@@ -104,6 +116,7 @@ class PointStudyModel(CompiledModel):
             ),
             description=self.spec.name,
             show_progress=options.progress,
+            accept=self.reusable,
             spec_hash=spec_hash(self.spec),
         )
         result = self.result([run.values[key] for key in points], run)

@@ -101,8 +101,8 @@ def plot_study(store: ResultStore, output_dir: str | Path) -> list[Path]:
     if study.type == "sweep":
         paths = _sweep(rows, study.parameters, folder)
         values = list(valid_points(store).values())
-        if desensitized_rows(values):
-            paths += plot_tradeoff(values, folder)
+        if desensitized_rows(values) and study.parameters:
+            paths += plot_tradeoff(values, folder, study.parameters[0])
         games = capture_rows(values)
         for name in study.parameters if games else []:
             points = [(row[name], row["metrics"]) for row in games if _number(row.get(name)) is not None]

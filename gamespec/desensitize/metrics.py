@@ -25,10 +25,8 @@ class MonteCarlo(BaseModel):
 
     model_config = ConfigDict(extra="allow")
 
-    samples: int | None = Field(None, description="Number of samples drawn.")
-    final_state_mean: dict[str, float | None] = Field(
-        default_factory=dict, description="Mean final value of each original state."
-    )
+    samples: int | None = Field(description="Number of samples drawn.")
+    final_state_mean: dict[str, float | None] = Field(description="Mean final value of each original state.")
 
     def check(self, result: Result, planar: list[tuple[str, str]]) -> None:
         """The states and bundles :func:`gamespec.desensitize.plotting.plot_desensitized` draws."""

@@ -48,8 +48,12 @@ class FlowGameMetrics(Metrics):
     game_scheme: str | None = None
 
     def check(self, result: Result) -> None:
-        if self.capture_time is not None and self.capture_point is None:
-            raise ValueError("metrics.capture_point is missing")
+        if self.capture_time is not None and (
+            self.capture_point is None or "game_converged" not in self.model_fields_set
+        ):
+            raise ValueError(
+                "metrics.capture_point and metrics.game_converged are needed with a capture time"
+            )
         if "nominal_positions" in result.arrays:
             if self.capture_time is None or self.reachability is None:
                 raise ValueError("metrics.capture_time and metrics.reachability are needed with paths")

@@ -21,10 +21,10 @@ class Figure(BaseModel):
 
     model_config = ConfigDict(extra="allow")
 
-    obstacle_radius: PositiveFloat | None = Field(None, allow_inf_nan=False, description="r of the obstacle.")
+    obstacle_radius: PositiveFloat | None = Field(allow_inf_nan=False, description="r of the obstacle.")
     positions: dict[str, tuple[str, str]] = Field(description="Each player's (x, y) state names.")
     lookahead_players: dict[str, list[str]] = Field(
-        default_factory=dict, description="Each viewing player's look-ahead: the players it simulates."
+        description="Each viewing player's look-ahead: the players it simulates."
     )
 
 
@@ -49,8 +49,8 @@ class GameMetrics(OcpMetrics):
     all_converged: bool | None = None
 
     def check(self, result: Result) -> None:
-        if self.steps is not None and self.captured is None:
-            raise ValueError("metrics.captured is missing")
+        if self.steps is not None and (self.captured is None or self.all_converged is None):
+            raise ValueError("metrics.captured and metrics.all_converged are needed with metrics.steps")
         if self.captured and self.capture_time is None:
             raise ValueError("metrics.capture_time is missing for a captured run")
         if self.figure is None:

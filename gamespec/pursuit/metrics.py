@@ -4,7 +4,7 @@
 
 from __future__ import annotations
 
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING, Annotated, Any
 
 from pydantic import BaseModel, ConfigDict, Field, ValidationError
 
@@ -20,12 +20,12 @@ class Arcs(BaseModel):
 
     model_config = ConfigDict(extra="allow")
 
-    tau1: Finite | None = None
-    tau2: Finite | None = None
-    interior_duration: Finite | None = None
-    boundary_duration: Finite | None = None
-    line_of_sight_duration: Finite | None = None
-    switching_residual: float | None = None
+    tau1: Finite
+    tau2: Finite
+    interior_duration: Finite
+    boundary_duration: Finite
+    line_of_sight_duration: Finite
+    switching_residual: float | None
 
 
 class EngagementMetrics(Metrics):
@@ -37,7 +37,9 @@ class EngagementMetrics(Metrics):
     terminal_distances: dict[str, float | None] = Field(default_factory=dict)
     region: str | None = Field(None, description="D1, D2 or N (§2.3) of P2.")
     initial_heading: float | None = None
-    arcs: Arcs | None = None
+    arcs: Arcs | Annotated[dict[str, Any], Field(max_length=0)] | None = Field(
+        None, description="Relay arcs (an empty mapping: none)."
+    )
     engagement: dict[str, Any] | None = Field(
         None, description="The players and the capture radius (an engagement spec's fields)."
     )
@@ -54,10 +56,6 @@ class EngagementMetrics(Metrics):
             raise ValueError(f"{where}: {' '.join(first['msg'].split())}") from None
 
     def check(self, result: Result) -> None:
-        if self.arcs is not None and self.arcs.model_fields_set:
-            missing = [k for k, v in self.arcs if k != "switching_residual" and v is None]
-            if missing:
-                raise ValueError(f"metrics.arcs lacks {', '.join(missing)}")
         if self.engagement is not None:
             self.spec()
         if "path_evader" not in result.arrays:
@@ -82,14 +80,14 @@ class TableRow(BaseModel):
     v: Finite = Field(description="Evader speed.")
     points: int | None = None
     solved: int | None = None
-    average_variation_percent: float | None = None
-    maximum_variation_percent: float | None = None
+    average_variation_percent: float | None
+    maximum_variation_percent: float | None
 
 
 class SuboptimalStudyMetrics(Metrics):
     """Metrics of a ``pursuit_suboptimal_study`` Result."""
 
-    table: list[TableRow] = Field(default_factory=list, description="One row per speed.")
+    table: list[TableRow] = Field(description="One row per speed.")
     points: int | None = None
     solved: int | None = None
     computed: int | None = None

@@ -18,7 +18,7 @@ class Rcs(BaseModel):
 
     model_config = ConfigDict(extra="allow")
 
-    relevance: str = Field("logistic_derivative", description="Name or expression of r̃(w).")
+    relevance: str = Field(description="Name or expression of r̃(w).")
 
 
 def check_obstacles(result: Result, obstacles: dict[str, float]) -> None:
@@ -55,9 +55,9 @@ class StudyRow(BaseModel):
 class RcsStudyMetrics(Metrics):
     """Metrics of an ``rcs_multi_obstacle_study`` Result (Fig. 6.11)."""
 
-    table: list[StudyRow] = Field(default_factory=list, description="One row per (N, α).")
+    table: list[StudyRow] = Field(description="One row per (N, α).")
     layout: dict[str, list[tuple[Finite, Finite, Finite]]] = Field(
-        default_factory=dict, description="Per N: each obstacle's x_i, y_i(0) and direction."
+        description="Per N: each obstacle's x_i, y_i(0) and direction."
     )
     radius: PositiveFloat = Field(1.0, allow_inf_nan=False, description="The obstacles' radius.")
     points: int | None = None

@@ -1,0 +1,166 @@
+"""Fuzzing saved inputs (README, "Security"): tampered Result folders through ``gamespec plot``,
+``Result.load`` and ``guess: {result: DIR}``, and tampered study stores through ``gamespec
+results``, ``gamespec plot`` and a resumed ``gamespec sweep``. Every input keeps the bad-input
+promise (:mod:`tests.fuzz.harness`) within the CPU-time bound, with no traceback, and no input
+grows the memory of the process by more than :data:`MEMORY_GROWTH_BYTES`. A FIFO ``result.json``
+is answered within a second."""
+
+from __future__ import annotations
+
+import os
+import resource
+import shutil
+import signal
+import tempfile
+from collections.abc import Iterator
+from contextlib import contextmanager
+from pathlib import Path
+
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from gamespec.errors import GamespecError
+from gamespec.limits import MAX_ARRAY_VALUES
+from gamespec.result import Result
+from tests.conftest import PROBLEMS
+from tests.fuzz.harness import TIME_BOUND_S, assert_promise, run_cli
+from tests.fuzz.saved import RESULTS, STORES, result_tampering, store_tampering
+
+pytestmark = pytest.mark.skipif(not RESULTS or not STORES, reason="no seeds: python -m tests.fuzz.make_saved")
+
+MEMORY_GROWTH_BYTES = 8 * MAX_ARRAY_VALUES
+"""Most a tampered input may add to the process's peak memory: one array of the largest size a
+saved Result may hold (an input claiming more is refused before anything is allocated)."""
+
+ANIMATION_BOUND_S = 12 * TIME_BOUND_S
+"""CPU seconds a ``plot --animate`` may take: an animation draws up to 60 frames (a shipped
+scenario's takes about 20 s of CPU on an idle core), each more than a still figure."""
+
+LONG = os.environ.get("HYPOTHESIS_PROFILE") == "long"
+
+
+def examples(fast: int) -> int:
+    """Inputs per test: ``fast`` in the default profile (a few seconds in all), 25 times as many
+    in the long one."""
+    return 25 * fast if LONG else fast
+
+
+ZERMELO = PROBLEMS / "ch6" / "zermelo_min_time.yaml"
+SWEPT = PROBLEMS / "ch2" / "one_on_one_pure_evasion.yaml"
+
+
+def _peak_bytes() -> int:
+    return resource.getrusage(resource.RUSAGE_SELF).ru_maxrss * 1024
+
+
+@contextmanager
+def _copy(seed: Path) -> Iterator[Path]:
+    with tempfile.TemporaryDirectory() as scratch:
+        folder = Path(scratch) / seed.name
+        shutil.copytree(seed, folder)
+        yield folder
+
+
+def _check(args: list[object], folder: Path, *, reports: bool = False, bound_s: float = TIME_BOUND_S) -> None:
+    """The promise for one run on a tampered ``folder`` within ``bound_s`` of CPU time;
+    ``reports``: a store's damaged-record lines (and ``wrote FILE``) may come with a successful
+    answer on stderr."""
+    before = _peak_bytes()
+    outcome = run_cli([str(a) for a in args], bound_s=bound_s)
+    assert _peak_bytes() - before < MEMORY_GROWTH_BYTES, outcome
+    if reports and outcome.code == 0:
+        assert all(
+            line.startswith((str(folder), "wrote ", "resuming: ")) for line in outcome.err.splitlines()
+        ), outcome
+        return
+    assert_promise(outcome, "")
+    assert "Traceback" not in outcome.err, outcome
+
+
+@settings(max_examples=examples(12))
+@given(
+    seed=st.sampled_from(RESULTS),
+    tampering=result_tampering(),
+    animate=st.integers(0, 9).map(lambda n: n == 0),
+)
+def test_tampered_result_folders_plot(seed: Path, tampering, animate: bool) -> None:
+    _, tamper = tampering
+    with _copy(seed) as folder:
+        tamper(folder)
+        small = animate and seed.name in {"optimal_control", "engagement", "lq_stochastic_game"}
+        _check(
+            ["plot", folder, "--out", folder.parent / "figures", *(["--animate"] if small else [])], folder
+        )
+
+
+@settings(max_examples=examples(25))
+@given(seed=st.sampled_from(RESULTS), tampering=result_tampering())
+def test_tampered_result_folders_load(seed: Path, tampering) -> None:
+    _, tamper = tampering
+    with _copy(seed) as folder:
+        tamper(folder)
+        before = _peak_bytes()
+        try:
+            Result.load(folder)
+        except GamespecError as err:
+            assert "\n" not in str(err)
+        assert _peak_bytes() - before < MEMORY_GROWTH_BYTES
+
+
+@settings(max_examples=examples(4))
+@given(tampering=result_tampering())
+def test_tampered_result_as_a_guess(tampering) -> None:
+    _, tamper = tampering
+    seed = next(r for r in RESULTS if r.name == "optimal_control")
+    with _copy(seed) as folder:
+        tamper(folder)
+        _check(["solve", ZERMELO, "--set", f"guess.result={folder}"], folder)
+
+
+@settings(max_examples=examples(12))
+@given(
+    seed=st.sampled_from(STORES),
+    tampering=store_tampering(),
+    command=st.sampled_from(["results", "results --csv", "results --json", "plot"]),
+)
+def test_tampered_study_stores(seed: Path, tampering, command: str) -> None:
+    _, tamper = tampering
+    with _copy(seed) as folder:
+        tamper(folder)
+        name, *flags = command.split()
+        extra = [folder.parent / "table.csv"] if flags == ["--csv"] else []
+        out = ["--out", folder.parent / "figures"] if name == "plot" else []
+        _check([name, folder, *flags, *extra, *out], folder, reports=True)
+
+
+@settings(max_examples=examples(3))
+@given(tampering=store_tampering())
+def test_tampered_sweep_store_resumes(tampering) -> None:
+    _, tamper = tampering
+    seed = next(s for s in STORES if s.name == "sweep")
+    with _copy(seed) as folder:
+        tamper(folder)
+        grid = ["--param", "v=0.3,0.5", "--param", "u=1,1.5"]
+        _check(["sweep", SWEPT, *grid, "--out", folder, "--json"], folder, reports=True)
+
+
+def test_a_fifo_result_json_is_answered_within_a_second(tmp_path) -> None:
+    """The one wall-clock bound here: a FIFO uses no CPU while it blocks, so a CPU bound cannot
+    see it; the answer takes microseconds of work."""
+    folder = tmp_path / "fifo"
+    shutil.copytree(RESULTS[0], folder)
+    (folder / "result.json").unlink()
+    os.mkfifo(folder / "result.json")
+
+    def expire(signum, frame):
+        raise TimeoutError("Result.load blocked on a FIFO")
+
+    previous = signal.signal(signal.SIGALRM, expire)
+    signal.setitimer(signal.ITIMER_REAL, 1.0)
+    try:
+        with pytest.raises(GamespecError, match="not a regular file"):
+            Result.load(folder)
+    finally:
+        signal.setitimer(signal.ITIMER_REAL, 0)
+        signal.signal(signal.SIGALRM, previous)

@@ -209,9 +209,14 @@ class Result(BaseModel):
         return validated(result, str(json_file))
 
     def _check_grids(self) -> None:
-        """ValueError unless the time grids are finite vectors and every trajectory has one row per
-        point of its grid (``states`` on ``time``, ``controls`` on ``control_time`` or ``time``,
-        ``costates`` on ``arrays["costate_time"]`` or ``time``)."""
+        """ValueError unless every array holds numbers or text, the time grids are finite vectors
+        and every trajectory has one row per point of its grid (``states`` on ``time``,
+        ``controls`` on ``control_time`` or ``time``, ``costates`` on ``arrays["costate_time"]``
+        or ``time``)."""
+        for field in ("states", "controls", "costates", "arrays"):
+            for name, values in getattr(self, field).items():
+                if values.dtype.kind not in "biufcU":
+                    raise ValueError(f"{field}.{name} is not an array of numbers or text ({values.dtype})")
         grids = {"time": self.time, "control_time": self.control_time, "costate_time": None}
         if "costate_time" in self.arrays:
             grids["costate_time"] = np.asarray(self.arrays["costate_time"], dtype=float)

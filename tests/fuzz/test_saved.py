@@ -7,12 +7,15 @@ is answered within a second."""
 
 from __future__ import annotations
 
+import json
 import os
+import re
 import resource
 import shutil
 import signal
 import tempfile
-from collections.abc import Iterator
+import zipfile
+from collections.abc import Callable, Iterator
 from contextlib import contextmanager
 from pathlib import Path
 
@@ -25,7 +28,7 @@ from gamespec.limits import MAX_ARRAY_VALUES
 from gamespec.result import Result
 from tests.conftest import PROBLEMS
 from tests.fuzz.harness import TIME_BOUND_S, assert_promise, run_cli
-from tests.fuzz.saved import RESULTS, STORES, result_tampering, store_tampering
+from tests.fuzz.saved import RESULTS, STORES, _npy, result_tampering, store_tampering
 
 pytestmark = pytest.mark.skipif(not RESULTS or not STORES, reason="no seeds: python -m tests.fuzz.make_saved")
 
@@ -164,3 +167,88 @@ def test_a_fifo_result_json_is_answered_within_a_second(tmp_path) -> None:
     finally:
         signal.setitimer(signal.ITIMER_REAL, 0)
         signal.signal(signal.SIGALRM, previous)
+
+
+def _json_edit(edit):
+    def tamper(folder: Path) -> None:
+        document = json.loads((folder / "result.json").read_text())
+        edit(document)
+        (folder / "result.json").write_text(json.dumps(document))
+
+    return tamper
+
+
+def _npy_member(header: str, data: bytes = b"") -> Callable[[Path], None]:
+    def tamper(folder: Path) -> None:
+        with zipfile.ZipFile(folder / "arrays.npz", "w") as archive:
+            archive.writestr("time.npy", _npy(header, data))
+
+    return tamper
+
+
+ISSUE_CASES = {
+    "a symlink to /dev/zero": ("optimal_control", lambda f: _replace_by_link(f, "/dev/zero"), "leads out"),
+    "a header claiming 10**15 values": (
+        "optimal_control",
+        _npy_member("{'descr': '<f8', 'fortran_order': False, 'shape': (1000000000000000,), }"),
+        "MAX_ARRAY_VALUES",
+    ),
+    "a header holding code": (
+        "optimal_control",
+        _npy_member("{'descr': __import__('os').getcwd(), 'fortran_order': False, 'shape': (3,), }"),
+        "not a plain array",
+    ),
+    "an object dtype": (
+        "optimal_control",
+        _npy_member("{'descr': '|O', 'fortran_order': False, 'shape': (1,), }", b"\0" * 8),
+        "not a plain array",
+    ),
+    "engagement.pursuers.1 = []": (
+        "engagement",
+        _json_edit(lambda d: d["metrics"]["engagement"]["pursuers"].__setitem__(1, [])),
+        "metrics.engagement.pursuers.1",
+    ),
+    "figure.obstacle_radius = 'abc'": (
+        "differential_game",
+        _json_edit(lambda d: d["metrics"]["figure"].__setitem__("obstacle_radius", "abc")),
+        "metrics.figure.obstacle_radius",
+    ),
+    "a scenario read as a differential game": (
+        "pursuit_scenario",
+        _json_edit(lambda d: d.__setitem__("kind", "differential_game")),
+        "states.pursuers",
+    ),
+    "allocation_history.2.assignment.2 = '0'": (
+        "pursuit_scenario",
+        _json_edit(lambda d: d["metrics"]["allocation_history"][2]["assignment"].__setitem__(2, "0")),
+        None,
+    ),
+}
+"""The tampered folders issue 27 names, with what the one line must say (None: the folder is still
+a Result its readers can draw, so it plots)."""
+
+
+def _replace_by_link(folder: Path, target: str) -> None:
+    (folder / "result.json").unlink()
+    (folder / "result.json").symlink_to(target)
+
+
+@pytest.mark.parametrize("case", sorted(ISSUE_CASES))
+def test_the_folders_issue_27_names(case: str) -> None:
+    seed_name, tamper, needle = ISSUE_CASES[case]
+    with _copy(next(r for r in RESULTS if r.name == seed_name)) as folder:
+        tamper(folder)
+        if needle is None:
+            assert Result.load(folder).kind == "pursuit_scenario"
+            return
+        with pytest.raises(GamespecError, match=re.escape(needle)) as refused:
+            Result.load(folder)
+        assert "\n" not in str(refused.value)
+
+
+@pytest.mark.slow
+def test_the_animated_scenario_of_issue_27_ends_within_its_bound() -> None:
+    _, tamper, _ = ISSUE_CASES["allocation_history.2.assignment.2 = '0'"]
+    with _copy(next(r for r in RESULTS if r.name == "pursuit_scenario")) as folder:
+        tamper(folder)
+        _check(["plot", folder, "--out", folder.parent / "f", "--animate"], folder, bound_s=ANIMATION_BOUND_S)

@@ -89,14 +89,17 @@ class ResultStore:
         try:
             return self._connect()
         except sqlite3.OperationalError as err:
-            raise GamespecError(f"{self.path}: cannot open the study store ({err})") from None
+            raise GamespecError(
+                f"{self.path}: cannot open the study store ({' '.join(str(err).split())})"
+            ) from None
         except sqlite3.DatabaseError as err:
             stamp = _dt.datetime.now(_dt.UTC).strftime("%Y%m%dT%H%M%S")
             aside = self.path.with_name(f"{FILENAME}.damaged-{stamp}")
             self.path.rename(aside)
             for suffix in ("-wal", "-shm"):
                 self.path.with_name(FILENAME + suffix).unlink(missing_ok=True)
-            self._unreadable.append(f"{self.path}: unreadable ({err}); moved to {aside.name}, starting anew")
+            why = " ".join(str(err).split())
+            self._unreadable.append(f"{self.path}: unreadable ({why}); moved to {aside.name}, starting anew")
             return self._connect()
 
     def close(self) -> None:

@@ -91,6 +91,14 @@ SchedulerOpt = Annotated[
         help="Address of a running Dask scheduler, e.g. tcp://host:8786 (env GAMESPEC_SCHEDULER).",
     ),
 ]
+StudySchedulerOpt = Annotated[
+    str | None,
+    typer.Option(
+        "--scheduler",
+        help="Run a study kind on this Dask scheduler, e.g. tcp://host:8786 (else GAMESPEC_SCHEDULER, "
+        "else the file's executor).",
+    ),
+]
 InsecureOpt = Annotated[
     bool,
     typer.Option(
@@ -141,7 +149,7 @@ def solve(
     out: OutOpt = None,
     json_: JsonOpt = False,
     plot: Annotated[bool, typer.Option("--plot", help="Also write plots (into --out or .).")] = False,
-    scheduler: SchedulerOpt = None,
+    scheduler: StudySchedulerOpt = None,
     insecure_scheduler: InsecureOpt = False,
 ) -> None:
     """Solve a problem file and print a summary (or the Result as JSON); a study kind runs on the

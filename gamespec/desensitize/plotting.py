@@ -87,7 +87,7 @@ def desensitized_rows(values: Iterable[Mapping[str, Any]]) -> list[Mapping[str, 
     """The rows of a sweep (its points' saved values, validated: :mod:`gamespec.studies.rows`)
     whose metrics carry both the original cost and the sensitivity measure."""
     keys = ("nominal_objective", "sensitivity_measure")
-    return [v for v in values if all(isinstance(v["metrics"].get(k), int | float) for k in keys)]
+    return [v for v in values if all(isinstance(v.get("metrics", {}).get(k), int | float) for k in keys)]
 
 
 def plot_tradeoff(values: Iterable[Mapping[str, Any]], output_dir: Path, parameter: str) -> list[Path]:

@@ -252,3 +252,25 @@ def test_the_animated_scenario_of_issue_27_ends_within_its_bound() -> None:
     with _copy(next(r for r in RESULTS if r.name == "pursuit_scenario")) as folder:
         tamper(folder)
         _check(["plot", folder, "--out", folder.parent / "f", "--animate"], folder, bound_s=ANIMATION_BOUND_S)
+
+
+@pytest.mark.parametrize("seed_name", ["sweep", "table_2_1"])
+def test_a_point_of_the_wrong_shape_is_reported_and_left_out(seed_name: str) -> None:
+    import sqlite3
+
+    from gamespec.studies.store import _digest
+
+    with _copy(next(s for s in STORES if s.name == seed_name)) as folder:
+        db = sqlite3.connect(folder / "store.sqlite", isolation_level=None)
+        (count,) = db.execute("SELECT count(*) FROM points").fetchone()
+        (key,) = db.execute("SELECT key FROM points LIMIT 1").fetchone()
+        db.execute("UPDATE points SET value = '[]', digest = ? WHERE key = ?", (_digest("[]"), key))
+        db.close()
+        table = run_cli(["results", folder, "--json"])
+        assert table.code == 0 and len(json.loads(table.out)) == count - 1
+        assert table.err.strip().splitlines() == [
+            f"{folder / 'store.sqlite'}: record {key!r} is damaged "
+            "(a sweep point is list, not a mapping); computing it again"
+        ]
+        figures = run_cli(["plot", folder, "--out", folder.parent / "figures"])
+        assert figures.code == 0, figures

@@ -91,10 +91,9 @@ def test_tampered_result_folders_plot(seed: Path, tampering, animate: bool) -> N
     _, tamper = tampering
     with _copy(seed) as folder:
         tamper(folder)
-        small = animate and seed.name in {"optimal_control", "engagement", "lq_stochastic_game"}
-        _check(
-            ["plot", folder, "--out", folder.parent / "figures", *(["--animate"] if small else [])], folder
-        )
+        flags = ["--animate"] if animate else []
+        bound = ANIMATION_BOUND_S if animate else TIME_BOUND_S
+        _check(["plot", folder, "--out", folder.parent / "figures", *flags], folder, bound_s=bound)
 
 
 @settings(max_examples=examples(25))

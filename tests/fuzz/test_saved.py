@@ -85,9 +85,10 @@ def _check(args: list[object], folder: Path, *, reports: bool = False, bound_s: 
 @given(
     seed=st.sampled_from(RESULTS),
     tampering=result_tampering(),
-    animate=st.integers(0, 9).map(lambda n: n == 0),
+    animate=st.integers(0, 9).map(lambda n: LONG and n == 0),
 )
 def test_tampered_result_folders_plot(seed: Path, tampering, animate: bool) -> None:
+    """A tenth of the long profile's plots are animations (seconds of CPU each; none in the fast one)."""
     _, tamper = tampering
     with _copy(seed) as folder:
         tamper(folder)

@@ -132,7 +132,7 @@ def _read_npy(member: BinaryIO, info: zipfile.ZipInfo, before: int) -> np.ndarra
         raise UnreadableArrays(f"{info.filename}: a header of {length} bytes")
     dtype, fortran, shape = parse_header(_read_exactly(member, length), info.filename)
     values = math.prod(shape)
-    if values > limits.MAX_ARRAY_VALUES:
+    if math.prod(n for n in shape if n) > limits.MAX_ARRAY_VALUES:  # (0, 10**16, 10**16) too
         raise UnreadableArrays(f"{info.filename}: shape {shape}, more values than MAX_ARRAY_VALUES")
     if before + values > limits.MAX_RESULT_VALUES:
         raise UnreadableArrays(f"{info.filename}: more values in all arrays than MAX_RESULT_VALUES")

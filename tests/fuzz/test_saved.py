@@ -193,6 +193,13 @@ ISSUE_CASES = {
         _npy_member("{'descr': '<f8', 'fortran_order': False, 'shape': (1000000000000000,), }"),
         "MAX_ARRAY_VALUES",
     ),
+    "a zero dimension beside huge ones (found by the fuzz)": (
+        "optimal_control",
+        _npy_member(
+            "{'descr': '<f8', 'fortran_order': False, 'shape': (0, 10000000000000000, 10000000000000000), }"
+        ),
+        "MAX_ARRAY_VALUES",
+    ),
     "a header holding code": (
         "optimal_control",
         _npy_member("{'descr': __import__('os').getcwd(), 'fortran_order': False, 'shape': (3,), }"),
@@ -224,8 +231,8 @@ ISSUE_CASES = {
         None,
     ),
 }
-"""The tampered folders issue 27 names, with what the one line must say (None: the folder is still
-a Result its readers can draw, so it plots)."""
+"""The tampered folders issue 27 names (and one the fuzz found), with what the one line must say
+(None: the folder is still a Result its readers can draw, so it plots)."""
 
 
 def _replace_by_link(folder: Path, target: str) -> None:

@@ -200,7 +200,7 @@ class Result(BaseModel):
             data.update(_read_arrays(folder, npz))
         try:
             result = cls.model_validate(data)
-            result._check_grids()
+            result._check_readable()
         except ValueError as err:
             source = npz if saved else json_file
             raise SpecError(f"not a readable Result: {_first_line(err)}", source=str(source)) from None
@@ -208,11 +208,14 @@ class Result(BaseModel):
 
         return validated(result, str(json_file))
 
-    def _check_grids(self) -> None:
-        """ValueError unless every array holds numbers or text, the time grids are finite vectors
+    def _check_readable(self) -> None:
+        """ValueError unless the problem's name is one file-name component (figures are named
+        after it), every array holds numbers or text, the time grids are finite vectors
         and every trajectory has one row per point of its grid (``states`` on ``time``,
         ``controls`` on ``control_time`` or ``time``, ``costates`` on ``arrays["costate_time"]``
         or ``time``)."""
+        if not self.problem or self.problem.startswith(".") or {"/", "\\", "\0"} & set(self.problem):
+            raise ValueError(f"problem {self.problem!r} is not a name figures can be written under")
         for field in ("states", "controls", "costates", "arrays"):
             for name, values in getattr(self, field).items():
                 if values.dtype.kind not in "biufcU":

@@ -12,12 +12,16 @@ stored, so only the model's fields are checked).
 from __future__ import annotations
 
 import math
-from typing import Any, Literal
+from typing import Annotated, Any, Literal
 
 from pydantic import BaseModel, ConfigDict, Field, ValidationError, model_validator
 
 from gamespec.metrics import metrics_model
 from gamespec.studies.store import ResultStore
+
+ParameterName = Annotated[str, Field(pattern=r"^[^./\\\x00][^/\\\x00]*$", max_length=200)]
+"""A swept parameter's dotted name; figures are named after it (``sweep_<name>.png``), so it is one
+file-name component."""
 
 
 class StudyMeta(BaseModel):
@@ -27,7 +31,7 @@ class StudyMeta(BaseModel):
 
     type: Literal["sweep", "compare"] | None = Field(None, description="sweep or compare.")
     problem: str = Field("", description="The problem's name.")
-    parameters: list[str] = Field(default_factory=list, description="A sweep's swept parameters.")
+    parameters: list[ParameterName] = Field(default_factory=list, description="A sweep's swept parameters.")
 
 
 class PointRow(BaseModel):

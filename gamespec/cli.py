@@ -416,7 +416,10 @@ def plot(
     if is_store(result):
         from gamespec.studies.plots import plot_study
 
-        paths = plot_study(ResultStore(result), folder)
+        store = ResultStore(result)
+        paths = plot_study(store, folder)
+        for line in store.damaged:
+            print(line, file=sys.stderr)
     else:
         paths = plot_result(Result.load(result), folder, animate=animate)
     for path in paths:

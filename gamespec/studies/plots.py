@@ -108,4 +108,6 @@ def plot_study(store: ResultStore, output_dir: str | Path) -> list[Path]:
             points = [(row[name], row["metrics"]) for row in games if _number(row.get(name)) is not None]
             paths.append(plot_capture_sweep(points, name, folder / f"capture_probability_{name}.png"))
         return paths
-    raise GamespecError(f"{store.folder}: not a sweep or a compare study")
+    damaged = [line for line in store.damaged if "meta:study" in line]
+    why = f" ({damaged[0].split(': ', 1)[1]})" if damaged else ""
+    raise GamespecError(f"{store.folder}: not a sweep or a compare study{why}")

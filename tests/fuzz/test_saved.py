@@ -281,3 +281,16 @@ def test_a_point_of_the_wrong_shape_is_reported_and_left_out(seed_name: str) -> 
         ]
         figures = run_cli(["plot", folder, "--out", folder.parent / "figures"])
         assert figures.code == 0, figures
+
+
+def test_a_parameter_name_cannot_write_a_figure_out_of_its_folder() -> None:
+    import sqlite3
+
+    with _copy(next(s for s in STORES if s.name == "sweep")) as folder:
+        db = sqlite3.connect(folder / "store.sqlite", isolation_level=None)
+        meta = json.dumps({"type": "sweep", "problem": "p", "parameters": ["../../escaped", "u"]})
+        db.execute("INSERT OR REPLACE INTO meta VALUES ('study', ?)", (meta,))
+        db.close()
+        outcome = run_cli(["plot", folder, "--out", folder / "figures"])
+        assert outcome.code == 2 and "meta:study" in outcome.err, outcome
+        assert not list(folder.parent.glob("*escaped*")) and not list(folder.parent.parent.glob("*escaped*"))

@@ -11,6 +11,7 @@ saying why; tracebacks are for bugs only.
 from __future__ import annotations
 
 import json
+import logging
 import sys
 import warnings
 from collections.abc import Iterator
@@ -81,6 +82,32 @@ JsonOpt = Annotated[bool, typer.Option("--json", help="Print the result as JSON 
 OutOpt = Annotated[Path | None, typer.Option("--out", help="Folder to save results into.")]
 
 
+SchedulerOpt = Annotated[
+    str | None,
+    typer.Option(
+        "--scheduler",
+        envvar="GAMESPEC_SCHEDULER",
+        help="Address of a running Dask scheduler, e.g. tcp://host:8786 (env GAMESPEC_SCHEDULER).",
+    ),
+]
+StudySchedulerOpt = Annotated[
+    str | None,
+    typer.Option(
+        "--scheduler",
+        help="Run a study kind on this Dask scheduler, e.g. tcp://host:8786 (else GAMESPEC_SCHEDULER, "
+        "else the file's executor).",
+    ),
+]
+InsecureOpt = Annotated[
+    bool,
+    typer.Option(
+        "--insecure-scheduler",
+        help="Reach a --scheduler on another machine without verified TLS: a scheduler can run code "
+        "in this process (README, Security).",
+    ),
+]
+
+
 def _version(value: bool) -> None:
     if value:
         from importlib.metadata import version
@@ -127,8 +154,11 @@ def solve(
     out: OutOpt = None,
     json_: JsonOpt = False,
     plot: Annotated[bool, typer.Option("--plot", help="Also write plots (into --out or .).")] = False,
+    scheduler: StudySchedulerOpt = None,
+    insecure_scheduler: InsecureOpt = False,
 ) -> None:
-    """Solve a problem file and print a summary (or the Result as JSON)."""
+    """Solve a problem file and print a summary (or the Result as JSON); a study kind runs on the
+    Dask ``--scheduler`` when one is given."""
     from gamespec.loader import load
     from gamespec.result import writable_folder
     from gamespec.solving import solve as run_solve
@@ -136,8 +166,9 @@ def solve(
     spec = load(file, set_ or [])
     if out is not None:
         writable_folder(out)
+    options = _where_it_runs(spec, backend, scheduler, insecure_scheduler)
     with _spinner(f"solving {spec.name} ..."):
-        result = run_solve(spec, backend)
+        result = run_solve(spec, backend, options=options)
     if out is not None:
         _remove_previous_figures(out)
         result.save(out)
@@ -159,6 +190,22 @@ def solve(
             file=sys.stderr,
         )
         raise typer.Exit(1)
+
+
+def _where_it_runs(spec, backend: str | None, scheduler: str | None, insecure: bool) -> dict | None:
+    """The study options ``--scheduler`` and ``--insecure-scheduler`` give, for a backend that runs
+    a study (None when neither is given); a GamespecError for any other backend."""
+    if not scheduler and not insecure:
+        return None
+    from gamespec.solving import backend_name
+    from gamespec.studies.point_study import PointStudyBackend
+
+    name = backend_name(spec, backend)
+    if not issubclass(registry.backend_class(name), PointStudyBackend):
+        raise GamespecError(
+            f"--scheduler: backend {name!r} runs no study (a sweep takes --scheduler: gamespec sweep)"
+        )
+    return {"scheduler": scheduler, "insecure_scheduler": insecure}
 
 
 FIGURE_SUFFIXES = (".png", ".gif", ".mp4")
@@ -241,14 +288,6 @@ ExecutorOpt = Annotated[
     ),
 ]
 WorkersOpt = Annotated[int, typer.Option(min=1, help="Worker processes (a LocalCluster's size for dask).")]
-SchedulerOpt = Annotated[
-    str | None,
-    typer.Option(
-        "--scheduler",
-        envvar="GAMESPEC_SCHEDULER",
-        help="Address of a running Dask scheduler, e.g. tcp://host:8786 (env GAMESPEC_SCHEDULER).",
-    ),
-]
 
 SWEEP_COLUMNS = ("status", "objective", "t_final", "solve_time_s")
 
@@ -262,6 +301,7 @@ def sweep(
     executor: ExecutorOpt = None,
     workers: WorkersOpt = 1,
     scheduler: SchedulerOpt = None,
+    insecure_scheduler: InsecureOpt = False,
     set_: SetOpt = None,
     json_: JsonOpt = False,
 ) -> None:
@@ -275,7 +315,7 @@ def sweep(
     load(file, set_ or [])
     ranges = [parse_range(p) for p in param]
     writable_folder(out)
-    runner = make_executor(executor, workers, scheduler)
+    runner = make_executor(executor, workers, scheduler, insecure=insecure_scheduler)
     run = run_sweep(file, ranges, out=out, overrides=tuple(set_ or []), backend=backend, executor=runner)
     rows = list(run.values.values())
     if json_:
@@ -346,21 +386,22 @@ def results(
     """Print a study's table (sweep, compare, Table 2.1) and export it as CSV or Parquet; for one
     Result's folder, its summary, and its trajectories as the exported table."""
     from gamespec.studies.export import find_store, study_rows, write_csv, write_parquet
+    from gamespec.studies.rows import study_meta
 
     if (folder / "result.json").is_file():
         _result_trajectories(folder, csv, parquet, json_)
         return
     store = find_store(folder)
     rows = study_rows(store)
+    study = study_meta(store)
     for line in store.damaged:
         print(line, file=sys.stderr)
     if json_:
         sys.stdout.write(json.dumps(rows, indent=2) + "\n")
     else:
-        study = store.meta("study") or {}
         present = {name for row in rows for name in row}
-        shown = [c for c in [*study.get("parameters", []), *RESULT_COLUMNS] if c in present]
-        title = f"{study.get('type', 'study')} {study.get('problem', '')}: {len(rows)} points".strip()
+        shown = [c for c in [*study.parameters, *RESULT_COLUMNS] if c in present]
+        title = f"{study.type or 'study'} {study.problem}: {len(rows)} points".strip()
         _console().print(_rows_table(rows, shown or ["key"], title))
     for path in (write_csv(rows, csv) if csv else None, write_parquet(rows, parquet) if parquet else None):
         if path is not None:
@@ -405,7 +446,10 @@ def plot(
     if is_store(result):
         from gamespec.studies.plots import plot_study
 
-        paths = plot_study(ResultStore(result), folder)
+        store = ResultStore(result)
+        paths = plot_study(store, folder)
+        for line in store.damaged:
+            print(line, file=sys.stderr)
     else:
         paths = plot_result(Result.load(result), folder, animate=animate)
     for path in paths:
@@ -477,9 +521,15 @@ def _quiet() -> Iterator[None]:
     already; where a command imports it later, they reach the same filter as warnings. NumPy is
     not imported for it: ``--help`` and ``validate`` of most files never need it."""
     numpy = sys.modules.get("numpy")
-    with warnings.catch_warnings(), numpy.errstate(all="ignore") if numpy else nullcontext():
-        warnings.simplefilter("ignore")
-        yield
+    matplotlib_log = logging.getLogger("matplotlib")
+    level = matplotlib_log.level
+    matplotlib_log.setLevel(logging.ERROR)  # its notes on axis limits are warnings too
+    try:
+        with warnings.catch_warnings(), numpy.errstate(all="ignore") if numpy else nullcontext():
+            warnings.simplefilter("ignore")
+            yield
+    finally:
+        matplotlib_log.setLevel(level)
 
 
 def run(argv: list[str] | None = None) -> int:

@@ -61,3 +61,28 @@ squared distances lose the precision a capture radius needs, and far beyond it t
 
 MAX_SPEED = 1e9
 """Largest speed of a player (``engagement``, ``pursuit_scenario``)."""
+
+# --- Saved Results and study stores (issue 27: a Result folder is untrusted input) -------------
+# Checked by gamespec.result.Result.load and gamespec.npyfile before anything is allocated.
+
+MAX_RESULT_JSON_BYTES = 64_000_000
+"""Largest ``result.json`` (or ``--json`` dump) read back (bytes)."""
+
+MAX_RESULT_NPZ_BYTES = 2_000_000_000
+"""Largest ``arrays.npz`` read back (bytes on disk)."""
+
+MAX_RESULT_ARRAYS = 10_000
+"""Most members (named arrays) of an ``arrays.npz``."""
+
+MAX_ARRAY_DIMENSIONS = 8
+"""Most dimensions of one saved array."""
+
+MAX_ARRAY_VALUES = 50_000_000
+"""Most values of one saved array (400 MB of doubles): room for an ``lq_stochastic_game``'s
+``MAX_SAMPLE_VALUES`` Monte Carlo samples."""
+
+MAX_RESULT_VALUES = 100_000_000
+"""Most values of all arrays of one saved Result together (800 MB of doubles)."""
+
+MAX_TEXT_CHARS = 10_000
+"""Longest text item of a saved text array (characters)."""

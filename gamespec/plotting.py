@@ -12,6 +12,7 @@ from __future__ import annotations
 from pathlib import Path
 
 from gamespec import registry
+from gamespec.metrics import validated
 from gamespec.obstacles import circles
 from gamespec.result import Result
 
@@ -135,6 +136,8 @@ def plot_plane(result: Result, pairs: list[tuple[str, str]], path: Path) -> Path
 
 
 def plot_result(result: Result, output_dir: Path, *, animate: bool = False) -> list[Path]:
-    """Dispatch to the plotter registered for the Result's kind."""
+    """Dispatch to the plotter registered for the Result's kind, with the Result's metrics
+    validated by the kind's schema (:func:`gamespec.metrics.validated`): a plotter reads only
+    metrics and arrays of the types and shapes that schema promises."""
     plotter = registry.load("gamespec.plotters", result.kind)
-    return plotter(result, output_dir, animate=animate)
+    return plotter(validated(result, result.problem or "<result>"), output_dir, animate=animate)

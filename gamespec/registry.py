@@ -2,7 +2,8 @@
 
 Groups: ``gamespec.kinds`` (spec classes by ``kind``), ``gamespec.backends`` (backend classes by
 name), ``gamespec.transforms`` (spec → spec reductions), ``gamespec.plotters`` (plot functions by
-kind), ``gamespec.summaries`` (the rows that lead a kind's solve summary), ``gamespec.executors``
+kind), ``gamespec.summaries`` (the rows that lead a kind's solve summary), ``gamespec.metrics``
+(the typed metrics of a kind's Results), ``gamespec.executors``
 (how a study runs its points) and ``gamespec.commands`` (Typer apps mounted as ``gamespec NAME``).
 Nothing is imported until it is asked for, so ``import gamespec`` stays light; the installed
 distributions' entry points are read in one pass, the first time any group is asked for.
@@ -22,6 +23,7 @@ GROUPS = (
     "gamespec.transforms",
     "gamespec.plotters",
     "gamespec.summaries",
+    "gamespec.metrics",
     "gamespec.executors",
     "gamespec.commands",
 )

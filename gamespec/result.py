@@ -9,16 +9,17 @@ from __future__ import annotations
 
 import json
 import math
-import zipfile
-import zlib
+import os
+import stat
 from dataclasses import dataclass
 from enum import StrEnum
 from pathlib import Path
-from typing import Any
+from typing import Any, BinaryIO
 
 import numpy as np
 from pydantic import BaseModel, ConfigDict, Field, field_serializer, field_validator
 
+from gamespec import limits
 from gamespec.errors import GamespecError, SpecError
 
 ArrayDict = dict[str, np.ndarray]
@@ -224,27 +225,41 @@ class Result(BaseModel):
     @classmethod
     def load(cls, path: str | Path) -> Result:
         """Read a Result saved by :meth:`save` (a folder or its ``result.json``), or a ``--json`` dump;
-        a SpecError naming the file that cannot be read (missing, empty, corrupt, arrays whose lengths
-        do not match their time grid, a time grid that is not finite) and why."""
+        a SpecError naming the file that cannot be read and why. The folder is untrusted input
+        (README, "Security"): only regular files inside it are opened (:func:`open_regular`), within
+        the limits of :mod:`gamespec.limits` (:mod:`gamespec.npyfile` for the arrays), and the
+        Result must hold together: trajectories with one row per point of their finite time grid,
+        and ``metrics`` of the kind's schema (:func:`gamespec.metrics.validated`)."""
         path = Path(path)
         folder = path if path.is_dir() else path.parent
         json_file = path / "result.json" if path.is_dir() else path
-        data = _read_json(json_file)
+        data = _read_json(folder, json_file)
         npz = folder / "arrays.npz"
-        if npz.exists() and json_file.name == "result.json":
-            data.update(_read_arrays(npz))
+        saved = json_file.name == "result.json" and (npz.is_symlink() or npz.exists())
+        if saved:
+            data.update(_read_arrays(folder, npz))
         try:
             result = cls.model_validate(data)
-            result._check_grids()
+            result._check_readable()
         except ValueError as err:
-            source = npz if npz.exists() and json_file.name == "result.json" else json_file
+            source = npz if saved else json_file
             raise SpecError(f"not a readable Result: {_first_line(err)}", source=str(source)) from None
-        return result
+        from gamespec.metrics import validated
 
-    def _check_grids(self) -> None:
-        """ValueError unless the time grids are finite vectors and every trajectory has one row per
-        point of its grid (``states`` on ``time``, ``controls`` on ``control_time`` or ``time``,
-        ``costates`` on ``arrays["costate_time"]`` or ``time``)."""
+        return validated(result, str(json_file))
+
+    def _check_readable(self) -> None:
+        """ValueError unless the problem's name is one file-name component (figures are named
+        after it), every array holds numbers or text, the time grids are finite vectors
+        and every trajectory has one row per point of its grid (``states`` on ``time``,
+        ``controls`` on ``control_time`` or ``time``, ``costates`` on ``arrays["costate_time"]``
+        or ``time``)."""
+        if not self.problem or self.problem.startswith(".") or {"/", "\\", "\0"} & set(self.problem):
+            raise ValueError(f"problem {self.problem!r} is not a name figures can be written under")
+        for field in ("states", "controls", "costates", "arrays"):
+            for name, values in getattr(self, field).items():
+                if values.dtype.kind not in "biufcU":
+                    raise ValueError(f"{field}.{name} is not an array of numbers or text ({values.dtype})")
         grids = {"time": self.time, "control_time": self.control_time, "costate_time": None}
         if "costate_time" in self.arrays:
             grids["costate_time"] = np.asarray(self.arrays["costate_time"], dtype=float)
@@ -266,31 +281,66 @@ def _first_line(err: BaseException) -> str:
     return " ".join(text.split("\n")[0].split()) or type(err).__name__
 
 
-def _read_json(json_file: Path) -> dict[str, Any]:
-    """The mapping in a Result's JSON file; a SpecError naming it when it is missing or not one."""
+def open_regular(folder: Path, path: Path, max_bytes: int) -> BinaryIO:
+    """``path`` opened for reading when it is a regular file of at most ``max_bytes`` that resolves
+    inside ``folder`` (symlinks within it are followed); a SpecError naming it otherwise. A FIFO or
+    a device is refused without blocking (it is opened non-blocking and checked before any read)."""
     try:
-        data = json.loads(json_file.read_text(encoding="utf-8"))
-    except (OSError, UnicodeDecodeError, ValueError, RecursionError) as err:
-        raise SpecError(f"not a readable Result: {_first_line(err)}", source=str(json_file)) from None
+        inside = path.resolve().is_relative_to(folder.resolve())
+    except (OSError, RuntimeError) as err:
+        raise SpecError(f"not a readable Result: {_first_line(err)}", source=str(path)) from None
+    if not inside:
+        raise SpecError(f"not a readable Result: it leads out of {folder}", source=str(path))
+    try:
+        fd = os.open(path, os.O_RDONLY | os.O_NONBLOCK | getattr(os, "O_CLOEXEC", 0))
+    except OSError as err:
+        raise SpecError(f"not a readable Result: {_first_line(err)}", source=str(path)) from None
+    info = os.fstat(fd)
+    why = None
+    if not stat.S_ISREG(info.st_mode):
+        why = "not a regular file (a FIFO, a device, a socket or a folder)"
+    elif info.st_size > max_bytes:
+        why = f"{info.st_size} bytes, more than the limit of {max_bytes}"
+    if why is not None:
+        os.close(fd)
+        raise SpecError(f"not a readable Result: {why}", source=str(path))
+    os.set_blocking(fd, True)
+    return os.fdopen(fd, "rb")
+
+
+def _read_json(folder: Path, json_file: Path) -> dict[str, Any]:
+    """The mapping in a Result's JSON file; a SpecError naming it when it is missing or not one."""
+    with open_regular(folder, json_file, limits.MAX_RESULT_JSON_BYTES) as handle:
+        try:
+            data = json.loads(handle.read(limits.MAX_RESULT_JSON_BYTES + 1).decode("utf-8"))
+        except (OSError, UnicodeDecodeError, ValueError, RecursionError) as err:
+            raise SpecError(f"not a readable Result: {_first_line(err)}", source=str(json_file)) from None
     if not isinstance(data, dict):
         raise SpecError("not a readable Result: the JSON does not hold a mapping", source=str(json_file))
     return data
 
 
-def _read_arrays(npz: Path) -> dict[str, Any]:
-    """The arrays of ``arrays.npz`` as Result fields; a SpecError naming the file when it is empty,
-    truncated or corrupt (a bad zip, a bad deflate stream, a pickled object)."""
+def _read_arrays(folder: Path, npz: Path) -> dict[str, Any]:
+    """The arrays of ``arrays.npz`` as Result fields (``states/x`` → ``states["x"]``); a SpecError
+    naming the file when it cannot be read within the limits (:mod:`gamespec.npyfile`)."""
+    from gamespec.npyfile import UnreadableArrays, read_npz
+
     fields: dict[str, Any] = {}
-    try:
-        with np.load(npz, allow_pickle=False) as packed:
-            for key in packed.files:
-                field, _, name = key.partition("/")
-                if name:
-                    fields.setdefault(field, {})[name] = packed[key]
-                else:
-                    fields[field] = packed[key]
-    except (OSError, EOFError, ValueError, KeyError, zipfile.BadZipFile, zlib.error) as err:
-        raise SpecError(f"not a readable Result: {_first_line(err)}", source=str(npz)) from None
+    with open_regular(folder, npz, limits.MAX_RESULT_NPZ_BYTES) as handle:
+        try:
+            arrays = read_npz(handle)
+        except (UnreadableArrays, OSError) as err:
+            raise SpecError(f"not a readable Result: {_first_line(err)}", source=str(npz)) from None
+    for key, array in arrays.items():
+        field, _, name = key.partition("/")
+        if field not in _ARRAY_FIELDS:
+            raise SpecError(f"not a readable Result: an array {key!r} of no Result field", source=str(npz))
+        if name:
+            fields.setdefault(field, {})[name] = array
+        elif field in ("time", "control_time"):
+            fields[field] = array
+        else:
+            raise SpecError(f"not a readable Result: {key!r} is a field of named arrays", source=str(npz))
     return fields
 
 

@@ -36,6 +36,13 @@ def study(
         str | None,
         typer.Option(envvar="GAMESPEC_SCHEDULER", help="Address of a running Dask scheduler."),
     ] = None,
+    insecure_scheduler: Annotated[
+        bool,
+        typer.Option(
+            "--insecure-scheduler",
+            help="Reach a --scheduler on another machine without verified TLS (README, Security).",
+        ),
+    ] = False,
     set_: Annotated[
         list[str] | None, typer.Option("--set", help="Override a value: dotted.path=value (repeatable).")
     ] = None,
@@ -59,6 +66,7 @@ def study(
         reason = f"expected kind 'pursuit_suboptimal_study', got {spec.kind!r}"
         raise SpecError(reason, field="kind", source=str(file))
     chosen = {"workers": workers, "executor": executor, "scheduler": scheduler}
+    chosen["insecure_scheduler"] = insecure_scheduler or None
     options = {"progress": True} | {name: value for name, value in chosen.items() if value is not None}
     result = solve(spec, options=options)
     if out is not None:

@@ -84,18 +84,20 @@ def plot_desensitized(result: Result, output_dir: Path) -> list[Path]:
 
 
 def desensitized_rows(values: Iterable[Mapping[str, Any]]) -> list[Mapping[str, Any]]:
-    """The rows of a sweep (its points' saved values) that carry desensitization metrics."""
-    return [value for value in values if "nominal_objective" in value.get("metrics", {})]
+    """The rows of a sweep (its points' saved values, validated: :mod:`gamespec.studies.rows`)
+    whose metrics carry both the original cost and the sensitivity measure."""
+    keys = ("nominal_objective", "sensitivity_measure")
+    return [v for v in values if all(isinstance(v.get("metrics", {}).get(k), int | float) for k in keys)]
 
 
-def plot_tradeoff(values: Iterable[Mapping[str, Any]], output_dir: Path) -> list[Path]:
-    """Original cost against the sensitivity measure, one point per swept value (Fig. 6.3(b)),
-    from a sweep's rows (:meth:`gamespec.studies.store.ResultStore.items`)."""
+def plot_tradeoff(values: Iterable[Mapping[str, Any]], output_dir: Path, parameter: str) -> list[Path]:
+    """Original cost against the sensitivity measure, one point per value of the swept
+    ``parameter`` (Fig. 6.3(b)), from a sweep's validated rows."""
     rows = desensitized_rows(values)
     if not rows:
         raise GamespecError("the sweep holds no solved desensitized points to plot")
     plt = _pyplot()
-    name = next(iter(rows[0]))  # a sweep row starts with its parameter values
+    name = parameter
     rows.sort(key=lambda r: r.get(name, 0.0))
     cost = [r["metrics"]["nominal_objective"] for r in rows]
     measure = [r["metrics"]["sensitivity_measure"] for r in rows]

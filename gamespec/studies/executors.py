@@ -52,7 +52,7 @@ class SerialExecutor:
     workers = 1
 
     @classmethod
-    def from_options(cls, workers: int, scheduler: str | None) -> SerialExecutor:
+    def from_options(cls, workers: int, scheduler: str | None, insecure: bool = False) -> SerialExecutor:
         return cls()
 
     def __enter__(self) -> Self:
@@ -110,7 +110,7 @@ class ProcessExecutor:
         self._pool: ProcessPoolExecutor | None = None
 
     @classmethod
-    def from_options(cls, workers: int, scheduler: str | None) -> ProcessExecutor:
+    def from_options(cls, workers: int, scheduler: str | None, insecure: bool = False) -> ProcessExecutor:
         return cls(workers)
 
     def _start(self) -> ProcessPoolExecutor:
@@ -175,16 +175,20 @@ class ProcessExecutor:
 _END: Any = object()
 
 
-def executor(name: str | None = None, workers: int = 1, scheduler: str | None = None) -> Executor:
+def executor(
+    name: str | None = None, workers: int = 1, scheduler: str | None = None, *, insecure: bool = False
+) -> Executor:
     """The executor plugin ``name`` for ``workers`` (and a Dask ``scheduler`` address, or the
-    ``GAMESPEC_SCHEDULER`` environment variable). Without a name: ``dask`` when a scheduler is
-    given, ``serial`` for one worker, ``process`` otherwise."""
+    ``GAMESPEC_SCHEDULER`` environment variable: the user's choice, never a problem file's).
+    Without a name: ``dask`` when a scheduler is given, ``serial`` for one worker, ``process``
+    otherwise. ``insecure`` lets the dask executor reach a scheduler on another machine without
+    verified TLS (:func:`gamespec.studies.dask_executor.connection_security`)."""
     scheduler = scheduler or os.environ.get(SCHEDULER_ENV) or None
     if name is None:
         name = "dask" if scheduler else ("serial" if workers <= 1 else "process")
     if workers < 1:
         raise GamespecError(f"--workers must be at least 1, got {workers}")
-    return registry.load(GROUP, name).from_options(workers, scheduler)
+    return registry.load(GROUP, name).from_options(workers, scheduler, insecure)
 
 
 def ordered_map(runner: Executor) -> Callable[[Callable[[T], R], Sequence[T]], list[R]]:

@@ -16,6 +16,7 @@ from pathlib import Path
 from typing import Any
 
 from gamespec.errors import GamespecError
+from gamespec.studies.rows import study_meta, valid_points
 from gamespec.studies.store import ResultStore, is_store
 
 
@@ -40,16 +41,17 @@ def _flatten(prefix: str, value: Any, into: dict[str, Any]) -> None:
 
 
 def study_rows(store: ResultStore) -> list[dict[str, Any]]:
-    """Flat rows of every intact point, provenance included: a sweep's in the order of its swept
-    parameters, others in the order they were saved."""
+    """Flat rows of every intact, valid point (:func:`~gamespec.studies.rows.valid_points`; the
+    others are reported in ``store.damaged``), provenance included: a sweep's in the order of its
+    swept parameters, others in the order they were saved."""
     provenance = store.provenance()
     rows = []
-    for key, value in store.items().items():
+    for key, value in valid_points(store).items():
         row: dict[str, Any] = {"key": key}
         _flatten("", value if isinstance(value, Mapping) else {"value": value}, row)
         _flatten("", provenance[key], row)
         rows.append(row)
-    swept = (store.meta("study") or {}).get("parameters", [])
+    swept = study_meta(store).parameters
     return sorted(
         rows, key=lambda row: [(row.get(p) is None, str(type(row.get(p))), row.get(p)) for p in swept]
     )

@@ -25,6 +25,7 @@ from gamespec.desensitize.plotting import desensitized_rows, plot_tradeoff
 from gamespec.errors import GamespecError
 from gamespec.flowfield.plotting import capture_rows, plot_capture_sweep
 from gamespec.studies.export import study_rows
+from gamespec.studies.rows import study_meta, valid_points
 from gamespec.studies.store import ResultStore
 
 OUTPUTS = ("objective", "t_final", "t_optimal", "t_suboptimal")
@@ -91,20 +92,22 @@ def _compare(rows: list[dict[str, Any]], folder: Path) -> list[Path]:
 def plot_study(store: ResultStore, output_dir: str | Path) -> list[Path]:
     """The figures of the study in ``store`` (see module doc), written into ``output_dir``."""
     folder = Path(output_dir)
-    study = store.meta("study") or {}
+    study = study_meta(store)
     rows = study_rows(store)
     if not rows:
-        raise GamespecError(f"{store.folder}: the study has no points yet")
-    if study.get("type") == "compare":
+        raise GamespecError(f"{store.folder}: the study has no valid points yet")
+    if study.type == "compare":
         return _compare(rows, folder)
-    if study.get("type") == "sweep":
-        paths = _sweep(rows, list(study.get("parameters", [])), folder)
-        values = [v for v in store.items().values() if isinstance(v, dict)]
-        if desensitized_rows(values):
-            paths += plot_tradeoff(values, folder)
+    if study.type == "sweep":
+        paths = _sweep(rows, study.parameters, folder)
+        values = list(valid_points(store).values())
+        if desensitized_rows(values) and study.parameters:
+            paths += plot_tradeoff(values, folder, study.parameters[0])
         games = capture_rows(values)
-        for name in study.get("parameters", []) if games else []:
+        for name in study.parameters if games else []:
             points = [(row[name], row["metrics"]) for row in games if _number(row.get(name)) is not None]
             paths.append(plot_capture_sweep(points, name, folder / f"capture_probability_{name}.png"))
         return paths
-    raise GamespecError(f"{store.folder}: not a sweep or a compare study")
+    damaged = [line for line in store.damaged if "meta:study" in line]
+    why = f" ({damaged[0].split(': ', 1)[1]})" if damaged else ""
+    raise GamespecError(f"{store.folder}: not a sweep or a compare study{why}")

@@ -8,13 +8,13 @@ from __future__ import annotations
 
 import time
 from abc import abstractmethod
-from collections.abc import Callable
+from collections.abc import Callable, Mapping
 from typing import Any, ClassVar
 
-from pydantic import Field
+from pydantic import BaseModel, Field, ValidationError
 
 from gamespec.backend import Backend, CompiledModel, Inputs, refuse_inputs
-from gamespec.errors import UnsupportedFeature
+from gamespec.errors import SpecError, UnsupportedFeature
 from gamespec.loader import spec_hash
 from gamespec.result import Result
 from gamespec.solving import get_backend
@@ -23,9 +23,19 @@ from gamespec.studies.executors import SCHEDULER_ENV, executor
 from gamespec.studies.runner import StudyRun, run_study
 from gamespec.studies.store import ResultStore
 
+USER_CHOICES = ("scheduler", "insecure_scheduler")
+"""Where a study runs: chosen by the user (``--scheduler``, ``GAMESPEC_SCHEDULER``, the API's
+``options``), never by a problem file."""
+
+SCHEDULER_FROM_FILE = (
+    "a problem file cannot choose the Dask scheduler its study runs on: a scheduler can run code in "
+    "the process that solves the file; pass --scheduler ADDRESS (or set GAMESPEC_SCHEDULER) instead"
+)
+
 
 class StudyOptions(StrictModel):
-    """Options of the point-study backends (``solver.options.study``, ``solver.options.rcs_study``)."""
+    """Options of the point-study backends (``solver.options.study``, ``solver.options.rcs_study``)
+    that a problem file may give; the scheduler is not one of them (:data:`USER_CHOICES`)."""
 
     workers: int = Field(1, ge=1, description="Worker processes (1: everything in this process).")
     executor: str | None = Field(
@@ -33,13 +43,21 @@ class StudyOptions(StrictModel):
         description="Executor plugin: serial, process or dask (default: serial for one worker, "
         "process for more, dask when a scheduler is given).",
     )
-    scheduler: str | None = Field(
-        None, description=f"Address of a running Dask scheduler (default: ${SCHEDULER_ENV})."
-    )
     progress: bool = Field(
         False,
         description="Show a progress bar on stderr (`gamespec pursuit study` does; `gamespec solve` "
         "shows its own spinner instead).",
+    )
+
+
+class StudyRunOptions(StudyOptions):
+    """:class:`StudyOptions` with where the study runs, as the user chose it (never from a file)."""
+
+    scheduler: str | None = Field(
+        None, description=f"Address of a running Dask scheduler (default: ${SCHEDULER_ENV})."
+    )
+    insecure_scheduler: bool = Field(
+        False, description="Reach a scheduler on another machine without verified TLS (README, Security)."
     )
 
 
@@ -63,6 +81,18 @@ class PointStudyModel(CompiledModel):
     def result(self, rows: list[dict[str, Any]], run: StudyRun) -> Result:
         """The Result of all rows (in the order of :meth:`points`)."""
 
+    row_model: ClassVar[type[BaseModel]]
+    """What a stored row must be to be reused (a store is untrusted input): one that does not
+    validate is computed again."""
+
+    def reusable(self, row: Any) -> bool:
+        """Whether a stored row validates as :attr:`row_model`."""
+        try:
+            self.row_model.model_validate(row)
+        except ValidationError:
+            return False
+        return True
+
     def prepare(self, store: ResultStore) -> None:
         """Record what the store holds before the run (nothing by default)."""
 
@@ -81,9 +111,12 @@ class PointStudyModel(CompiledModel):
             points,
             self.point_function(),
             store,
-            executor=executor(options.executor, options.workers, options.scheduler),
+            executor=executor(
+                options.executor, options.workers, options.scheduler, insecure=options.insecure_scheduler
+            ),
             description=self.spec.name,
             show_progress=options.progress,
+            accept=self.reusable,
             spec_hash=spec_hash(self.spec),
         )
         result = self.result([run.values[key] for key in points], run)
@@ -98,6 +131,30 @@ class PointStudyBackend(Backend):
     options_model: ClassVar[type[StrictModel]] = StudyOptions
     model: ClassVar[type[PointStudyModel]]
 
+    @classmethod
+    def validate_options(cls, raw: Mapping[str, Any], source: str = "<spec>") -> StrictModel:
+        """The file's block, refused with :data:`SCHEDULER_FROM_FILE` when it names a scheduler."""
+        for name in USER_CHOICES:
+            if name in raw:
+                raise SpecError(SCHEDULER_FROM_FILE, field=f"solver.options.{cls.name}.{name}", source=source)
+        return super().validate_options(raw, source)
+
+    def options(self, spec: SpecBase, overrides: dict[str, Any] | None = None) -> StudyRunOptions:
+        """The file's options (:meth:`validate_options`) with the caller's ``overrides``, which
+        alone may say where the study runs (``scheduler``, ``insecure_scheduler``)."""
+        chosen = dict(overrides or {})
+        where = {name: chosen.pop(name) for name in USER_CHOICES if name in chosen}
+        given = super().options(spec, chosen)
+        try:
+            return StudyRunOptions.model_validate(given.model_dump() | where)
+        except ValidationError as err:
+            raise SpecError(_first_error(err), field="options", source=spec.source) from None
+
     def _compile(self, spec: SpecBase, options: StudyOptions) -> PointStudyModel:
         get_backend(spec.ocp_backend)
         return self.model(spec, options)
+
+
+def _first_error(err: ValidationError) -> str:
+    first = err.errors()[0]
+    return f"{'.'.join(map(str, first['loc']))}: {first['msg']}"

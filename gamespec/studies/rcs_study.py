@@ -13,7 +13,10 @@ import time
 from collections.abc import Callable
 from typing import Any, ClassVar
 
+from pydantic import BaseModel, ConfigDict, model_validator
+
 from gamespec.loader import spec_from_dict
+from gamespec.metrics import Finite
 from gamespec.rcs import study
 from gamespec.rcs.study import StudyPoint, point_problem
 from gamespec.result import Result, Status
@@ -58,8 +61,39 @@ def evaluate(point: StudyPoint) -> dict[str, Any]:
     }
 
 
+class StoredPath(BaseModel):
+    """A kept path of one point: x and y along its time grid."""
+
+    x: list[Finite]
+    y: list[Finite]
+
+
+class StoredRow(BaseModel):
+    """A stored point of the §6.4.4 study (:func:`evaluate`'s row), as it must be to be reused."""
+
+    model_config = ConfigDict(extra="allow")
+
+    obstacles: int
+    alpha: Finite
+    status: str
+    seconds: Finite
+    t_final: Finite | None = None
+    objective: float | None = None
+    collision_probability: Finite | None = None
+    path: StoredPath | None = None
+    time: list[Finite] | None = None
+
+    @model_validator(mode="after")
+    def _path_on_its_grid(self) -> StoredRow:
+        if self.path is not None and not (len(self.path.x) == len(self.path.y) == len(self.time or [])):
+            raise ValueError("path.x, path.y and time differ in length")
+        return self
+
+
 class RcsStudyModel(PointStudyModel):
     """The §6.4.4 study ready to run (or resume) into its store."""
+
+    row_model = StoredRow
 
     def points(self) -> dict[str, Any]:
         return study.study_points(self.spec)

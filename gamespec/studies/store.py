@@ -3,11 +3,12 @@
 Each finished point is one row ``(key, value JSON, digest, provenance)``; a batch of rows is one
 transaction, committed with ``synchronous=FULL`` (fsynced before :meth:`ResultStore.put_many`
 returns), so a crash or a power loss leaves every committed point intact and no half-written one.
-A record whose digest or JSON no longer checks out is reported (:attr:`ResultStore.damaged`) and
-left out, so the study computes it again; a database file that SQLite cannot read at all is moved
-aside (``store.sqlite.damaged-<time>``) and a fresh one started. 10⁵ points are 10⁵ rows of one
-file. ``meta`` holds what the study was (sweep or compare, its parameters) for ``gamespec results``
-and ``gamespec plot``.
+A record whose digest, JSON or column types no longer check out is reported
+(:attr:`ResultStore.damaged`) and left out, so the study computes it again (and so is a value of the
+wrong shape for its study, :mod:`gamespec.studies.rows`); a database file that SQLite cannot read
+at all, or whose tables are not these, is moved aside (``store.sqlite.damaged-<time>``) and a
+fresh one started. 10⁵ points are 10⁵ rows of one file. ``meta`` holds what the study was (sweep
+or compare, its parameters) for ``gamespec results`` and ``gamespec plot``.
 """
 
 from __future__ import annotations
@@ -58,6 +59,10 @@ class ResultStore:
         except OSError as err:
             raise GamespecError(f"{self.folder}: cannot write there ({err.strerror or err})") from None
         self.path = self.folder / FILENAME
+        if (self.path.is_symlink() or self.path.exists()) and not self.path.is_file():
+            raise GamespecError(
+                f"{self.path}: not a regular file (a FIFO, a device, a folder or a broken link)"
+            )
         self._unreadable: list[str] = []
         self._damaged_records: list[str] = []
         self._db = self._open()
@@ -73,6 +78,8 @@ class ResultStore:
         db.execute("PRAGMA synchronous=FULL")
         db.executescript(_SCHEMA)
         (verdict,) = db.execute("PRAGMA quick_check").fetchone()
+        if verdict == "ok":
+            verdict = _schema_problem(db)
         if verdict != "ok":
             db.close()
             raise sqlite3.DatabaseError(verdict)
@@ -82,14 +89,17 @@ class ResultStore:
         try:
             return self._connect()
         except sqlite3.OperationalError as err:
-            raise GamespecError(f"{self.path}: cannot open the study store ({err})") from None
+            raise GamespecError(
+                f"{self.path}: cannot open the study store ({' '.join(str(err).split())})"
+            ) from None
         except sqlite3.DatabaseError as err:
             stamp = _dt.datetime.now(_dt.UTC).strftime("%Y%m%dT%H%M%S")
             aside = self.path.with_name(f"{FILENAME}.damaged-{stamp}")
             self.path.rename(aside)
             for suffix in ("-wal", "-shm"):
                 self.path.with_name(FILENAME + suffix).unlink(missing_ok=True)
-            self._unreadable.append(f"{self.path}: unreadable ({err}); moved to {aside.name}, starting anew")
+            why = " ".join(str(err).split())
+            self._unreadable.append(f"{self.path}: unreadable ({why}); moved to {aside.name}, starting anew")
             return self._connect()
 
     def close(self) -> None:
@@ -115,19 +125,25 @@ class ResultStore:
     def _intact(self) -> dict[str, tuple[Any, dict[str, Any]]]:
         found: dict[str, tuple[Any, dict[str, Any]]] = {}
         self._damaged_records = []
-        rows = self._db.execute("SELECT key, value, digest, spec_hash, versions, created FROM points")
-        for key, text, digest, spec_hash, versions, created in rows:
+        try:
+            rows = self._db.execute(
+                "SELECT key, value, digest, spec_hash, versions, created FROM points"
+            ).fetchall()
+        except sqlite3.DatabaseError as err:
+            raise GamespecError(f"{self.path}: cannot read the study store ({err})") from None
+        for row in rows:
             try:
-                if _digest(text) != digest:
-                    raise ValueError("its digest does not match")
-                value = json.loads(text)
-                provenance = {"spec_hash": spec_hash, "versions": json.loads(versions), "created": created}
-            except (ValueError, TypeError) as err:
-                why = f"record {key!r} is damaged ({err}); computing it again"
-                self._damaged_records.append(f"{self.path}: {why}")
+                key, value, provenance = _checked_row(row)
+            except ValueError as err:
+                self.report_damaged(row[0], str(err))
                 continue
             found[key] = (value, provenance)
         return found
+
+    def report_damaged(self, key: object, why: str) -> None:
+        """Add a damaged record to :attr:`damaged` (``why``: its digest, its JSON, its shape)."""
+        shown = key if isinstance(key, str) else repr(key)
+        self._damaged_records.append(f"{self.path}: record {shown!r} is damaged ({why}); computing it again")
 
     def done(self) -> set[str]:
         """Keys saved intact."""
@@ -148,6 +164,53 @@ class ResultStore:
             self._db.execute("INSERT OR REPLACE INTO meta VALUES (?, ?)", (name, json.dumps(value)))
 
     def meta(self, name: str) -> Any:
-        """A recorded meta value, or None."""
-        row = self._db.execute("SELECT value FROM meta WHERE name = ?", (name,)).fetchone()
-        return None if row is None else json.loads(row[0])
+        """A recorded meta value, or None (also when it is damaged: reported in :attr:`damaged`)."""
+        try:
+            row = self._db.execute("SELECT value FROM meta WHERE name = ?", (name,)).fetchone()
+        except sqlite3.DatabaseError as err:
+            raise GamespecError(f"{self.path}: cannot read the study store ({err})") from None
+        if row is None:
+            return None
+        try:
+            if not isinstance(row[0], str):
+                raise ValueError(f"its value is {type(row[0]).__name__}, not JSON text")
+            return json.loads(row[0])
+        except (ValueError, RecursionError) as err:
+            self._unreadable.append(f"{self.path}: meta {name!r} is damaged ({err}); ignored")
+            return None
+
+
+_COLUMNS = {
+    "points": ["key", "value", "digest", "spec_hash", "versions", "created"],
+    "meta": ["name", "value"],
+}
+
+
+def _schema_problem(db: sqlite3.Connection) -> str:
+    """``ok`` when the tables have the columns of :data:`_SCHEMA`, else what differs."""
+    for table, expected in _COLUMNS.items():
+        found = [row[1] for row in db.execute(f"PRAGMA table_info({table})")]
+        if found != expected:
+            return f"table {table} has columns {found}, not {expected}"
+    return "ok"
+
+
+def _checked_row(row: tuple[Any, ...]) -> tuple[str, Any, dict[str, Any]]:
+    """``(key, value, provenance)`` of one ``points`` row; ValueError saying what is wrong with it
+    (SQLite keeps any type in any column: each is checked before it is used)."""
+    key, text, digest, spec_hash, versions, created = row
+    for name, value in (("key", key), ("value", text), ("digest", digest), ("created", created)):
+        if not isinstance(value, str):
+            raise ValueError(f"its {name} is {type(value).__name__}, not text")
+    if not isinstance(spec_hash, str | None) or not isinstance(versions, str):
+        raise ValueError("its provenance is not text")
+    if _digest(text) != digest:
+        raise ValueError("its digest does not match")
+    try:
+        value = json.loads(text)
+        packages = json.loads(versions)
+    except RecursionError:
+        raise ValueError("its JSON is nested too deeply") from None
+    if not isinstance(packages, dict) or not all(isinstance(v, str) for v in packages.values()):
+        raise ValueError("its package versions are not a mapping of names to versions")
+    return key, value, {"spec_hash": spec_hash, "versions": packages, "created": created}

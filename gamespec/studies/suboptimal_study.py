@@ -21,7 +21,9 @@ from functools import cache
 from typing import Any, ClassVar
 
 import numpy as np
+from pydantic import BaseModel, ConfigDict, model_validator
 
+from gamespec.metrics import Finite
 from gamespec.pursuit import pure_pursuit, study
 from gamespec.pursuit.ocp_generation import to_ocp, trajectory_guess
 from gamespec.pursuit.ocp_report import heading_law
@@ -103,8 +105,37 @@ def evaluate(point: StudyPoint) -> dict[str, Any]:
     }
 
 
+class StoredRow(BaseModel):
+    """A stored point of the Table 2.1 study (:func:`evaluate`'s row), as it must be to be reused."""
+
+    model_config = ConfigDict(extra="allow")
+
+    v: Finite
+    r2: Finite
+    psi: Finite
+    status: str
+    max_defect: float | None = None
+    t_optimal: float | None = None
+    variation_percent: float | None = None
+    simultaneous_capture_gap: float | None = None
+    resimulated_capture_time_error: float | None = None
+
+    @model_validator(mode="after")
+    def _solved_rows_are_complete(self) -> StoredRow:
+        missing = [name for name in SOLVED_FIELDS if getattr(self, name) is None]
+        if self.variation_percent is not None and missing:
+            raise ValueError(f"a solved point lacks {', '.join(missing)}")
+        return self
+
+
+SOLVED_FIELDS = ("max_defect", "t_optimal", "simultaneous_capture_gap", "resimulated_capture_time_error")
+"""What a solved point's row carries besides its variation (the checks are maxima over them)."""
+
+
 class StudyModel(PointStudyModel):
     """The Table 2.1 study ready to run (or resume) into its store."""
+
+    row_model = StoredRow
 
     def points(self) -> dict[str, Any]:
         return study.study_points(self.spec)

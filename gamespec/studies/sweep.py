@@ -25,6 +25,7 @@ from gamespec.errors import SpecError
 from gamespec.limits import MAX_SWEEP_POINTS
 from gamespec.result import status_ok
 from gamespec.studies.executors import Executor, SerialExecutor
+from gamespec.studies.rows import StudyMeta, valid_value
 from gamespec.studies.runner import StudyRun, run_study
 from gamespec.studies.store import ResultStore
 
@@ -84,6 +85,15 @@ def solve_point(job: SweepJob) -> dict[str, Any]:
     return {**dict(job.parameters), **result.summary(), "metrics": result.metrics}
 
 
+def _solved(row: Any, names: list[str]) -> bool:
+    """Whether a stored point is a valid sweep row (:mod:`gamespec.studies.rows`) that solved."""
+    try:
+        valid_value(row, StudyMeta(type="sweep", parameters=names))
+    except ValueError:
+        return False
+    return status_ok(row["status"])
+
+
 def sweep(
     path: str | Path,
     ranges: list[tuple[str, list[float]]],
@@ -121,6 +131,6 @@ def sweep(
         executor=executor or SerialExecutor(),
         description=f"sweep {Path(path).stem}",
         show_progress=show_progress,
-        accept=lambda row: status_ok(row["status"]),
+        accept=lambda row: _solved(row, names),
         spec_hash=digest,
     )

@@ -10,7 +10,7 @@ from pathlib import Path
 import gamespec
 
 LAYERS = [
-    {"errors", "result", "registry", "best_response", "limits", "reading", "terminal"},
+    {"errors", "result", "registry", "best_response", "limits", "reading", "terminal", "metrics", "npyfile"},
     {"symbolic"},
     {"specs", "loader"},
     {"ocp", "lqgame", "pursuit", "flowfield", "desensitize", "rcs", "montecarlo", "obstacles", "plotting"},

@@ -26,7 +26,7 @@ def test_tradeoff_from_a_sweep_folder(tmp_path) -> None:
     for alpha in (0.0, 25.0, 75.0):
         result = solver.solve({"alpha": alpha})
         store.put(f"alpha={alpha}", {"alpha": alpha, **result.summary(), "metrics": result.metrics})
-    (path,) = plot_tradeoff(store.items().values(), tmp_path / "figures")
+    (path,) = plot_tradeoff(store.items().values(), tmp_path / "figures", "alpha")
     assert path.name == "tradeoff.png" and path.stat().st_size > 0
     with pytest.raises(GamespecError, match="no solved desensitized points"):
-        plot_tradeoff([{"alpha": 1.0, "metrics": {}}], tmp_path)
+        plot_tradeoff([{"alpha": 1.0, "metrics": {}}], tmp_path, "alpha")

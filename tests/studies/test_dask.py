@@ -51,8 +51,7 @@ def test_table_2_1_study_on_the_cluster_matches_serial(cli, tmp_path, scheduler)
         return json.loads(out)
 
     serial = solve("--set", f"store={tmp_path / 'serial'}")
-    on_cluster = f"solver.options.study.scheduler={scheduler}"
-    dask = solve("--set", f"store={tmp_path / 'dask'}", "--set", on_cluster)
+    dask = solve("--set", f"store={tmp_path / 'dask'}", "--scheduler", scheduler)
     assert serial["metrics"]["points"] == dask["metrics"]["points"] == dask["metrics"]["computed"] == 8
     # the suboptimal heading is a closed-form simulation: bit for bit the same in any process
     assert dask["arrays"]["t_suboptimal"] == serial["arrays"]["t_suboptimal"]

@@ -105,6 +105,8 @@ class Provenance(BaseModel):
     file_hash: str = ""
     versions: dict[str, str] = Field(default_factory=dict)
     created: str = ""
+    transforms: list[str] = Field(default_factory=list)
+    """The transforms the chain applied, in order (requested, then lowering)."""
 
 
 class Result(BaseModel):

@@ -251,6 +251,7 @@ class Solver:
             file_hash=self.spec.file_hash,
             versions=_versions(self.backend),
             created=_dt.datetime.now(_dt.UTC).isoformat(timespec="seconds"),
+            transforms=[step.transform.name for step in steps],
         )
         return status_policy(result).model_copy(
             update={

@@ -18,11 +18,15 @@ Rows = list[tuple[str, object]]
 
 
 def outcome(result: Result) -> Rows:
-    """The kind's summary rows of ``result`` (none when the kind registers no summary), then the
-    failed and the left-out checks."""
+    """The kind's summary rows of ``result`` (none when the kind registers no summary), the rows of
+    each transform the chain applied that registers one under its own name (the desensitization's
+    sensitivities and Monte Carlo, the RCS collision probability), then the failed and the
+    left-out checks."""
+    registered = registry.names("gamespec.summaries")
     rows = []
-    if result.kind in registry.names("gamespec.summaries"):
-        rows = registry.load("gamespec.summaries", result.kind)(result)
+    for name in [result.kind, *result.provenance.transforms]:
+        if name in registered:
+            rows += registry.load("gamespec.summaries", name)(result)
     return rows + check_rows(result)
 
 

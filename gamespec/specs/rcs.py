@@ -26,6 +26,7 @@ from pydantic import Field, field_validator
 
 from gamespec.specs.base import StrictModel, Value
 from gamespec.specs.desensitize import MonteCarloOptions
+from gamespec.specs.ocp import GuessSpec
 
 
 class RcsOptions(StrictModel):
@@ -39,7 +40,18 @@ class RcsOptions(StrictModel):
     )
     relevance: str = Field("logistic_derivative", description="r̃ of eq. 6.33: a name or an expression of w.")
     relevant: bool = Field(True, description="Weight S_g by r(g) (eq. 6.34); false: eq. 6.32.")
+    cost_state: bool = Field(
+        True,
+        description="Integrate the cost as states (rcs_cost, and rcs_measure with unit weights), so "
+        "the defect estimate measures its quadrature error and method.refine refines where the risk "
+        "is under-resolved; false: a Lagrange term, seen at the collocation points only.",
+    )
     monte_carlo: MonteCarloOptions = Field(default_factory=MonteCarloOptions)
+    restarts: list[GuessSpec] = Field(
+        default_factory=list,
+        description="Other starting points (each a guess section of the problem) re-solved from when "
+        "the first solution fails a check; the best one that passes every check is kept.",
+    )
 
 
 class Track(StrictModel):

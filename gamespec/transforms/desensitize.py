@@ -251,7 +251,12 @@ def report(result: Result, spec: OptimalControlSpec, inverse: InverseData) -> Re
 
 
 def _penalty_value(spec: OptimalControlSpec, result: Result, penalty: Penalty) -> float:
-    """The added cost on the solution, with the transcription's own quadrature (``T q·L``)."""
+    """The added cost on the solution, with the transcription's own quadrature (``T q·L``; on the
+    file's mesh, so a running term needs an unrefined Result: carried as a state, see the ``rcs``
+    transform's ``cost_state``, it has none)."""
+    final = float(evaluate([penalty.final], _end_values(result), ())[0])
+    if penalty.running == 0:
+        return final
     grid = Transcription(spec).grid
     _, _, q = grid.triplets
     idx = grid.eval_index
@@ -261,7 +266,6 @@ def _penalty_value(spec: OptimalControlSpec, result: Result, penalty: Penalty) -
     values.update({symbol(k): np.asarray(v) for k, v in result.controls.items()})
     values[TIME] = t[idx]
     running = evaluate([penalty.running], values, (len(idx),))[0]
-    final = float(evaluate([penalty.final], _end_values(result), ())[0])
     return float((t[-1] - t[0]) * q @ running) + final
 
 

@@ -16,16 +16,17 @@ path constraint somewhere on that fine grid, with its Wilson interval (``gamespe
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from typing import Any, ClassVar
 
 import numpy as np
 import sympy as sp
 
-from gamespec.desensitize.augment import sensitivity_functions
+from gamespec.desensitize.augment import Augmentation, NewState, sensitivity_functions
 from gamespec.desensitize.simulate import evaluate, open_loop
 from gamespec.errors import ExpressionError, SpecError
 from gamespec.ocp.symbolic import SymbolicOcp
+from gamespec.ocp.transcription import Transcription
 from gamespec.rcs import obstacles as geometry
 from gamespec.rcs.sensitivity import (
     constraint_sensitivity,
@@ -35,10 +36,10 @@ from gamespec.rcs.sensitivity import (
     state_sensitivity,
     weighted_square,
 )
-from gamespec.result import Result
+from gamespec.result import Result, Status
 from gamespec.specs.base import SpecBase
 from gamespec.specs.desensitize import DesensitizeOptions
-from gamespec.specs.ocp import OptimalControlSpec
+from gamespec.specs.ocp import GuessSpec, OptimalControlSpec
 from gamespec.specs.rcs import MovingObstaclesOptions, RcsOptions
 from gamespec.symbolic.language import TIME, parse, symbol
 from gamespec.symbolic.printer import to_text
@@ -119,6 +120,7 @@ class RcsData:
     S_g: sp.Matrix
     S_r: sp.Matrix
     options: RcsOptions
+    target: OptimalControlSpec
 
 
 class Rcs(OcpRewrite):
@@ -134,6 +136,20 @@ class Rcs(OcpRewrite):
 
     def invert(self, result: Result, spec: SpecBase, inverse_data: RcsData) -> Result:
         return rcs_report(result, spec, inverse_data)
+
+    def verify(self, result: Result, spec: SpecBase, inverse_data: RcsData) -> str | None:
+        """The first check of the Result that fails its tolerance (``metrics.checks_passed``; with
+        ``cost_state`` an under-resolved risk integral fails ``max_defect_relative``), or None."""
+        failed = [name for name, passed in result.metrics.get("checks_passed", {}).items() if not passed]
+        if not failed:
+            return None
+        value = result.checks.get(failed[0])
+        return f"check {failed[0]} failed ({value:.3g})" if value is not None else f"check {failed[0]} failed"
+
+    def restarts(self, spec: SpecBase, inverse_data: RcsData) -> list[Result]:
+        """The starting points of ``restarts`` (each a ``guess`` section of the file's problem) on
+        the target's mesh, in the file's order."""
+        return [starting_point(inverse_data.target, g) for g in inverse_data.options.restarts]
 
 
 FIELD = "transforms.rcs"
@@ -155,8 +171,13 @@ def regularized(spec: OptimalControlSpec, options: RcsOptions) -> tuple[OptimalC
         raise SpecError(str(err), field=f"{FIELD}.relevance", source=spec.source) from None
     penalized = S_r if options.relevant else S_g
     weights = _weights(spec, options, len(chosen))
-    penalty = Penalty(weighted_square(penalized, weights), sp.Integer(0))
-    measure = Penalty(weighted_square(penalized, [sp.Integer(1)] * len(chosen)), sp.Integer(0))
+    cost = weighted_square(penalized, weights)
+    unit = weighted_square(penalized, [sp.Integer(1)] * len(chosen))
+    if options.cost_state:
+        aug, (cost, unit) = _as_states(aug, {COST_STATE: cost, MEASURE_STATE: unit})
+        penalty, measure = Penalty(sp.Integer(0), cost), Penalty(sp.Integer(0), unit)
+    else:
+        penalty, measure = Penalty(cost, sp.Integer(0)), Penalty(unit, sp.Integer(0))
     new = augmented_spec(spec, aug, penalty)
     data = InverseData(
         aug,
@@ -166,7 +187,36 @@ def regularized(spec: OptimalControlSpec, options: RcsOptions) -> tuple[OptimalC
         len(spec.problem.states),
         len(new.problem.states),
     )
-    return new, RcsData(data, [q.label for q in chosen], uncertain, S_g, S_r, options)
+    return new, RcsData(data, [q.label for q in chosen], uncertain, S_g, S_r, options, new)
+
+
+def starting_point(target: OptimalControlSpec, guess: GuessSpec) -> Result:
+    """``guess`` (a ``guess`` section in the names of the file's problem; the added states start
+    from their default) evaluated on ``target``'s mesh as a Result of ``target``."""
+    tr = Transcription(target.model_copy(update={"guess": guess}))
+    start = tr.guess(target.runtime_parameters())
+    t = tr.t0 + start.T * tr.grid.nodes
+    return Result(
+        status=Status.FEASIBLE,
+        message="starting point",
+        t_final=float(t[-1]),
+        time=t,
+        control_time=tr.t0 + start.T * tr.grid.eval_tau,
+        states={n: start.X[i] for i, n in enumerate(tr.ocp.states)},
+        controls={n: start.U[j] for j, n in enumerate(tr.ocp.controls)},
+        parameters=target.runtime_parameters(),
+    )
+
+
+COST_STATE, MEASURE_STATE = "rcs_cost", "rcs_measure"
+"""The states that integrate ``‖vec S_r‖²_Q`` and its unit-weight measure (``cost_state: true``)."""
+
+
+def _as_states(aug: Augmentation, integrands: dict[str, sp.Expr]) -> tuple[Augmentation, list[sp.Expr]]:
+    """``aug`` with one state per integrand (``q' = integrand``, ``q(t0) = 0``, free end) and the
+    end symbols ``q_f`` that stand for the integrals."""
+    added = [NewState(name, rhs, sp.Integer(0), None) for name, rhs in integrands.items()]
+    return replace(aug, states=[*aug.states, *added]), [symbol(f"{name}_f") for name in integrands]
 
 
 def _chosen(spec: OptimalControlSpec, ocp: SymbolicOcp, options: RcsOptions) -> list:

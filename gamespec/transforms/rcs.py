@@ -22,7 +22,7 @@ from typing import Any, ClassVar
 import numpy as np
 import sympy as sp
 
-from gamespec.desensitize.augment import Augmentation, NewState, sensitivity_functions
+from gamespec.desensitize.augment import NewState, sensitivity_functions
 from gamespec.desensitize.simulate import evaluate, open_loop
 from gamespec.errors import ExpressionError, SpecError
 from gamespec.ocp.symbolic import SymbolicOcp
@@ -121,6 +121,8 @@ class RcsData:
     S_r: sp.Matrix
     options: RcsOptions
     target: OptimalControlSpec
+    unit: sp.Expr
+    """The integrand of the sensitivity measure (unit weights)."""
 
 
 class Rcs(OcpRewrite):
@@ -174,8 +176,9 @@ def regularized(spec: OptimalControlSpec, options: RcsOptions) -> tuple[OptimalC
     cost = weighted_square(penalized, weights)
     unit = weighted_square(penalized, [sp.Integer(1)] * len(chosen))
     if options.cost_state:
-        aug, (cost, unit) = _as_states(aug, {COST_STATE: cost, MEASURE_STATE: unit})
-        penalty, measure = Penalty(sp.Integer(0), cost), Penalty(sp.Integer(0), unit)
+        aug = replace(aug, states=[*aug.states, NewState(COST_STATE, cost, sp.Integer(0), None)])
+        cost = symbol(f"{COST_STATE}_f")
+        penalty = measure = Penalty(sp.Integer(0), cost)  # the measure: see rcs_report
     else:
         penalty, measure = Penalty(cost, sp.Integer(0)), Penalty(unit, sp.Integer(0))
     new = augmented_spec(spec, aug, penalty)
@@ -187,7 +190,7 @@ def regularized(spec: OptimalControlSpec, options: RcsOptions) -> tuple[OptimalC
         len(spec.problem.states),
         len(new.problem.states),
     )
-    return new, RcsData(data, [q.label for q in chosen], uncertain, S_g, S_r, options, new)
+    return new, RcsData(data, [q.label for q in chosen], uncertain, S_g, S_r, options, new, unit)
 
 
 def starting_point(target: OptimalControlSpec, guess: GuessSpec) -> Result:
@@ -208,15 +211,12 @@ def starting_point(target: OptimalControlSpec, guess: GuessSpec) -> Result:
     )
 
 
-COST_STATE, MEASURE_STATE = "rcs_cost", "rcs_measure"
-"""The states that integrate ``‖vec S_r‖²_Q`` and its unit-weight measure (``cost_state: true``)."""
+COST_STATE = "rcs_cost"
+"""The state that integrates ``‖vec S_r‖²_Q`` (``cost_state: true``: ``q' = ‖vec S_r‖²_Q``,
+``q(t0) = 0``, free end, ``q(t_f)`` added to the objective)."""
 
-
-def _as_states(aug: Augmentation, integrands: dict[str, sp.Expr]) -> tuple[Augmentation, list[sp.Expr]]:
-    """``aug`` with one state per integrand (``q' = integrand``, ``q(t0) = 0``, free end) and the
-    end symbols ``q_f`` that stand for the integrals."""
-    added = [NewState(name, rhs, sp.Integer(0), None) for name, rhs in integrands.items()]
-    return replace(aug, states=[*aug.states, *added]), [symbol(f"{name}_f") for name in integrands]
+DENSE = 20
+"""Points per gap of the Result's time grid on which :func:`dense_integral` integrates."""
 
 
 def _chosen(spec: OptimalControlSpec, ocp: SymbolicOcp, options: RcsOptions) -> list:
@@ -258,6 +258,8 @@ def rcs_report(result: Result, spec: OptimalControlSpec, data: RcsData) -> Resul
     }
     if result.ok and result.time is not None:
         arrays |= along(result, spec, data)
+        if data.options.cost_state:
+            metrics["sensitivity_measure"] = dense_integral(result, spec, data.unit)
         mc = metrics.get("monte_carlo")
         if mc is not None and "violation_probability" in mc:
             mc = dict(mc)
@@ -267,15 +269,32 @@ def rcs_report(result: Result, spec: OptimalControlSpec, data: RcsData) -> Resul
     return result.model_copy(update={"metrics": metrics, "arrays": arrays})
 
 
-def along(result: Result, spec: OptimalControlSpec, data: RcsData) -> dict[str, Any]:
-    """``S_g<i>_<ρ>`` and ``S_r<i>_<ρ>`` at the Result's time points."""
+def _values(result: Result, spec: OptimalControlSpec, t: np.ndarray) -> dict[sp.Symbol, Any]:
+    """Parameters, states (linear between the Result's points) and controls at ``t``."""
     ocp = SymbolicOcp(spec)
-    t = np.asarray(result.time)
     values: dict[sp.Symbol, Any] = {symbol(k): v for k, v in result.parameters.items()}
-    values |= {symbol(k): np.asarray(v) for k, v in result.states.items()}
+    time = np.asarray(result.time)
+    values |= {symbol(k): np.interp(t, time, np.asarray(v)) for k, v in result.states.items()}
     if ocp.controls:
         values |= dict(zip(ocp.u, open_loop(result, ocp.controls)(t), strict=True))
     values[TIME] = t
+    return values
+
+
+def dense_integral(result: Result, spec: OptimalControlSpec, integrand: sp.Expr) -> float:
+    """``∫ integrand dt`` along the Result by the trapezoid rule on :data:`DENSE` points per gap of
+    its time grid: independent of the collocation's quadrature (which sees the integrand at the
+    collocation points only) and of the mesh (refined or not)."""
+    time = np.asarray(result.time)
+    steps = time[:-1, None] + np.diff(time)[:, None] * (np.arange(DENSE) / DENSE)[None, :]
+    t = np.append(steps.ravel(), time[-1])
+    return float(np.trapezoid(evaluate([integrand], _values(result, spec, t), t.shape)[0], t))
+
+
+def along(result: Result, spec: OptimalControlSpec, data: RcsData) -> dict[str, Any]:
+    """``S_g<i>_<ρ>`` and ``S_r<i>_<ρ>`` at the Result's time points."""
+    t = np.asarray(result.time)
+    values = _values(result, spec, t)
     out = {}
     for prefix, M in (("S_g", data.S_g), ("S_r", data.S_r)):
         flat = [M[i, j] for i in range(M.rows) for j in range(M.cols)]

@@ -128,7 +128,7 @@ def test_collision_probability_matches_the_normal_cdf():
     assert ci[0] < p < ci[1]
 
 
-@pytest.mark.parametrize("name", ["rcs_single_obstacle", "rcs_constraint_form", "car_vs_train"])
+@pytest.mark.parametrize("name", ["rcs_single_obstacle", "rcs_constraint_form"])  # car_vs_train: its own file
 def test_files_solve(name):
     result = solve(PROBLEMS / "ch6" / f"{name}.yaml")
     assert result.ok, result.message
@@ -151,7 +151,10 @@ def test_plain_constraint_sensitivity_option():
     data["transforms"][1]["rcs"] |= {"relevant": False, "monte_carlo": {"samples": 0}}
     result = solve(spec_from_dict(data))
     assert result.ok
+    # the cost is the collocated state's, the measure a dense trapezoid along the solution: they
+    # agree to the 40-interval mesh's accuracy
     np.testing.assert_allclose(
         result.metrics["sensitivity_cost"],
         result.metrics["sensitivity_measure"] * data["problem"]["parameters"]["Q"],
+        rtol=1e-3,
     )

@@ -23,7 +23,7 @@ import numpy as np
 import sympy as sp
 
 from gamespec.desensitize.augment import NewState, sensitivity_functions
-from gamespec.desensitize.simulate import evaluate, open_loop
+from gamespec.desensitize.simulate import dense_integral, evaluate, values_at
 from gamespec.errors import ExpressionError, SpecError
 from gamespec.ocp.symbolic import SymbolicOcp
 from gamespec.ocp.transcription import Transcription
@@ -215,9 +215,6 @@ COST_STATE = "rcs_cost"
 """The state that integrates ``‖vec S_r‖²_Q`` (``cost_state: true``: ``q' = ‖vec S_r‖²_Q``,
 ``q(t0) = 0``, free end, ``q(t_f)`` added to the objective)."""
 
-DENSE = 20
-"""Points per gap of the Result's time grid on which :func:`dense_integral` integrates."""
-
 
 def _chosen(spec: OptimalControlSpec, ocp: SymbolicOcp, options: RcsOptions) -> list:
     found = inequalities(ocp)
@@ -259,7 +256,7 @@ def rcs_report(result: Result, spec: OptimalControlSpec, data: RcsData) -> Resul
     if result.ok and result.time is not None:
         arrays |= along(result, spec, data)
         if data.options.cost_state:
-            metrics["sensitivity_measure"] = dense_integral(result, spec, data.unit)
+            metrics["sensitivity_measure"] = dense_integral(result, SymbolicOcp(spec), data.unit)
         mc = metrics.get("monte_carlo")
         if mc is not None and "violation_probability" in mc:
             mc = dict(mc)
@@ -269,32 +266,10 @@ def rcs_report(result: Result, spec: OptimalControlSpec, data: RcsData) -> Resul
     return result.model_copy(update={"metrics": metrics, "arrays": arrays})
 
 
-def _values(result: Result, spec: OptimalControlSpec, t: np.ndarray) -> dict[sp.Symbol, Any]:
-    """Parameters, states (linear between the Result's points) and controls at ``t``."""
-    ocp = SymbolicOcp(spec)
-    values: dict[sp.Symbol, Any] = {symbol(k): v for k, v in result.parameters.items()}
-    time = np.asarray(result.time)
-    values |= {symbol(k): np.interp(t, time, np.asarray(v)) for k, v in result.states.items()}
-    if ocp.controls:
-        values |= dict(zip(ocp.u, open_loop(result, ocp.controls)(t), strict=True))
-    values[TIME] = t
-    return values
-
-
-def dense_integral(result: Result, spec: OptimalControlSpec, integrand: sp.Expr) -> float:
-    """``∫ integrand dt`` along the Result by the trapezoid rule on :data:`DENSE` points per gap of
-    its time grid: independent of the collocation's quadrature (which sees the integrand at the
-    collocation points only) and of the mesh (refined or not)."""
-    time = np.asarray(result.time)
-    steps = time[:-1, None] + np.diff(time)[:, None] * (np.arange(DENSE) / DENSE)[None, :]
-    t = np.append(steps.ravel(), time[-1])
-    return float(np.trapezoid(evaluate([integrand], _values(result, spec, t), t.shape)[0], t))
-
-
 def along(result: Result, spec: OptimalControlSpec, data: RcsData) -> dict[str, Any]:
     """``S_g<i>_<ρ>`` and ``S_r<i>_<ρ>`` at the Result's time points."""
     t = np.asarray(result.time)
-    values = _values(result, spec, t)
+    values = values_at(result, SymbolicOcp(spec), t)
     out = {}
     for prefix, M in (("S_g", data.S_g), ("S_r", data.S_r)):
         flat = [M[i, j] for i in range(M.rows) for j in range(M.cols)]

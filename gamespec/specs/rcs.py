@@ -14,6 +14,9 @@ transforms:
                                       # | inverse_abs_square | any expression of w
       relevant: true                  # false: the plain constraint-sensitivity penalty of eq. 6.32
       monte_carlo: {samples: 1000, seed: 0, steps: 500}
+      cost_state: true                # the cost integrated as a state (its quadrature is checked)
+      restarts:                       # guess sections re-solved from when a solve fails a check
+        - {states: {y: -3*sin(pi*tau)}}
 ```
 
 Weights, radii, centres, velocities and β are numbers or expressions of the problem's parameters, so

@@ -14,7 +14,7 @@ transforms:
                                       # | inverse_abs_square | any expression of w
       relevant: true                  # false: the plain constraint-sensitivity penalty of eq. 6.32
       monte_carlo: {samples: 1000, seed: 0, steps: 500}
-      cost_state: true                # the cost integrated as a state (its quadrature is checked)
+      cost_state: false               # true: the cost integrated as a state (its quadrature checked)
       restarts:                       # guess sections re-solved from when a solve fails a check
         - {states: {y: -3*sin(pi*tau)}}
 ```
@@ -44,10 +44,10 @@ class RcsOptions(StrictModel):
     relevance: str = Field("logistic_derivative", description="r̃ of eq. 6.33: a name or an expression of w.")
     relevant: bool = Field(True, description="Weight S_g by r(g) (eq. 6.34); false: eq. 6.32.")
     cost_state: bool = Field(
-        True,
-        description="Integrate the cost as states (rcs_cost, and rcs_measure with unit weights), so "
-        "the defect estimate measures its quadrature error and method.refine refines where the risk "
-        "is under-resolved; false: a Lagrange term, seen at the collocation points only.",
+        False,
+        description="Integrate the cost as a state (rcs_cost), so the defect estimate measures its "
+        "quadrature error and method.refine refines where the risk is under-resolved (a steep "
+        "integrand: car_vs_train); false: a Lagrange term, seen at the collocation points only.",
     )
     monte_carlo: MonteCarloOptions = Field(default_factory=MonteCarloOptions)
     restarts: list[GuessSpec] = Field(

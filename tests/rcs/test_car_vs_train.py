@@ -11,14 +11,25 @@ that motion (eqs. 6.35, 6.43-6.45 written out here, not taken from the transform
 
 import numpy as np
 import pytest
+import yaml
 from scipy.integrate import quad
 from scipy.optimize import minimize_scalar
 
-from gamespec.loader import load
+from gamespec.loader import load, spec_from_dict
 from gamespec.solving import solve
 from tests.conftest import PROBLEMS
 
 FILE = PROBLEMS / "ch6" / "car_vs_train.yaml"
+
+
+def risk_rate(x, t, p: dict[str, float], gamma: int):
+    """``S_r²`` for the car at ``x`` at time ``t``: ``S_r = r(g) ∂g/∂ρ`` with
+    ``g = φ(x)(r_o² - z²)``, ``z = -d + ρt`` (eqs. 6.43-6.45) and r of eq. 6.35 at min(g, 0)."""
+    phi = np.exp(-(((x - p["c"]) / p["w_o"]) ** gamma))
+    z = -p["d"] + p["rho"] * t
+    g = phi * (p["r_o"] ** 2 - z**2)
+    e = np.exp(np.minimum(g, 0.0))
+    return (e / (1 + e) ** 2 * phi * (-2 * z * t)) ** 2
 
 
 def reduced_cost(t_s: float, p: dict[str, float], gamma: int, x_s: float) -> float:
@@ -26,13 +37,7 @@ def reduced_cost(t_s: float, p: dict[str, float], gamma: int, x_s: float) -> flo
     v = p["v_max"]
 
     def risk(t: float) -> float:
-        x = x_s + v * (t - t_s)
-        phi = np.exp(-(((x - p["c"]) / p["w_o"]) ** gamma))
-        z = -p["d"] + p["rho"] * t
-        g = phi * (p["r_o"] ** 2 - z**2)
-        e = np.exp(min(g, 0.0))
-        relevance = e / (1 + e) ** 2  # eq. 6.35 at min(g, 0) (eq. 6.33)
-        return (relevance * phi * (-2 * z * t)) ** 2  # S_r = r(g) ∂g/∂ρ, z = -d + ρt
+        return float(risk_rate(x_s + v * (t - t_s), t, p, gamma))
 
     edges = [t_s + (p["c"] - p["w_o"] - x_s) / v, t_s + (p["c"] + p["w_o"] - x_s) / v]
     end = t_s + (p["c"] + 2 * p["w_o"] - x_s) / v
@@ -94,3 +99,31 @@ def test_q0_enters_the_track_as_the_train_leaves_it():
     p = {k: float(v) for k, v in load(FILE).problem.parameters.items()}
     leaves = (p["d"] + p["r_o"]) / p["rho"]
     assert result.t_final == pytest.approx(leaves + (10.0 - (p["c"] - p["w_o"])) / p["v_max"], abs=0.25)
+
+
+def test_the_cost_state_exposes_an_under_resolved_risk():
+    """The setup of earlier versions (60 intervals, no refinement, a linear guess): the collocation
+    points step over the track's edges, so the risk the NLP sees is a fraction of the true one. As
+    a Lagrange term nothing says so (the dynamics x' = u are integrated exactly); as a state, its
+    re-integration between the points fails the defect check and the transform restarts."""
+    data = yaml.safe_load(FILE.read_text())
+    data["problem"]["parameters"]["Q"] = 10.0
+    data["method"] = {"scheme": "radau", "intervals": 60, "degree": 3}
+    data["guess"] = {"states": {"x": "10*tau"}, "controls": {"u": 0.33}}
+    rcs = data["transforms"][1]["rcs"]
+    rcs |= {"monte_carlo": {"samples": 0}, "restarts": []}
+    hidden = solve(
+        spec_from_dict({**data, "transforms": [data["transforms"][0], {"rcs": rcs | {"cost_state": False}}]})
+    )
+    assert hidden.metrics["checks_passed"]["max_defect_relative"]
+    seen = solve(spec_from_dict(data))
+    assert not seen.metrics["checks_passed"]["max_defect_relative"]
+    assert seen.status.value != "optimal" and "max_defect_relative" in seen.message
+    # along the Lagrange-form solution (x linear between its points, 200 steps each) the risk is
+    # several times what the NLP integrated
+    p = data["problem"]["parameters"]
+    t = np.linspace(0.0, hidden.t_final, 200 * len(hidden.time))
+    x = np.interp(t, hidden.time, hidden.states["x"])
+    gamma = data["transforms"][0]["moving_obstacles"]["obstacles"]["train"]["track"]["gamma"]
+    true_risk = p["Q"] * np.trapezoid(risk_rate(x, t, p, gamma), t)
+    assert true_risk > 3 * hidden.metrics["sensitivity_cost"]

@@ -12,6 +12,14 @@ desensitize transform's report (``metrics.sensitivity_cost`` is the RCS cost,
 and ``metrics.monte_carlo.collision_probability``: the share of sampled speeds for which the
 open-loop re-simulation (RK4, ``monte_carlo.steps`` steps, agent and obstacles together) breaks a
 path constraint somewhere on that fine grid, with its Wilson interval (``gamespec.montecarlo.proportion``).
+
+With ``cost_state: true`` the cost is integrated as a state ``rcs_cost`` (its end value in the
+objective), so the defect check re-integrates it between the collocation points and
+``method.refine`` refines where a steep integrand is under-resolved (the super-Gaussian of
+eq. 6.44); ``metrics.sensitivity_measure`` is then a dense trapezoid along the solution.
+:meth:`Rcs.verify` rejects a Result that fails any check, and :meth:`Rcs.restarts` offers the
+file's ``restarts`` (guess sections, e.g. other homotopy classes) for the solving layer's
+multi-start.
 """
 
 from __future__ import annotations

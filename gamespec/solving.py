@@ -11,8 +11,8 @@ them as ``--set`` would and re-validates the source spec, re-applies the (pure) 
 that the target changed in runtime parameter values only (else a SpecError naming the parameters),
 and re-solves the compiled model with the target's values — cvxpy's ``update_parameters``. When the
 last transform's :meth:`~gamespec.transforms.base.Transform.verify` rejects the mapped-back Result,
-the same compiled model is re-solved from that transform's ``restarts`` (multi-start) with the
-caller's parameters and inputs, and the best verified Result is kept.
+or the solve fails, the same compiled model is re-solved from that transform's ``restarts``
+(multi-start) with the caller's parameters and inputs, and the best verified Result is kept.
 """
 
 from __future__ import annotations
@@ -243,8 +243,11 @@ class Solver:
         for index in reversed(range(len(steps))):
             step = steps[index]
             result = step.transform.invert(result, step.source, step.inverse)
+            last = index == len(steps) - 1
             if result.ok:
-                result = self._verified(step, result, values, inputs, multistart=index == len(steps) - 1)
+                result = self._verified(step, result, values, inputs, multistart=last)
+            elif last:
+                result = self._restarted(step, values, inputs) or result
         provenance = Provenance(
             spec_hash=spec_hash(spec),
             source=self.spec.source,

@@ -56,6 +56,32 @@ def evaluate(exprs: list[sp.Expr], values: Values, shape: tuple[int, ...]) -> np
     return np.broadcast_to(function(*values.values()), (len(exprs), *shape))
 
 
+DENSE = 20
+"""Points per gap of a Result's time grid on which :func:`dense_integral` integrates."""
+
+
+def values_at(result: Result, ocp: SymbolicOcp, t: np.ndarray) -> dict[sp.Symbol, np.ndarray | float]:
+    """The Result's parameters, states (linear between its points) and controls
+    (:func:`open_loop`) at times ``t``, by symbol."""
+    values: dict[sp.Symbol, np.ndarray | float] = {symbol(k): v for k, v in result.parameters.items()}
+    time = np.asarray(result.time)
+    values |= {symbol(k): np.interp(t, time, np.asarray(v)) for k, v in result.states.items()}
+    if ocp.controls:
+        values |= dict(zip(ocp.u, open_loop(result, ocp.controls)(t), strict=True))
+    values[TIME] = t
+    return values
+
+
+def dense_integral(result: Result, ocp: SymbolicOcp, integrand: sp.Expr) -> float:
+    """``∫ integrand dt`` along the Result by the trapezoid rule on :data:`DENSE` points per gap of
+    its time grid: independent of the collocation's quadrature (which sees the integrand at the
+    collocation points only) and of the mesh (the file's or a refined one)."""
+    time = np.asarray(result.time)
+    steps = time[:-1, None] + np.diff(time)[:, None] * (np.arange(DENSE) / DENSE)[None, :]
+    t = np.append(steps.ravel(), time[-1])
+    return float(np.trapezoid(evaluate([integrand], values_at(result, ocp, t), t.shape)[0], t))
+
+
 def rk4(
     ocp: SymbolicOcp,
     x0: np.ndarray,

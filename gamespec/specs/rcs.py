@@ -14,6 +14,9 @@ transforms:
                                       # | inverse_abs_square | any expression of w
       relevant: true                  # false: the plain constraint-sensitivity penalty of eq. 6.32
       monte_carlo: {samples: 1000, seed: 0, steps: 500}
+      cost_state: false               # true: the cost integrated as a state (its quadrature checked)
+      restarts:                       # guess sections re-solved from when a solve fails a check
+        - {states: {y: -3*sin(pi*tau)}}
 ```
 
 Weights, radii, centres, velocities and β are numbers or expressions of the problem's parameters, so
@@ -26,6 +29,7 @@ from pydantic import Field, field_validator
 
 from gamespec.specs.base import StrictModel, Value
 from gamespec.specs.desensitize import MonteCarloOptions
+from gamespec.specs.ocp import GuessSpec
 
 
 class RcsOptions(StrictModel):
@@ -39,7 +43,18 @@ class RcsOptions(StrictModel):
     )
     relevance: str = Field("logistic_derivative", description="r̃ of eq. 6.33: a name or an expression of w.")
     relevant: bool = Field(True, description="Weight S_g by r(g) (eq. 6.34); false: eq. 6.32.")
+    cost_state: bool = Field(
+        False,
+        description="Integrate the cost as a state (rcs_cost), so the defect estimate measures its "
+        "quadrature error and method.refine refines where the risk is under-resolved (a steep "
+        "integrand: car_vs_train); false: a Lagrange term, seen at the collocation points only.",
+    )
     monte_carlo: MonteCarloOptions = Field(default_factory=MonteCarloOptions)
+    restarts: list[GuessSpec] = Field(
+        default_factory=list,
+        description="Other starting points (each a guess section of the problem) re-solved from when "
+        "the first solution fails a check; the best one that passes every check is kept.",
+    )
 
 
 class Track(StrictModel):

@@ -9,8 +9,8 @@ needs solving is asked of the solving layer (:mod:`gamespec.solving`):
   solves it and passes its Result to ``apply(..., upstream=result)``;
 - a transform whose mapped-back Result can fail a check of the source problem says so in
   :meth:`Transform.verify` and offers other starting points in :meth:`Transform.restarts`; the
-  solving layer re-solves the same compiled model from them (multi-start) and keeps the best
-  verified Result.
+  solving layer re-solves the same compiled model from them (multi-start) when the check fails or
+  the solve does, and keeps the best verified Result.
 
 Runtime parameters go through the chain as in cvxpy's ``update_parameters``: the solving layer
 re-applies the (pure) transforms to the source spec with new values and hands the compiled model
@@ -85,7 +85,7 @@ class Transform(ABC):
 
     def restarts(self, spec: SpecBase, inverse_data: Any) -> list[Result]:
         """Other starting points of the target spec, best first, to re-solve from when
-        :meth:`verify` fails (the default: none)."""
+        :meth:`verify` fails or the solve itself does not succeed (the default: none)."""
         return []
 
 

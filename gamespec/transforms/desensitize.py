@@ -23,7 +23,7 @@ import sympy as sp
 
 from gamespec.desensitize.augment import METHODS, Augmentation
 from gamespec.desensitize.montecarlo import monte_carlo
-from gamespec.desensitize.simulate import evaluate
+from gamespec.desensitize.simulate import dense_integral, evaluate
 from gamespec.errors import ExpressionError, SpecError
 from gamespec.ocp.symbolic import SymbolicOcp
 from gamespec.ocp.transcription import Transcription
@@ -251,7 +251,15 @@ def report(result: Result, spec: OptimalControlSpec, inverse: InverseData) -> Re
 
 
 def _penalty_value(spec: OptimalControlSpec, result: Result, penalty: Penalty) -> float:
-    """The added cost on the solution, with the transcription's own quadrature (``T q·L``)."""
+    """The added cost on the solution, with the transcription's own quadrature (``T q·L``) on the
+    file's mesh; on a refined mesh (``metrics.refinement``), whose points the Result does not
+    describe, the running part is a dense trapezoid along the solution (refined to the file's
+    tolerance, the two agree to it)."""
+    final = float(evaluate([penalty.final], _end_values(result), ())[0])
+    if penalty.running == 0:
+        return final
+    if len(result.metrics.get("refinement", ())) > 1:
+        return dense_integral(result, SymbolicOcp(spec), penalty.running) + final
     grid = Transcription(spec).grid
     _, _, q = grid.triplets
     idx = grid.eval_index
@@ -261,7 +269,6 @@ def _penalty_value(spec: OptimalControlSpec, result: Result, penalty: Penalty) -
     values.update({symbol(k): np.asarray(v) for k, v in result.controls.items()})
     values[TIME] = t[idx]
     running = evaluate([penalty.running], values, (len(idx),))[0]
-    final = float(evaluate([penalty.final], _end_values(result), ())[0])
     return float((t[-1] - t[0]) * q @ running) + final
 
 

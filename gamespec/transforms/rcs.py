@@ -12,20 +12,29 @@ desensitize transform's report (``metrics.sensitivity_cost`` is the RCS cost,
 and ``metrics.monte_carlo.collision_probability``: the share of sampled speeds for which the
 open-loop re-simulation (RK4, ``monte_carlo.steps`` steps, agent and obstacles together) breaks a
 path constraint somewhere on that fine grid, with its Wilson interval (``gamespec.montecarlo.proportion``).
+
+With ``cost_state: true`` the cost is integrated as a state ``rcs_cost`` (its end value in the
+objective), so the defect check re-integrates it between the collocation points and
+``method.refine`` refines where a steep integrand is under-resolved (the super-Gaussian of
+eq. 6.44); ``metrics.sensitivity_measure`` is then a dense trapezoid along the solution.
+:meth:`Rcs.verify` rejects a Result that fails any check, and :meth:`Rcs.restarts` offers the
+file's ``restarts`` (guess sections, e.g. other homotopy classes) for the solving layer's
+multi-start.
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from typing import Any, ClassVar
 
 import numpy as np
 import sympy as sp
 
-from gamespec.desensitize.augment import sensitivity_functions
-from gamespec.desensitize.simulate import evaluate, open_loop
+from gamespec.desensitize.augment import NewState, sensitivity_functions
+from gamespec.desensitize.simulate import dense_integral, evaluate, values_at
 from gamespec.errors import ExpressionError, SpecError
 from gamespec.ocp.symbolic import SymbolicOcp
+from gamespec.ocp.transcription import Transcription
 from gamespec.rcs import obstacles as geometry
 from gamespec.rcs.sensitivity import (
     constraint_sensitivity,
@@ -35,10 +44,10 @@ from gamespec.rcs.sensitivity import (
     state_sensitivity,
     weighted_square,
 )
-from gamespec.result import Result
+from gamespec.result import Result, Status
 from gamespec.specs.base import SpecBase
 from gamespec.specs.desensitize import DesensitizeOptions
-from gamespec.specs.ocp import OptimalControlSpec
+from gamespec.specs.ocp import GuessSpec, OptimalControlSpec
 from gamespec.specs.rcs import MovingObstaclesOptions, RcsOptions
 from gamespec.symbolic.language import TIME, parse, symbol
 from gamespec.symbolic.printer import to_text
@@ -119,6 +128,9 @@ class RcsData:
     S_g: sp.Matrix
     S_r: sp.Matrix
     options: RcsOptions
+    target: OptimalControlSpec
+    unit: sp.Expr
+    """The integrand of the sensitivity measure (unit weights)."""
 
 
 class Rcs(OcpRewrite):
@@ -134,6 +146,20 @@ class Rcs(OcpRewrite):
 
     def invert(self, result: Result, spec: SpecBase, inverse_data: RcsData) -> Result:
         return rcs_report(result, spec, inverse_data)
+
+    def verify(self, result: Result, spec: SpecBase, inverse_data: RcsData) -> str | None:
+        """The first check of the Result that fails its tolerance (``metrics.checks_passed``; with
+        ``cost_state`` an under-resolved risk integral fails ``max_defect_relative``), or None."""
+        failed = [name for name, passed in result.metrics.get("checks_passed", {}).items() if not passed]
+        if not failed:
+            return None
+        value = result.checks.get(failed[0])
+        return f"check {failed[0]} failed ({value:.3g})" if value is not None else f"check {failed[0]} failed"
+
+    def restarts(self, spec: SpecBase, inverse_data: RcsData) -> list[Result]:
+        """The starting points of ``restarts`` (each a ``guess`` section of the file's problem) on
+        the target's mesh, in the file's order."""
+        return [starting_point(inverse_data.target, g) for g in inverse_data.options.restarts]
 
 
 FIELD = "transforms.rcs"
@@ -155,8 +181,14 @@ def regularized(spec: OptimalControlSpec, options: RcsOptions) -> tuple[OptimalC
         raise SpecError(str(err), field=f"{FIELD}.relevance", source=spec.source) from None
     penalized = S_r if options.relevant else S_g
     weights = _weights(spec, options, len(chosen))
-    penalty = Penalty(weighted_square(penalized, weights), sp.Integer(0))
-    measure = Penalty(weighted_square(penalized, [sp.Integer(1)] * len(chosen)), sp.Integer(0))
+    cost = weighted_square(penalized, weights)
+    unit = weighted_square(penalized, [sp.Integer(1)] * len(chosen))
+    if options.cost_state:
+        aug = replace(aug, states=[*aug.states, NewState(COST_STATE, cost, sp.Integer(0), None)])
+        cost = symbol(f"{COST_STATE}_f")
+        penalty = measure = Penalty(sp.Integer(0), cost)  # the measure: see rcs_report
+    else:
+        penalty, measure = Penalty(cost, sp.Integer(0)), Penalty(unit, sp.Integer(0))
     new = augmented_spec(spec, aug, penalty)
     data = InverseData(
         aug,
@@ -166,7 +198,30 @@ def regularized(spec: OptimalControlSpec, options: RcsOptions) -> tuple[OptimalC
         len(spec.problem.states),
         len(new.problem.states),
     )
-    return new, RcsData(data, [q.label for q in chosen], uncertain, S_g, S_r, options)
+    return new, RcsData(data, [q.label for q in chosen], uncertain, S_g, S_r, options, new, unit)
+
+
+def starting_point(target: OptimalControlSpec, guess: GuessSpec) -> Result:
+    """``guess`` (a ``guess`` section in the names of the file's problem; the added states start
+    from their default) evaluated on ``target``'s mesh as a Result of ``target``."""
+    tr = Transcription(target.model_copy(update={"guess": guess}))
+    start = tr.guess(target.runtime_parameters())
+    t = tr.t0 + start.T * tr.grid.nodes
+    return Result(
+        status=Status.FEASIBLE,
+        message="starting point",
+        t_final=float(t[-1]),
+        time=t,
+        control_time=tr.t0 + start.T * tr.grid.eval_tau,
+        states={n: start.X[i] for i, n in enumerate(tr.ocp.states)},
+        controls={n: start.U[j] for j, n in enumerate(tr.ocp.controls)},
+        parameters=target.runtime_parameters(),
+    )
+
+
+COST_STATE = "rcs_cost"
+"""The state that integrates ``‖vec S_r‖²_Q`` (``cost_state: true``: ``q' = ‖vec S_r‖²_Q``,
+``q(t0) = 0``, free end, ``q(t_f)`` added to the objective)."""
 
 
 def _chosen(spec: OptimalControlSpec, ocp: SymbolicOcp, options: RcsOptions) -> list:
@@ -208,6 +263,8 @@ def rcs_report(result: Result, spec: OptimalControlSpec, data: RcsData) -> Resul
     }
     if result.ok and result.time is not None:
         arrays |= along(result, spec, data)
+        if data.options.cost_state:
+            metrics["sensitivity_measure"] = dense_integral(result, SymbolicOcp(spec), data.unit)
         mc = metrics.get("monte_carlo")
         if mc is not None and "violation_probability" in mc:
             mc = dict(mc)
@@ -219,13 +276,8 @@ def rcs_report(result: Result, spec: OptimalControlSpec, data: RcsData) -> Resul
 
 def along(result: Result, spec: OptimalControlSpec, data: RcsData) -> dict[str, Any]:
     """``S_g<i>_<ρ>`` and ``S_r<i>_<ρ>`` at the Result's time points."""
-    ocp = SymbolicOcp(spec)
     t = np.asarray(result.time)
-    values: dict[sp.Symbol, Any] = {symbol(k): v for k, v in result.parameters.items()}
-    values |= {symbol(k): np.asarray(v) for k, v in result.states.items()}
-    if ocp.controls:
-        values |= dict(zip(ocp.u, open_loop(result, ocp.controls)(t), strict=True))
-    values[TIME] = t
+    values = values_at(result, SymbolicOcp(spec), t)
     out = {}
     for prefix, M in (("S_g", data.S_g), ("S_r", data.S_r)):
         flat = [M[i, j] for i in range(M.rows) for j in range(M.cols)]

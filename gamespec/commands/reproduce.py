@@ -29,6 +29,9 @@ from gamespec.commands.reproduction import (
     write_markdown,
 )
 
+WIDTH = 200
+"""Characters per line of the table where stdout is not a terminal (a file, a pipe)."""
+
 reproduce_app = typer.Typer(invoke_without_command=True, help="Reproduce the thesis experiments.")
 
 
@@ -116,7 +119,7 @@ def reproduce(
         view.add_column(column, overflow="fold")
     for row in rows:
         view.add_row(*(escape(row[c]) for c in SHOWN))
-    Console().print(view)
+    Console(width=None if sys.stdout.isatty() else WIDTH).print(view)
     markdown, table = write_markdown(rows, out / "reproduce.md"), write_csv(rows, out / "reproduce.csv")
     print(f"wrote {markdown} and {table}", file=sys.stderr)
     failed = [e.name for e in experiments if values[e.name] is None]

@@ -250,25 +250,29 @@ def yaml_commands(path: Path) -> list[Command]:
     return _commands_in_lines(lines, source, source, file_arg=source)
 
 
-FENCE = re.compile(r"^```(\w*)\s*$")
+FENCE = re.compile(r"^(`{3,})(\w*)\s*$")
+EXAMPLE_LANGUAGES = ("markdown", "text")
+"""Blocks that show text as it is written (the syntax itself), whose commands are not run."""
 
 
 def markdown_commands(path: Path) -> list[Command]:
-    """The commands in the fenced ``bash`` blocks of a Markdown page (a claim line is a comment)."""
+    """The commands in the fenced ``bash`` blocks of a Markdown page (a claim line is a comment); a
+    block inside a longer fence, or fenced as ``markdown`` or ``text``, is an example, not run."""
     source = path.relative_to(ROOT).as_posix()
     found: list[Command] = []
     block: list[tuple[int, str]] | None = None
-    language = ""
-    start = 0
+    opening, language, start = "", "", 0
     for number, line in enumerate(path.read_text().splitlines(), 1):
         fence = FENCE.match(line.strip())
         if fence and block is None:
-            block, language, start = [], fence[1], number
-        elif fence:
+            block, opening, language, start = [], fence[1], fence[2], number
+        elif fence and fence[1] == opening and not fence[2]:
             if language == "bash":
                 text = [(n, t[1:] if t.strip().startswith(f"# {ARROW}") else t) for n, t in block]
                 found += _commands_in_lines(text, source, f"{source}:{start}", file_arg=None)
-            elif any(t.strip().startswith("gamespec ") for _, t in block):
+            elif language not in EXAMPLE_LANGUAGES and any(
+                t.strip().startswith("gamespec ") for _, t in block
+            ):
                 raise ClaimError(f"{source}:{start}: a block with gamespec commands is fenced as ```bash")
             block = None
         elif block is not None:
@@ -386,12 +390,23 @@ def mismatches(command: Command, outcome: Outcome) -> list[str]:
     return problems
 
 
+def _warm_up() -> None:
+    """Import the libraries that solves and plots import, so that a command's measured CPU time is
+    its own, as in the test suite, where one process runs them all."""
+    import importlib
+
+    for name in ("casadi", "cvxpy", "matplotlib.pyplot", "pyomo.environ", "scipy.integrate", "sympy"):
+        importlib.import_module(name)
+    importlib.import_module("gamespec.solving")
+
+
 def _measure_one(identifier: str) -> dict[str, Any]:
     """Run one command (and what it needs) in a fresh folder; the outcome as a JSON-ready dict."""
     import tempfile
     import warnings
 
     warnings.simplefilter("ignore")
+    _warm_up()
     commands = {c.id: c for c in documented_commands()}
     command = commands[identifier]
     with tempfile.TemporaryDirectory() as tmp, workspace(Path(tmp)):

@@ -46,7 +46,7 @@ from pathlib import Path
 from typing import Any
 
 ROOT = Path(__file__).resolve().parents[2]
-SLOW_CPU_S = 3.0
+SLOW_CPU_S = 2.5
 """A command whose recorded CPU time reaches this many seconds is tagged ``slow``."""
 DEFAULT_BUDGET_CPU_S = 30.0
 """The recorded CPU time of all commands of the default suite together stays under this."""

@@ -88,9 +88,9 @@ def load_manifest(path: Path | None = None) -> Manifest:
         raise SpecError(" ".join(str(err).split()), source=str(path or MANIFEST)) from None
 
 
-def read_metric(data: dict, path: str) -> float | None:
-    """A number at ``path`` (dots, list items by index) of a Result's JSON, or None."""
-    node: object = data
+def dotted(data: object, path: str) -> object:
+    """The value at ``path`` (keys joined by dots, list items by index) of a Result's JSON, or None."""
+    node = data
     for key in path.split("."):
         if isinstance(node, dict) and key in node:
             node = node[key]
@@ -98,6 +98,12 @@ def read_metric(data: dict, path: str) -> float | None:
             node = node[int(key)]
         else:
             return None
+    return node
+
+
+def read_metric(data: dict, path: str) -> float | None:
+    """The number at ``path`` of a Result's JSON (a flag as 0 or 1), or None."""
+    node = dotted(data, path)
     if isinstance(node, bool):
         return float(node)
     return float(node) if isinstance(node, int | float) else None

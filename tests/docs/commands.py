@@ -131,7 +131,6 @@ class Command:
     text: str
     parts: list[list[str]]
     claim: Claim | None
-    block: str
     needs: list[Command] = field(default_factory=list)
 
     @property
@@ -209,9 +208,7 @@ def _split_chain(text: str, where: str) -> list[list[str]]:
     return parts
 
 
-def _commands_in_lines(
-    lines: list[tuple[int, str]], source: str, block: str, file_arg: str | None
-) -> list[Command]:
+def _commands_in_lines(lines: list[tuple[int, str]], source: str, file_arg: str | None) -> list[Command]:
     """Command lines and their claims among ``lines`` (number, text without the comment marker)."""
     found: list[Command] = []
     i = 0
@@ -234,7 +231,7 @@ def _commands_in_lines(
         if i + 1 < len(lines) and lines[i + 1][1].strip().startswith(ARROW):
             i += 1
             claim = parse_claim(lines[i][1].strip().removeprefix(ARROW), where)
-        found.append(Command(source, number, joined, _split_chain(joined, where), claim, block))
+        found.append(Command(source, number, joined, _split_chain(joined, where), claim))
         i += 1
     return found
 
@@ -247,7 +244,7 @@ def yaml_commands(path: Path) -> list[Command]:
         for n, line in enumerate(path.read_text().splitlines(), 1)
         if line.strip().startswith("#")
     ]
-    return _commands_in_lines(lines, source, source, file_arg=source)
+    return _commands_in_lines(lines, source, file_arg=source)
 
 
 FENCE = re.compile(r"^(`{3,})(\w*)\s*$")
@@ -269,7 +266,7 @@ def markdown_commands(path: Path) -> list[Command]:
         elif fence and fence[1] == opening and not fence[2]:
             if language == "bash":
                 text = [(n, t[1:] if t.strip().startswith(f"# {ARROW}") else t) for n, t in block]
-                found += _commands_in_lines(text, source, f"{source}:{start}", file_arg=None)
+                found += _commands_in_lines(text, source, file_arg=None)
             elif language not in EXAMPLE_LANGUAGES and any(
                 t.strip().startswith("gamespec ") for _, t in block
             ):
@@ -312,15 +309,9 @@ class Outcome:
 
     def value(self, name: str) -> object:
         """A field of the JSON Result, or a dotted path into it (list items by index)."""
-        node: object = self.result
-        for key in name.split("."):
-            if isinstance(node, dict) and key in node:
-                node = node[key]
-            elif isinstance(node, list) and key.isdigit() and int(key) < len(node):
-                node = node[int(key)]
-            else:
-                return None
-        return node
+        from gamespec.commands.reproduction import dotted
+
+        return dotted(self.result, name)
 
 
 def _cpu_s() -> float:

@@ -12,7 +12,9 @@ from gamespec.metrics import Finite, Metrics, array
 if TYPE_CHECKING:
     from gamespec.result import Result
 
-LOOPS = ("open_loop", "closed_loop", "pursuer_feedback")
+LOOPS = ("open_loop", "closed_loop", "lower_value", "minimax_mixed", "gauss_seidel")
+"""The capture-probability series a Result may hold: open loop, the chosen concept's closed loop and
+each solution concept of :mod:`gamespec.flowfield.concepts`."""
 
 
 class Reachability(BaseModel):
@@ -43,7 +45,9 @@ class FlowGameMetrics(Metrics):
     monte_carlo_capture_probability: dict[str, CaptureEstimate] = Field(default_factory=dict)
     capture_probability_open_loop: float | None = None
     capture_probability_closed_loop: float | None = None
-    capture_probability_pursuer_feedback: float | None = None
+    capture_probability_lower_value: float | None = None
+    capture_probability_minimax_mixed: float | None = None
+    capture_probability_gauss_seidel: float | None = None
     game_converged: Any = None
     game_scheme: str | None = None
 

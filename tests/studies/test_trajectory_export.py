@@ -37,7 +37,9 @@ def test_one_results_trajectories_round_trip_through_csv(tmp_path) -> None:
 
 def test_a_repeated_time_stays_two_rows(tmp_path) -> None:
     """A phase boundary (a time the grid holds twice) keeps both values."""
-    result = Result(status=Status.OPTIMAL, time=np.array([0.0, 1.0, 1.0, 2.0]), states={"x": [0, 1, 5, 6]})
+    result = Result(
+        problem="r", status=Status.OPTIMAL, time=np.array([0.0, 1.0, 1.0, 2.0]), states={"x": [0, 1, 5, 6]}
+    )
     result.save(tmp_path / "r")
     assert run(["results", str(tmp_path / "r"), "--csv", str(tmp_path / "r.csv")]) == 0
     rows = _read(tmp_path / "r.csv")
@@ -50,6 +52,6 @@ def test_a_repeated_time_stays_two_rows(tmp_path) -> None:
 
 
 def test_a_result_without_trajectories_is_refused_for_export(tmp_path, capsys) -> None:
-    Result(status=Status.OPTIMAL, objective=1.0).save(tmp_path / "r")
+    Result(problem="r", status=Status.OPTIMAL, objective=1.0).save(tmp_path / "r")
     assert run(["results", str(tmp_path / "r"), "--csv", str(tmp_path / "r.csv")]) == 2
     assert "no trajectories" in capsys.readouterr().err

@@ -18,13 +18,24 @@ from tests.plots.recording import legend_texts, recording, titles
 FAST = {
     "pursuit_scenario": ["time_step=0.05"],
     "lq_stochastic_game": ["method.monte_carlo.samples=20"],
+    "flow_field_game": ["method.monte_carlo.samples=500"],
 }
-FILES = sorted(p for p in PROBLEMS.rglob("*.yaml") if "study" not in p.stem)
+FAST_FILES = {
+    "car_vs_train": ["method.refine=null", "transforms.1.rcs.monte_carlo.samples=100"],
+}
+"""Settings that keep a figure test's solve short (the figures show what was solved, at any mesh)."""
+SLOW_FILES = {"hurricane_hugo"}
+"""Files whose solve takes many seconds of CPU whatever the settings: their kind's figures are
+checked in the default suite on another file (``linear_flow``), theirs with ``-m slow``."""
+FILES = [
+    pytest.param(p, marks=pytest.mark.slow) if p.stem in SLOW_FILES else p
+    for p in sorted(p for p in PROBLEMS.rglob("*.yaml") if "study" not in p.stem)
+]
 
 
 def _solve(path: Path) -> gamespec.Result:
     spec = gamespec.load(path)
-    return gamespec.solve(gamespec.load(path, FAST.get(spec.kind, [])))
+    return gamespec.solve(gamespec.load(path, FAST.get(spec.kind, []) + FAST_FILES.get(path.stem, [])))
 
 
 def _check_common(result: gamespec.Result, saved) -> None:

@@ -61,3 +61,14 @@ squared distances lose the precision a capture radius needs, and far beyond it t
 
 MAX_SPEED = 1e9
 """Largest speed of a player (``engagement``, ``pursuit_scenario``)."""
+
+MAX_GAME_STATE = 1e9
+"""Largest absolute value of a ``differential_game`` state's initial or final value (as
+:data:`MAX_COORDINATE`: beyond it distances lose the precision a capture needs)."""
+
+MAX_RECEDING_STEPS = 10_000
+"""Most steps of a ``differential_game`` receding-horizon run (``time_limit / step``)."""
+
+MAX_BEST_RESPONSES = 2_000_000
+"""Most best-response solves a ``differential_game`` may ask for: steps times players² (one game
+per player, each with every player's problem) times ``game.max_iterations``."""

@@ -34,7 +34,7 @@ def open_loop(model: GameModel) -> Result:
     each game's own trajectories are in ``arrays["game/<player>/<state>"]``.
     """
     game = model.game
-    x0, t0 = initial_state(game), game.problem.time.initial
+    x0, t0 = initial_state(game, model.parameters), game.problem.time.initial
     solutions = [model.solve(view, x0, t0) for view in model.views]
     own = {name: _own(solutions, name) for name in game.problem.players}
     first = solutions[0].states
@@ -82,7 +82,9 @@ def _simulated(
     horizon = float(reference.time[-1] - reference.time[0])
     signals = {c: control_signal(grid, v, t0, horizon) for c, v in controls.items()}
     system = TrueSystem(game, true_parameters(model))
-    times, rows = system.advance(initial_state(game), signals, t0, horizon, t0 + horizon * grid.nodes)
+    times, rows = system.advance(
+        initial_state(game, model.parameters), signals, t0, horizon, t0 + horizon * grid.nodes
+    )
     return times, dict(zip(system.states, rows.T, strict=True))
 
 

@@ -30,10 +30,9 @@ from gamespec.games.equilibrium import GameModel, GameSolution
 from gamespec.games.problems import initial_state, predicted_states
 from gamespec.games.simulate import TrueSystem, control_signal, grid_of
 from gamespec.result import Result, Status
-from gamespec.specs.differential_game import DifferentialGameSpec, sensitivity_name
+from gamespec.specs.differential_game import DifferentialGameSpec, intervals_per_step, sensitivity_name
 from gamespec.symbolic.calculus import numeric_function
 from gamespec.symbolic.language import parse, parse_relation, symbol
-from gamespec.symbolic.translate import numeric
 
 SAMPLES_PER_STEP = 10
 """Points of the true trajectory per step at which capture and collisions are checked."""
@@ -120,12 +119,6 @@ class Predictor:
         return rows
 
 
-def _horizon(game: DifferentialGameSpec, params: Mapping[str, float]) -> float:
-    p = game.problem
-    table = {n: symbol(n) for n in [*p.parameters, *p.uncertain]}
-    return float(numeric(parse(p.time.final, table), {table[k]: v for k, v in params.items() if k in table}))
-
-
 @dataclass
 class Record:
     """What the run keeps: true samples, applied controls, look-ahead trajectories, per-step games."""
@@ -156,18 +149,13 @@ class RecedingHorizon:
         self.players = list(game.problem.players)
         self.truth = TrueSystem(game, true_parameters(model))
         self.predicting = [n for n, pl in game.problem.players.items() if pl.observes is not None]
-        self.horizon = _horizon(game, model.parameters)
+        self.horizon = game.problem.evaluate(model.parameters).horizon
         intervals = game.method.intervals
         self.interval = self.horizon / intervals
-        per_step = rh.step / self.interval
-        if abs(per_step - round(per_step)) > 1e-9 or round(per_step) < 1:
-            raise SpecError(
-                f"the step ({rh.step:g}) must be a whole number of collocation intervals "
-                f"(horizon / intervals = {self.interval:g})",
-                field="receding_horizon.step",
-                source=game.source,
-            )
-        self.intervals_per_step = round(per_step)
+        try:
+            self.intervals_per_step = intervals_per_step(rh.step, self.horizon, intervals)
+        except SpecError as err:
+            raise SpecError(err.reason, field=err.field, source=game.source) from None
         self.points_per_step = self.intervals_per_step * grid_of(game.method).points_per_interval
         self.models: dict[int, GameModel] = {intervals: model}
         self.capture = (
@@ -207,7 +195,7 @@ class RecedingHorizon:
         end = t + rh.time_limit
         if rh.horizon == "shrinking":
             end = min(end, t + self.horizon)
-        x = initial_state(game)
+        x = initial_state(game, self.model.parameters)
         predictors = {n: Predictor(self.model, n, x) for n in self.predicting}
         record = Record(times=[t], states=[np.array([x[s] for s in self.truth.states])])
         record.predicted = {n: [record.states[0]] for n in self.predicting}

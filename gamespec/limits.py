@@ -72,3 +72,6 @@ MAX_RECEDING_STEPS = 10_000
 MAX_BEST_RESPONSES = 2_000_000
 """Most best-response solves a ``differential_game`` may ask for: steps times players² (one game
 per player, each with every player's problem) times ``game.max_iterations``."""
+
+MAX_RCS_OBSTACLES = 100
+"""Most obstacles of one point of an ``rcs_multi_obstacle_study``."""

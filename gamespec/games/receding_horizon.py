@@ -385,15 +385,17 @@ def _padded(rows: list[np.ndarray]) -> np.ndarray:
 
 
 def _progress(enabled: bool) -> Progress:
+    """The run's progress bar on stderr, shown only on a terminal (a pipe gets nothing)."""
+    console = Console(stderr=True)
     return Progress(
         TextColumn("[bold]{task.description}"),
         BarColumn(),
         TextColumn("{task.completed}/{task.total} steps"),
         TimeElapsedColumn(),
         TextColumn("{task.fields[info]}"),
-        console=Console(stderr=True),
+        console=console,
         transient=True,
-        disable=not enabled,
+        disable=not enabled or not console.is_terminal,
     )
 
 

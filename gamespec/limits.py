@@ -75,3 +75,15 @@ per player, each with every player's problem) times ``game.max_iterations``."""
 
 MAX_RCS_OBSTACLES = 100
 """Most obstacles of one point of an ``rcs_multi_obstacle_study``."""
+
+MAX_GRID_CELL_STEPS = 5e7
+"""Most cell updates of a ``flow_field_game``'s level sets: grid cells times the fewest CFL time
+steps up to ``max_time`` (the Chapter 5 files need about 2e6; 5e7 is minutes of CPU)."""
+
+MAX_EXTREMAL_VALUES = 2e7
+"""Most front points of a ``flow_field_game``'s extremal shooting, directions times RK4 steps up to
+``max_time`` (each kept: 320 MB of doubles)."""
+
+MAX_SAMPLE_STEPS = 1e9
+"""Most Euler–Maruyama sample steps of a ``flow_field_game``'s Monte Carlo: samples times
+``substeps`` per control step times the control steps up to ``max_time``."""

@@ -23,7 +23,7 @@ from pydantic import Field, model_validator
 
 from gamespec.errors import SpecError
 from gamespec.limits import MAX_RCS_OBSTACLES, MAX_SAMPLE_VALUES, MAX_STUDY_POINTS
-from gamespec.specs.base import Number, SpecBase
+from gamespec.specs.base import BackendName, Number, SpecBase
 from gamespec.specs.ocp import MethodSpec
 
 
@@ -50,7 +50,7 @@ class RcsStudySpec(SpecBase):
     seed: int = Field(0, ge=0)
     steps: int = Field(1000, ge=10, le=100_000, description="RK4 steps of the Monte Carlo re-simulation.")
     method: MethodSpec = Field(default_factory=lambda: MethodSpec(intervals=40, degree=3))
-    ocp_backend: str = "casadi"
+    ocp_backend: BackendName = "casadi"
     store: Path = Field(Path("runs/rcs_multi_obstacle/points"), description="Folder of per-point records.")
 
     default_backend: ClassVar[str] = "rcs_study"

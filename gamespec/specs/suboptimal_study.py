@@ -15,7 +15,7 @@ from pydantic import Field, ValidationError, ValidationInfo, field_validator, mo
 
 from gamespec.errors import SpecError
 from gamespec.limits import MAX_STUDY_POINTS
-from gamespec.specs.base import Number, SpecBase, StrictModel
+from gamespec.specs.base import BackendName, Number, SpecBase, StrictModel
 from gamespec.specs.ocp import MethodSpec
 
 MethodChange = dict[str, int | float | str]
@@ -48,7 +48,7 @@ class SuboptimalStudySpec(SpecBase):
         default_factory=lambda: [{"intervals": 80}, {"intervals": 60, "grading": 100}],
         description="Changes to method tried in turn when a solution fails the defect check.",
     )
-    ocp_backend: str = Field("casadi", description="Backend that solves each point's eq. 2.21 OCP.")
+    ocp_backend: BackendName = Field("casadi", description="Backend that solves each point's eq. 2.21 OCP.")
     store: Path = Field(
         Path("runs/table_2_1/points"),
         description="Folder of the per-point records (relative to the current directory); "

@@ -90,11 +90,26 @@ def names(node: Any) -> list[str]:
     return sorted(set(found))
 
 
+def _monte_carlo_blocks(node: Any, prefix: str = "") -> list[str]:
+    """The dotted paths of the ``monte_carlo`` blocks that give a ``samples`` count (analyses of
+    requested transforms, studies)."""
+    found = []
+    if isinstance(node, dict | list):
+        items = node.items() if isinstance(node, dict) else enumerate(node)
+        for key, value in items:
+            at = f"{prefix}.{key}" if prefix else str(key)
+            if key == "monte_carlo" and isinstance(value, dict) and "samples" in value:
+                found.append(at)
+            found += _monte_carlo_blocks(value, at)
+    return found
+
+
 def tiny_overrides(path: Path, store: Path) -> list[str]:
     """``--set`` assignments that make the shipped file ``path`` tiny (see :data:`TINY`)."""
     document = _document(path)
     kind = document["kind"]
     values = {k: v for k, v in TINY.get(kind, {}).items() if _has(document, k.split(".")[0])}
+    values |= {f"{at}.samples": 20 for at in _monte_carlo_blocks(document)}
     rh = document.get("receding_horizon")
     if rh is not None:
         values["receding_horizon.time_limit"] = rh["step"]

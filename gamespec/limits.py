@@ -87,3 +87,8 @@ MAX_EXTREMAL_VALUES = 2e7
 MAX_SAMPLE_STEPS = 1e9
 """Most Euler–Maruyama sample steps of a ``flow_field_game``'s Monte Carlo: samples times
 ``substeps`` per control step times the control steps up to ``max_time``."""
+
+MAX_LQ_ENTRY = 1e12
+"""Largest absolute value of an entry of an ``lq_stochastic_game``'s evaluated matrices, and of its
+open-loop state transition and covariance over the horizon (products of a few of them stay far
+from overflow)."""

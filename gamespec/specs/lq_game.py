@@ -24,7 +24,7 @@ from pydantic import Discriminator, Field, Tag, field_validator, model_validator
 
 from gamespec.best_response import Settings
 from gamespec.errors import ExpressionError, SpecError
-from gamespec.limits import MAX_INTERVALS, MAX_MAGNITUDE, MAX_SAMPLE_VALUES, MAX_SAMPLES
+from gamespec.limits import MAX_INTERVALS, MAX_LQ_ENTRY, MAX_MAGNITUDE, MAX_SAMPLE_VALUES, MAX_SAMPLES
 from gamespec.specs.base import Number, ProblemParameters, SpecBase, StrictModel, Value
 from gamespec.specs.lq_model import LQGame, zero_order_hold
 from gamespec.symbolic.language import RESERVED, float_value, parse, symbol
@@ -389,6 +389,24 @@ class _Evaluator:
                     "the terminal covariance must be positive definite (Lemma 13)",
                     field="problem.terminal.covariance",
                 )
+        Sigma0 = self.covariance(p.initial.covariance, n, "initial.covariance")
+        for name, M in (
+            ("dynamics", A),
+            ("dynamics", B),
+            ("dynamics", C),
+            ("dynamics", D),
+            ("cost", Q),
+            ("cost", R),
+            ("cost", S),
+            ("initial", mu0),
+            ("initial", Sigma0),
+        ):
+            if not np.abs(M).max(initial=0.0) <= MAX_LQ_ENTRY:
+                raise SpecError(
+                    f"an entry is beyond {MAX_LQ_ENTRY:g} in size (README, Limits)",
+                    field=f"problem.{'continuous' if name == 'dynamics' and p.continuous else name}",
+                )
+        _open_loop_bounded(A, D, Sigma0)
         return LQGame(
             A=A,
             B=B,
@@ -398,8 +416,25 @@ class _Evaluator:
             R=R,
             S=S,
             mu0=mu0,
-            Sigma0=self.covariance(p.initial.covariance, n, "initial.covariance"),
+            Sigma0=Sigma0,
             muN=muN,
             SigmaN=SigmaN,
             dt=dt,
         )
+
+
+def _open_loop_bounded(A: np.ndarray, D: np.ndarray, Sigma0: np.ndarray) -> None:
+    """The open-loop covariance ``Σ_{k+1} = A_k Σ_k A_kᵀ + D_k D_kᵀ`` (eq. 4.2 without controls)
+    and the state transition ``A_k ⋯ A_0`` stay within :data:`~gamespec.limits.MAX_LQ_ENTRY` over
+    the horizon, so the backends' products of them are finite; a SpecError otherwise."""
+    Sigma, Phi = Sigma0, np.eye(A.shape[1])
+    with np.errstate(over="ignore", invalid="ignore"):
+        for k in range(A.shape[0]):
+            Sigma = A[k] @ Sigma @ A[k].T + D[k] @ D[k].T
+            Phi = A[k] @ Phi
+            if not (np.abs(Sigma).max() <= MAX_LQ_ENTRY and np.abs(Phi).max() <= MAX_LQ_ENTRY):
+                raise SpecError(
+                    f"the open-loop state transition or covariance grows beyond {MAX_LQ_ENTRY:g} by step "
+                    f"{k + 1}: the model is too unstable (or too noisy) for this horizon",
+                    field="problem.horizon",
+                )

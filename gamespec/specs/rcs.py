@@ -22,10 +22,30 @@ Weights, radii, centres, velocities and β are numbers or expressions of the pro
 
 from __future__ import annotations
 
+from typing import TYPE_CHECKING
+
 from pydantic import Field, field_validator
 
+from gamespec.errors import ExpressionError, SpecError
 from gamespec.specs.base import StrictModel, Value
 from gamespec.specs.desensitize import MonteCarloOptions
+from gamespec.symbolic.grammar import FLOATS, expression, unknowns
+
+if TYPE_CHECKING:
+    from gamespec.specs.ocp import OptimalControlSpec
+
+
+def check_values(spec: OptimalControlSpec, items: list[tuple[str, Value]], states: bool = False) -> None:
+    """Each ``(field, value)`` an expression of the problem's parameters at the file's values (and of
+    its states and ``t`` when ``states``), finite and real there: checked at load, so a bad centre
+    or weight is one line naming its field, never an error of the transform or a plot later."""
+    p = spec.problem
+    symbols = dict(p.parameter_values()) | (unknowns([*p.states, *p.controls, "t"]) if states else {})
+    for field, value in items:
+        try:
+            expression(value, symbols, FLOATS)
+        except ExpressionError as err:
+            raise SpecError(str(err), field=field) from None
 
 
 class RcsOptions(StrictModel):
@@ -40,6 +60,11 @@ class RcsOptions(StrictModel):
     relevance: str = Field("logistic_derivative", description="r̃ of eq. 6.33: a name or an expression of w.")
     relevant: bool = Field(True, description="Weight S_g by r(g) (eq. 6.34); false: eq. 6.32.")
     monte_carlo: MonteCarloOptions = Field(default_factory=MonteCarloOptions)
+
+    def check_against(self, spec: OptimalControlSpec, field: str) -> None:
+        """The weights at the file's parameter values (:func:`check_values`)."""
+        weights = self.weight if isinstance(self.weight, list) else [self.weight]
+        check_values(spec, [(f"{field}.weight", w) for w in weights])
 
 
 class Track(StrictModel):
@@ -72,3 +97,17 @@ class MovingObstaclesOptions(StrictModel):
     agent: tuple[Value, Value] = ("x", "y")
     power: Value = Field(1.0, description="β of eq. 6.41 (β = 1 is eq. 6.39); a number or parameter.")
     obstacles: dict[str, Obstacle] = Field(min_length=1)
+
+    def check_against(self, spec: OptimalControlSpec, field: str) -> None:
+        """The agent's position over the states, and β, the centres, velocities, radii and track
+        widths at the file's parameter values (:func:`check_values`)."""
+        check_values(spec, [(f"{field}.agent.{i}", a) for i, a in enumerate(self.agent)], states=True)
+        items = [(f"{field}.power", self.power)]
+        for name, o in self.obstacles.items():
+            at = f"{field}.obstacles.{name}"
+            items += [(f"{at}.center.{i}", c) for i, c in enumerate(o.center)]
+            items += [(f"{at}.velocity.{i}", v) for i, v in enumerate(o.velocity)]
+            items += [(f"{at}.radius", o.radius)]
+            if o.track is not None:
+                items += [(f"{at}.track.half_width", o.track.half_width)]
+        check_values(spec, items)

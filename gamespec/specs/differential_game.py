@@ -168,7 +168,7 @@ class GameProblem(StrictModel):
                 )
         self._check_expressions()
         for name, player in self.players.items():
-            _check_transforms(name, player)
+            _check_transforms(name, player, self)
         return self
 
     def _check_player(self, name: str, player: PlayerSpec) -> None:
@@ -273,9 +273,11 @@ class GameProblem(StrictModel):
         return GameValues(initial, final - self.time.initial)
 
 
-def _check_transforms(name: str, player: PlayerSpec) -> None:
+def _check_transforms(name: str, player: PlayerSpec, problem: GameProblem) -> None:
     """Each of the player's transforms is a requested ``optimal_control`` transform with valid
-    options (a SpecError naming ``problem.players.<name>.transforms.<i>`` otherwise)."""
+    options, their expressions checked at each of the game's parameter values
+    (:meth:`GameProblem.value_sets`); a SpecError naming ``problem.players.<name>.transforms.<i>``
+    otherwise."""
     from gamespec.specs.requested import entry, transform_class, validated_options
 
     for index, item in enumerate(player.transforms):
@@ -287,7 +289,11 @@ def _check_transforms(name: str, player: PlayerSpec) -> None:
                     f"transform {tname!r} is not a requested optimal_control transform",
                     field=f"transforms.{index}",
                 )
-            validated_options(cls, tname, options, index)
+            checked = validated_options(cls, tname, options, index)
+            if hasattr(checked, "check_against"):
+                running = [*problem.states, *(c for p in problem.players.values() for c in p.controls), "t"]
+                for values in problem.value_sets():
+                    checked.check_against(values, running, f"transforms.{index}.{tname}")
         except SpecError as err:
             raise SpecError(err.reason, field=f"problem.players.{name}.{err.field}") from None
 

@@ -22,7 +22,7 @@ Weights, radii, centres, velocities and β are numbers or expressions of the pro
 
 from __future__ import annotations
 
-from typing import TYPE_CHECKING
+from collections.abc import Iterable, Mapping
 
 from pydantic import Field, field_validator
 
@@ -31,16 +31,15 @@ from gamespec.specs.base import StrictModel, Value
 from gamespec.specs.desensitize import MonteCarloOptions
 from gamespec.symbolic.grammar import FLOATS, expression, unknowns
 
-if TYPE_CHECKING:
-    from gamespec.specs.ocp import OptimalControlSpec
 
-
-def check_values(spec: OptimalControlSpec, items: list[tuple[str, Value]], states: bool = False) -> None:
-    """Each ``(field, value)`` an expression of the problem's parameters at the file's values (and of
-    its states and ``t`` when ``states``), finite and real there: checked at load, so a bad centre
-    or weight is one line naming its field, never an error of the transform or a plot later."""
-    p = spec.problem
-    symbols = dict(p.parameter_values()) | (unknowns([*p.states, *p.controls, "t"]) if states else {})
+def check_values(
+    parameters: Mapping[str, float], running: Iterable[str], items: list[tuple[str, Value]]
+) -> None:
+    """Each ``(field, value)`` an expression of the problem's ``parameters`` at their values and of
+    the ``running`` names (states, controls, ``t``; none for a value of the parameters only), finite
+    and real there: checked at load, so a bad centre or weight is one line naming its field, never
+    an error of the transform or of a plot later."""
+    symbols = dict(parameters) | unknowns(running)
     for field, value in items:
         try:
             expression(value, symbols, FLOATS)
@@ -61,10 +60,10 @@ class RcsOptions(StrictModel):
     relevant: bool = Field(True, description="Weight S_g by r(g) (eq. 6.34); false: eq. 6.32.")
     monte_carlo: MonteCarloOptions = Field(default_factory=MonteCarloOptions)
 
-    def check_against(self, spec: OptimalControlSpec, field: str) -> None:
-        """The weights at the file's parameter values (:func:`check_values`)."""
+    def check_against(self, parameters: Mapping[str, float], running: Iterable[str], field: str) -> None:
+        """The weights at the parameters' values (:func:`check_values`)."""
         weights = self.weight if isinstance(self.weight, list) else [self.weight]
-        check_values(spec, [(f"{field}.weight", w) for w in weights])
+        check_values(parameters, [], [(f"{field}.weight", w) for w in weights])
 
 
 class Track(StrictModel):
@@ -98,10 +97,10 @@ class MovingObstaclesOptions(StrictModel):
     power: Value = Field(1.0, description="β of eq. 6.41 (β = 1 is eq. 6.39); a number or parameter.")
     obstacles: dict[str, Obstacle] = Field(min_length=1)
 
-    def check_against(self, spec: OptimalControlSpec, field: str) -> None:
-        """The agent's position over the states, and β, the centres, velocities, radii and track
-        widths at the file's parameter values (:func:`check_values`)."""
-        check_values(spec, [(f"{field}.agent.{i}", a) for i, a in enumerate(self.agent)], states=True)
+    def check_against(self, parameters: Mapping[str, float], running: Iterable[str], field: str) -> None:
+        """The agent's position over the ``running`` names, and β, the centres, velocities, radii and
+        track widths at the parameters' values (:func:`check_values`)."""
+        check_values(parameters, running, [(f"{field}.agent.{i}", a) for i, a in enumerate(self.agent)])
         items = [(f"{field}.power", self.power)]
         for name, o in self.obstacles.items():
             at = f"{field}.obstacles.{name}"
@@ -110,4 +109,4 @@ class MovingObstaclesOptions(StrictModel):
             items += [(f"{at}.radius", o.radius)]
             if o.track is not None:
                 items += [(f"{at}.track.half_width", o.track.half_width)]
-        check_values(spec, items)
+        check_values(parameters, [], items)

@@ -3,9 +3,9 @@
 Each entry is ``{<transform name>: {<options>}}``. The name is looked up lazily in the
 ``gamespec.transforms`` entry-point group (an unknown one is refused with the nearest name), the
 transform must be a requested one of the spec's kind, and its options are validated by its
-``options_model`` (and against the spec by the model's ``check_against(spec, field)`` where it has
-one: expressions of the problem's parameters at their values); a bad option names its dotted field,
-``transforms.<i>.<name>.<key>``.
+``options_model`` (and against the problem by the model's ``check_against(parameters, running,
+field)`` where it has one: expressions of the parameters at their values); a bad option names its
+dotted field, ``transforms.<i>.<name>.<key>``.
 """
 
 from __future__ import annotations
@@ -84,4 +84,6 @@ def check_requested(spec: SpecBase) -> None:
             )
         checked = validated_options(cls, name, options, index)
         if hasattr(checked, "check_against"):
-            checked.check_against(spec, f"transforms.{index}.{name}")
+            p = spec.problem
+            running = [*p.states, *p.controls, "t"]
+            checked.check_against(p.parameter_values(), running, f"transforms.{index}.{name}")

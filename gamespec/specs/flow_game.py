@@ -132,7 +132,7 @@ class MonteCarloMethod(StrictModel):
     """Euler–Maruyama samples of the nonlinear SDE (0 to skip), ``substeps`` per control step."""
 
     samples: int = Field(20_000, ge=0, le=1_000_000)
-    seed: int = 0
+    seed: int = Field(0, ge=0, description="Seed of the random generator (a non-negative integer).")
     substeps: int = Field(5, ge=1, le=100)
 
 

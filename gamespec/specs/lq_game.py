@@ -159,7 +159,7 @@ class MonteCarloSpec(StrictModel):
     """Closed-loop samples drawn after the solve (0 to skip)."""
 
     samples: int = Field(100, ge=0, le=MAX_SAMPLES)
-    seed: int = 0
+    seed: int = Field(0, ge=0, description="Seed of the random generator (a non-negative integer).")
 
 
 class LQMethodSpec(StrictModel):

@@ -8,7 +8,9 @@ own game (or, when that game did not converge and ``on_not_converged: previous_p
 of its last converged plan); the true system (true parameter values) is integrated over the step
 (:class:`~gamespec.games.simulate.TrueSystem`). A state a player does not observe (the pursuer's
 obstacle) it predicts with its own beliefs from the controls applied. The run stops at capture, at a
-collision with the obstacle (when ``stop_at_collision``) or at the time limit.
+collision with the obstacle (when ``stop_at_collision``) or at the time limit; after
+``max_wall_time`` seconds it stops at the end of a step with the status ``time_limit`` (the
+progress bar on a terminal shows each step).
 
 The horizon is ``N Δt`` ahead at every step (``receding``), or reaches the game's final time
 (``shrinking``: each remaining length has its own compiled models); with a shrinking horizon and a
@@ -17,6 +19,7 @@ time-consistent open-loop equilibrium the run reproduces the open-loop solution.
 
 from __future__ import annotations
 
+import time
 from collections.abc import Mapping
 from dataclasses import dataclass, field
 
@@ -204,6 +207,7 @@ class RecedingHorizon:
         intervals = game.method.intervals
         stop, captured_at = "time_limit", None
         total = round((end - t) / rh.step)
+        started = time.perf_counter()
         with _progress(progress) as bar:
             task = bar.add_task(game.name, total=total, info="")
             for _ in range(total):
@@ -249,6 +253,9 @@ class RecedingHorizon:
                     break
                 if rh.stop_at_collision and self._collided(record):
                     stop = "collision"
+                    break
+                if rh.max_wall_time is not None and time.perf_counter() - started > rh.max_wall_time:
+                    stop = "max_wall_time"
                     break
         return self._result(record, stop, captured_at)
 
@@ -360,8 +367,9 @@ class RecedingHorizon:
         }
         failed = sum(not g["converged"] for s in record.steps for g in s["games"].values())
         message = f"stopped: {stop}" + (f"; {failed} game(s) did not converge" if failed else "")
+        status = Status.OPTIMAL if converged else Status.FEASIBLE
         return Result(
-            status=Status.OPTIMAL if converged else Status.FEASIBLE,
+            status=Status.TIME_LIMIT if stop == "max_wall_time" else status,
             message=message,
             objective=captured_at,
             t_final=record.times[-1],

@@ -343,6 +343,12 @@ class RecedingHorizonSpec(StrictModel):
 
     step: float = Field(gt=0)
     time_limit: float = Field(gt=0)
+    max_wall_time: Number | None = Field(
+        None,
+        gt=0,
+        description="Seconds of wall time after which the run stops at the end of a step, with the "
+        "status time_limit and what it has so far (none: no limit).",
+    )
     capture: StopRule | None = None
     obstacle: ObstacleSpec | None = None
     stop_at_collision: bool = True

@@ -19,15 +19,14 @@ from collections.abc import Mapping
 from typing import Annotated, Any, Literal
 
 import numpy as np
-import sympy as sp
 from pydantic import Discriminator, Field, Tag, field_validator, model_validator
 
 from gamespec.best_response import Settings
 from gamespec.errors import ExpressionError, SpecError
-from gamespec.limits import MAX_INTERVALS, MAX_LQ_ENTRY, MAX_MAGNITUDE, MAX_SAMPLE_VALUES, MAX_SAMPLES
+from gamespec.limits import MAX_INTERVALS, MAX_LQ_ENTRY, MAX_SAMPLE_VALUES, MAX_SAMPLES
 from gamespec.specs.base import Number, ProblemParameters, SpecBase, StrictModel, Value
 from gamespec.specs.lq_model import LQGame, zero_order_hold
-from gamespec.symbolic.language import RESERVED, float_value, parse, symbol
+from gamespec.symbolic.grammar import RESERVED, numeric_value
 
 
 class Diagonal(StrictModel):
@@ -264,26 +263,21 @@ class LQGameSpec(ProblemParameters, SpecBase):
 
 
 class _Evaluator:
-    """Evaluates a problem's entries for given parameter values (parse, then substitute; no eval)."""
+    """Evaluates a problem's entries for given parameter values (the grammar's float walk; no eval)."""
 
     def __init__(self, problem: LQGameProblem, values: Mapping[str, float]) -> None:
         self.problem = problem
-        self.symbols = {name: symbol(name) for name in values}
-        self.substitution = {symbol(name): sp.Float(v) for name, v in values.items()}
+        self.values = {name: float(v) for name, v in values.items()}
 
     def scalar(self, value: Value, field: str) -> float:
+        """The value of an entry: a number, or an expression of the parameters computed in floating
+        point with the grammar's overflow checks (never by SymPy's exact arithmetic)."""
         if not isinstance(value, str):
             return float(value)
         try:
-            return float_value(parse(value, self.symbols).xreplace(self.substitution))
+            return numeric_value(value, self.values)
         except ExpressionError as err:
             raise SpecError(str(err), field=f"problem.{field}") from None
-        except OverflowError:
-            reason = f"{value!r} is out of range (beyond {MAX_MAGNITUDE:g})"
-            raise SpecError(reason, field=f"problem.{field}") from None
-        except (TypeError, ValueError, RecursionError):
-            reason = f"{value!r} does not evaluate to a real number"
-            raise SpecError(reason, field=f"problem.{field}") from None
 
     def vector(self, values: list[Value], field: str) -> np.ndarray:
         return np.array([self.scalar(v, f"{field}.{i}") for i, v in enumerate(values)])

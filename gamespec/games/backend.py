@@ -16,7 +16,7 @@ from gamespec.backend import Backend, CompiledModel, Inputs, refuse_inputs
 from gamespec.games.equilibrium import GameModel, GameSolution, status_of
 from gamespec.games.problems import initial_state
 from gamespec.games.simulate import TrueSystem, control_signal, grid_of
-from gamespec.result import Result
+from gamespec.result import Result, Status
 from gamespec.specs.base import SpecBase, StrictModel
 from gamespec.specs.differential_game import DifferentialGameSpec
 
@@ -37,6 +37,16 @@ def open_loop(model: GameModel) -> Result:
     x0, t0 = initial_state(game, model.parameters), game.problem.time.initial
     solutions = [model.solve(view, x0, t0) for view in model.views]
     own = {name: _own(solutions, name) for name in game.problem.players}
+    message = "; ".join(s.run.message for s in solutions if s.run.message)
+    unanswered = [p for p in game.problem.players if p not in own[p].results]
+    if unanswered:
+        status = status_of(solutions)
+        return Result(
+            status=status if not status.ok else Status.ERROR,
+            message=f"{message}; no best response of {', '.join(unanswered)} was computed".lstrip("; "),
+            iterations=sum(s.run.iterations for s in solutions),
+            metrics={"best_response": _runs(solutions), "builds": model.builds},
+        )
     first = solutions[0].states
     tc = first.control_time + t0
     controls = {
@@ -52,7 +62,7 @@ def open_loop(model: GameModel) -> Result:
     metrics = {"best_response": _runs(solutions), "builds": model.builds}
     return Result(
         status=status_of(solutions),
-        message="; ".join(s.run.message for s in solutions if s.run.message),
+        message=message,
         objective=first.objective,
         t_final=float(time[-1]),
         time=time,

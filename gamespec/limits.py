@@ -62,6 +62,38 @@ squared distances lose the precision a capture radius needs, and far beyond it t
 MAX_SPEED = 1e9
 """Largest speed of a player (``engagement``, ``pursuit_scenario``)."""
 
+MAX_GAME_STATE = 1e9
+"""Largest absolute value of a ``differential_game`` state's initial or final value (as
+:data:`MAX_COORDINATE`: beyond it distances lose the precision a capture needs)."""
+
+MAX_RECEDING_STEPS = 10_000
+"""Most steps of a ``differential_game`` receding-horizon run (``time_limit / step``)."""
+
+MAX_BEST_RESPONSES = 2_000_000
+"""Most best-response solves a ``differential_game`` may ask for: steps times players² (one game
+per player, each with every player's problem) times ``game.max_iterations``."""
+
+MAX_RCS_OBSTACLES = 100
+"""Most obstacles of one point of an ``rcs_multi_obstacle_study``."""
+
+MAX_GRID_CELL_STEPS = 5e7
+"""Most cell updates of a ``flow_field_game``'s level sets: grid cells times the fewest CFL time
+steps up to ``max_time`` (the Chapter 5 files need about 2e6; 5e7 is minutes of CPU)."""
+
+MAX_EXTREMAL_VALUES = 2e7
+"""Most front points of a ``flow_field_game``'s extremal shooting, directions times RK4 steps up to
+``max_time`` (each kept: 320 MB of doubles)."""
+
+MAX_SAMPLE_STEPS = 1e9
+"""Most Euler–Maruyama sample steps of a ``flow_field_game``'s Monte Carlo: samples times
+``substeps`` per control step times the control steps up to ``max_time``."""
+
+MAX_LQ_ENTRY = 1e12
+"""Largest absolute value of an entry of an ``lq_stochastic_game``'s evaluated matrices, and of its
+open-loop state transition and covariance over the horizon (products of a few of them stay far
+from overflow)."""
+
+
 # --- Saved Results and study stores (issue 27: a Result folder is untrusted input) -------------
 # Checked by gamespec.result.Result.load and gamespec.npyfile before anything is allocated.
 

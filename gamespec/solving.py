@@ -27,7 +27,7 @@ from typing import Any
 
 from gamespec import registry
 from gamespec.backend import Backend, CompiledModel, Inputs
-from gamespec.errors import BackendError, SpecError, UnsupportedFeature
+from gamespec.errors import BackendError, ExpressionError, SpecError, UnsupportedFeature
 from gamespec.loader import load, spec_hash, with_values
 from gamespec.result import Provenance, Result, Status
 from gamespec.specs.base import SpecBase, StrictModel
@@ -100,6 +100,23 @@ def _applied(
     return Step(transform, options, spec, target, inverse, upstream)
 
 
+def _from_file(
+    transform: Transform, options: StrictModel, spec: SpecBase, source: str, field: str = ""
+) -> Step:
+    """:func:`_applied` on a spec read from ``source``: what the transform cannot build from the file
+    (an expression it generates that is undefined or out of range, a spec it generates that is
+    invalid) is a SpecError naming the file and ``field`` (``transforms.<i>`` for a requested one)."""
+    try:
+        return _applied(transform, options, spec)
+    except ExpressionError as err:
+        raise SpecError(f"{transform.name}: {err}", field=field, source=source) from None
+    except SpecError as err:
+        if err.source != "<spec>":
+            raise
+        inner = f"{err.field}: " if err.field else ""
+        raise SpecError(f"{transform.name}: {inner}{err.reason}", field=field, source=source) from None
+
+
 def _unrequested(spec: SpecBase) -> SpecBase:
     """``spec`` with an empty ``transforms:`` section: what its first transform receives, so that
     the spec the backend gets does not ask for them again."""
@@ -111,14 +128,14 @@ def build_steps(spec: SpecBase, backend: Backend) -> list[Step]:
     solves."""
     steps: list[Step] = []
     current = _unrequested(spec)
-    for transform, options in requested_steps(spec):
-        steps.append(_applied(transform, options, current))
+    for index, (transform, options) in enumerate(requested_steps(spec)):
+        steps.append(_from_file(transform, options, current, spec.source, f"transforms.{index}"))
         current = steps[-1].target
     lowering = lowering_path(current, backend.kinds)
     if lowering is None:
         raise UnsupportedFeature(f"backend {backend.name!r} does not solve kind {spec.kind!r}")
     for transform in lowering:
-        steps.append(_applied(transform, transform.options_model(), current))
+        steps.append(_from_file(transform, transform.options_model(), current, spec.source))
         current = steps[-1].target
     return steps
 

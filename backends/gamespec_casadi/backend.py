@@ -82,7 +82,15 @@ def nlp_solver(nlp: Any, options: CasadiOptions) -> Any:
 
     ipopt = {"print_level": 0, "sb": "yes", "tol": options.tol, "max_iter": options.max_iter}
     ipopt["max_wall_time"] = options.max_wall_time
-    nlp_opts = {"ipopt": ipopt | IPOPT_DEFAULTS | options.ipopt, "print_time": False}
+    # NaN in a function evaluation ends as the status numerical_error; CasADi's own warnings about it
+    # (and about the parameter multipliers lam_p, which nothing reads) would be extra lines on stderr
+    # (README, "Bad input": one line).
+    nlp_opts = {
+        "ipopt": ipopt | IPOPT_DEFAULTS | options.ipopt,
+        "print_time": False,
+        "show_eval_warnings": False,
+        "calc_lam_p": False,
+    }
     if options.graph == "assembled" and options.solver == "ipopt":
         from gamespec_casadi.assembly import assembled_nlp
 

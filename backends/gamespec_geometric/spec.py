@@ -77,7 +77,7 @@ class BlindEvasion(StrictModel):
     type: Literal["blind"] = "blind"
     headings: list[Heading] = Field(min_length=1)
     switch_period: PositiveFloat = 1.0
-    seed: int = 0
+    seed: int = Field(0, ge=0, description="Seed of the random generator (a non-negative integer).")
 
     @field_validator("headings", mode="before")
     @classmethod

@@ -23,13 +23,14 @@ from gamespec.backend import Availability, Inputs
 from gamespec.backend.collocation import IPOPT_DEFAULTS, CollocationBackend, CollocationModel
 from gamespec.errors import BackendError
 from gamespec.ocp.transcription import Bounds, Transcription
-from gamespec.result import Result
+from gamespec.result import Result, Status
 from gamespec.specs.base import StrictModel
 from gamespec.specs.ocp import OptimalControlSpec
 from gamespec_pyomo.model import build_model
 from gamespec_pyomo.nlfile import NLFile
 from gamespec_pyomo.solvers import (
     PRINT_LEVEL,
+    LinearFeasibility,
     Run,
     check_options,
     find_executable,
@@ -87,6 +88,7 @@ class PyomoModel(CollocationModel):
         self.executable = find_executable(options.solver)
         self.model = build_model(self.tr, self.tr.ocp.parameter_values())
         self.nl = NLFile(self.model)
+        self.linear = LinearFeasibility(self.model)
         self._solved = False
 
     def _set_data(self, params: Mapping[str, float], Win: np.ndarray) -> None:
@@ -188,6 +190,22 @@ class PyomoModel(CollocationModel):
             self._set_start(start.X, start.U, start.d, start.T, b)
         m.dual.clear()
         tic = time.perf_counter()
+        why = self.linear.infeasibility()
+        if why is not None:
+            X, U, T = self._values()
+            return tr.result(
+                X=X,
+                U=U,
+                T=T,
+                objective=None,
+                params=params,
+                inputs=Win,
+                status=Status.INFEASIBLE,
+                message=why,
+                solve_time_s=time.perf_counter() - tic,
+                iterations=0,
+                solver_stats={"solver": "highs (LP feasibility check)"},
+            )
         run = self._execute()
         elapsed = time.perf_counter() - tic
         results, log = run.results, run.log

@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import difflib
 import importlib.util
+import math
 import os
 import re
 import shutil
@@ -20,6 +21,8 @@ from functools import cache
 from importlib.metadata import PackageNotFoundError, version
 from pathlib import Path
 from typing import Any
+
+import numpy as np
 
 from gamespec.errors import BackendError
 from gamespec.result import Status
@@ -214,3 +217,93 @@ def solver_seconds_in(log: str) -> float | None:
     seconds in IPOPT = 0.16``): the solve time less NL writing and process start."""
     match = _SECONDS.search(log)
     return float(match.group(1)) if match else None
+
+
+class LinearFeasibility:
+    """A feasibility pre-check for models whose constraints are linear once the Vars held by equal
+    bounds (parameters, grid inputs, a fixed horizon, fixed end values) are read as the constants
+    they are — a linear system's transcription with box bounds, such as ``x'' = u, |u| <= 1`` with
+    fixed ends: the feasible set is then a polyhedron, and an LP with no objective (HiGHS, through
+    SciPy) decides in milliseconds whether it is empty, a proof of infeasibility where ripopt, which
+    has no infeasibility-detection option (Ipopt's ``expect_infeasible_problem``), runs to its
+    iteration limit. A model found nonlinear once is not checked again (which constraints are
+    nonlinear depends on the structure only)."""
+
+    def __init__(self, model: Any) -> None:
+        self.model = model
+        self.linear = True
+
+    def _rows(self) -> tuple[list[Any], list[tuple[Any, list[int], list[float], float]]] | None:
+        """The constraints' linear rows over the free Vars, or None when one is not linear."""
+        from pyomo.environ import Constraint, Var
+        from pyomo.repn.standard_repn import generate_standard_repn
+
+        held = [
+            v
+            for v in self.model.component_data_objects(Var)
+            if not v.fixed and v.lb is not None and v.lb == v.ub
+        ]
+        for v in held:
+            v.fix(v.lb)
+        try:
+            variables: list[Any] = []
+            index: dict[int, int] = {}
+            rows = []
+            for con in self.model.component_data_objects(Constraint, active=True):
+                repn = generate_standard_repn(con.body, quadratic=False)
+                if not repn.is_linear():
+                    return None
+                cols = []
+                for v in repn.linear_vars:
+                    if id(v) not in index:
+                        index[id(v)] = len(variables)
+                        variables.append(v)
+                    cols.append(index[id(v)])
+                rows.append((con, cols, [float(c) for c in repn.linear_coefs], float(repn.constant)))
+            return variables, rows
+        finally:
+            for v in held:
+                v.unfix()
+
+    def infeasibility(self) -> str | None:
+        """Why the model's constraints have no solution at the Vars' current bounds (None when they
+        have one, or the model is not linear)."""
+        if not self.linear:
+            return None
+        found = self._rows()
+        if found is None:
+            self.linear = False
+            return None
+        variables, rows = found
+        if not rows:
+            return None
+        from scipy.optimize import linprog
+        from scipy.sparse import coo_matrix, vstack
+
+        def bounded(value: Any, default: float) -> float:
+            return default if value is None else float(value)
+
+        data, at_row, at_col, lower, upper = [], [], [], [], []
+        for r, (con, columns, coefs, constant) in enumerate(rows):
+            data += coefs
+            at_row += [r] * len(columns)
+            at_col += columns
+            lower.append(bounded(con.lb, -math.inf) - constant)
+            upper.append(bounded(con.ub, math.inf) - constant)
+        matrix = coo_matrix((data, (at_row, at_col)), shape=(len(rows), len(variables))).tocsr()
+        lo, hi = np.array(lower), np.array(upper)
+        finite_hi, finite_lo = np.isfinite(hi), np.isfinite(lo)
+        answer = linprog(
+            np.zeros(len(variables)),
+            A_ub=vstack([matrix[finite_hi], -matrix[finite_lo]]),
+            b_ub=np.concatenate([hi[finite_hi], -lo[finite_lo]]),
+            bounds=[(bounded(v.lb, -math.inf), bounded(v.ub, math.inf)) for v in variables],
+            method="highs",
+        )
+        if answer.status == 2:
+            return (
+                "the transcribed constraints are linear and have no solution (an LP feasibility check "
+                "by HiGHS proves it; the NLP solver was not run): relax the bounds, the end values or "
+                "the final time"
+            )
+        return None

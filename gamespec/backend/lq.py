@@ -13,12 +13,13 @@ from __future__ import annotations
 
 import importlib
 from abc import abstractmethod
+from collections.abc import Mapping
 from typing import Any, ClassVar
 
 from pydantic import Field
 
 from gamespec.backend import Availability, Backend, CompiledModel, Inputs, refuse_inputs
-from gamespec.errors import BackendError
+from gamespec.errors import BackendError, SpecError
 from gamespec.lqgame.solution import (
     CovarianceOutcome,
     GameModel,
@@ -147,15 +148,31 @@ class LQBackend(Backend):
         version = importlib.import_module(cls.library).__version__
         return Availability(True, f"{cls.library} {version}; solvers {', '.join(solvers)}")
 
-    def _compile(self, spec: SpecBase, options: StrictModel) -> CompiledModel:
-        assert isinstance(spec, LQGameSpec) and isinstance(options, LQSolverOptions)
-        solvers = self.installed_solvers()
-        found = [s for s in solvers if s.lower() == options.solver.lower()]
+    @classmethod
+    def installed_name(cls, solver: str) -> str:
+        """The installed solver ``solver`` names (ignoring case); BackendError when none."""
+        solvers = cls.installed_solvers()
+        found = [s for s in solvers if s.lower() == solver.lower()]
         if not found:
             raise BackendError(
-                f"solver {options.solver!r} is not installed for {self.library} "
-                f"(installed: {', '.join(solvers)})"
+                f"solver {solver!r} is not installed for {cls.library} (installed: {', '.join(solvers)})"
             )
-        options = options.model_copy(update={"solver": found[0]})
+        return found[0]
+
+    @classmethod
+    def validate_options(cls, raw: Mapping[str, Any], source: str = "<spec>") -> StrictModel:
+        """The options block, its ``solver`` an installed one (checked at load, naming the field)."""
+        options = super().validate_options(raw, source)
+        try:
+            cls.installed_name(options.solver)
+        except BackendError as err:
+            raise SpecError(str(err), field=f"solver.options.{cls.name}.solver", source=source) from None
+        except ImportError:
+            pass
+        return options
+
+    def _compile(self, spec: SpecBase, options: StrictModel) -> CompiledModel:
+        assert isinstance(spec, LQGameSpec) and isinstance(options, LQSolverOptions)
+        options = options.model_copy(update={"solver": self.installed_name(options.solver)})
         self.probe_options(options)
         return self.model_class(spec, options)

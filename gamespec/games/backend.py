@@ -47,9 +47,19 @@ def open_loop(model: GameModel) -> Result:
             "sought_concept": model.concept(),
         }
         return Result(status=Status.UNBOUNDED, message=exists.reason, metrics=metrics)
-    x0, t0 = initial_state(game), game.problem.time.initial
+    x0, t0 = initial_state(game, model.parameters), game.problem.time.initial
     solutions = [model.solve(view, x0, t0) for view in model.views]
     own = {name: _own(solutions, name) for name in game.problem.players}
+    message = "; ".join(s.run.message for s in solutions if s.run.message)
+    unanswered = [p for p in game.problem.players if p not in own[p].results]
+    if unanswered:
+        status = status_of(solutions)
+        return Result(
+            status=status if not status.ok else Status.ERROR,
+            message=f"{message}; no best response of {', '.join(unanswered)} was computed".lstrip("; "),
+            iterations=sum(s.run.iterations for s in solutions),
+            metrics={"best_response": _runs(solutions), "builds": model.builds},
+        )
     first = solutions[0].states
     tc = first.control_time + t0
     controls = {c: own[p].controls_of(p)[c] for p, pl in game.problem.players.items() for c in pl.controls}
@@ -65,7 +75,7 @@ def open_loop(model: GameModel) -> Result:
     metrics |= report.metrics
     return Result(
         status=status_of(solutions),
-        message="; ".join(m for m in [*(s.run.message for s in solutions), report.message] if m),
+        message="; ".join(m for m in [message, report.message] if m),
         objective=first.objective,
         t_final=float(time[-1]),
         time=time,
@@ -96,7 +106,9 @@ def _simulated(
     horizon = float(reference.time[-1] - reference.time[0])
     signals = {c: control_signal(grid, v, t0, horizon) for c, v in controls.items()}
     system = TrueSystem(game, true_parameters(model))
-    times, rows = system.advance(initial_state(game), signals, t0, horizon, t0 + horizon * grid.nodes)
+    times, rows = system.advance(
+        initial_state(game, model.parameters), signals, t0, horizon, t0 + horizon * grid.nodes
+    )
     return times, dict(zip(system.states, rows.T, strict=True))
 
 

@@ -21,6 +21,7 @@ Every expression is parsed from the file and printed back from SymPy by
 from __future__ import annotations
 
 import math
+from collections.abc import Mapping
 from dataclasses import dataclass
 
 import sympy as sp
@@ -86,9 +87,16 @@ def applies_transforms(game: DifferentialGameSpec, player: str, view: str) -> bo
     return player == view or game.problem.players[view].knows_transforms
 
 
-def initial_state(game: DifferentialGameSpec) -> dict[str, float]:
-    """The game's initial state (eq. 7.2's x_0); a free initial value starts at 0."""
-    return {n: float(s.initial) if s.initial is not None else 0.0 for n, s in game.problem.states.items()}
+def initial_state(
+    game: DifferentialGameSpec, parameters: Mapping[str, float] | None = None
+) -> dict[str, float]:
+    """The game's initial state (eq. 7.2's x_0; a free initial value starts at 0), evaluated at load
+    (:attr:`~gamespec.specs.differential_game.GameProblem.values`), or again at the runtime
+    ``parameters`` of a compiled game where they differ from the file's."""
+    p = game.problem
+    if parameters is None or all(parameters.get(n, v) == v for n, v in p.parameters.items()):
+        return dict(p.values.initial)
+    return p.evaluate(parameters).initial
 
 
 def predicted_states(game: DifferentialGameSpec, view: str) -> list[str]:

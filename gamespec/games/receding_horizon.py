@@ -8,7 +8,9 @@ own game (or, when that game did not converge and ``on_not_converged: previous_p
 of its last converged plan); the true system (true parameter values) is integrated over the step
 (:class:`~gamespec.games.simulate.TrueSystem`). A state a player does not observe (the pursuer's
 obstacle) it predicts with its own beliefs from the controls applied. The run stops at capture, at a
-collision with the obstacle (when ``stop_at_collision``) or at the time limit.
+collision with the obstacle (when ``stop_at_collision``) or at the time limit; after
+``max_wall_time`` seconds it stops at the end of a step with the status ``time_limit`` (the
+progress bar on a terminal shows each step).
 
 The horizon is ``N Δt`` ahead at every step (``receding``), or reaches the game's final time
 (``shrinking``: each remaining length has its own compiled models); with a shrinking horizon and a
@@ -23,6 +25,7 @@ realized trajectory is computed: the run's figure is the capture time.
 
 from __future__ import annotations
 
+import time
 from collections.abc import Mapping
 from dataclasses import dataclass, field
 
@@ -35,10 +38,9 @@ from gamespec.games.equilibrium import GameModel, GameSolution
 from gamespec.games.problems import initial_state, predicted_states
 from gamespec.games.simulate import TrueSystem, control_signal, grid_of
 from gamespec.result import Result, Status
-from gamespec.specs.differential_game import DifferentialGameSpec, sensitivity_name
+from gamespec.specs.differential_game import DifferentialGameSpec, intervals_per_step, sensitivity_name
 from gamespec.symbolic.calculus import numeric_function
 from gamespec.symbolic.language import parse, parse_relation, symbol
-from gamespec.symbolic.translate import numeric
 
 SAMPLES_PER_STEP = 10
 """Points of the true trajectory per step at which capture and collisions are checked."""
@@ -125,12 +127,6 @@ class Predictor:
         return rows
 
 
-def _horizon(game: DifferentialGameSpec, params: Mapping[str, float]) -> float:
-    p = game.problem
-    table = {n: symbol(n) for n in [*p.parameters, *p.uncertain]}
-    return float(numeric(parse(p.time.final, table), {table[k]: v for k, v in params.items() if k in table}))
-
-
 @dataclass
 class Record:
     """What the run keeps: true samples, applied controls, look-ahead trajectories, per-step games."""
@@ -161,18 +157,13 @@ class RecedingHorizon:
         self.players = list(game.problem.players)
         self.truth = TrueSystem(game, true_parameters(model))
         self.predicting = [n for n, pl in game.problem.players.items() if pl.observes is not None]
-        self.horizon = _horizon(game, model.parameters)
+        self.horizon = game.problem.evaluate(model.parameters).horizon
         intervals = game.method.intervals
         self.interval = self.horizon / intervals
-        per_step = rh.step / self.interval
-        if abs(per_step - round(per_step)) > 1e-9 or round(per_step) < 1:
-            raise SpecError(
-                f"the step ({rh.step:g}) must be a whole number of collocation intervals "
-                f"(horizon / intervals = {self.interval:g})",
-                field="receding_horizon.step",
-                source=game.source,
-            )
-        self.intervals_per_step = round(per_step)
+        try:
+            self.intervals_per_step = intervals_per_step(rh.step, self.horizon, intervals)
+        except SpecError as err:
+            raise SpecError(err.reason, field=err.field, source=game.source) from None
         self.points_per_step = self.intervals_per_step * grid_of(game.method).points_per_interval
         self.models: dict[int, GameModel] = {intervals: model}
         self.capture = (
@@ -212,7 +203,7 @@ class RecedingHorizon:
         end = t + rh.time_limit
         if rh.horizon == "shrinking":
             end = min(end, t + self.horizon)
-        x = initial_state(game)
+        x = initial_state(game, self.model.parameters)
         predictors = {n: Predictor(self.model, n, x) for n in self.predicting}
         record = Record(times=[t], states=[np.array([x[s] for s in self.truth.states])])
         record.predicted = {n: [record.states[0]] for n in self.predicting}
@@ -221,6 +212,7 @@ class RecedingHorizon:
         intervals = game.method.intervals
         stop, captured_at = "time_limit", None
         total = round((end - t) / rh.step)
+        started = time.perf_counter()
         with terminal.progress(f"{game.name} (receding horizon)", total, enabled=progress) as tracker:
             for _ in range(total):
                 model = self._model(intervals, t) if rh.horizon == "shrinking" else self.model
@@ -265,6 +257,9 @@ class RecedingHorizon:
                     break
                 if rh.stop_at_collision and self._collided(record):
                     stop = "collision"
+                    break
+                if rh.max_wall_time is not None and time.perf_counter() - started > rh.max_wall_time:
+                    stop = "max_wall_time"
                     break
         return self._result(record, stop, captured_at)
 
@@ -394,8 +389,9 @@ class RecedingHorizon:
         message = f"stopped: {stop}" + (f"; {failed} game(s) did not converge" if failed else "")
         if gap is not None and gap > tolerance:
             message += f"; saddle gap {gap:.3g} of a step's game exceeds the tolerance {tolerance:.3g}"
+        status = Status.OPTIMAL if converged else Status.FEASIBLE
         return Result(
-            status=Status.OPTIMAL if converged else Status.FEASIBLE,
+            status=Status.TIME_LIMIT if stop == "max_wall_time" else status,
             message=message,
             objective=captured_at,
             t_final=record.times[-1],

@@ -22,7 +22,7 @@ from gamespec.ocp.inputs import InputGrid, InputValue, on_grid
 from gamespec.ocp.symbolic import SymbolicOcp
 from gamespec.result import Result, Status
 from gamespec.specs.ocp import NORMALIZED_TIME, OptimalControlSpec, bounds_midpoint
-from gamespec.symbolic.grammar import expression
+from gamespec.symbolic.grammar import FLOATS, dependencies, expression, relation, unknowns
 from gamespec.symbolic.library import NUMPY, LibraryAlgebra
 
 
@@ -168,7 +168,39 @@ class Transcription:
                 raw, self.grid.eval_tau, params, f"guess.controls.{name}", None, None, lo, hi
             )
         d = np.array([g for *_, g in self.ocp.design_bounds(params)], dtype=float)
+        self._off_flat_boundary(X, U, tf_guess, params, d)
         return Guess(X, U, tf_guess - self.t0, d)
+
+    def _off_flat_boundary(
+        self, X: np.ndarray, U: np.ndarray, tf: float, params: Mapping[str, float], d: np.ndarray
+    ) -> None:
+        """Move the ``linear`` guess of the states free at both ends (the middle of their bounds, 0
+        when unbounded) off a point where a boundary constraint over their end values has a zero
+        gradient (``x_0**2 + v_0**2 == 1`` at the origin: no Newton step can reach it), by a quarter
+        of their bounds' width (1 toward the open side when a bound is infinite)."""
+        bounds = self.ocp.state_bounds(params)
+        free = [
+            i
+            for i, (name, (_, _, x0, xf)) in enumerate(zip(self.ocp.states, bounds, strict=True))
+            if x0 is None and xf is None and name not in self.spec.guess.states
+        ]
+        if not free or not self.spec.problem.boundary_constraints:
+            return
+        values = dict(params) | dict(zip(self.ocp.design, map(float, d), strict=True)) | {"t_f": float(tf)}
+        for names, rows in ((self.ocp.states, X), (self.ocp.controls, U)):
+            for name, row in zip(names, rows, strict=True):
+                values |= {f"{name}_0": float(row[0]), f"{name}_f": float(row[-1])}
+        ends = [f"{self.ocp.states[i]}_{e}" for i in free for e in "0f"]
+        if any(_flat(text, values, ends) for text in self.spec.problem.boundary_constraints):
+            for i in free:
+                lo, hi = bounds[i][:2]
+                X[i] += (
+                    0.25 * (hi - lo)
+                    if np.isfinite(lo) and np.isfinite(hi)
+                    else -1.0
+                    if np.isfinite(hi)
+                    else 1.0
+                )
 
     def _profile(
         self,
@@ -338,6 +370,21 @@ class Transcription:
             },
             solver_stats=solver_stats or {},
         )
+
+
+def _flat(text: str, values: Mapping[str, float], names: list[str]) -> bool:
+    """Whether the constraint ``text`` uses some of ``names`` and its gradient in them vanishes at
+    ``values`` (central differences; False where it is not defined there)."""
+    try:
+        used = dependencies(relation(text, dict(values) | unknowns(names), FLOATS).expr) & set(names)
+        slopes = []
+        for name in used:
+            h = 1e-6 * max(1.0, abs(values[name]))
+            up, down = (relation(text, dict(values) | {name: values[name] + s}, FLOATS).expr for s in (h, -h))
+            slopes.append(abs(up - down) / (2 * h))
+    except ExpressionError:
+        return False
+    return bool(slopes) and max(slopes) <= 1e-12
 
 
 def _linear_ends(start: float | None, end: float | None, lo: float, hi: float) -> tuple[float, float]:

@@ -8,7 +8,7 @@ from __future__ import annotations
 
 from typing import Annotated, Any, ClassVar
 
-from pydantic import BaseModel, ConfigDict, Field, FiniteFloat, PrivateAttr, model_validator
+from pydantic import AfterValidator, BaseModel, ConfigDict, Field, FiniteFloat, PrivateAttr, model_validator
 
 from gamespec.limits import MAX_COORDINATE, MAX_SPEED
 
@@ -24,6 +24,19 @@ Coordinate = Annotated[Number, Field(ge=-MAX_COORDINATE, le=MAX_COORDINATE)]
 
 Speed = Annotated[Number, Field(ge=0, le=MAX_SPEED)]
 """A player's speed, finite, non-negative and within :data:`~gamespec.limits.MAX_SPEED`."""
+
+
+def _known_backend(name: str) -> str:
+    from gamespec import registry
+
+    known = registry.names("gamespec.backends")
+    if name not in known:
+        raise ValueError(f"unknown backend {name!r} (known: {', '.join(known)})")
+    return name
+
+
+BackendName = Annotated[str, AfterValidator(_known_backend)]
+"""The name of an installed backend (an entry point of ``gamespec.backends``), checked at load."""
 
 
 class StrictModel(BaseModel):
@@ -45,7 +58,7 @@ class SolverSection(StrictModel):
     once to every collocation backend.
     """
 
-    backend: str | None = Field(None, description="Backend name; the kind's default when omitted.")
+    backend: BackendName | None = Field(None, description="Backend name; the kind's default when omitted.")
     options: dict[str, dict[str, Any]] = Field(
         default_factory=dict, description="Per-backend option blocks, keyed by backend name."
     )

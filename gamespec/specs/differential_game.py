@@ -19,15 +19,19 @@ eqs. 7.27–7.29 for dynamics that do not depend on the state), ``game`` the ite
 
 from __future__ import annotations
 
+import math
+from collections.abc import Mapping
+from dataclasses import dataclass
 from typing import Literal
 
-from pydantic import Field, model_validator
+from pydantic import Field, PrivateAttr, model_validator
 
 from gamespec.errors import ExpressionError, SpecError
+from gamespec.limits import MAX_BEST_RESPONSES, MAX_GAME_STATE, MAX_RECEDING_STEPS
 from gamespec.specs.base import Number, ProblemParameters, RequestedTransforms, SpecBase, StrictModel, Value
-from gamespec.specs.ocp import ControlSpec, MethodSpec, StateSpec
+from gamespec.specs.ocp import ControlSpec, MethodSpec, StateSpec, _ordered, is_time_varying
 from gamespec.specs.uncertainty import UncertainParameter
-from gamespec.symbolic.language import RESERVED, parse, parse_relation, symbol
+from gamespec.symbolic.grammar import FLOATS, RESERVED, expression, numeric_value, relation, unknowns
 
 INITIAL_PREFIX = "initial_"
 """A generated player problem takes the initial state ``<state>`` as the parameter ``initial_<state>``."""
@@ -41,6 +45,34 @@ def sensitivity_name(state: str, parameter: str) -> str:
     """``initial_S_<state>_<parameter>``: the predicted sensitivity of an unobserved state at the
     start of a player's problem."""
     return f"{INITIAL_PREFIX}S_{state}_{parameter}"
+
+
+@dataclass(frozen=True)
+class GameValues:
+    """What :meth:`GameProblem.evaluate` gives: the initial state x_0 of eq. 7.2 (a free value at 0)
+    and the horizon ``t_f - t_0``."""
+
+    initial: dict[str, float]
+    horizon: float
+
+
+def checked_expression(
+    text: float | str, names: list[str], values: Mapping[str, float], field: str, constraint: bool = False
+) -> float | None:
+    """Check ``text`` over ``names`` (unknowns) and the parameters' ``values`` (numbers); its value
+    when it uses no name, else None. A SpecError naming ``field`` when it is outside the language, or
+    any part of it that only uses numbers is infinite, undefined, not real or out of range."""
+    symbols = dict(values) | unknowns(names)
+    try:
+        if constraint:
+            relation(str(text), symbols, FLOATS)
+            return None
+        if not names:
+            return numeric_value(text, values)
+        expression(text, symbols, FLOATS)
+    except ExpressionError as err:
+        raise SpecError(str(err), field=field) from None
+    return None
 
 
 class PayoffSpec(StrictModel):
@@ -107,6 +139,8 @@ class GameProblem(StrictModel):
     terminal_constraints: list[str] = Field(default_factory=list)
     time: GameTime = Field(default_factory=GameTime)
 
+    _values: GameValues = PrivateAttr()
+
     @model_validator(mode="after")
     def _consistent(self) -> GameProblem:
         if len(self.players) < 2:
@@ -134,7 +168,7 @@ class GameProblem(StrictModel):
                 )
         self._check_expressions()
         for name, player in self.players.items():
-            _check_transforms(name, player)
+            _check_transforms(name, player, self)
         return self
 
     def _check_player(self, name: str, player: PlayerSpec) -> None:
@@ -147,12 +181,26 @@ class GameProblem(StrictModel):
         if unknown:
             raise ValueError(f"players.{name}.start names controls it does not have: {sorted(unknown)}")
 
+    def value_sets(self, parameters: Mapping[str, float] | None = None) -> list[dict[str, float]]:
+        """The parameter values some problem of the game is built with: ``parameters`` (else the
+        file's) with the uncertain ones at their true values, then at each player's beliefs."""
+        given = parameters or {}
+        base = {n: float(given.get(n, v)) for n, v in self.parameters.items()}
+        holders = [None, *self.players]
+        sets = [
+            base | {n: u.actual if h is None else u.belief(h) for n, u in self.uncertain.items()}
+            for h in holders
+        ]
+        return [dict(v) for v in {tuple(v.items()): v for v in sets}.values()]
+
     def _check_expressions(self) -> None:
-        params = {n: symbol(n) for n in [*self.parameters, *self.uncertain]}
-        controls = {c: symbol(c) for p in self.players.values() for c in p.controls}
-        running = params | controls | {n: symbol(n) for n in [*self.states, "t"]}
-        ends = params | {f"{s}_f": symbol(f"{s}_f") for s in self.states} | {"t_f": symbol("t_f")}
-        checks: list[tuple[str, Value, dict, bool]] = [
+        """Every expression over the names its field may use, at each of :meth:`value_sets`: the
+        parameters are numbers there, so what is undefined, not real or out of range at the file's
+        values (``sqrt(-w2)``, ``exp(ve)*exp(ve)``) is refused here, never at solve time."""
+        controls = [c for p in self.players.values() for c in p.controls]
+        running = [*self.states, *controls, "t"]
+        ends = [*(f"{s}_f" for s in self.states), "t_f"]
+        checks: list[tuple[str, Value, list[str], bool]] = [
             (f"dynamics.{k}", v, running, False) for k, v in self.dynamics.items()
         ]
         payoffs = [("payoff", self.payoff)] + [
@@ -169,17 +217,67 @@ class GameProblem(StrictModel):
         checks += [
             (f"terminal_constraints.{i}", c, ends, True) for i, c in enumerate(self.terminal_constraints)
         ]
-        checks += [("time.final", self.time.final, params, False)]
-        for field, text, symbols, relation in checks:
-            try:
-                (parse_relation if relation else parse)(text, symbols)
-            except ExpressionError as err:
-                raise ValueError(f"{field}: {err}") from None
+        for values in self.value_sets():
+            for field, text, names, constraint in checks:
+                checked_expression(text, names, values, f"problem.{field}", constraint)
+        self._values = self.evaluate()
+
+    @property
+    def values(self) -> GameValues:
+        """:meth:`evaluate` at the file's parameter values, computed once at load."""
+        return self._values
+
+    def evaluate(self, parameters: Mapping[str, float] | None = None) -> GameValues:
+        """The numbers the file's values stand for at ``parameters`` (else the file's), checked at
+        each of :meth:`value_sets`: every state's and control's bounds (ordered), the initial and
+        final values (within the bounds and :data:`~gamespec.limits.MAX_GAME_STATE`; a free
+        initial value starts at 0) and the horizon; a SpecError naming the field otherwise. Their
+        values at the true parameters are returned."""
+        found = [self._evaluated(values) for values in self.value_sets(parameters)]
+        return found[0]
+
+    def _evaluated(self, values: Mapping[str, float]) -> GameValues:
+        def number(raw: float | str | None, default: float, field: str) -> float:
+            if raw is not None and default in (-math.inf, math.inf) and is_time_varying(raw):
+                checked_expression(raw, ["t"], values, f"problem.{field}")
+                return default
+            if raw is None:
+                return default
+            value = checked_expression(raw, [], values, f"problem.{field}")
+            if default == 0.0 and not abs(value) <= MAX_GAME_STATE:
+                raise SpecError(f"{value:g} is beyond {MAX_GAME_STATE:g} in size", field=f"problem.{field}")
+            return value
+
+        initial = {}
+        for name, st in self.states.items():
+            lo = number(st.lower, -math.inf, f"states.{name}.lower")
+            hi = number(st.upper, math.inf, f"states.{name}.upper")
+            _ordered(lo, hi, f"states.{name}")
+            for key in ("initial", "final"):
+                raw = getattr(st, key)
+                value = None if raw is None else number(raw, 0.0, f"states.{name}.{key}")
+                if value is not None and not lo <= value <= hi:
+                    raise SpecError(
+                        f"{value:g} lies outside [{lo:g}, {hi:g}]", field=f"problem.states.{name}.{key}"
+                    )
+                if key == "initial":
+                    initial[name] = 0.0 if value is None else value
+        for player, p in self.players.items():
+            for name, c in p.controls.items():
+                lo = number(c.lower, -math.inf, f"players.{player}.controls.{name}.lower")
+                hi = number(c.upper, math.inf, f"players.{player}.controls.{name}.upper")
+                _ordered(lo, hi, f"players.{player}.controls.{name}")
+        final = checked_expression(self.time.final, [], values, "problem.time.final")
+        if not final > self.time.initial:
+            raise SpecError("the final time must be after the initial time", field="problem.time.final")
+        return GameValues(initial, final - self.time.initial)
 
 
-def _check_transforms(name: str, player: PlayerSpec) -> None:
+def _check_transforms(name: str, player: PlayerSpec, problem: GameProblem) -> None:
     """Each of the player's transforms is a requested ``optimal_control`` transform with valid
-    options (a SpecError naming ``problem.players.<name>.transforms.<i>`` otherwise)."""
+    options, their expressions checked at each of the game's parameter values
+    (:meth:`GameProblem.value_sets`); a SpecError naming ``problem.players.<name>.transforms.<i>``
+    otherwise."""
     from gamespec.specs.requested import entry, transform_class, validated_options
 
     for index, item in enumerate(player.transforms):
@@ -191,7 +289,11 @@ def _check_transforms(name: str, player: PlayerSpec) -> None:
                     f"transform {tname!r} is not a requested optimal_control transform",
                     field=f"transforms.{index}",
                 )
-            validated_options(cls, tname, options, index)
+            checked = validated_options(cls, tname, options, index)
+            if hasattr(checked, "check_against"):
+                running = [*problem.states, *(c for p in problem.players.values() for c in p.controls), "t"]
+                for values in problem.value_sets():
+                    checked.check_against(values, running, f"transforms.{index}.{tname}")
         except SpecError as err:
             raise SpecError(err.reason, field=f"problem.players.{name}.{err.field}") from None
 
@@ -249,6 +351,12 @@ class RecedingHorizonSpec(StrictModel):
 
     step: float = Field(gt=0)
     time_limit: float = Field(gt=0)
+    max_wall_time: Number | None = Field(
+        None,
+        gt=0,
+        description="Seconds of wall time after which the run stops at the end of a step, with the "
+        "status time_limit and what it has so far (none: no limit).",
+    )
     capture: StopRule | None = None
     obstacle: ObstacleSpec | None = None
     stop_at_collision: bool = True
@@ -277,18 +385,67 @@ class DifferentialGameSpec(ProblemParameters, SpecBase):
     default_backend = "best_response"
 
     @model_validator(mode="after")
-    def _receding_names(self) -> DifferentialGameSpec:
+    def _receding_horizon(self) -> DifferentialGameSpec:
+        """The receding-horizon section against the problem: names of players and states, its
+        expressions at the parameters' values, a step of whole collocation intervals and the work
+        it implies (:data:`~gamespec.limits.MAX_RECEDING_STEPS`,
+        :data:`~gamespec.limits.MAX_BEST_RESPONSES`)."""
         rh = self.receding_horizon
         if rh is None:
             return self
         if self.game.information == "feedback":
             raise ValueError("game.information: feedback solves the whole horizon; drop receding_horizon")
         players = self.problem.players
-        states = set(self.problem.states)
-        pairs = dict(rh.positions) | (dict(rh.obstacle.avoided_by) if rh.obstacle else {})
-        for player, pair in pairs.items():
-            if player not in players:
-                raise ValueError(f"receding_horizon names unknown player {player!r}")
-            if not set(pair) <= states:
-                raise ValueError(f"receding_horizon: positions of {player!r} must be states, got {pair}")
+        steps = 1
+        if rh is not None:
+            self._check_receding(rh)
+            steps = math.ceil(rh.time_limit / rh.step - 1e-9)
+            if steps > MAX_RECEDING_STEPS:
+                raise SpecError(
+                    f"time_limit / step = {steps} steps is more than {MAX_RECEDING_STEPS}",
+                    field="receding_horizon.step",
+                )
+        solves = steps * len(players) ** 2 * self.game.max_iterations
+        if solves > MAX_BEST_RESPONSES:
+            raise SpecError(
+                f"up to {solves} best responses (steps x players^2 x max_iterations) is more than "
+                f"{MAX_BEST_RESPONSES}",
+                field="game.max_iterations",
+            )
         return self
+
+    def _check_receding(self, rh: RecedingHorizonSpec) -> None:
+        players = self.problem.players
+        states = list(self.problem.states)
+        groups = [("positions", rh.positions)]
+        if rh.obstacle is not None:
+            groups.append(("obstacle.avoided_by", rh.obstacle.avoided_by))
+        for group, pairs in groups:
+            for player, pair in pairs.items():
+                field = f"receding_horizon.{group}.{player}"
+                if player not in players:
+                    raise SpecError(f"names unknown player {player!r}", field=field)
+                unknown = [n for n in pair if n not in states]
+                if unknown:
+                    raise SpecError(f"{', '.join(map(repr, unknown))} is not a state", field=field)
+        checks = [("capture.when", rh.capture.when, True)] if rh.capture else []
+        if rh.obstacle is not None:
+            checks += [(f"obstacle.{k}", getattr(rh.obstacle, k), False) for k in ("x", "y", "radius")]
+        for values in self.problem.value_sets():
+            for field, text, constraint in checks:
+                checked_expression(text, states, values, f"receding_horizon.{field}", constraint)
+        intervals_per_step(rh.step, self.problem.values.horizon, self.method.intervals)
+
+
+def intervals_per_step(step: float, horizon: float, intervals: int) -> int:
+    """How many collocation intervals (``horizon / intervals`` long) a receding-horizon ``step``
+    spans; a SpecError naming ``receding_horizon.step`` when it is not a whole number of them."""
+    interval = horizon / intervals
+    per_step = step / interval
+    if abs(per_step - round(per_step)) > 1e-9 or round(per_step) < 1:
+        raise SpecError(
+            f"the step ({step:g}) must be a whole number of collocation intervals "
+            f"(horizon / intervals = {interval:g})",
+            field="receding_horizon.step",
+        )
+    return round(per_step)

@@ -29,6 +29,7 @@ import sympy as sp
 from pydantic import Field, FiniteFloat, PositiveFloat, model_validator
 
 from gamespec.errors import ExpressionError, SpecError
+from gamespec.limits import MAX_EXTREMAL_VALUES, MAX_GRID_CELL_STEPS, MAX_SAMPLE_STEPS
 from gamespec.specs.base import ProblemParameters, SpecBase, StrictModel, Value
 from gamespec.symbolic.calculus import jacobian, numeric_function
 from gamespec.symbolic.language import RESERVED, parse, symbol
@@ -144,7 +145,7 @@ class MonteCarloMethod(StrictModel):
     """Euler–Maruyama samples of the nonlinear SDE (0 to skip), ``substeps`` per control step."""
 
     samples: int = Field(20_000, ge=0, le=1_000_000)
-    seed: int = 0
+    seed: int = Field(0, ge=0, description="Seed of the random generator (a non-negative integer).")
     substeps: int = Field(5, ge=1, le=100)
 
 
@@ -188,6 +189,43 @@ class FlowGameMethod(StrictModel):
             return self.levels
         side = max(hi - lo for lo, hi in zip(self.grid.lower, self.grid.upper, strict=True))
         return (LEVEL_FRACTIONS[0] * side, LEVEL_FRACTIONS[1] * side)
+
+    def check_work(self, max_speed: float, step: float) -> None:
+        """The work the method implies, before anything runs (README, "Limits"): the level sets'
+        cells times their fewest time steps (``max_time`` over the CFL step ``cfl·dx/max_speed`` at
+        the fastest agent's speed, the flow only shortening it) within
+        :data:`~gamespec.limits.MAX_GRID_CELL_STEPS`; the extremals' directions times RK4 steps
+        within :data:`~gamespec.limits.MAX_EXTREMAL_VALUES`; the Monte Carlo's samples times its
+        steps (``substeps`` per control step ``step`` over ``max_time``) within
+        :data:`~gamespec.limits.MAX_SAMPLE_STEPS`. A SpecError naming the field otherwise."""
+        nx, ny = self.grid.nodes
+        spacing = min(
+            (hi - lo) / (n - 1)
+            for lo, hi, n in zip(self.grid.lower, self.grid.upper, self.grid.nodes, strict=True)
+        )
+        cells = nx * ny
+        steps = self.max_time * max_speed / (self.cfl * spacing)
+        if cells * steps > MAX_GRID_CELL_STEPS:
+            raise SpecError(
+                f"{cells} cells times at least {steps:.3g} CFL steps (max_time · max_speed / (cfl · dx)) "
+                f"exceed the limit of {MAX_GRID_CELL_STEPS:g} cell steps",
+                field="method.grid.nodes",
+            )
+        extremal = self.extremals.directions * self.max_time / self.extremals.step
+        if extremal > MAX_EXTREMAL_VALUES:
+            raise SpecError(
+                f"{extremal:.3g} front points (directions · max_time / step) exceed the limit of "
+                f"{MAX_EXTREMAL_VALUES:g}",
+                field="method.extremals.step",
+            )
+        mc = self.monte_carlo
+        sampled = mc.samples * mc.substeps * self.max_time / step
+        if sampled > MAX_SAMPLE_STEPS:
+            raise SpecError(
+                f"{sampled:.3g} sample steps (samples · substeps · max_time / step) exceed the limit of "
+                f"{MAX_SAMPLE_STEPS:g}",
+                field="method.monte_carlo.samples",
+            )
 
 
 class FlowGameSpec(ProblemParameters, SpecBase):
@@ -332,6 +370,8 @@ class _Evaluator:
         if not np.all((origins >= m.grid.lower) & (origins <= m.grid.upper)):
             raise SpecError("both starting points must lie inside the grid", field="method.grid")
         drift, diffusion = self.flow()
+        step = self.number(p.step, "step", positive=True)
+        m.check_work(max(pursuer.max_speed, evader.max_speed), step)
         return FlowGameValues(
             position=self.position,
             drift=drift,
@@ -339,7 +379,7 @@ class _Evaluator:
             players=(pursuer, evader),
             speed_fraction=fraction,
             capture_radius=self.number(p.capture_radius, "capture_radius", positive=True),
-            step=self.number(p.step, "step", positive=True),
+            step=step,
             payoff=p.payoff,
             feedforward=p.feedforward,
             grid_lower=m.grid.lower,

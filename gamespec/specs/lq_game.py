@@ -19,15 +19,14 @@ from collections.abc import Mapping
 from typing import Annotated, Any, Literal
 
 import numpy as np
-import sympy as sp
 from pydantic import Discriminator, Field, Tag, field_validator, model_validator
 
 from gamespec.best_response import Settings
 from gamespec.errors import ExpressionError, SpecError
-from gamespec.limits import MAX_INTERVALS, MAX_MAGNITUDE, MAX_SAMPLE_VALUES, MAX_SAMPLES
+from gamespec.limits import MAX_INTERVALS, MAX_LQ_ENTRY, MAX_SAMPLE_VALUES, MAX_SAMPLES
 from gamespec.specs.base import Number, ProblemParameters, SpecBase, StrictModel, Value
 from gamespec.specs.lq_model import LQGame, zero_order_hold
-from gamespec.symbolic.language import RESERVED, float_value, parse, symbol
+from gamespec.symbolic.grammar import RESERVED, numeric_value
 
 
 class Diagonal(StrictModel):
@@ -159,7 +158,7 @@ class MonteCarloSpec(StrictModel):
     """Closed-loop samples drawn after the solve (0 to skip)."""
 
     samples: int = Field(100, ge=0, le=MAX_SAMPLES)
-    seed: int = 0
+    seed: int = Field(0, ge=0, description="Seed of the random generator (a non-negative integer).")
 
 
 class LQMethodSpec(StrictModel):
@@ -264,26 +263,21 @@ class LQGameSpec(ProblemParameters, SpecBase):
 
 
 class _Evaluator:
-    """Evaluates a problem's entries for given parameter values (parse, then substitute; no eval)."""
+    """Evaluates a problem's entries for given parameter values (the grammar's float walk; no eval)."""
 
     def __init__(self, problem: LQGameProblem, values: Mapping[str, float]) -> None:
         self.problem = problem
-        self.symbols = {name: symbol(name) for name in values}
-        self.substitution = {symbol(name): sp.Float(v) for name, v in values.items()}
+        self.values = {name: float(v) for name, v in values.items()}
 
     def scalar(self, value: Value, field: str) -> float:
+        """The value of an entry: a number, or an expression of the parameters computed in floating
+        point with the grammar's overflow checks (never by SymPy's exact arithmetic)."""
         if not isinstance(value, str):
             return float(value)
         try:
-            return float_value(parse(value, self.symbols).xreplace(self.substitution))
+            return numeric_value(value, self.values)
         except ExpressionError as err:
             raise SpecError(str(err), field=f"problem.{field}") from None
-        except OverflowError:
-            reason = f"{value!r} is out of range (beyond {MAX_MAGNITUDE:g})"
-            raise SpecError(reason, field=f"problem.{field}") from None
-        except (TypeError, ValueError, RecursionError):
-            reason = f"{value!r} does not evaluate to a real number"
-            raise SpecError(reason, field=f"problem.{field}") from None
 
     def vector(self, values: list[Value], field: str) -> np.ndarray:
         return np.array([self.scalar(v, f"{field}.{i}") for i, v in enumerate(values)])
@@ -389,6 +383,24 @@ class _Evaluator:
                     "the terminal covariance must be positive definite (Lemma 13)",
                     field="problem.terminal.covariance",
                 )
+        Sigma0 = self.covariance(p.initial.covariance, n, "initial.covariance")
+        for name, M in (
+            ("dynamics", A),
+            ("dynamics", B),
+            ("dynamics", C),
+            ("dynamics", D),
+            ("cost", Q),
+            ("cost", R),
+            ("cost", S),
+            ("initial", mu0),
+            ("initial", Sigma0),
+        ):
+            if not np.abs(M).max(initial=0.0) <= MAX_LQ_ENTRY:
+                raise SpecError(
+                    f"an entry is beyond {MAX_LQ_ENTRY:g} in size (README, Limits)",
+                    field=f"problem.{'continuous' if name == 'dynamics' and p.continuous else name}",
+                )
+        _open_loop_bounded(A, D, Sigma0)
         return LQGame(
             A=A,
             B=B,
@@ -398,8 +410,25 @@ class _Evaluator:
             R=R,
             S=S,
             mu0=mu0,
-            Sigma0=self.covariance(p.initial.covariance, n, "initial.covariance"),
+            Sigma0=Sigma0,
             muN=muN,
             SigmaN=SigmaN,
             dt=dt,
         )
+
+
+def _open_loop_bounded(A: np.ndarray, D: np.ndarray, Sigma0: np.ndarray) -> None:
+    """The open-loop covariance ``Σ_{k+1} = A_k Σ_k A_kᵀ + D_k D_kᵀ`` (eq. 4.2 without controls)
+    and the state transition ``A_k ⋯ A_0`` stay within :data:`~gamespec.limits.MAX_LQ_ENTRY` over
+    the horizon, so the backends' products of them are finite; a SpecError otherwise."""
+    Sigma, Phi = Sigma0, np.eye(A.shape[1])
+    with np.errstate(over="ignore", invalid="ignore"):
+        for k in range(A.shape[0]):
+            Sigma = A[k] @ Sigma @ A[k].T + D[k] @ D[k].T
+            Phi = A[k] @ Phi
+            if not (np.abs(Sigma).max() <= MAX_LQ_ENTRY and np.abs(Phi).max() <= MAX_LQ_ENTRY):
+                raise SpecError(
+                    f"the open-loop state transition or covariance grows beyond {MAX_LQ_ENTRY:g} by step "
+                    f"{k + 1}: the model is too unstable (or too noisy) for this horizon",
+                    field="problem.horizon",
+                )

@@ -23,6 +23,7 @@ from typing import ClassVar, Literal
 
 from pydantic import Field, field_validator, model_validator
 
+from gamespec.errors import ExpressionError, SpecError
 from gamespec.limits import MAX_INTERVALS
 from gamespec.specs.base import Number, SpecBase, StrictModel, Value
 from gamespec.specs.ocp import (
@@ -187,6 +188,14 @@ class MultiPhaseSpec(OcpFamily, SpecBase):
 
     @model_validator(mode="after")
     def _lowers(self) -> MultiPhaseSpec:
+        """The phases lower to one ``optimal_control`` problem; an expression the lowering generates
+        from the file's values that has no form in the language (a guess spread over a duration of
+        1e308) is a SpecError naming ``problem.phases``."""
         self.check_plot_names()
-        lower(self)
+        try:
+            lower(self)
+        except ExpressionError as err:
+            raise SpecError(
+                f"the phases do not lower to one problem: {err}", field="problem.phases"
+            ) from None
         return self

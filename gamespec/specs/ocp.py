@@ -32,6 +32,7 @@ from gamespec.symbolic.grammar import (
     expression,
     numeric_value,
     relation,
+    unknown,
     unknowns,
 )
 
@@ -371,9 +372,10 @@ class OcpProblem(StrictModel):
         checks += [
             (f"boundary_constraints.{i}", c, ends, True) for i, c in enumerate(self.boundary_constraints)
         ]
+        numbers = self.parameter_values()
         for field, text, symbols, constraint in checks:
             try:
-                check(text, symbols, constraint=constraint)
+                _check_at(text, symbols, numbers, constraint)
             except ExpressionError as err:
                 used = _inputs_in(constraint, text, symbols, inputs)
                 reason = (
@@ -383,6 +385,19 @@ class OcpProblem(StrictModel):
                     else str(err)
                 )
                 raise SpecError(reason, field=f"problem.{field}") from None
+
+
+def _check_at(
+    text: str | float, names: Mapping[str, object], numbers: Mapping[str, float], constraint: bool
+) -> None:
+    """:func:`~gamespec.symbolic.grammar.check` of ``text`` over ``names``, the parameters among them
+    at their ``numbers`` (the file's values): what is undefined, not real or out of range at those
+    values (``acos(xf)`` with ``xf = 2``, ``sqrt(-w)``) is refused at load, not met by the solver."""
+    symbols = {n: numbers[n] if n in numbers else unknown(n) for n in names}
+    if constraint:
+        relation(str(text), symbols, FLOATS)
+    else:
+        expression(text, symbols, FLOATS)
 
 
 def parameter_values(

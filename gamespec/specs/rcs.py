@@ -25,11 +25,30 @@ Weights, radii, centres, velocities and β are numbers or expressions of the pro
 
 from __future__ import annotations
 
+from collections.abc import Iterable, Mapping
+
 from pydantic import Field, field_validator
 
+from gamespec.errors import ExpressionError, SpecError
 from gamespec.specs.base import StrictModel, Value
 from gamespec.specs.desensitize import MonteCarloOptions
 from gamespec.specs.ocp import GuessSpec
+from gamespec.symbolic.grammar import FLOATS, expression, unknowns
+
+
+def check_values(
+    parameters: Mapping[str, float], running: Iterable[str], items: list[tuple[str, Value]]
+) -> None:
+    """Each ``(field, value)`` an expression of the problem's ``parameters`` at their values and of
+    the ``running`` names (states, controls, ``t``; none for a value of the parameters only), finite
+    and real there: checked at load, so a bad centre or weight is one line naming its field, never
+    an error of the transform or of a plot later."""
+    symbols = dict(parameters) | unknowns(running)
+    for field, value in items:
+        try:
+            expression(value, symbols, FLOATS)
+        except ExpressionError as err:
+            raise SpecError(str(err), field=field) from None
 
 
 class RcsOptions(StrictModel):
@@ -55,6 +74,11 @@ class RcsOptions(StrictModel):
         description="Other starting points (each a guess section of the problem) re-solved from when "
         "the first solution fails a check; the best one that passes every check is kept.",
     )
+
+    def check_against(self, parameters: Mapping[str, float], running: Iterable[str], field: str) -> None:
+        """The weights at the parameters' values (:func:`check_values`)."""
+        weights = self.weight if isinstance(self.weight, list) else [self.weight]
+        check_values(parameters, [], [(f"{field}.weight", w) for w in weights])
 
 
 class Track(StrictModel):
@@ -87,3 +111,17 @@ class MovingObstaclesOptions(StrictModel):
     agent: tuple[Value, Value] = ("x", "y")
     power: Value = Field(1.0, description="β of eq. 6.41 (β = 1 is eq. 6.39); a number or parameter.")
     obstacles: dict[str, Obstacle] = Field(min_length=1)
+
+    def check_against(self, parameters: Mapping[str, float], running: Iterable[str], field: str) -> None:
+        """The agent's position over the ``running`` names, and β, the centres, velocities, radii and
+        track widths at the parameters' values (:func:`check_values`)."""
+        check_values(parameters, running, [(f"{field}.agent.{i}", a) for i, a in enumerate(self.agent)])
+        items = [(f"{field}.power", self.power)]
+        for name, o in self.obstacles.items():
+            at = f"{field}.obstacles.{name}"
+            items += [(f"{at}.center.{i}", c) for i, c in enumerate(o.center)]
+            items += [(f"{at}.velocity.{i}", v) for i, v in enumerate(o.velocity)]
+            items += [(f"{at}.radius", o.radius)]
+            if o.track is not None:
+                items += [(f"{at}.track.half_width", o.track.half_width)]
+        check_values(parameters, [], items)

@@ -17,11 +17,13 @@ again resumes.
 from __future__ import annotations
 
 from pathlib import Path
-from typing import ClassVar, Literal
+from typing import Annotated, ClassVar, Literal
 
-from pydantic import Field
+from pydantic import Field, model_validator
 
-from gamespec.specs.base import Number, SpecBase
+from gamespec.errors import SpecError
+from gamespec.limits import MAX_RCS_OBSTACLES, MAX_SAMPLE_VALUES, MAX_STUDY_POINTS
+from gamespec.specs.base import BackendName, Number, SpecBase
 from gamespec.specs.ocp import MethodSpec
 
 
@@ -29,7 +31,9 @@ class RcsStudySpec(SpecBase):
     """Fig. 6.11: travel time against collision probability per number of obstacles and weight."""
 
     kind: Literal["rcs_multi_obstacle_study"] = "rcs_multi_obstacle_study"
-    obstacles: list[int] = Field(default_factory=lambda: [2, 3, 5, 10], min_length=1)
+    obstacles: list[Annotated[int, Field(ge=1, le=MAX_RCS_OBSTACLES)]] = Field(
+        default_factory=lambda: [2, 3, 5, 10], min_length=1, description="Numbers of obstacles N."
+    )
     alphas: list[Number] = Field(default_factory=lambda: [0.0, 0.1, 0.33, 1.0], min_length=1)
     sigma: Number = Field(0.1, gt=0, description="σ (sigma_is: std) or σ² (sigma_is: variance) of Δρ.")
     sigma_is: Literal["std", "variance"] = "std"
@@ -46,10 +50,30 @@ class RcsStudySpec(SpecBase):
     seed: int = Field(0, ge=0)
     steps: int = Field(1000, ge=10, le=100_000, description="RK4 steps of the Monte Carlo re-simulation.")
     method: MethodSpec = Field(default_factory=lambda: MethodSpec(intervals=40, degree=3))
-    ocp_backend: str = "casadi"
+    ocp_backend: BackendName = "casadi"
     store: Path = Field(Path("runs/rcs_multi_obstacle/points"), description="Folder of per-point records.")
 
     default_backend: ClassVar[str] = "rcs_study"
+
+    @model_validator(mode="after")
+    def _work_bounded(self) -> RcsStudySpec:
+        """The solves (points times guesses) within :data:`~gamespec.limits.MAX_STUDY_POINTS` and one
+        point's Monte Carlo (samples times steps times obstacles) within
+        :data:`~gamespec.limits.MAX_SAMPLE_VALUES`."""
+        solves = len(self.obstacles) * len(self.alphas) * len(self.guesses)
+        if solves > MAX_STUDY_POINTS:
+            raise SpecError(
+                f"{solves} solves (obstacles x alphas x guesses) exceed the limit of {MAX_STUDY_POINTS}",
+                field="obstacles",
+            )
+        values = self.samples * self.steps * max(self.obstacles)
+        if values > MAX_SAMPLE_VALUES:
+            raise SpecError(
+                f"{values} simulated values (samples x steps x obstacles) exceed the limit of "
+                f"{MAX_SAMPLE_VALUES}",
+                field="samples",
+            )
+        return self
 
     @property
     def std(self) -> float:

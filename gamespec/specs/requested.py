@@ -3,7 +3,9 @@
 Each entry is ``{<transform name>: {<options>}}``. The name is looked up lazily in the
 ``gamespec.transforms`` entry-point group (an unknown one is refused with the nearest name), the
 transform must be a requested one of the spec's kind, and its options are validated by its
-``options_model``; a bad option names its dotted field, ``transforms.<i>.<name>.<key>``.
+``options_model`` (and against the problem by the model's ``check_against(parameters, running,
+field)`` where it has one: expressions of the parameters at their values); a bad option names its
+dotted field, ``transforms.<i>.<name>.<key>``.
 """
 
 from __future__ import annotations
@@ -80,4 +82,8 @@ def check_requested(spec: SpecBase) -> None:
                 f"transform {name!r} takes kind {cls.source_kind!r}, not {spec.kind!r}",
                 field=f"transforms.{index}",
             )
-        validated_options(cls, name, options, index)
+        checked = validated_options(cls, name, options, index)
+        if hasattr(checked, "check_against"):
+            p = spec.problem
+            running = [*p.states, *p.controls, "t"]
+            checked.check_against(p.parameter_values(), running, f"transforms.{index}.{name}")

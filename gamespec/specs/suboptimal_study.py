@@ -13,8 +13,9 @@ from typing import ClassVar, Literal
 
 from pydantic import Field, ValidationError, ValidationInfo, field_validator, model_validator
 
+from gamespec.errors import SpecError
 from gamespec.limits import MAX_STUDY_POINTS
-from gamespec.specs.base import Number, SpecBase, StrictModel
+from gamespec.specs.base import BackendName, Number, SpecBase, StrictModel
 from gamespec.specs.ocp import MethodSpec
 
 MethodChange = dict[str, int | float | str]
@@ -47,7 +48,7 @@ class SuboptimalStudySpec(SpecBase):
         default_factory=lambda: [{"intervals": 80}, {"intervals": 60, "grading": 100}],
         description="Changes to method tried in turn when a solution fails the defect check.",
     )
-    ocp_backend: str = Field("casadi", description="Backend that solves each point's eq. 2.21 OCP.")
+    ocp_backend: BackendName = Field("casadi", description="Backend that solves each point's eq. 2.21 OCP.")
     store: Path = Field(
         Path("runs/table_2_1/points"),
         description="Folder of the per-point records (relative to the current directory); "
@@ -62,6 +63,20 @@ class SuboptimalStudySpec(SpecBase):
         if points > MAX_STUDY_POINTS:
             raise ValueError(
                 f"{points} grid points (angles × fractions × speeds) exceed the limit of {MAX_STUDY_POINTS}"
+            )
+        return self
+
+    @model_validator(mode="after")
+    def _capture_radius_inside(self) -> SuboptimalStudySpec:
+        """Every point's engagement starts outside the capture radius: P2's distance r2(0) lies
+        beyond F on its ray (eqs. 2.5–2.6), at least ``r1 (u - v) / (u + v)`` (the ray along P1's
+        line of sight), and P1's is r1."""
+        nearest = min(self.r1 * (self.u - v) / (self.u + v) for v in self.speeds)
+        if not self.capture_radius < nearest:
+            raise SpecError(
+                f"{self.capture_radius:g} is not below the nearest start of a pursuer, "
+                f"r1 (u - v) / (u + v) = {nearest:g} at the fastest speed",
+                field="capture_radius",
             )
         return self
 

@@ -146,6 +146,16 @@ class SympyAlgebra:
         return self.finite(base**exponent)
 
     def call(self, name: str, args: list[sp.Expr]) -> sp.Expr:
+        """``name(*args)``; of numbers, first computed in floating point, so that one out of range
+        (``exp(1e+300)``, which SymPy's own evaluation of a Float fails on with a decimal error) is
+        refused; one that is not real there (``asin(2)``) is kept as SymPy keeps it (see :meth:`finite`)."""
+        if args and all(a.is_number for a in args):
+            try:
+                FLOAT_FUNCTIONS[name](*(float_value(a) for a in args))
+            except OverflowError:
+                raise Refused(f"number out of range (beyond {MAX_MAGNITUDE:g})") from None
+            except (ValueError, TypeError, ZeroDivisionError, RecursionError):
+                pass
         return self.finite(_SYMPY_FUNCTIONS[name](*args))
 
     def scalar(self, value: sp.Expr) -> float | None:

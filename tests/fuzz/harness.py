@@ -73,8 +73,11 @@ def run_cli(args: Sequence[str], bound_s: float = TIME_BOUND_S) -> Outcome:
 
     out, err = io.StringIO(), io.StringIO()
     start = time.perf_counter()
-    with _time_bound(bound_s), contextlib.redirect_stdout(out), contextlib.redirect_stderr(err):
-        code = run([str(a) for a in args])
+    try:
+        with _time_bound(bound_s), contextlib.redirect_stdout(out), contextlib.redirect_stderr(err):
+            code = run([str(a) for a in args])
+    except Hang as hang:
+        raise Hang(f"{hang}: gamespec {' '.join(map(str, args))}") from None
     EXIT_CODES[code] += 1
     return Outcome(code, out.getvalue(), err.getvalue(), time.perf_counter() - start)
 

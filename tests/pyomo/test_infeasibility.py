@@ -1,0 +1,61 @@
+"""Fast honest statuses on Pyomo (issue 27, item 6): a transcription whose constraints are linear is
+checked for feasibility by an LP before ripopt runs.
+
+The double integrator ``x'' = u, |u| <= 1`` from rest at x = x0 to rest at 0 needs at least the
+bang-bang time ``2 sqrt(x0)`` (accelerate for half, brake for half): with x0 = 1 a fixed final time
+of 1 is infeasible, one of 2.5 feasible (both independent of any solver)."""
+
+from __future__ import annotations
+
+import math
+import resource
+
+import pytest
+
+import gamespec
+from gamespec.result import Status
+
+
+def _double_integrator(x0: float, t_final: float, parameter: bool = False) -> dict:
+    """The problem; with ``parameter`` the control enters as ``b*u`` with b = 1 a parameter (a Var
+    held by equal bounds in the Pyomo model: the defects are linear only once it is read as one)."""
+    return {
+        "kind": "optimal_control",
+        "name": "double_integrator_to_rest",
+        "problem": {
+            "parameters": {"b": 1.0} if parameter else {},
+            "states": {"x": {"initial": x0, "final": 0.0}, "v": {"initial": 0.0, "final": 0.0}},
+            "controls": {"u": {"lower": -1.0, "upper": 1.0}},
+            "dynamics": {"x": "v", "v": "b*u" if parameter else "u"},
+            "objective": {"lagrange": "u**2"},
+            "time": {"final": t_final},
+        },
+        "method": {"intervals": 40, "degree": 3},
+    }
+
+
+def _cpu_seconds() -> float:
+    usage = [resource.getrusage(who) for who in (resource.RUSAGE_SELF, resource.RUSAGE_CHILDREN)]
+    return sum(u.ru_utime + u.ru_stime for u in usage)
+
+
+@pytest.mark.parametrize("parameter", [False, True])
+def test_infeasible_linear_transcription_is_infeasible_without_the_nlp_solver(parameter: bool) -> None:
+    spec = gamespec.spec_from_dict(_double_integrator(1.0, 0.5 * 2 * math.sqrt(1.0), parameter))
+    start = _cpu_seconds()
+    result = gamespec.solve(spec, "pyomo")
+    assert result.status is Status.INFEASIBLE, result.message
+    assert "LP feasibility check" in result.message
+    assert _cpu_seconds() - start < 20  # ripopt ran 3000 iterations (minutes on a loaded machine)
+
+
+def test_feasible_linear_transcription_is_solved_and_agrees_with_casadi() -> None:
+    spec = gamespec.spec_from_dict(_double_integrator(1.0, 1.25 * 2 * math.sqrt(1.0)))
+    pyomo, casadi = gamespec.solve(spec, "pyomo"), gamespec.solve(spec, "casadi")
+    assert pyomo.status is Status.OPTIMAL and casadi.status is Status.OPTIMAL
+    assert pyomo.objective == pytest.approx(casadi.objective, rel=1e-6)
+
+
+def test_casadi_agrees_that_it_is_infeasible() -> None:
+    spec = gamespec.spec_from_dict(_double_integrator(1.0, 1.0))
+    assert gamespec.solve(spec, "casadi").status is Status.LOCALLY_INFEASIBLE

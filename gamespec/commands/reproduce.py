@@ -15,19 +15,12 @@ import sys
 from collections.abc import Callable
 from contextlib import AbstractContextManager, nullcontext
 from pathlib import Path
-from typing import Annotated
+from typing import TYPE_CHECKING, Annotated
 
 import typer
 
-from gamespec.commands.reproduction import (
-    SHOWN,
-    Experiment,
-    load_manifest,
-    read_metric,
-    table_rows,
-    write_csv,
-    write_markdown,
-)
+if TYPE_CHECKING:
+    from gamespec.commands.reproduction import Experiment
 
 WIDTH = 200
 """Characters per line of the table where stdout is not a terminal (a file, a pipe)."""
@@ -95,6 +88,14 @@ def reproduce(
     from rich.markup import escape
     from rich.table import Table
 
+    from gamespec.commands.reproduction import (
+        SHOWN,
+        load_manifest,
+        read_metric,
+        table_rows,
+        write_csv,
+        write_markdown,
+    )
     from gamespec.result import writable_folder
 
     experiments = [e for e in load_manifest(manifest).experiments if not chapter or e.chapter in chapter]

@@ -300,7 +300,7 @@ def test_the_chattering_check_fires_on_goddard_and_a_rate_penalty_removes_it(bac
 
 
 @pytest.mark.parametrize("strategy", ["h", "hp"])
-@pytest.mark.parametrize("backend", ["casadi", "pyomo"])
+@pytest.mark.parametrize("backend", ["casadi", pytest.param("pyomo", marks=pytest.mark.slow)])
 def test_mesh_refinement_reaches_its_tolerance_on_the_hang_glider(backend: str, strategy: str) -> None:
     tolerance = 1e-6
     overrides = ["method.intervals=10", f"method.refine.tolerance={tolerance}"]

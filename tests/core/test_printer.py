@@ -155,7 +155,7 @@ def assert_round_trip(expr: sp.Expr) -> None:
     assert parse(text, SYMBOLS) == canonical(expr), text
 
 
-@SETTINGS
+@settings(SETTINGS, max_examples=150)
 @given(trees(REAL_UNARY + MORE_UNARY, REAL_BINARY + MORE_BINARY))
 def test_round_trip_of_random_trees(expr: sp.Expr) -> None:
     assume(representable(expr))

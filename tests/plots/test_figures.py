@@ -24,9 +24,10 @@ FAST_FILES = {
     "car_vs_train": ["method.refine=null", "transforms.1.rcs.monte_carlo.samples=100"],
 }
 """Settings that keep a figure test's solve short (the figures show what was solved, at any mesh)."""
-SLOW_FILES = {"hurricane_hugo"}
-"""Files whose solve takes many seconds of CPU whatever the settings: their kind's figures are
-checked in the default suite on another file (``linear_flow``), theirs with ``-m slow``."""
+SLOW_FILES = {"hurricane_hugo", "asymmetric_obstacle"}
+"""Files whose solve takes seconds of CPU whatever the settings: their kind's figures are checked
+in the default suite on another file (``linear_flow``; the receding-horizon figures and GIF in
+``tests/games/test_plotting.py``), theirs with ``-m slow``."""
 FILES = [
     pytest.param(p, marks=pytest.mark.slow) if p.stem in SLOW_FILES else p
     for p in sorted(p for p in PROBLEMS.rglob("*.yaml") if "study" not in p.stem)

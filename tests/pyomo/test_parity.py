@@ -20,7 +20,22 @@ def _close(a: dict[str, np.ndarray], b: dict[str, np.ndarray], rel: float) -> No
         np.testing.assert_allclose(b[name], a[name], rtol=0, atol=rel * scale, err_msg=name)
 
 
-@pytest.fixture(scope="module", params=OCP_FILES, ids=lambda p: p.stem)
+SLOW_PAIRS = {
+    "hyper_sensitive",
+    "cdoc_lqr_b_uncertain",
+    "cdoc_lqr_marginal",
+    "rcs_constraint_form",
+    "free_flying_robot",
+}
+"""Files whose refined or long solves cost a second or more on each backend: compared with ``-m slow``
+(the other C-DOC, RCS and refined files keep the parity in the default suite)."""
+
+
+@pytest.fixture(
+    scope="module",
+    params=[pytest.param(p, marks=pytest.mark.slow) if p.stem in SLOW_PAIRS else p for p in OCP_FILES],
+    ids=lambda p: p.stem,
+)
 def pair(request) -> tuple[Result, Result]:
     spec = gamespec.load(request.param)
     return gamespec.solve(spec, "casadi"), gamespec.solve(spec, "pyomo")

@@ -12,10 +12,10 @@ from typing import Any
 import numpy as np
 
 from gamespec.desensitize.augment import initial_values
-from gamespec.desensitize.simulate import Trajectories, cost, evaluate, open_loop, rk4
+from gamespec.desensitize.simulate import Trajectories, cost, evaluate, rk4
 from gamespec.desensitize.tracking import linearization, riccati_gains
 from gamespec.montecarlo import Distribution, Normal, Uniform, proportion, sample, summarize
-from gamespec.ocp.control_signal import TranscribedSignal
+from gamespec.ocp.control_signal import TranscribedSignal, transcribed_signal
 from gamespec.ocp.symbolic import SymbolicOcp
 from gamespec.result import Result
 from gamespec.specs.desensitize import MonteCarloOptions
@@ -63,8 +63,8 @@ def monte_carlo(
     params = {symbol(k): drawn.get(k, v) for k, v in nominal.items()}
     t0, tf = float(result.time[0]), float(result.t_final)
     x0 = initial_state(ocp, result, params, n)
-    u_star = open_loop(result, ocp.controls)
-    signals = open_loop(result, ocp.inputs) if ocp.inputs else None
+    u_star = transcribed_signal(result, ocp.controls)
+    signals = transcribed_signal(result, ocp.inputs) if ocp.inputs else None
     run = rk4(ocp, x0, u_star, params, t0, tf, options.steps, keep=BUNDLE, inputs=signals)
     spread = summarize(drawn)
     metrics = {

@@ -44,12 +44,6 @@ class Trajectories:
     violation: np.ndarray
 
 
-def open_loop(result: Result, names: list[str]) -> TranscribedSignal:
-    """The Result's controls (or grid inputs) of these names as the transcription holds them
-    (:func:`gamespec.ocp.control_signal.transcribed_signal`)."""
-    return transcribed_signal(result, names)
-
-
 def evaluate(exprs: list[sp.Expr], values: Values, shape: tuple[int, ...]) -> np.ndarray:
     """The expressions with each symbol of ``values`` given its value, stacked (len(exprs), *shape)."""
     function = numeric_function(exprs, list(values))
@@ -62,12 +56,12 @@ DENSE = 20
 
 def values_at(result: Result, ocp: SymbolicOcp, t: np.ndarray) -> dict[sp.Symbol, np.ndarray | float]:
     """The Result's parameters, states (linear between its points) and controls
-    (:func:`open_loop`) at times ``t``, by symbol."""
+    (as the transcription holds them) at times ``t``, by symbol."""
     values: dict[sp.Symbol, np.ndarray | float] = {symbol(k): v for k, v in result.parameters.items()}
     time = np.asarray(result.time)
     values |= {symbol(k): np.interp(t, time, np.asarray(v)) for k, v in result.states.items()}
     if ocp.controls:
-        values |= dict(zip(ocp.u, open_loop(result, ocp.controls)(t), strict=True))
+        values |= dict(zip(ocp.u, transcribed_signal(result, ocp.controls)(t), strict=True))
     values[TIME] = t
     return values
 

@@ -125,10 +125,11 @@ class GameCompiled(CompiledModel):
         self, parameters: dict[str, float] | None = None, guess: Result | None = None, inputs: Inputs = None
     ) -> Result:
         refuse_inputs(inputs, self.game.kind)
-        self.parameters |= parameters or {}
         if self.feedback is not None:
+            self.parameters |= parameters or {}
             return feedback_equilibrium(self.game, self.feedback, self.parameters)
-        self.model.parameters = {**self.model.parameters, **self.parameters}
+        if parameters:
+            self.model.parameters = {**self.model.parameters, **parameters}
         if self.game.receding_horizon is not None:
             from gamespec.games.receding_horizon import receding_horizon
 

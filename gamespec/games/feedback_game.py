@@ -72,7 +72,7 @@ def feedback_equilibrium(game: DifferentialGameSpec, form: LQForm, parameters: d
         objective=payoffs[form.players[0]],
         t_final=float(solution.times[-1]),
         time=solution.times,
-        states={s: solution.x[:, i] for i, s in enumerate(form.states[:n])},
+        states={s: solution.x[:, i] for i, s in enumerate(form.states)},
         controls={c: solution.u[:, j] for j, c in enumerate(controls)},
         checks={"saddle_gap": gap},
         metrics=base

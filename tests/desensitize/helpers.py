@@ -8,8 +8,9 @@ from pathlib import Path
 import numpy as np
 import yaml
 
-from gamespec.desensitize.simulate import Trajectories, open_loop, rk4
+from gamespec.desensitize.simulate import Trajectories, rk4
 from gamespec.loader import spec_from_dict
+from gamespec.ocp.control_signal import transcribed_signal
 from gamespec.ocp.symbolic import SymbolicOcp
 from gamespec.result import Result
 from gamespec.solving import compile_spec
@@ -73,5 +74,5 @@ def resimulate(
     start = float(result.time[0]) if t0 is None else t0
     if x0 is None:
         x0 = np.array([[np.interp(start, result.time, result.states[s])] * samples for s in ocp.states])
-    u = open_loop(result, ocp.controls)
+    u = transcribed_signal(result, ocp.controls)
     return rk4(ocp, x0, u, values, start, float(result.t_final), steps)

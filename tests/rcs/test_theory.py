@@ -8,8 +8,9 @@ import pytest
 import yaml
 from scipy.stats import norm
 
-from gamespec.desensitize.simulate import open_loop, rk4
+from gamespec.desensitize.simulate import rk4
 from gamespec.loader import load, spec_from_dict
+from gamespec.ocp.control_signal import transcribed_signal
 from gamespec.ocp.symbolic import SymbolicOcp
 from gamespec.rcs.sensitivity import inequalities
 from gamespec.solving import compile_spec, solve
@@ -59,7 +60,9 @@ def test_constraint_sensitivity_matches_finite_differences():
     values = []
     for r in (rho + h, rho - h):
         params = {symbol(k): v for k, v in result.parameters.items()} | {symbol("rho"): r}
-        run = rk4(ocp, x0, open_loop(result, ocp.controls), params, t[0], float(result.t_final), steps)
+        run = rk4(
+            ocp, x0, transcribed_signal(result, ocp.controls), params, t[0], float(result.t_final), steps
+        )
         xs = [np.interp(t, run.t, run.x[:, i, 0]) for i in range(2)]
         args = [params[p] for p in ocp.p]
         values.append(np.broadcast_to(G(*args, *xs, t), (1, t.size))[0])

@@ -34,7 +34,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from gamespec.best_response import BestResponseRun, Outcome, Settings, VectorPlayer, iterate
+from gamespec.best_response import BestResponseRun, Settings, VectorPlayer, iterate
 from gamespec.games.evaluation import payoff_at, states_at
 from gamespec.games.lq_structure import LQForm, lq_form
 from gamespec.games.problems import parameter_values, player_problem, views
@@ -152,6 +152,9 @@ class GameModel:
     lq: LQForm | str = ""
     """The game's expressions for the Riccati existence test (:mod:`gamespec.games.existence`),
     parsed once, or why the test does not apply."""
+    joint: dict = field(default_factory=dict)
+    """Per game, the stacked KKT system of ``game.scheme: joint`` (:mod:`gamespec.games.joint`),
+    built on first use."""
 
     def __post_init__(self) -> None:
         self.parameters = dict(self.game.problem.parameters) | self.parameters
@@ -227,13 +230,18 @@ class GameModel:
 
             return response
 
-        players = [VectorPlayer(r.name, responder(r)) for r in order]
-        run = iterate(
-            players,
-            dict(start) if start is not None else self.start(view),
-            Settings(settings.scheme, settings.tolerance, settings.max_iterations, settings.damping),
-            payoff=lambda _: _objective(self.responders[(view, last[0])].last),
-        )
+        first = dict(start) if start is not None else self.start(view)
+        if settings.scheme == "joint":
+            from gamespec.games.joint import joint_run
+
+            run = joint_run(self, view, order, first)
+        else:
+            run = iterate(
+                [VectorPlayer(r.name, responder(r)) for r in order],
+                first,
+                Settings(settings.scheme, settings.tolerance, settings.max_iterations, settings.damping),
+                payoff=lambda _: _objective(self.responders[(view, last[0])].last),
+            )
         equilibrium = self._verify(order, run) if run.best is not None else None
         results = {r.name: r.last for r in order if r.last is not None}
         return GameSolution(view, run, results, last[0], equilibrium)
@@ -252,7 +260,7 @@ class GameModel:
         (none when a player's problem goes through transforms: its states and payoff are not the
         game's)."""
         point = run.strategies
-        concept = self.concept() if run.outcome is Outcome.CONVERGED else "none"
+        concept = self.concept() if run.converged else "none"
         if any(r.solver.steps or not hasattr(r.solver.compiled, "tr") for r in order):
             missing = dict.fromkeys((r.name for r in order), None)
             note = "a player's problem goes through transforms: no payoffs or gap at the returned point"

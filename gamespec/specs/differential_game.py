@@ -311,12 +311,23 @@ class GameSettings(StrictModel):
         "feedback: a law of the state, the feedback Nash (saddle, zero-sum) equilibrium of a "
         "linear-quadratic game by coupled Riccati equations.",
     )
-    scheme: Literal["gauss_seidel", "jacobi"] = "gauss_seidel"
+    scheme: Literal["gauss_seidel", "jacobi", "joint"] = Field(
+        "gauss_seidel",
+        description="gauss_seidel (Algorithm 4) or jacobi: best responses; joint: every player's "
+        "first-order conditions stacked and solved as one system (gamespec.games.joint; casadi only), "
+        "its point verified by one best response per player.",
+    )
     tolerance: float = Field(1e-6, gt=0)
     max_iterations: int = Field(100, ge=1)
     damping: float = Field(1.0, gt=0, le=1)
     backend: Literal["casadi", "pyomo"] = "casadi"
     """The OCP backend each player's best response is compiled on."""
+
+    @model_validator(mode="after")
+    def _joint_on_casadi(self) -> GameSettings:
+        if self.scheme == "joint" and self.backend != "casadi":
+            raise ValueError("scheme: joint stacks the players' CasADi transcriptions: use backend: casadi")
+        return self
 
 
 class StopRule(StrictModel):

@@ -4,7 +4,9 @@ Compiling builds a :class:`~gamespec.games.equilibrium.GameModel` (each player's
 compiled once on ``game.backend``); solving runs the receding horizon of Algorithm 4 when the file
 has a ``receding_horizon`` section (:mod:`gamespec.games.receding_horizon`), else the open-loop game
 over the whole horizon. With ``game.information: feedback`` it parses the linear-quadratic game
-instead and solves its coupled Riccati equations (:mod:`gamespec.games.feedback_game`). Runtime
+instead and solves its coupled Riccati equations (:mod:`gamespec.games.feedback_game`), or runs
+iterative LQ games on a game that is not LQ (:mod:`gamespec.games.iterative_lq`); ``game.scheme:
+joint`` solves the players' stacked optimality conditions (:mod:`gamespec.games.joint`). Runtime
 parameters are the game's ``problem.parameters``.
 """
 
@@ -17,7 +19,9 @@ import numpy as np
 from gamespec.backend import Backend, CompiledModel, Inputs, refuse_inputs
 from gamespec.games.equilibrium import GameModel, GameSolution, equilibrium_report, status_of
 from gamespec.games.existence import existence
-from gamespec.games.feedback_game import feedback_equilibrium, feedback_form
+from gamespec.games.feedback import LQGame
+from gamespec.games.feedback_game import feedback_equilibrium
+from gamespec.games.lq_structure import LQForm, lq_form, lq_game
 from gamespec.games.problems import initial_state
 from gamespec.games.simulate import TrueSystem, control_signal, grid_of
 from gamespec.result import Result, Status
@@ -117,17 +121,24 @@ class GameCompiled(CompiledModel):
 
     def __init__(self, game: DifferentialGameSpec) -> None:
         self.game = game
-        self.feedback = feedback_form(game) if game.game.information == "feedback" else None
-        self.model = GameModel(game) if self.feedback is None else None
+        feedback = game.game.information == "feedback"
+        form = lq_form(game) if feedback else None
+        self.feedback = form if isinstance(form, LQForm) else None
+        self.iterative = feedback
+        self.model = GameModel(game) if not feedback else None
         self.parameters = dict(game.problem.parameters)
 
     def solve(
         self, parameters: dict[str, float] | None = None, guess: Result | None = None, inputs: Inputs = None
     ) -> Result:
         refuse_inputs(inputs, self.game.kind)
-        if self.feedback is not None:
+        if self.iterative:
             self.parameters |= parameters or {}
-            return feedback_equilibrium(self.game, self.feedback, self.parameters)
+            if self.feedback is not None and isinstance(lq_game(self.feedback, self.parameters), LQGame):
+                return feedback_equilibrium(self.game, self.feedback, self.parameters)
+            from gamespec.games.iterative_lq import feedback_nash_nonlinear
+
+            return feedback_nash_nonlinear(self.game, self.parameters)
         if parameters:
             self.model.parameters = {**self.model.parameters, **parameters}
         if self.game.receding_horizon is not None:

@@ -17,24 +17,12 @@ import numpy as np
 
 from gamespec.errors import UnsupportedFeature
 from gamespec.games.feedback import LQGame, best_response_improvements, feedback_nash
-from gamespec.games.lq_structure import LQForm, lq_form, lq_game
+from gamespec.games.lq_structure import LQForm, lq_game
 from gamespec.result import Result, Status
 from gamespec.specs.differential_game import DifferentialGameSpec
 
 POINTS_PER_INTERVAL = 10
 """Points of the returned trajectory per interval of the file's ``method`` grid."""
-
-
-def feedback_form(game: DifferentialGameSpec) -> LQForm:
-    """The game's parsed LQ form; UnsupportedFeature naming why when the game is not LQ."""
-    form = lq_form(game)
-    if isinstance(form, str):
-        raise UnsupportedFeature(
-            f"game.information: feedback needs a linear-quadratic game (coupled Riccati equations), "
-            f"and {game.name!r} has {form}; nonlinear feedback equilibria (iterative LQ games) are "
-            "not implemented: solve the open-loop game instead (game.information: open_loop)"
-        )
-    return form
 
 
 def _lq(form: LQForm, parameters: dict[str, float], name: str) -> LQGame:

@@ -309,13 +309,20 @@ class GameSettings(StrictModel):
         "open_loop",
         description="open_loop: each player's strategy is a control signal of time (best responses); "
         "feedback: a law of the state, the feedback Nash (saddle, zero-sum) equilibrium of a "
-        "linear-quadratic game by coupled Riccati equations.",
+        "linear-quadratic game by coupled Riccati equations, of another game by iterative LQ games.",
     )
     scheme: Literal["gauss_seidel", "jacobi", "joint"] = Field(
         "gauss_seidel",
         description="gauss_seidel (Algorithm 4) or jacobi: best responses; joint: every player's "
         "first-order conditions stacked and solved as one system (gamespec.games.joint; casadi only), "
         "its point verified by one best response per player.",
+    )
+    iterative_lq: Literal["second_order", "gauss_newton"] = Field(
+        "second_order",
+        description="information: feedback on a nonlinear game (iterative LQ games, "
+        "gamespec.games.iterative_lq): second_order adds each player's value gradient times the "
+        "dynamics' Hessian to its LQ game (needed where a control enters its owner's cost only through "
+        "the dynamics); gauss_newton is iLQGames' own linearization.",
     )
     tolerance: float = Field(1e-6, gt=0)
     max_iterations: int = Field(100, ge=1)

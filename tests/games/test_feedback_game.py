@@ -75,10 +75,11 @@ def test_nonzero_sum_feedback_nash_reports_both_payoffs() -> None:
     assert max(result.metrics["improvements"].values()) < 1e-8
 
 
-def test_a_game_that_is_not_linear_quadratic_is_refused_naming_why() -> None:
+def test_a_game_neither_method_takes_is_refused_naming_why() -> None:
+    """Not LQ (a terminal constraint) and outside iterative LQ games (the constraint again)."""
     data = yaml.safe_load(SCALAR)
-    data["problem"]["dynamics"]["x"] = "a*x + u + v + x**2"
-    with pytest.raises(UnsupportedFeature, match="not linear"):
+    data["problem"]["terminal_constraints"] = ["x_f >= 0.1"]
+    with pytest.raises(UnsupportedFeature, match="terminal constraints"):
         solve(_spec(yaml.safe_dump(data)))
 
 

@@ -58,7 +58,7 @@ JOINT_CASES = {
     "scalar_lq_three_sevenths": ["game.damping=0.3", "game.max_iterations=300"],
     "scalar_lq_saddle": ["game.damping=0.2", "game.max_iterations=300"],
     "homicidal_chauffeur": [],
-    "unicycle_pursuit_evasion": [],
+    "unicycle_pursuit_evasion": ["game.max_iterations=100"],
 }
 """``problems/ch7`` files and the best-response settings of the baseline (Gauss–Seidel; the damping
 that makes it converge where one does: the scalar saddle game stalls at 7e-7 even damped by 0.2,

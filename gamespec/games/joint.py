@@ -81,6 +81,9 @@ IPOPT stopped at a local minimum of the residual that is not zero (no root found
 
 
 class JointOutcome(StrEnum):
+    """How a joint solve ended: every stage's Newton solve converged, one hit IPOPT's iteration
+    limit, or one failed (no root found near its start, or numerical trouble)."""
+
     CONVERGED = "converged"
     ITERATION_LIMIT = "iteration_limit"
     FAILED = "failed"
@@ -112,7 +115,7 @@ class JointRun:
 
     @property
     def best(self) -> int | None:
-        """0 when the run returned a point (the engine's index of the best iterate), else None."""
+        """The engine's index of the returned iterate: 0, the run's one point (None without one)."""
         return 0 if self.strategies else None
 
     def as_metrics(self) -> dict:
@@ -168,7 +171,8 @@ def _casadi_model(r: BestResponder) -> Any:
 
 @dataclass
 class _Numbers:
-    """One player's numbers for one solve: parameters, bounds, the grid inputs' start."""
+    """One player's numbers for one solve: its parameter values, the NLP parameters without the
+    grid inputs (``p``: the parameters and the horizon) and its variable and constraint bounds."""
 
     params: dict[str, float]
     p: np.ndarray
@@ -240,6 +244,7 @@ class JointSystem:
     def _build(self, nlps: list[dict]) -> None:
         ca = self.ca
         variables, residuals, parameters, estimates = [], [], [], []
+        mu = ca.SX.sym("mu")
         self.blocks: list[dict[str, slice]] = []
         offset = 0
         for player, nlp in zip(self.players, nlps, strict=True):
@@ -258,7 +263,6 @@ class JointSystem:
             n_w, n_g = player.n_w, g.numel()
             bounds = ca.SX.sym(f"b_{player.name}", 2 * n_w + 2 * n_g)
             lbx, ubx, lbg, ubg = ca.vertsplit(bounds, [0, n_w, 2 * n_w, 2 * n_w + n_g, 2 * n_w + 2 * n_g])
-            mu = ca.SX.sym(f"mu_{player.name}")
             sizes = {
                 "lam": int(player.equal.sum()),
                 "y_l": int(player.g_lower.sum()),
@@ -298,9 +302,9 @@ class JointSystem:
                 offset += sizes[key]
                 variables.append(sym[key])
             self.blocks.append(block)
-            parameters += [numeric, bounds, mu]
+            parameters += [numeric, bounds]
         self.n_z = offset
-        z, p = ca.vertcat(*variables), ca.vertcat(*parameters)
+        z, p = ca.vertcat(*variables), ca.vertcat(*parameters, mu)
         F = ca.vertcat(*residuals)
         self.n_inequalities = sum(
             int(pl.lower.sum() + pl.upper.sum() + pl.g_lower.sum() + pl.g_upper.sum()) for pl in self.players
@@ -326,7 +330,6 @@ class JointSystem:
         }
         options = {"ipopt": ipopt, "print_time": False, "calc_lam_p": False, "calc_lam_x": False}
         self.solver = ca.nlpsol("joint", "ipopt", {"x": z, "p": p, "f": 0, "g": F}, options)
-        self.n_f = F.numel()
 
     def _start(
         self, strategies: dict[str, np.ndarray], responses: dict[str, Any], numbers: list[_Numbers], mu: float
@@ -382,8 +385,8 @@ class JointSystem:
         parts = []
         for num in numbers:
             bounds = np.concatenate([num.lbx, num.ubx, num.lbg, num.ubg])
-            parts += [num.p, np.where(np.isfinite(bounds), bounds, 0.0), [mu]]
-        return np.concatenate(parts)
+            parts += [num.p, np.where(np.isfinite(bounds), bounds, 0.0)]
+        return np.concatenate([*parts, [mu]])
 
     def _structure_holds(self, numbers: list[_Numbers]) -> bool:
         return all(
@@ -391,12 +394,16 @@ class JointSystem:
             and np.array_equal(p.lower, np.isfinite(n.lbx) & ~p.fixed)
             and np.array_equal(p.upper, np.isfinite(n.ubx) & ~p.fixed)
             and np.array_equal(p.equal, n.lbg == n.ubg)
+            and np.array_equal(p.g_lower, np.isfinite(n.lbg) & ~p.equal)
+            and np.array_equal(p.g_upper, np.isfinite(n.ubg) & ~p.equal)
             for p, n in zip(self.players, numbers, strict=True)
         )
 
     def solve(self, strategies: dict[str, np.ndarray], responses: dict[str, Any]) -> JointRun:
         """Solve the system from ``strategies`` (each player's controls at the evaluation points)
-        along the barrier path; a run with no strategies when no stage returned a point."""
+        along the barrier path, started from each player's best response to them (``responses``);
+        where a stage fails, the point of the last stage that converged (the start when none did)
+        is returned with the outcome that says so."""
         numbers = [_numbers(p.model, _values(p.responder)) for p in self.players]
         if not self._structure_holds(numbers):
             raise UnsupportedFeature(

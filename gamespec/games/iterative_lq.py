@@ -128,7 +128,7 @@ class DiscreteGame:
             payoff = pl.payoff or p.payoff
             sign = 1.0 if pl.objective == "minimize" else -1.0
             stage.append(h * sign * expression(payoff.lagrange, running, algebra))
-            terminal.append(sign * expression(payoff.mayer, ends, algebra))
+            terminal.append(ca.SX(sign * expression(payoff.mayer, ends, algebra)))
             own = self.slices[self.players.index(name)]
             finite = [
                 side

@@ -31,6 +31,7 @@ from __future__ import annotations
 
 from collections.abc import Mapping
 from dataclasses import dataclass, field
+from typing import TYPE_CHECKING
 
 import numpy as np
 
@@ -43,6 +44,9 @@ from gamespec.result import Result, Status
 from gamespec.solving import Solver, compile_spec, get_backend
 from gamespec.specs.differential_game import INITIAL_PREFIX, NOMINAL_PREFIX, START_TIME, DifferentialGameSpec
 from gamespec.specs.ocp import OptimalControlSpec
+
+if TYPE_CHECKING:
+    from gamespec.games.joint import JointRun
 
 TOLERANCE_RATIO = 1e-2
 """A player's NLP ``tol`` is at most this fraction of ``game.tolerance``: IPOPT's error in a response
@@ -122,7 +126,7 @@ class GameSolution:
     returned point is (:class:`Equilibrium`; else the last responder's Result stands for it)."""
 
     view: str
-    run: BestResponseRun
+    run: BestResponseRun | JointRun
     results: dict[str, Result]
     last_player: str
     equilibrium: Equilibrium | None = None

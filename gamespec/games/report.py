@@ -11,7 +11,7 @@ from gamespec.result import Result
 Rows = list[tuple[str, object]]
 
 
-SCHEMES = {"gauss_seidel": "Gauss–Seidel", "jacobi": "Jacobi"}
+SCHEMES = {"gauss_seidel": "Gauss–Seidel", "jacobi": "Jacobi", "joint": "joint Newton"}
 
 
 def _equilibrium(view: str, run: dict, several: bool) -> tuple[str, object]:
@@ -58,7 +58,12 @@ def game_summary(result: Result) -> Rows:
             else "objective (first player's payoff)"
         )
         return [
-            ("equilibrium", "feedback laws, coupled Riccati equations"),
+            (
+                "equilibrium",
+                "feedback laws, iterative LQ games"
+                if m.get("method") == "iterative_lq"
+                else "feedback laws, coupled Riccati equations",
+            ),
             (label, result.objective),
             *_solution(m),
         ]

@@ -17,11 +17,12 @@ Validation at load evaluates every entry through the symbolic layer only (SymPy 
 :class:`FlowGameValues`; the numerics build their objects from those values
 (:func:`gamespec.flowfield.problem.evaluate`).
 
-The chapter's two stages are kinds of their own, which the staged transform
+The chapter's two stages have specs of their own, which the staged transform
 :mod:`gamespec.transforms.flow_game` writes: ``flow_reachability`` (:class:`FlowReachabilitySpec`,
-section 5.2: the game without its diffusion, solved for ``T̂``, ``x_f`` and the nominal paths) and
-``flow_covariance_game`` (:class:`FlowCovarianceGameSpec`, section 5.3: the chance-constrained
-covariance game about those nominal paths).
+section 5.2: the game without its diffusion, solved for ``T̂``, ``x_f`` and the nominal paths; the
+solving layer's upstream stage, not a kind of file) and the kind ``flow_covariance_game``
+(:class:`FlowCovarianceGameSpec`, section 5.3: the chance-constrained covariance game about those
+nominal paths, what ``gamespec show --transformed`` prints and a file may hold).
 """
 
 from __future__ import annotations
@@ -269,7 +270,8 @@ class FlowReachabilitySpec(FlowGameSpec):
     diffusion removed ("we ignore the disturbance term", the flow is the drift alone) and no Monte
     Carlo; a reachability backend (``levelset``, ``extremals``, ``hj_reachability``) solves it for
     ``T̂``, ``x_f`` (Theorem 6) and the nominal paths (eqs. 5.23–5.26). Written by
-    :func:`gamespec.flowfield.stages.reachability_spec`; the game's fields it keeps are unused."""
+    :func:`gamespec.flowfield.stages.reachability_spec` for the solving layer (not registered as a
+    kind of file); the game's fields it keeps are unused."""
 
     kind: Literal["flow_reachability"] = "flow_reachability"  # type: ignore[assignment]
 

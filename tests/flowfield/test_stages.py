@@ -12,7 +12,7 @@ import pytest
 import yaml
 from gamespec_levelset import reachability
 
-from gamespec.loader import spec_from_dict
+from gamespec.loader import load, spec_from_dict
 from gamespec.solving import compile_spec, solve
 from gamespec.specs.flow_game import FlowCovarianceGameSpec
 from tests.flowfield.test_flow_game import SPEC, T_EXACT
@@ -48,7 +48,8 @@ def test_show_transformed_prints_the_covariance_game(tmp_path, cli) -> None:
     """The backend receives the covariance game of section 5.3: the file's flow, players and
     parameters, ``N = round(T̂ / step)`` (eq. 5.7) and the nominal paths (eqs. 5.23–5.26) from
     ``x₀`` to the capture point ``x_f``, in a uniform flow the closed form of Theorem 6, within a
-    cell."""
+    cell. The printed game, read back as a file, is what the backend solves: the same answers to
+    the last bit as the chain's."""
     path = tmp_path / "uniform.yaml"
     path.write_text(yaml.safe_dump(_spec()))
     code, out, err = cli("show", path, "--transformed")
@@ -67,6 +68,14 @@ def test_show_transformed_prints_the_covariance_game(tmp_path, cli) -> None:
         x = np.array(getattr(p.nominal, player).positions)
         assert np.linalg.norm(x[0] - start) < dx
         assert np.linalg.norm(x[-1] - x_f) < dx
+    game_file = tmp_path / "game.yaml"
+    game_file.write_text(out)
+    printed = solve(load(game_file))
+    chained = solve(spec_from_dict(_spec()))
+    assert printed.kind == "flow_covariance_game" and chained.kind == "flow_field_game"
+    assert printed.status == chained.status and printed.objective == chained.objective
+    for key in ("capture_probability_open_loop", "capture_probability_closed_loop", "lower_value"):
+        assert printed.metrics[key] == chained.metrics[key]
 
 
 def test_a_new_noise_re_solves_the_game_without_the_level_sets(counted) -> None:

@@ -8,9 +8,9 @@ nominal paths backward along ∇φ (eqs. 5.23–5.26); ``extremals`` shoots the 
 ``metrics.capture_time``), ``x_f``, the nominal paths (arrays ``nominal_time``,
 ``nominal_positions``, ``nominal_directions``), the closure errors, the other method's ``T̂`` as a
 cross-check and, for the NumPy level sets, the grid-error estimate with its check. The model keeps
-its last reachability for the values that determine it
+its last Result for the values that determine it
 (:func:`gamespec.flowfield.stages.reachability_key`), so a re-solve with new values of parameters
-that enter only the game (α) does not recompute it.
+that enter only the game (α) recomputes nothing, the cross-check included.
 """
 
 from __future__ import annotations
@@ -137,18 +137,13 @@ REACHABILITY = {
 
 class ReachabilityModel(CompiledModel):
     """Stage 1 for one ``flow_reachability`` spec by ``method`` (a key of :data:`REACHABILITY`);
-    ``cross_check`` also runs the other method and reports the difference of ``T̂``."""
+    ``cross_check`` also runs the other method and reports the difference of ``T̂``. The last
+    Result is kept for its :func:`~gamespec.flowfield.stages.reachability_key` and returned again
+    (with the new parameter values) while the key stays the same."""
 
     def __init__(self, spec: FlowReachabilitySpec, method: str, cross_check: bool) -> None:
         self.spec, self.method, self.cross_check = spec, method, cross_check
-        self._reach: tuple[tuple, Reachability] | None = None
-
-    def reachability(self, data: FlowGameData) -> Reachability:
-        """The reachability for ``data``, computed only when its key differs from the last one's."""
-        key = reachability_key(data)
-        if self._reach is None or self._reach[0] != key:
-            self._reach = key, REACHABILITY[self.method](self.spec, data)
-        return self._reach[1]
+        self._solved: tuple[tuple, Result] | None = None
 
     def _cross_check(self, data: FlowGameData, reach: Reachability) -> dict[str, float | None]:
         if not self.cross_check:
@@ -172,15 +167,22 @@ class ReachabilityModel(CompiledModel):
         start = time.perf_counter()
         values = {**self.spec.problem.parameters, **(parameters or {})}
         data = evaluate(self.spec, values)
-        reach = self.reachability(data)
+        key = reachability_key(data)
+        if self._solved is None or self._solved[0] != key:
+            self._solved = key, self._reached(data)
+        return self._solved[1].model_copy(
+            update={"parameters": values, "solve_time_s": time.perf_counter() - start}
+        )
+
+    def _reached(self, data: FlowGameData) -> Result:
+        """Stage 1's Result for ``data``: the reachability, the nominal paths and the checks."""
+        reach = REACHABILITY[self.method](self.spec, data)
         if reach.capture_time is None:
             return Result(
                 status=Status.INFEASIBLE,
                 message=reach.message,
-                parameters=values,
                 arrays=reach.arrays,
                 metrics={"reachability": reach.metrics},
-                solve_time_s=time.perf_counter() - start,
             )
         graded: dict[str, tuple[float | None, float]] = {}
         metrics: dict[str, Any] = {
@@ -205,7 +207,6 @@ class ReachabilityModel(CompiledModel):
             status=Status.OPTIMAL,
             objective=reach.capture_time,
             t_final=reach.capture_time,
-            parameters=values,
             arrays={
                 **reach.arrays,
                 "nominal_time": paths.times,
@@ -214,5 +215,4 @@ class ReachabilityModel(CompiledModel):
             },
             metrics=metrics,
             checks=checks,
-            solve_time_s=time.perf_counter() - start,
         )

@@ -30,17 +30,23 @@ def _spec(**problem: object) -> dict:
     return data
 
 
-@pytest.fixture
-def counted(monkeypatch) -> list[int]:
-    """Counts the level-set reachability solves of the ``levelset`` backend."""
-    calls = [0]
-    solve_once = reachability.REACHABILITY["levelset"]
-
+def _counting(calls: list[int], index: int, solve_once):
     def counting(*args, **kwargs):
-        calls[0] += 1
+        calls[index] += 1
         return solve_once(*args, **kwargs)
 
-    monkeypatch.setitem(reachability.REACHABILITY, "levelset", counting)
+    return counting
+
+
+@pytest.fixture
+def counted(monkeypatch) -> list[int]:
+    """Counts the level-set reachability solves of the ``levelset`` backend and its extremal
+    cross-checks."""
+    calls = [0, 0]
+    monkeypatch.setitem(
+        reachability.REACHABILITY, "levelset", _counting(calls, 0, reachability.REACHABILITY["levelset"])
+    )
+    monkeypatch.setattr(reachability, "_extremal_reach", _counting(calls, 1, reachability._extremal_reach))
     return calls
 
 
@@ -81,14 +87,19 @@ def test_show_transformed_prints_the_covariance_game(tmp_path, cli) -> None:
 def test_a_new_noise_re_solves_the_game_without_the_level_sets(counted) -> None:
     """The noise enters the game only: the compiled chain keeps the reachability stage's Result
     (``Step.upstream``) and re-solves the game for each new value; each re-solve equals a fresh
-    compile at that value (which solves the level sets again)."""
-    solver = compile_spec(spec_from_dict(_spec()))
-    assert counted[0] == 1
+    compile at that value (which solves the level sets and the extremal cross-check again)."""
+    data = _spec()
+    data["solver"] = {"options": {"levelset": {"cross_check": True}}}
+    data["method"]["extremals"] = {"directions": 64, "step": 0.01}
+    solver = compile_spec(spec_from_dict(data))
+    assert counted == [1, 1]
     first = solver.solve()
     again = solver.solve(parameters={"noise": 0.1})
-    assert counted[0] == 1, "the re-solve recomputed the level sets"
-    fresh = solve(spec_from_dict(_spec(parameters={"noise": 0.1})))
-    assert counted[0] == 2
+    assert counted == [1, 1], "the re-solve recomputed the reachability"
+    data["problem"]["parameters"]["noise"] = 0.1
+    fresh = solve(spec_from_dict(data))
+    assert counted == [2, 2]
+    assert again.checks["capture_time_difference"] == fresh.checks["capture_time_difference"]
     assert again.status == fresh.status and again.ok
     assert again.objective == pytest.approx(fresh.objective, rel=1e-9)
     assert again.objective > first.objective  # more noise, more relative spread
@@ -114,7 +125,7 @@ def test_parameter_map_reuses_the_stage_only_when_it_cannot_change(counted) -> N
     windier = copy.deepcopy(data)
     windier["problem"]["parameters"]["wind"] = 0.5
     assert step.transform.parameter_map(spec_from_dict(windier), step.inverse) is None
-    assert counted[0] == 1
+    assert counted == [1, 0]
 
 
 def test_no_capture_is_an_infeasible_result() -> None:

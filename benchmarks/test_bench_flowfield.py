@@ -155,12 +155,16 @@ def test_hj_reachability_hugo(benchmark, n: int) -> None:
 
 def _linear_game(feedforward: str):
     """The linear-flow file's covariance game and its Gauss–Seidel players."""
-    from gamespec_levelset.backend import FlowGameModel, FlowGameOptions, game_players, linearized_game
+    from gamespec_levelset.game import game_players, linearized_game
+    from gamespec_levelset.options import FlowGameOptions
 
-    spec = gamespec.load(LINEAR, [f"problem.feedforward={feedforward}", "method.game.scheme=gauss_seidel"])
+    from gamespec.flowfield.problem import evaluate_game
+    from gamespec.solving import transformed
+
+    settings = [f"problem.feedforward={feedforward}", "method.game.scheme=gauss_seidel"]
+    spec = transformed(gamespec.load(LINEAR, [*settings, "solver.options.levelset.cross_check=false"]))
     options = FlowGameOptions(cross_check=False)
-    data = evaluate(spec)
-    game = linearized_game(data, FlowGameModel(spec, options, "levelset").reachability(data)).game
+    game = linearized_game(evaluate_game(spec)).game
     return game, game_players(spec, options, game)
 
 

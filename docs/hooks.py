@@ -82,6 +82,22 @@ def _example_file(kind: str) -> Path | None:
     return min(files, key=lambda p: p.stat().st_size, default=None)
 
 
+def _written_example(kind: str) -> list[str]:
+    """For a kind no shipped file has but a lowering transform writes: the command that prints it
+    from the smallest shipped file of the transform's source kind."""
+    for name in registry.names("gamespec.transforms"):
+        cls = registry.load("gamespec.transforms", name)
+        source = _example_file(cls.source_kind) if cls.target_kind == kind and not cls.requested else None
+        if source is not None:
+            relative = source.relative_to(ROOT)
+            return [
+                "## Worked example\n",
+                f"What the transform `{name}` writes from `{relative}` (and the backend receives):\n",
+                f"```bash\ngamespec show --transformed {relative}\n```\n",
+            ]
+    return []
+
+
 def kind_page(kind: str) -> str:
     """The page of one problem kind."""
     cls = registry.spec_class(kind)
@@ -97,6 +113,8 @@ def kind_page(kind: str) -> str:
             f"```yaml\n{example.read_text().rstrip()}\n```\n",
             f"```bash\ngamespec solve {relative} --out runs/{example.stem} --plot\n```\n",
         ]
+    else:
+        text += _written_example(kind)
     text += [
         "## File format\n",
         f"Generated from the JSON Schema (`gamespec schema {kind}`).\n",

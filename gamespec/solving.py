@@ -82,17 +82,26 @@ class Step:
 
 
 def _applied(
-    transform: Transform, options: StrictModel, spec: SpecBase, upstream: Solver | None = None
+    transform: Transform,
+    options: StrictModel,
+    spec: SpecBase,
+    upstream: Solver | None = None,
+    chosen: tuple[Backend, dict[str, Any] | None] | None = None,
 ) -> Step:
     """Apply one transform to ``spec`` (solving its upstream stage on ``upstream``, or compiling
-    that stage first when ``upstream`` is None and the transform is staged)."""
+    that stage first when ``upstream`` is None and the transform is staged: on the stage's backend,
+    else on the ``chosen`` backend (with its options) when that one solves the stage's kind, else
+    on the stage kind's default)."""
     if not transform.accepts(spec):
         raise UnsupportedFeature(f"transform {transform.name!r} does not accept problem {spec.name!r}")
     stage = transform.stage(spec, options)
     stage_result = None
     if stage is not None:
         if upstream is None:
-            upstream = compile_spec(stage.spec, stage.backend)
+            backend, backend_options = stage.backend, None
+            if backend is None and chosen is not None and stage.spec.kind in chosen[0].kinds:
+                backend, backend_options = chosen[0].name, chosen[1]
+            upstream = compile_spec(stage.spec, backend, backend_options)
             stage_result = upstream.solve()
         else:
             stage_result = upstream.solve_spec(stage.spec)
@@ -101,13 +110,18 @@ def _applied(
 
 
 def _from_file(
-    transform: Transform, options: StrictModel, spec: SpecBase, source: str, field: str = ""
+    transform: Transform,
+    options: StrictModel,
+    spec: SpecBase,
+    source: str,
+    field: str = "",
+    chosen: tuple[Backend, dict[str, Any] | None] | None = None,
 ) -> Step:
     """:func:`_applied` on a spec read from ``source``: what the transform cannot build from the file
     (an expression it generates that is undefined or out of range, a spec it generates that is
     invalid) is a SpecError naming the file and ``field`` (``transforms.<i>`` for a requested one)."""
     try:
-        return _applied(transform, options, spec)
+        return _applied(transform, options, spec, chosen=chosen)
     except ExpressionError as err:
         raise SpecError(f"{transform.name}: {err}", field=field, source=source) from None
     except SpecError as err:
@@ -123,19 +137,23 @@ def _unrequested(spec: SpecBase) -> SpecBase:
     return spec.model_copy(update={"transforms": []}) if spec.transforms else spec
 
 
-def build_steps(spec: SpecBase, backend: Backend) -> list[Step]:
+def build_steps(
+    spec: SpecBase, backend: Backend, backend_options: dict[str, Any] | None = None
+) -> list[Step]:
     """The requested transforms of ``spec`` in order, then the lowering ones to a kind ``backend``
-    solves."""
+    solves (a staged one's upstream stage on ``backend`` with ``backend_options`` where it solves
+    that stage's kind)."""
+    chosen = (backend, backend_options)
     steps: list[Step] = []
     current = _unrequested(spec)
     for index, (transform, options) in enumerate(requested_steps(spec)):
-        steps.append(_from_file(transform, options, current, spec.source, f"transforms.{index}"))
+        steps.append(_from_file(transform, options, current, spec.source, f"transforms.{index}", chosen))
         current = steps[-1].target
     lowering = lowering_path(current, backend.kinds)
     if lowering is None:
         raise UnsupportedFeature(f"backend {backend.name!r} does not solve kind {spec.kind!r}")
     for transform in lowering:
-        steps.append(_from_file(transform, transform.options_model(), current, spec.source))
+        steps.append(_from_file(transform, transform.options_model(), current, spec.source, chosen=chosen))
         current = steps[-1].target
     return steps
 
@@ -331,7 +349,7 @@ def compile_spec(
     name = backend_name(spec, backend)
     instance = get_backend(name)
     start = time.perf_counter()
-    steps = build_steps(spec, instance)
+    steps = build_steps(spec, instance, options)
     target = steps[-1].target if steps else spec
     compiled = instance.compile(target, instance.options(target, options))
     build = time.perf_counter() - start

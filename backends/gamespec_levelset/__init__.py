@@ -1,2 +1,4 @@
-"""Backends of the ``flow_field_game`` kind: reachability by level sets (``levelset``) or by extremal
-shooting (``extremals``), then the chapter-5 covariance game on CVXPY."""
+"""Backends of chapter 5's two stages (a ``flow_field_game`` reaches them through the staged
+transform :mod:`gamespec.transforms.flow_game`): the reachability by level sets (``levelset``,
+``hj_reachability``) or by extremal shooting (``extremals``) in :mod:`.reachability`, then the
+covariance game on CVXPY in :mod:`.game`."""

@@ -5,5 +5,6 @@ The flow field (:mod:`.field`), forward reachability by level sets on a grid (:m
 :mod:`.levelset`, :mod:`.capture`) and by extremal shooting (:mod:`.extremals`), the nominal
 trajectories (:mod:`.nominal`), their linearization and zero-order hold (:mod:`.linearize`), the
 covariance game (:mod:`.covariance_game`), the capture probability (:mod:`.capture_probability`)
-and the Monte Carlo of the SDE (:mod:`.simulation`). No solver is imported here.
+and the Monte Carlo of the SDE (:mod:`.simulation`); the two stages' specs and the Result that joins
+them (:mod:`.stages`). No solver is imported here.
 """

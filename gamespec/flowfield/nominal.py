@@ -23,13 +23,14 @@ from gamespec.flowfield.levelset import LevelSetReach
 @dataclass(frozen=True)
 class NominalPaths:
     """Both agents' nominal paths: ``times`` (fine, ascending from 0 to T̂), ``positions`` and unit
-    ``directions`` (2, len(times), 2), the speeds v̂ and the closure errors (2,)."""
+    ``directions`` (2, len(times), 2), the speeds v̂ and the closure errors (2,) (None for paths
+    read back from a covariance game's spec, which the reachability stage checked)."""
 
     times: np.ndarray
     positions: np.ndarray
     directions: np.ndarray
     speeds: np.ndarray
-    closure_error: np.ndarray
+    closure_error: np.ndarray | None = None
 
     @property
     def final_time(self) -> float:

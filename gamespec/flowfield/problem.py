@@ -1,4 +1,5 @@
-"""A flow-field pursuit-evasion game with every value evaluated: what the numerics take."""
+"""A flow-field pursuit-evasion game, and the covariance game about its nominal paths, with every
+value evaluated: what the numerics take."""
 
 from __future__ import annotations
 
@@ -10,7 +11,8 @@ import numpy as np
 from gamespec.flowfield.covariance_game import Feedforward, Payoff, PlayerBounds
 from gamespec.flowfield.field import FlowField
 from gamespec.flowfield.grid import Grid
-from gamespec.specs.flow_game import FlowGameSpec
+from gamespec.flowfield.nominal import NominalPaths
+from gamespec.specs.flow_game import FlowCovarianceGameSpec, FlowGameSpec, PlayerValues
 
 
 @dataclass(frozen=True)
@@ -41,11 +43,58 @@ def evaluate(spec: FlowGameSpec, parameters: Mapping[str, float] | None = None) 
     return FlowGameData(
         field=FlowField(v.position, v.drift, v.diffusion),
         origins=np.array([p.initial for p in v.players], dtype=float),
-        bounds=tuple(PlayerBounds(p.max_speed, p.delta_x, p.delta_u, p.beta) for p in v.players),
+        bounds=_bounds(v.players),
         speed_fraction=v.speed_fraction,
         capture_radius=v.capture_radius,
         step=v.step,
         payoff=v.payoff,
         feedforward=v.feedforward,
         grid=Grid(v.grid_lower, v.grid_upper, v.grid_nodes),
+    )
+
+
+def _bounds(players: tuple[PlayerValues, PlayerValues]) -> tuple[PlayerBounds, PlayerBounds]:
+    return tuple(PlayerBounds(p.max_speed, p.delta_x, p.delta_u, p.beta) for p in players)
+
+
+@dataclass(frozen=True)
+class CovarianceGameData:
+    """Section 5.3's game: the flow field, the starts ``origins`` (2, 2), the bounds, ε, the payoff,
+    the feedforward rule, and the nominal paths with the number of steps ``N`` (None: no capture)."""
+
+    field: FlowField
+    origins: np.ndarray
+    bounds: tuple[PlayerBounds, PlayerBounds]
+    capture_radius: float
+    payoff: Payoff
+    feedforward: Feedforward
+    paths: NominalPaths | None
+    steps: int | None
+
+
+def evaluate_game(
+    spec: FlowCovarianceGameSpec, parameters: Mapping[str, float] | None = None
+) -> CovarianceGameData:
+    """The numerics' objects for the covariance game ``spec`` at its parameter values updated by
+    ``parameters``; the nominal paths as the reachability stage wrote them."""
+    v = spec.values(parameters)
+    p = spec.problem
+    paths = None
+    if p.nominal is not None:
+        n = p.nominal
+        paths = NominalPaths(
+            times=np.array(n.times, dtype=float),
+            positions=np.array([n.pursuer.positions, n.evader.positions], dtype=float),
+            directions=np.array([n.pursuer.directions, n.evader.directions], dtype=float),
+            speeds=np.array(n.speeds, dtype=float),
+        )
+    return CovarianceGameData(
+        field=FlowField(v.position, v.drift, v.diffusion),
+        origins=np.array([q.initial for q in v.players], dtype=float),
+        bounds=_bounds(v.players),
+        capture_radius=v.capture_radius,
+        payoff=p.payoff,
+        feedforward=p.feedforward,
+        paths=paths,
+        steps=p.steps,
     )

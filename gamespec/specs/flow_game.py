@@ -16,6 +16,13 @@ Validation at load evaluates every entry through the symbolic layer only (SymPy 
 :func:`gamespec.symbolic.calculus.numeric_function` at a probe point) into
 :class:`FlowGameValues`; the numerics build their objects from those values
 (:func:`gamespec.flowfield.problem.evaluate`).
+
+The chapter's two stages have specs of their own, which the staged transform
+:mod:`gamespec.transforms.flow_game` writes: ``flow_reachability`` (:class:`FlowReachabilitySpec`,
+section 5.2: the game without its diffusion, solved for ``T̂``, ``x_f`` and the nominal paths; the
+solving layer's upstream stage, not a kind of file) and the kind ``flow_covariance_game``
+(:class:`FlowCovarianceGameSpec`, section 5.3: the chance-constrained covariance game about those
+nominal paths, what ``gamespec show --transformed`` prints and a file may hold).
 """
 
 from __future__ import annotations
@@ -258,6 +265,124 @@ class FlowGameSpec(ProblemParameters, SpecBase):
         return _Evaluator(self, {**self.problem.parameters, **(parameters or {})}).values()
 
 
+class FlowReachabilitySpec(FlowGameSpec):
+    """The reachability stage of a ``flow_field_game`` (section 5.2): the same file with its
+    diffusion removed ("we ignore the disturbance term", the flow is the drift alone) and no Monte
+    Carlo; a reachability backend (``levelset``, ``extremals``, ``hj_reachability``) solves it for
+    ``T̂``, ``x_f`` (Theorem 6) and the nominal paths (eqs. 5.23–5.26). Written by
+    :func:`gamespec.flowfield.stages.reachability_spec` for the solving layer (not registered as a
+    kind of file); the game's fields it keeps are unused."""
+
+    kind: Literal["flow_reachability"] = "flow_reachability"  # type: ignore[assignment]
+
+
+class NominalPath(StrictModel):
+    """One agent's nominal path (eqs. 5.23–5.26) at the nodes ``nominal.times``: the positions
+    ``x̂`` and the unit directions ``n`` of the nominal control ``û = v̂ n``."""
+
+    positions: list[tuple[FiniteFloat, FiniteFloat]] = Field(min_length=2)
+    directions: list[tuple[FiniteFloat, FiniteFloat]] = Field(min_length=2)
+
+
+class NominalSpec(StrictModel):
+    """Both agents' nominal paths from the reachability stage, ``0 = t_0 < … < t_M = T̂``, and their
+    nominal speeds ``v̂`` (eq. 5.24, 5.26)."""
+
+    times: list[FiniteFloat] = Field(min_length=2)
+    speeds: tuple[PositiveFloat, PositiveFloat]
+    pursuer: NominalPath
+    evader: NominalPath
+
+    @model_validator(mode="after")
+    def _nodes(self) -> NominalSpec:
+        times = np.asarray(self.times)
+        if times[0] != 0 or np.any(np.diff(times) <= 0):
+            raise ValueError("times must increase from 0")
+        for path in (self.pursuer, self.evader):
+            if not len(path.positions) == len(path.directions) == len(times):
+                raise ValueError("each path needs one position and one direction per time")
+        return self
+
+
+class CovarianceGameProblem(StrictModel):
+    """The covariance game of section 5.3 about the nominal paths: the flow and players of the
+    ``flow_field_game`` it came from, the number of steps ``N`` and the nominal paths (both None
+    when the reachability stage found no capture: there is no game to play)."""
+
+    parameters: dict[str, FiniteFloat] = Field(default_factory=dict)
+    position: tuple[str, str] = ("x1", "x2")
+    flow: FlowSpec
+    pursuer: PlayerSpec
+    evader: PlayerSpec
+    capture_radius: Value = Field(description="ε of eq. 5.4.")
+    payoff: Literal["trace", "frobenius"] = "trace"
+    feedforward: Literal["nominal", "free"] = "free"
+    steps: int | None = Field(description="N of eq. 5.7, round(T̂ / step) of the flow_field_game.", ge=1)
+    nominal: NominalSpec | None = Field(description="The paths of eq. 5.5's linearization.")
+
+    @model_validator(mode="after")
+    def _game(self) -> CovarianceGameProblem:
+        if (self.steps is None) != (self.nominal is None):
+            raise ValueError("steps and nominal are given together (or neither: no capture)")
+        return self
+
+
+class CovarianceGameMethod(StrictModel):
+    """The game's solution concept and iteration, the evader's procedure and the Monte Carlo (as in
+    ``flow_field_game``'s ``method``)."""
+
+    game: GameMethod = Field(default_factory=GameMethod)
+    convex_concave: ConvexConcaveMethod = Field(default_factory=ConvexConcaveMethod)
+    monte_carlo: MonteCarloMethod = Field(default_factory=MonteCarloMethod)
+
+
+class FlowCovarianceGameSpec(ProblemParameters, SpecBase):
+    """The chance-constrained covariance game of section 5.3 (eqs. 5.27–5.36) about given nominal
+    paths: the backend linearizes the flow along them (eqs. 5.5–5.8), lifts the model (eq. 5.10)
+    and solves the game; what :mod:`gamespec.transforms.flow_game` makes of a ``flow_field_game``
+    once its reachability stage is solved. Its runtime parameters are the flow game's."""
+
+    kind: Literal["flow_covariance_game"] = "flow_covariance_game"
+    problem: CovarianceGameProblem
+    method: CovarianceGameMethod = Field(default_factory=CovarianceGameMethod)
+
+    default_backend = "levelset"
+
+    @property
+    def objective_sense(self) -> str:
+        """``saddle``, as the ``flow_field_game``'s."""
+        return "saddle"
+
+    @model_validator(mode="after")
+    def _evaluates(self) -> FlowCovarianceGameSpec:
+        self.values()
+        mc = self.method.monte_carlo
+        sampled = mc.samples * mc.substeps * (self.problem.steps or 0)
+        if sampled > MAX_SAMPLE_STEPS:
+            raise SpecError(
+                f"{sampled:.3g} sample steps (samples · substeps · steps) exceed the limit of "
+                f"{MAX_SAMPLE_STEPS:g}",
+                field="method.monte_carlo.samples",
+            )
+        return self
+
+    def values(self, parameters: Mapping[str, float] | None = None) -> CovarianceGameValues:
+        """The evaluated flow, players and capture radius for the file's parameter values updated
+        by ``parameters`` (:func:`gamespec.flowfield.problem.evaluate_game` builds on it)."""
+        unknown = set(parameters or {}) - set(self.problem.parameters)
+        if unknown:
+            raise SpecError(f"unknown parameter(s) {sorted(unknown)}", field="problem.parameters")
+        evaluator = _Evaluator(self, {**self.problem.parameters, **(parameters or {})})
+        drift, diffusion = evaluator.flow()
+        return CovarianceGameValues(
+            position=evaluator.position,
+            drift=drift,
+            diffusion=diffusion,
+            players=(evaluator.player("pursuer"), evaluator.player("evader")),
+            capture_radius=evaluator.number(self.problem.capture_radius, "capture_radius", positive=True),
+        )
+
+
 @dataclass(frozen=True)
 class PlayerValues:
     """One agent's evaluated start, speed limit and bounds (eqs. 5.2, 5.35–5.36)."""
@@ -288,10 +413,21 @@ class FlowGameValues:
     grid_nodes: tuple[int, int]
 
 
+@dataclass(frozen=True)
+class CovarianceGameValues:
+    """A covariance game's flow (SymPy matrices of the ``position`` symbols), players and ε."""
+
+    position: tuple[sp.Symbol, sp.Symbol]
+    drift: sp.Matrix
+    diffusion: sp.Matrix
+    players: tuple[PlayerValues, PlayerValues]
+    capture_radius: float
+
+
 class _Evaluator:
     """Parses every entry and substitutes the parameter values (no eval)."""
 
-    def __init__(self, spec: FlowGameSpec, values: Mapping[str, float]) -> None:
+    def __init__(self, spec: FlowGameSpec | FlowCovarianceGameSpec, values: Mapping[str, float]) -> None:
         self.spec = spec
         self.position = tuple(symbol(n) for n in spec.problem.position)
         self.symbols = {name: symbol(name) for name in values}

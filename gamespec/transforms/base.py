@@ -39,7 +39,8 @@ from gamespec.specs.requested import entry, transform_class, validated_options
 
 @dataclass(frozen=True)
 class Stage:
-    """An upstream solve a staged transform needs: ``spec`` on ``backend`` (None: its default)."""
+    """An upstream solve a staged transform needs: ``spec`` on ``backend`` (None: the caller's
+    backend, with its options, where it solves ``spec``'s kind, else that kind's default)."""
 
     spec: SpecBase
     backend: str | None = None

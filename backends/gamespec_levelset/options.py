@@ -1,0 +1,20 @@
+"""The options block of the ``levelset``, ``extremals`` and ``hj_reachability`` backends, one for
+both of chapter 5's stages (``solver.options.<backend>`` in a file, or ``options=``)."""
+
+from __future__ import annotations
+
+from typing import Any
+
+from pydantic import Field
+
+from gamespec.specs.base import StrictModel
+
+
+class FlowGameOptions(StrictModel):
+    """The conic solver of the players' steps and its keyword arguments (the covariance game);
+    ``cross_check`` also runs the other reachability method and reports the difference of ``T̂``
+    (the reachability stage)."""
+
+    solver: str = "CLARABEL"
+    solver_options: dict[str, Any] = Field(default_factory=dict)
+    cross_check: bool = True

@@ -222,8 +222,8 @@ def test_animations_show_time_legend_labels_and_growing_paths(name, tmp_path, mo
 
     monkeypatch.setattr(PillowWriter, "grab_frame", grab)
     monkeypatch.setitem(matplotlib.rcParams, "savefig.dpi", 20)
-    monkeypatch.setattr(engagement_plots, "FRAMES", 15)
-    monkeypatch.setattr(scenario_plots, "_FRAMES", 15)
+    monkeypatch.setattr(engagement_plots, "FRAMES", 12)
+    monkeypatch.setattr(scenario_plots, "_FRAMES", 12)
     plot_result(fixtures.saved(PROBLEMS / name), tmp_path, animate=True)
     assert len(frames) > 10
     assert all("t = " in title and legend and xlabel for title, legend, xlabel, _ in frames)

@@ -18,6 +18,7 @@ import time
 from pathlib import Path
 
 import gamespec
+from gamespec.errors import GamespecError
 from gamespec.loader import spec_hash
 
 ROOT = Path(__file__).resolve().parents[2]
@@ -66,12 +67,17 @@ def spec_of(path: Path):
 
 def saved(path: Path) -> gamespec.Result:
     """The saved Result of ``path``; :class:`StaleFixture`, with the command that regenerates it,
-    when it is missing or its provenance spec hash is not the file's under :func:`overrides`."""
+    when it is missing, no longer reads as a Result (a kind's metrics schema changed), or its
+    provenance spec hash is not the file's under :func:`overrides`."""
     folder = FIXTURES / path.stem
     regenerate = f"regenerate it: python -m tests.plots.fixtures {path.stem}"
     if not (folder / "result.json").is_file():
         raise StaleFixture(f"{folder.relative_to(ROOT)} is missing; {regenerate}")
-    result = gamespec.Result.load(folder)
+    try:
+        result = gamespec.Result.load(folder)
+    except GamespecError as error:
+        unreadable = f"{folder.relative_to(ROOT)} no longer reads as a Result ({error})"
+        raise StaleFixture(f"{unreadable}; {regenerate}") from None
     expected = spec_hash(spec_of(path))
     if result.provenance.spec_hash != expected:
         raise StaleFixture(

@@ -1,6 +1,6 @@
 """One regression case per class of bad input found by the mutation fuzz of issue 15: each returns
 exit 2 with one line naming the file (or ``--set``), the field or line, and the reason (or, for a
-failed solve, exit 1 with its status), within a second once gamespec is imported."""
+failed solve, exit 1 with its status), within a second of CPU time once gamespec is imported."""
 
 from __future__ import annotations
 
@@ -32,7 +32,8 @@ def _imported() -> None:
 
 
 def _refused(args: list[object], *needles: str, source: str | None = None) -> Outcome:
-    """Exit 2, one line from the file (or ``source``) holding every needle, within a second."""
+    """Exit 2, one line from the file (or ``source``) holding every needle, within a second of CPU
+    time."""
     outcome = run_cli([str(a) for a in args], bound_s=10 * ONE_SECOND)
     target = source or str(args[1])
     assert_promise(outcome, target)

@@ -129,7 +129,13 @@ def test_solve_json_save_load_and_plot(cli, tmp_path: Path) -> None:
     assert (tmp_path / "run" / "snapshots.png").stat().st_size > 0
 
 
-def test_animation_writes_a_gif(tmp_path: Path) -> None:
+def test_animation_writes_a_gif(tmp_path: Path, monkeypatch) -> None:
+    """A GIF of few frames at a low resolution (what an animation shows: tests/plots)."""
+    import gamespec_geometric.plot as scenario_plots
+    import matplotlib
+
+    monkeypatch.setattr(scenario_plots, "_FRAMES", 8)
+    monkeypatch.setitem(matplotlib.rcParams, "savefig.dpi", 20)
     data = _scenario(3, 3, 1, heterogeneous=False)
     data["horizon"] = capture_time_bound(data) + 1.0
     result = gamespec.solve(spec_from_dict(data))

@@ -1,6 +1,7 @@
-"""Every shipped problem's figures, drawn from a solve with fast settings and checked for what they
-show (titles with problem, backend, status and the headline number; axis labels; legends outside
-the axes; the artists each kind must draw), not for their pixels."""
+"""Every shipped problem's figures, drawn from its saved Result (:mod:`tests.plots.fixtures`: a
+solve with fast settings, saved once) and checked for what they show (titles with problem, backend,
+status and the headline number; axis labels; legends outside the axes; the artists each kind must
+draw), not for their pixels."""
 
 from __future__ import annotations
 
@@ -13,30 +14,19 @@ from matplotlib.patches import Circle
 import gamespec
 from gamespec.plotting import plot_result
 from tests.conftest import PROBLEMS
+from tests.plots import fixtures
 from tests.plots.recording import legend_texts, recording, titles
 
-FAST = {
-    "pursuit_scenario": ["time_step=0.05"],
-    "lq_stochastic_game": ["method.monte_carlo.samples=20"],
-    "flow_field_game": ["method.monte_carlo.samples=500"],
-}
-FAST_FILES = {
-    "car_vs_train": ["method.refine=null", "transforms.1.rcs.monte_carlo.samples=100"],
-}
-"""Settings that keep a figure test's solve short (the figures show what was solved, at any mesh)."""
-SLOW_FILES = {"hurricane_hugo", "asymmetric_obstacle"}
-"""Files whose solve takes seconds of CPU whatever the settings: their kind's figures are checked
-in the default suite on another file (``linear_flow``; the receding-horizon figures and GIF in
-``tests/games/test_plotting.py``), theirs with ``-m slow``."""
-FILES = [
-    pytest.param(p, marks=pytest.mark.slow) if p.stem in SLOW_FILES else p
-    for p in sorted(p for p in PROBLEMS.rglob("*.yaml") if "study" not in p.stem)
-]
 
-
-def _solve(path: Path) -> gamespec.Result:
-    spec = gamespec.load(path)
-    return gamespec.solve(gamespec.load(path, FAST.get(spec.kind, []) + FAST_FILES.get(path.stem, [])))
+@pytest.mark.parametrize("path", fixtures.FILES, ids=lambda p: p.stem)
+def test_each_fixture_is_its_problem_file_solved(path: Path) -> None:
+    """The saved Result is of the file as shipped under the fixture's settings (its provenance spec
+    hash, :func:`tests.plots.fixtures.saved`: a stale one fails with the command that regenerates
+    it), of the file's problem and kind."""
+    result = fixtures.saved(path)
+    spec = fixtures.spec_of(path)
+    assert (result.problem, result.kind) == (spec.name, spec.kind)
+    assert result.provenance.source == str(path.relative_to(fixtures.ROOT))
 
 
 def _check_common(result: gamespec.Result, saved) -> None:
@@ -51,9 +41,9 @@ def _check_common(result: gamespec.Result, saved) -> None:
             assert outside, figure.name
 
 
-@pytest.mark.parametrize("path", FILES, ids=lambda p: p.stem)
+@pytest.mark.parametrize("path", fixtures.FILES, ids=lambda p: p.stem)
 def test_shipped_problem_figures(path: Path, tmp_path: Path) -> None:
-    result = _solve(path)
+    result = fixtures.saved(path)
     with recording() as saved:
         written = plot_result(result, tmp_path)
     assert [s.name for s in saved] == [p.name for p in written]
@@ -213,11 +203,8 @@ def test_a_planar_pair_must_name_states(cli, tmp_path: Path) -> None:
     assert code == 2 and "plot.planar.0" in err and "xE" in err and len(err.strip().splitlines()) == 1
 
 
-@pytest.mark.parametrize(
-    ("name", "overrides"),
-    [("ch2/pure_pursuit_two_on_one.yaml", []), ("ch3/mpse_five_on_one_cb.yaml", ["time_step=0.05"])],
-)
-def test_animations_show_time_legend_labels_and_growing_paths(name, overrides, tmp_path, monkeypatch) -> None:
+@pytest.mark.parametrize("name", ["ch2/pure_pursuit_two_on_one.yaml", "ch3/mpse_five_on_one_cb.yaml"])
+def test_animations_show_time_legend_labels_and_growing_paths(name, tmp_path, monkeypatch) -> None:
     import gamespec_geometric.plot as scenario_plots
     import matplotlib
     from matplotlib.animation import PillowWriter
@@ -235,10 +222,9 @@ def test_animations_show_time_legend_labels_and_growing_paths(name, overrides, t
 
     monkeypatch.setattr(PillowWriter, "grab_frame", grab)
     monkeypatch.setitem(matplotlib.rcParams, "savefig.dpi", 20)
-    monkeypatch.setattr(engagement_plots, "FRAMES", 15)
-    monkeypatch.setattr(scenario_plots, "_FRAMES", 15)
-    result = gamespec.solve(gamespec.load(PROBLEMS / name, overrides))
-    plot_result(result, tmp_path, animate=True)
+    monkeypatch.setattr(engagement_plots, "FRAMES", 12)
+    monkeypatch.setattr(scenario_plots, "_FRAMES", 12)
+    plot_result(fixtures.saved(PROBLEMS / name), tmp_path, animate=True)
     assert len(frames) > 10
     assert all("t = " in title and legend and xlabel for title, legend, xlabel, _ in frames)
     lengths = [n for *_, n in frames]

@@ -2,9 +2,11 @@
 
 from __future__ import annotations
 
+import matplotlib
 import pytest
 
 import gamespec
+from gamespec.pursuit import plotting as engagement_plots
 from tests.conftest import PROBLEMS
 
 
@@ -16,7 +18,12 @@ from tests.conftest import PROBLEMS
         ("ch3/mpse_optimal_evasion_cb.yaml", "analytic", {"paths.png", "distances.png"}),
     ],
 )
-def test_plot_from_a_saved_result(cli, tmp_path, name: str, backend: str | None, expected: set[str]) -> None:
+def test_plot_from_a_saved_result(
+    cli, tmp_path, monkeypatch, name: str, backend: str | None, expected: set[str]
+) -> None:
+    """The files; an animation of few frames at a low resolution (what one shows: tests/plots)."""
+    monkeypatch.setattr(engagement_plots, "FRAMES", 8)
+    monkeypatch.setitem(matplotlib.rcParams, "savefig.dpi", 20)
     result = gamespec.solve(PROBLEMS / name, backend)
     result.save(tmp_path / "run")
     args = ["plot", tmp_path / "run", "--out", tmp_path / "figs"]

@@ -129,24 +129,65 @@ def test_collision_probability_matches_the_normal_cdf():
     assert abs(p - exact) < 4 * np.sqrt(exact * (1 - exact) / n)
     ci = result.metrics["monte_carlo"]["collision_probability_ci"]
     assert ci[0] < p < ci[1]
+    assert collision_probability_along(result, std) == pytest.approx(exact, abs=1e-3)
+
+
+def collision_probability_along(result, std: float) -> float:
+    """P(min_t D(t; ρ) < r_o) for ρ ~ N(ρ̂, std²), by quadrature over ρ along the returned path (the
+    agent's dynamics do not hold ρ, so its path is the same for every ρ), D the distance to the
+    obstacle at (c, ρt - d) of the ch6 RCS files."""
+    p = result.parameters
+    t = np.linspace(result.time[0], result.time[-1], 2000)
+    x, y = (np.interp(t, result.time, result.states[name]) for name in ("x", "y"))
+    edges = np.linspace(p["rho"] - 8 * std, p["rho"] + 8 * std, 16001)
+    rho = 0.5 * (edges[1:] + edges[:-1])
+    closest = np.concatenate(
+        [np.hypot(x - p["c"], y - (r[:, None] * t - p["d"])).min(axis=1) for r in np.split(rho, 32)]
+    )
+    return float(np.diff(norm.cdf(edges, p["rho"], std))[closest < p["r_o"]].sum())
 
 
 @pytest.mark.parametrize("name", ["rcs_single_obstacle", "rcs_constraint_form"])  # car_vs_train: its own file
 def test_files_solve(name):
-    result = solve(PROBLEMS / "ch6" / f"{name}.yaml")
+    """The file solves, and its Monte Carlo collision probability is the quadrature's along the
+    returned path within four binomial standard deviations (and one sample)."""
+    path = PROBLEMS / "ch6" / f"{name}.yaml"
+    data = yaml.safe_load(path.read_text())
+    assert data["transforms"][0]["moving_obstacles"]["obstacles"]["obstacle"] == {
+        "center": ["c", "-d"],
+        "velocity": [0, "rho"],
+        "radius": "r_o",
+    }
+    result = solve(path)
     assert result.ok, result.message
-    assert 0 <= result.metrics["monte_carlo"]["collision_probability"] <= 1
+    carlo = result.metrics["monte_carlo"]
+    exact = collision_probability_along(result, data["problem"]["uncertain"]["rho"]["normal"]["std"])
+    n = carlo["samples"]
+    assert abs(carlo["collision_probability"] - exact) <= 4 * np.sqrt(exact * (1 - exact) / n) + 1 / n
 
 
 def test_constraint_form_power_is_a_parameter():
-    """One compiled model re-solved for three powers. Each solve starts cold: warm from the beta = 1
-    optimum, beta = 4 is a hard continuation for IPOPT (756 iterations to another local optimum on
-    the flat SX graph, a failed restoration on the assembled one), where a cold start takes 42
-    iterations to the same optimum on every graph."""
+    """One compiled model re-solved for three powers, each answer holding the constraint of its own
+    β: the obstacle at (c, ρt - d) does not move the agent, so S_g = ∂g_β/∂ρ of eq. 6.41 is
+    β D^(β-2) (y - ρt + d) t along the returned path (D the distance to the obstacle), which a β
+    left at the file's value fails. Each solve starts cold: warm from the beta = 1 optimum,
+    beta = 4 is a hard continuation for IPOPT (756 iterations to another local optimum on the flat
+    SX graph, a failed restoration on the assembled one), where a cold start takes 42 iterations to
+    the same optimum on every graph."""
     spec = load(PROBLEMS / "ch6" / "rcs_constraint_form.yaml", ["solver.options.casadi.warm_start=false"])
     solver = compile_spec(spec)
     for beta in (0.5, 1.0, 4.0):
-        assert solver.solve(parameters={"problem.parameters.beta": beta}).ok
+        result = solver.solve(parameters={"problem.parameters.beta": beta})
+        assert result.ok, result.message
+        assert result.metrics["obstacle_power"] == beta
+        p = result.parameters
+        t = np.asarray(result.time)
+        dx = result.states["x"] - p["c"]
+        dy = result.states["y"] - (p["rho"] * t - p["d"])
+        distance = np.hypot(dx, dy)
+        assert distance.min() >= p["r_o"] * (1 - 1e-6)
+        expected = beta * distance ** (beta - 2) * dy * t
+        np.testing.assert_allclose(result.arrays["S_g0_rho"], expected, atol=1e-8 * np.abs(expected).max())
 
 
 def test_plain_constraint_sensitivity_option():

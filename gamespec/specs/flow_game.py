@@ -30,6 +30,7 @@ from pydantic import Field, FiniteFloat, PositiveFloat, model_validator
 
 from gamespec.errors import ExpressionError, SpecError
 from gamespec.limits import MAX_EXTREMAL_VALUES, MAX_GRID_CELL_STEPS, MAX_SAMPLE_STEPS
+from gamespec.registry import Kind
 from gamespec.specs.base import ProblemParameters, SpecBase, StrictModel, Value
 from gamespec.symbolic.calculus import jacobian, numeric_function
 from gamespec.symbolic.language import RESERVED, parse, symbol
@@ -236,8 +237,6 @@ class FlowGameSpec(ProblemParameters, SpecBase):
     problem: FlowGameProblem
     method: FlowGameMethod
 
-    default_backend = "levelset"
-
     @property
     def objective_sense(self) -> str:
         """``saddle``: the objective is the game's value, which the pursuer minimizes and the
@@ -386,3 +385,13 @@ class _Evaluator:
             grid_upper=m.grid.upper,
             grid_nodes=m.grid.nodes,
         )
+
+
+KIND = Kind(
+    FlowGameSpec,
+    default_backend="levelset",
+    plot="gamespec.flowfield.plotting:plot",
+    summary="gamespec.flowfield.report:flow_game_summary",
+    metrics="gamespec.flowfield.metrics:FlowGameMetrics",
+)
+"""The ``FlowGameSpec`` kind as one plugin (:class:`~gamespec.registry.Kind`)."""

@@ -25,6 +25,7 @@ from pydantic import Field, field_validator, model_validator
 
 from gamespec.errors import ExpressionError, SpecError
 from gamespec.limits import MAX_INTERVALS
+from gamespec.registry import Kind
 from gamespec.specs.base import Number, SpecBase, StrictModel, Value
 from gamespec.specs.ocp import (
     NORMALIZED_TIME,
@@ -184,8 +185,6 @@ class MultiPhaseSpec(OcpFamily, SpecBase):
     method: MethodSpec = Field(default_factory=MethodSpec)
     plot: PlotHint = Field(default_factory=PlotHint)
 
-    default_backend = "casadi"
-
     @model_validator(mode="after")
     def _lowers(self) -> MultiPhaseSpec:
         """The phases lower to one ``optimal_control`` problem; an expression the lowering generates
@@ -199,3 +198,13 @@ class MultiPhaseSpec(OcpFamily, SpecBase):
                 f"the phases do not lower to one problem: {err}", field="problem.phases"
             ) from None
         return self
+
+
+KIND = Kind(
+    MultiPhaseSpec,
+    default_backend="casadi",
+    plot="gamespec.plotting:plot_trajectories",
+    summary="gamespec.summaries:multiphase_summary",
+    metrics="gamespec.ocp.metrics:OcpMetrics",
+)
+"""The ``MultiPhaseSpec`` kind as one plugin (:class:`~gamespec.registry.Kind`)."""

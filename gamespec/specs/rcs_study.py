@@ -17,12 +17,13 @@ again resumes.
 from __future__ import annotations
 
 from pathlib import Path
-from typing import Annotated, ClassVar, Literal
+from typing import Annotated, Literal
 
 from pydantic import Field, model_validator
 
 from gamespec.errors import SpecError
 from gamespec.limits import MAX_RCS_OBSTACLES, MAX_SAMPLE_VALUES, MAX_STUDY_POINTS
+from gamespec.registry import Kind
 from gamespec.specs.base import BackendName, Number, SpecBase
 from gamespec.specs.ocp import MethodSpec
 
@@ -53,8 +54,6 @@ class RcsStudySpec(SpecBase):
     ocp_backend: BackendName = "casadi"
     store: Path = Field(Path("runs/rcs_multi_obstacle/points"), description="Folder of per-point records.")
 
-    default_backend: ClassVar[str] = "rcs_study"
-
     @model_validator(mode="after")
     def _work_bounded(self) -> RcsStudySpec:
         """The solves (points times guesses) within :data:`~gamespec.limits.MAX_STUDY_POINTS` and one
@@ -79,3 +78,13 @@ class RcsStudySpec(SpecBase):
     def std(self) -> float:
         """σ, whichever way ``sigma`` is given."""
         return float(self.sigma if self.sigma_is == "std" else self.sigma**0.5)
+
+
+KIND = Kind(
+    RcsStudySpec,
+    default_backend="rcs_study",
+    plot="gamespec.rcs.plotting:plot_study",
+    summary="gamespec.studies.report:study_summary",
+    metrics="gamespec.rcs.metrics:RcsStudyMetrics",
+)
+"""The ``RcsStudySpec`` kind as one plugin (:class:`~gamespec.registry.Kind`)."""

@@ -9,12 +9,13 @@ identical pure-pursuit pursuers, over a grid of initial conditions per evader sp
 from __future__ import annotations
 
 from pathlib import Path
-from typing import ClassVar, Literal
+from typing import Literal
 
 from pydantic import Field, ValidationError, ValidationInfo, field_validator, model_validator
 
 from gamespec.errors import SpecError
 from gamespec.limits import MAX_STUDY_POINTS
+from gamespec.registry import Kind
 from gamespec.specs.base import BackendName, Number, SpecBase, StrictModel
 from gamespec.specs.ocp import MethodSpec
 
@@ -54,8 +55,6 @@ class SuboptimalStudySpec(SpecBase):
         description="Folder of the per-point records (relative to the current directory); "
         "solving the file again skips the points it holds.",
     )
-
-    default_backend: ClassVar[str] = "study"
 
     @model_validator(mode="after")
     def _grid_fits(self) -> SuboptimalStudySpec:
@@ -108,3 +107,13 @@ class SuboptimalStudySpec(SpecBase):
         base = self.method.model_dump()
         steps = [self.method, *(MethodSpec.model_validate(base | r) for r in self.refinements)]
         return tuple(m.model_dump_json() for m in steps)
+
+
+KIND = Kind(
+    SuboptimalStudySpec,
+    default_backend="study",
+    plot="gamespec.pursuit.study_plot:plot_study",
+    summary="gamespec.studies.report:study_summary",
+    metrics="gamespec.pursuit.metrics:SuboptimalStudyMetrics",
+)
+"""The ``SuboptimalStudySpec`` kind as one plugin (:class:`~gamespec.registry.Kind`)."""

@@ -64,6 +64,8 @@ class Desensitize(OcpRewrite):
     """Desensitized optimal control (chapter 6) by sensitivity functions, Seywald's method or C-DOC."""
 
     name: ClassVar[str] = "desensitize"
+    plot: ClassVar[str] = "gamespec.desensitize.plotting:plot_desensitized"
+    summary: ClassVar[str] = "gamespec.desensitize.report:desensitization_summary"
     options_model: ClassVar[type[DesensitizeOptions]] = DesensitizeOptions
 
     def apply(

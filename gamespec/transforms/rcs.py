@@ -137,6 +137,8 @@ class Rcs(OcpRewrite):
     """Relevant constraint sensitivity (eqs. 6.31-6.36), or eq. 6.32 with ``relevant: false``."""
 
     name: ClassVar[str] = "rcs"
+    plot: ClassVar[str] = "gamespec.rcs.plotting:plot_rcs"
+    summary: ClassVar[str] = "gamespec.rcs.report:rcs_summary"
     options_model: ClassVar[type[RcsOptions]] = RcsOptions
 
     def apply(

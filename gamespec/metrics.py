@@ -52,9 +52,7 @@ class Metrics(BaseModel):
 
 def metrics_model(kind: str) -> type[Metrics]:
     """The metrics model of ``kind`` (:class:`Metrics` when the kind names none or is not installed)."""
-    if kind not in registry.names("gamespec.kinds"):
-        return Metrics
-    return registry.kind(kind).part("metrics") or Metrics
+    return registry.kind_part(kind, "metrics") or Metrics
 
 
 def validated(result: Result, source: str = "<result>") -> Result:

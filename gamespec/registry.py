@@ -2,7 +2,7 @@
 
 Groups: ``gamespec.kinds`` (one :class:`Kind` per problem kind: a kind is one plugin),
 ``gamespec.backends`` (backend classes by name), ``gamespec.studies`` (the :class:`~gamespec.
-studies.study.Study` plugins that run a study kind's many solves), ``gamespec.transforms`` (spec →
+backend.study.Study` plugins that run a study kind's many solves), ``gamespec.transforms`` (spec →
 spec reductions, each owning its plot and summary rows), ``gamespec.executors`` (how a study runs
 its points) and ``gamespec.commands`` (Typer apps mounted as ``gamespec NAME``). Nothing is
 imported until it is asked for, so ``import gamespec`` stays light; the installed distributions'
@@ -48,7 +48,7 @@ class Kind:
 
     ``spec`` is its pydantic model (a :class:`~gamespec.specs.base.SpecBase` with a ``kind``
     literal); ``default_backend`` the backend that solves it when a file names none, or, for a study
-    kind, ``study`` the :class:`~gamespec.studies.study.Study` plugin that runs it (exactly one of
+    kind, ``study`` the :class:`~gamespec.backend.study.Study` plugin that runs it (exactly one of
     the two); ``plot`` its plotter ``(result, output_dir, *, animate) -> list[Path]``, ``summary``
     its rows ``(result) -> list[(label, value)]`` that lead ``gamespec solve``'s table, ``metrics``
     the :class:`~gamespec.metrics.Metrics` model of its Results' ``metrics`` (None: the common one).
@@ -135,6 +135,12 @@ def load(group: str, name: str) -> Any:
 def kind(name: str) -> Kind:
     """The :class:`Kind` registered as ``name`` (a SpecError naming the ``kind`` field if none is)."""
     return load("gamespec.kinds", name)
+
+
+def kind_part(name: str, part: str) -> Any:
+    """The ``part`` of kind ``name`` (:meth:`Kind.part`), None when no kind ``name`` is installed (a
+    Result read from a folder may name one that is not)."""
+    return kind(name).part(part) if name in names("gamespec.kinds") else None
 
 
 def spec_class(name: str) -> type:

@@ -19,10 +19,11 @@ Rows = list[tuple[str, object]]
 
 
 def outcome(result: Result) -> Rows:
-    """The kind's summary rows of ``result`` (none when the kind names no summary), the rows of
-    each transform the chain applied that names one (the desensitization's sensitivities and Monte
-    Carlo, the RCS collision probability), then the failed and the left-out checks."""
-    own = registry.kind(result.kind).part("summary")
+    """The kind's summary rows of ``result`` (none when the kind names no summary or is not
+    installed), the rows of each transform the chain applied that names one (the desensitization's
+    sensitivities and Monte Carlo, the RCS collision probability), then the failed and the left-out
+    checks."""
+    own = registry.kind_part(result.kind, "summary")
     summaries = [own, *registry.transform_parts(result.provenance.transforms, "summary")]
     rows = [row for summary in summaries if summary is not None for row in summary(result)]
     return rows + check_rows(result)

@@ -82,7 +82,7 @@ class RcsStudySpec(SpecBase):
 
 KIND = Kind(
     RcsStudySpec,
-    default_backend="rcs_study",
+    study="rcs_study",
     plot="gamespec.rcs.plotting:plot_study",
     summary="gamespec.studies.report:study_summary",
     metrics="gamespec.rcs.metrics:RcsStudyMetrics",

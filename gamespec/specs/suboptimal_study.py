@@ -111,7 +111,7 @@ class SuboptimalStudySpec(SpecBase):
 
 KIND = Kind(
     SuboptimalStudySpec,
-    default_backend="study",
+    study="study",
     plot="gamespec.pursuit.study_plot:plot_study",
     summary="gamespec.studies.report:study_summary",
     metrics="gamespec.pursuit.metrics:SuboptimalStudyMetrics",

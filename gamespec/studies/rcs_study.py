@@ -1,4 +1,4 @@
-"""The ``rcs_study`` backend: runs an ``rcs_multi_obstacle_study`` (Fig. 6.11) point by point
+"""The ``rcs_study`` study: runs an ``rcs_multi_obstacle_study`` (Fig. 6.11) point by point
 through :func:`gamespec.studies.runner.run_study` into a :class:`~gamespec.studies.store.ResultStore`
 at the spec's ``store`` (points already stored are reused, so solving again resumes).
 
@@ -22,7 +22,7 @@ from gamespec.rcs.study import StudyPoint, point_problem
 from gamespec.result import Result, Status
 from gamespec.solving import solve
 from gamespec.specs.rcs_study import RcsStudySpec
-from gamespec.studies.point_study import PointStudyBackend, PointStudyModel
+from gamespec.studies.point_study import PointStudy, PointStudyModel
 from gamespec.studies.runner import StudyRun
 
 
@@ -127,7 +127,7 @@ class RcsStudyModel(PointStudyModel):
         )
 
 
-class RcsStudyBackend(PointStudyBackend):
+class RcsStudy(PointStudy):
     """Runs the §6.4.4 study (see module doc); each point's OCP is solved on ``ocp_backend``."""
 
     name: ClassVar[str] = "rcs_study"

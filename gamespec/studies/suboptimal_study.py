@@ -1,4 +1,4 @@
-"""The ``study`` backend: runs a ``pursuit_suboptimal_study`` (Table 2.1, §2.4.4) point by point.
+"""The ``study`` study: runs a ``pursuit_suboptimal_study`` (Table 2.1, §2.4.4) point by point.
 
 Every point of :func:`gamespec.pursuit.study.study_points` is solved by :func:`evaluate` (the
 generated eq. 2.21 OCP compiled once per speed and process) and goes through
@@ -34,7 +34,7 @@ from gamespec.pursuit.simulation import Players, simulate_to_capture
 from gamespec.pursuit.study import DEFECT_TOL, StudyPoint, point_engagement
 from gamespec.result import Result, Status
 from gamespec.solving import get_backend
-from gamespec.studies.point_study import PointStudyBackend, PointStudyModel
+from gamespec.studies.point_study import PointStudy, PointStudyModel
 from gamespec.studies.runner import StudyRun
 from gamespec.studies.store import ResultStore
 
@@ -176,7 +176,7 @@ def _outcome(points: int, solved: int) -> tuple[Status, str]:
     return Status.ERROR, f"none of the {points} points solved"
 
 
-class StudyBackend(PointStudyBackend):
+class SuboptimalStudy(PointStudy):
     """Runs the Table 2.1 study (see module doc); each point's OCP is solved on ``ocp_backend``."""
 
     name: ClassVar[str] = "study"

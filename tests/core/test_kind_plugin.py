@@ -1,7 +1,8 @@
 """A kind is one plugin (issue 24, item 5): one ``gamespec.kinds`` entry point per kind returns a
 :class:`~gamespec.registry.Kind` whose parts (spec model, default backend or study, plotter, summary,
 metrics schema) all resolve; a transform owns its figures and summary rows, found by the names in
-``Result.provenance.transforms``, not by the keys a Result's metrics happen to hold."""
+``Result.provenance.transforms``, not by the keys a Result's metrics happen to hold; a study kind is
+run by a ``gamespec.studies`` plugin, which no backend poses as."""
 
 from __future__ import annotations
 
@@ -11,14 +12,18 @@ from typing import ClassVar
 import numpy as np
 import pytest
 
+import gamespec
 from gamespec import registry
-from gamespec.errors import BackendError
+from gamespec.backend.study import Study
+from gamespec.errors import BackendError, UnsupportedFeature
 from gamespec.metrics import Metrics, metrics_model
 from gamespec.plotting import plot_result
 from gamespec.result import Provenance, Result, Status
+from gamespec.solving import compile_spec
 from gamespec.specs.base import SpecBase
 from gamespec.summaries import outcome
 from gamespec.transforms.base import OcpRewrite
+from tests.conftest import PROBLEMS
 
 
 @pytest.mark.parametrize("name", registry.names("gamespec.kinds"))
@@ -89,3 +94,16 @@ def test_a_transform_s_figure_and_rows_follow_the_kind_s_only_when_it_ran(markin
     not_ran = _ocp_result([])
     assert "marked.txt" not in [p.name for p in plot_result(not_ran, tmp_path / "not")]
     assert ("mark", 7) not in outcome(not_ran)
+
+
+@pytest.mark.parametrize("name", registry.names("gamespec.studies"))
+def test_a_study_is_a_study_plugin_not_a_backend(name: str) -> None:
+    study = registry.load("gamespec.studies", name)
+    assert isinstance(study(), Study) and name not in registry.names("gamespec.backends")
+    assert all(registry.kind(kind).study == name for kind in study.kinds)
+
+
+def test_a_study_kind_is_refused_by_a_backend_with_the_reason() -> None:
+    spec = gamespec.load(PROBLEMS / "ch2" / "pure_pursuit_suboptimal_study.yaml")
+    with pytest.raises(UnsupportedFeature, match="is a study, run by a study plugin"):
+        compile_spec(spec, "casadi")

@@ -31,6 +31,7 @@ import numpy as np
 import sympy as sp
 
 from gamespec.desensitize.augment import NewState, sensitivity_functions
+from gamespec.desensitize.penalized import InverseData, Penalty, augmented_spec, report
 from gamespec.desensitize.simulate import dense_integral, evaluate, values_at
 from gamespec.errors import ExpressionError, SpecError
 from gamespec.ocp.symbolic import SymbolicOcp
@@ -52,7 +53,6 @@ from gamespec.specs.rcs import MovingObstaclesOptions, RcsOptions
 from gamespec.symbolic.language import TIME, parse, symbol
 from gamespec.symbolic.printer import to_text
 from gamespec.transforms.base import OcpRewrite
-from gamespec.transforms.desensitize import InverseData, Penalty, augmented_spec, report
 
 
 def _parser(spec: OptimalControlSpec, field: str, running: bool = False):

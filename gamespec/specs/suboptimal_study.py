@@ -114,6 +114,6 @@ KIND = Kind(
     study="study",
     plot="gamespec.pursuit.study_plot:plot_study",
     summary="gamespec.studies.report:study_summary",
-    metrics="gamespec.pursuit.metrics:SuboptimalStudyMetrics",
+    metrics="gamespec.pursuit.study_metrics:SuboptimalStudyMetrics",
 )
 """The ``SuboptimalStudySpec`` kind as one plugin (:class:`~gamespec.registry.Kind`)."""

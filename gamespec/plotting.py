@@ -15,7 +15,7 @@ from pathlib import Path
 from gamespec import registry
 from gamespec.errors import BackendError
 from gamespec.metrics import validated
-from gamespec.obstacles import circles
+from gamespec.rcs.circles import circles
 from gamespec.result import Result
 
 LEGEND_RIGHT = {"loc": "upper left", "bbox_to_anchor": (1.02, 1.0), "borderaxespad": 0.0, "fontsize": "small"}
@@ -97,7 +97,7 @@ def _mark_phases(result: Result, axes) -> None:
 
 def plot_plane(result: Result, pairs: list[tuple[str, str]], path: Path) -> Path:
     """The path of each planar pair (start ``o``, end ``s``) with the circular path constraints over
-    it: obstacles as grey disks, keep-in circles as dashed outlines (:mod:`gamespec.obstacles`)."""
+    it: obstacles as grey disks, keep-in circles as dashed outlines (:mod:`gamespec.rcs.circles`)."""
     plt = _pyplot()
     hint = result.metrics.get("plot", {})
     units = hint.get("units", {})

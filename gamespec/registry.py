@@ -1,8 +1,9 @@
 """Lazy plugin registries read from entry points (after pluggy's ``_importlib_metadata``).
 
 Groups: ``gamespec.kinds`` (one :class:`Kind` per problem kind: a kind is one plugin),
-``gamespec.backends`` (backend classes by name), ``gamespec.studies`` (the :class:`~gamespec.
-backend.study.Study` plugins that run a study kind's many solves), ``gamespec.transforms`` (spec →
+``gamespec.backends`` (backend classes by name), ``gamespec.studies`` (the
+:class:`~gamespec.compiling.study_protocol.Study` plugins that run a study kind's many solves),
+``gamespec.transforms`` (spec →
 spec reductions, each owning its plot and summary rows), ``gamespec.executors`` (how a study runs
 its points) and ``gamespec.commands`` (Typer apps mounted as ``gamespec NAME``). Nothing is
 imported until it is asked for, so ``import gamespec`` stays light; the installed distributions'
@@ -43,15 +44,16 @@ def resolved(ref: Ref) -> Any:
 
 @dataclass(frozen=True)
 class Kind:
-    """One problem kind, everything about it in one entry point of ``gamespec.kinds`` (DESIGN.md
-    "Layers": a kind is one plugin).
+    """One problem kind, everything about it in one entry point of ``gamespec.kinds``
+    (``docs/architecture.md``: a kind is one plugin).
 
     ``spec`` is its pydantic model (a :class:`~gamespec.specs.base.SpecBase` with a ``kind``
     literal); ``default_backend`` the backend that solves it when a file names none, or, for a study
-    kind, ``study`` the :class:`~gamespec.backend.study.Study` plugin that runs it (exactly one of
-    the two); ``plot`` its plotter ``(result, output_dir, *, animate) -> list[Path]``, ``summary``
-    its rows ``(result) -> list[(label, value)]`` that lead ``gamespec solve``'s table, ``metrics``
-    the :class:`~gamespec.metrics.Metrics` model of its Results' ``metrics`` (None: the common one).
+    kind, ``study`` the :class:`~gamespec.compiling.study_protocol.Study` plugin that runs it
+    (exactly one of the two); ``plot`` its plotter ``(result, output_dir, *, animate) ->
+    list[Path]``, ``summary`` its rows ``(result) -> list[(label, value)]`` that lead ``gamespec
+    solve``'s table, ``metrics`` the :class:`~gamespec.metrics.Metrics` model of its Results'
+    ``metrics`` (None: the common one).
     The parts other than ``spec`` may be ``"module:attribute"`` texts, imported when first used.
     """
 

@@ -26,8 +26,8 @@ from pathlib import Path
 from typing import Any
 
 from gamespec import registry
-from gamespec.backend import Backend, CompiledModel, Inputs
-from gamespec.backend.study import Study
+from gamespec.compiling import Backend, CompiledModel, Inputs
+from gamespec.compiling.study_protocol import Study
 from gamespec.errors import BackendError, ExpressionError, SpecError, UnsupportedFeature
 from gamespec.loader import load, spec_hash, with_values
 from gamespec.result import Provenance, Result, Status
@@ -344,9 +344,9 @@ def compile_spec(
 
 
 def _study(spec: SpecBase, name: str, options: dict[str, Any] | None) -> Solver:
-    """A study kind compiled by the :class:`~gamespec.backend.study.Study` plugin ``name`` (the one
-    its kind names, unless the caller or the file names another study), which drives the solves of
-    its points itself; no transform applies to a study kind."""
+    """A study kind compiled by the :class:`~gamespec.compiling.study_protocol.Study` plugin
+    ``name`` (the one its kind names, unless the caller or the file names another study), which
+    drives the solves of its points itself; no transform applies to a study kind."""
     if name not in registry.names("gamespec.studies"):
         studies = ", ".join(registry.names("gamespec.studies"))
         raise UnsupportedFeature(

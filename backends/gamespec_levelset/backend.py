@@ -24,8 +24,8 @@ from typing import Any, ClassVar
 import numpy as np
 from pydantic import Field
 
-from gamespec.backend import Availability, Backend, CompiledModel, Inputs, refuse_inputs
 from gamespec.best_response import Outcome, Settings, iterate
+from gamespec.compiling import Availability, Backend, CompiledModel, Inputs, refuse_inputs
 from gamespec.flowfield.capture_probability import capture_probabilities
 from gamespec.flowfield.concepts import saddle_gap, solution_concept
 from gamespec.flowfield.covariance_game import PLAYERS, CovarianceGame, Strategy
@@ -42,10 +42,10 @@ from gamespec.flowfield.linearize import DiscreteModel, lifted, zero_order_hold
 from gamespec.flowfield.nominal import NominalPaths, from_extremals, from_level_sets
 from gamespec.flowfield.problem import FlowGameData, evaluate
 from gamespec.flowfield.simulation import simulate
+from gamespec.flowfield.spec import FlowGameSpec
 from gamespec.montecarlo import proportion
 from gamespec.result import Result, Status
 from gamespec.specs.base import SpecBase, StrictModel
-from gamespec.specs.flow_game import FlowGameSpec
 from gamespec_levelset.players import (
     EvaderStep,
     GamePlayer,

@@ -21,11 +21,11 @@ import sympy as sp
 from gamespec.desensitize.augment import Augmentation
 from gamespec.desensitize.montecarlo import monte_carlo
 from gamespec.desensitize.simulate import dense_integral, evaluate
+from gamespec.desensitize.spec import DesensitizeOptions
 from gamespec.errors import SpecError
 from gamespec.ocp.symbolic import SymbolicOcp
 from gamespec.ocp.transcription import Transcription
 from gamespec.result import Result
-from gamespec.specs.desensitize import DesensitizeOptions
 from gamespec.specs.ocp import OptimalControlSpec
 from gamespec.symbolic.language import TIME, symbol
 from gamespec.symbolic.printer import to_text

@@ -10,7 +10,7 @@ import numpy as np
 from gamespec.flowfield.covariance_game import Feedforward, Payoff, PlayerBounds
 from gamespec.flowfield.field import FlowField
 from gamespec.flowfield.grid import Grid
-from gamespec.specs.flow_game import FlowGameSpec
+from gamespec.flowfield.spec import FlowGameSpec
 
 
 @dataclass(frozen=True)

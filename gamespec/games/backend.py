@@ -14,7 +14,7 @@ from typing import ClassVar
 
 import numpy as np
 
-from gamespec.backend import Backend, CompiledModel, Inputs, refuse_inputs
+from gamespec.compiling import Backend, CompiledModel, Inputs, refuse_inputs
 from gamespec.games.equilibrium import GameModel, GameSolution, equilibrium_report, status_of
 from gamespec.games.existence import existence
 from gamespec.games.feedback_game import feedback_equilibrium, feedback_form

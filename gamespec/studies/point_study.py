@@ -13,7 +13,7 @@ from typing import Any, ClassVar
 
 from pydantic import BaseModel, Field, ValidationError
 
-from gamespec.backend import Availability, CompiledModel, Inputs, refuse_inputs, validated_options
+from gamespec.compiling import Availability, CompiledModel, Inputs, refuse_inputs, validated_options
 from gamespec.errors import SpecError, UnsupportedFeature
 from gamespec.loader import spec_hash
 from gamespec.result import Result
@@ -125,8 +125,8 @@ class PointStudyModel(CompiledModel):
 
 
 class PointStudy:
-    """A :class:`~gamespec.backend.study.Study` of independent points: checks that the file's
-    ``ocp_backend`` is there, then builds :attr:`model`."""
+    """A :class:`~gamespec.compiling.study_protocol.Study` of independent points: checks that the
+    file's ``ocp_backend`` is there, then builds :attr:`model`."""
 
     name: ClassVar[str]
     kinds: ClassVar[frozenset[str]]

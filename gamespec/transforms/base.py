@@ -33,7 +33,7 @@ from dataclasses import dataclass
 from typing import Any, ClassVar
 
 from gamespec import registry
-from gamespec.backend import NoOptions
+from gamespec.compiling import NoOptions
 from gamespec.result import Result
 from gamespec.specs.base import SpecBase, StrictModel
 from gamespec.specs.requested import entry, transform_class, validated_options

@@ -14,7 +14,7 @@ import pytest
 
 import gamespec
 from gamespec import registry
-from gamespec.backend.study import Study
+from gamespec.compiling.study_protocol import Study
 from gamespec.errors import BackendError, UnsupportedFeature
 from gamespec.metrics import Metrics, metrics_model
 from gamespec.plotting import plot_result

@@ -33,6 +33,7 @@ import sympy as sp
 from gamespec.desensitize.augment import NewState, sensitivity_functions
 from gamespec.desensitize.penalized import InverseData, Penalty, augmented_spec, report
 from gamespec.desensitize.simulate import dense_integral, evaluate, values_at
+from gamespec.desensitize.spec import DesensitizeOptions
 from gamespec.errors import ExpressionError, SpecError
 from gamespec.ocp.symbolic import SymbolicOcp
 from gamespec.ocp.transcription import Transcription
@@ -45,11 +46,10 @@ from gamespec.rcs.sensitivity import (
     state_sensitivity,
     weighted_square,
 )
+from gamespec.rcs.spec import MovingObstaclesOptions, RcsOptions
 from gamespec.result import Result, Status
 from gamespec.specs.base import SpecBase
-from gamespec.specs.desensitize import DesensitizeOptions
 from gamespec.specs.ocp import GuessSpec, OptimalControlSpec
-from gamespec.specs.rcs import MovingObstaclesOptions, RcsOptions
 from gamespec.symbolic.language import TIME, parse, symbol
 from gamespec.symbolic.printer import to_text
 from gamespec.transforms.base import OcpRewrite

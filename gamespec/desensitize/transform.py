@@ -22,11 +22,11 @@ import sympy as sp
 
 from gamespec.desensitize.augment import METHODS, Augmentation
 from gamespec.desensitize.penalized import FIELD, InverseData, Penalty, augmented_spec, report
+from gamespec.desensitize.spec import DesensitizeOptions, Weights
 from gamespec.errors import ExpressionError, SpecError
 from gamespec.ocp.symbolic import SymbolicOcp
 from gamespec.result import Result
 from gamespec.specs.base import SpecBase
-from gamespec.specs.desensitize import DesensitizeOptions, Weights
 from gamespec.specs.ocp import OptimalControlSpec
 from gamespec.symbolic.language import parse, symbol
 from gamespec.transforms.base import OcpRewrite

@@ -2,8 +2,8 @@
 
 The suboptimal constant heading of eq. 2.27 against the optimal evasion of Proposition 1, two
 identical pure-pursuit pursuers, over a grid of initial conditions per evader speed (see
-:mod:`gamespec.pursuit.study`). The ``study`` backend runs it; every finished point is saved under
-``store`` as it completes, so solving the same file again resumes where it stopped.
+:mod:`gamespec.suboptimal_study.points`). The ``study`` study runs it; every finished point is
+saved under ``store`` as it completes, so solving the same file again resumes where it stopped.
 """
 
 from __future__ import annotations
@@ -24,7 +24,7 @@ MethodChange = dict[str, int | float | str]
 
 
 class StudyGrid(StrictModel):
-    """The grid of (r2(0), ψ(0)) per speed (see :mod:`gamespec.pursuit.study`)."""
+    """The grid of (r2(0), ψ(0)) per speed (see :mod:`gamespec.suboptimal_study.points`)."""
 
     angles: int = Field(16, ge=1, description="Values of psi(0), evenly spread, none on P1's ray.")
     fractions: int = Field(9, ge=1, description="Values of r2(0) per angle, between F and E.")
@@ -112,8 +112,8 @@ class SuboptimalStudySpec(SpecBase):
 KIND = Kind(
     SuboptimalStudySpec,
     study="study",
-    plot="gamespec.pursuit.study_plot:plot_study",
+    plot="gamespec.suboptimal_study.plotting:plot_study",
     summary="gamespec.studies.report:study_summary",
-    metrics="gamespec.pursuit.study_metrics:SuboptimalStudyMetrics",
+    metrics="gamespec.suboptimal_study.metrics:SuboptimalStudyMetrics",
 )
 """The ``SuboptimalStudySpec`` kind as one plugin (:class:`~gamespec.registry.Kind`)."""

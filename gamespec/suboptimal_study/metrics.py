@@ -1,5 +1,5 @@
 """Metrics of ``pursuit_suboptimal_study`` Results (Table 2.1): what
-:mod:`gamespec.pursuit.study_plot` and ``gamespec pursuit study`` read."""
+:mod:`gamespec.suboptimal_study.plotting` and ``gamespec pursuit study`` read."""
 
 from __future__ import annotations
 

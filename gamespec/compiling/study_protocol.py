@@ -15,7 +15,7 @@ from __future__ import annotations
 from collections.abc import Mapping
 from typing import Any, ClassVar, Protocol, runtime_checkable
 
-from gamespec.backend import Availability, CompiledModel
+from gamespec.compiling import Availability, CompiledModel
 from gamespec.specs.base import SpecBase, StrictModel
 
 

@@ -10,7 +10,7 @@ just when a straight-line agent at full speed gets there: every obstacle blocks 
 The Monte Carlo draws ρ_i = ρ̂ + Δρ_i, Δρ_i ~ N(0, σ²). §6.4.4 writes "σ² = 0.1": ``sigma`` is σ
 when ``sigma_is: std`` (the default, so ``--set sigma=0.1`` means σ = 0.1) and σ² when
 ``sigma_is: variance`` (``--set sigma_is=variance`` reads the thesis literally: σ ≈ 0.316).
-The ``rcs_study`` backend saves each (N, α) point under ``store`` as it finishes; solving the file
+The ``rcs_study`` study saves each (N, α) point under ``store`` as it finishes; solving the file
 again resumes.
 """
 

@@ -14,8 +14,8 @@ import pytest
 
 from gamespec.desensitize.montecarlo import monte_carlo
 from gamespec.desensitize.simulate import open_loop, rk4
+from gamespec.desensitize.spec import MonteCarloOptions
 from gamespec.ocp.symbolic import SymbolicOcp
-from gamespec.specs.desensitize import MonteCarloOptions
 from gamespec.symbolic.language import symbol
 from tests.desensitize.helpers import SEYWALD, TRAJECTORY, file_solver
 

@@ -11,10 +11,10 @@ import numpy as np
 import pytest
 
 import gamespec
-from gamespec.pursuit import study
 from gamespec.pursuit.simulation import simulate_to_capture
 from gamespec.result import Status
-from gamespec.studies import suboptimal_study
+from gamespec.suboptimal_study import points as study
+from gamespec.suboptimal_study import study as suboptimal_study
 from tests.conftest import PROBLEMS
 
 CASES = {

@@ -12,9 +12,9 @@ from __future__ import annotations
 import pytest
 
 from gamespec.loader import spec_from_dict
-from gamespec.rcs.study import point_problem
+from gamespec.rcs.study_points import point_problem
+from gamespec.rcs.study_spec import RcsStudySpec
 from gamespec.solving import compile_spec
-from gamespec.specs.rcs_study import RcsStudySpec
 
 COUNTS = (2, 3, 5, 10)
 

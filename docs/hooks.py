@@ -124,15 +124,16 @@ def kind_page(kind: str) -> str:
 
 
 def backends_page() -> str:
-    """Every backend: what it solves, its features and its options block."""
+    """Every backend, then every study: what it solves, its features and its options block."""
     text = [
         "# Backend options\n",
-        "Each backend reads its own block `solver.options.<backend>` of a problem file, validated when",
-        "the file is solved (a wrong key or value exits 2 naming `solver.options.<backend>.<key>`).",
+        "Each backend (and each study, which runs a study kind) reads its own block",
+        "`solver.options.<backend>` of a problem file, validated when the file is solved (a wrong key",
+        "or value exits 2 naming `solver.options.<backend>.<key>`).",
         "Generated from each backend's `options_model`.\n",
     ]
-    for name in registry.names("gamespec.backends"):
-        cls = registry.backend_class(name)
+    for name in registry.runner_names():
+        cls = registry.runner_class(name)
         summary = (cls.__doc__ or "").strip().split("\n\n")[0]
         text += [
             f"## `{name}`\n",

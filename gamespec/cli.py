@@ -193,15 +193,14 @@ def solve(
 
 
 def _where_it_runs(spec, backend: str | None, scheduler: str | None, insecure: bool) -> dict | None:
-    """The study options ``--scheduler`` and ``--insecure-scheduler`` give, for a backend that runs
-    a study (None when neither is given); a GamespecError for any other backend."""
+    """The study options ``--scheduler`` and ``--insecure-scheduler`` give, for a study kind (None
+    when neither is given); a GamespecError for a kind a backend solves."""
     if not scheduler and not insecure:
         return None
-    from gamespec.solving import backend_name
-    from gamespec.studies.point_study import PointStudyBackend
+    if registry.kind(spec.kind).study is None:
+        from gamespec.solving import backend_name
 
-    name = backend_name(spec, backend)
-    if not issubclass(registry.backend_class(name), PointStudyBackend):
+        name = backend_name(spec, backend)
         raise GamespecError(
             f"--scheduler: backend {name!r} runs no study (a sweep takes --scheduler: gamespec sweep)"
         )
@@ -468,7 +467,8 @@ def schema(
 
 @app.command()
 def backends() -> None:
-    """List installed backends: whether each is available (and why not), its kinds and features."""
+    """List installed backends, then the studies that run the study kinds: whether each is
+    available (and why not), its kinds and features."""
     from rich import box
     from rich.table import Table
 
@@ -476,9 +476,11 @@ def backends() -> None:
     table.add_column("backend", no_wrap=True)
     table.add_column("kinds")
     table.add_column("available, features, package")
-    for name in registry.names("gamespec.backends"):
+    studies = registry.names("gamespec.studies")
+    for name in [*registry.names("gamespec.backends"), *studies]:
+        group = "gamespec.studies" if name in studies else "gamespec.backends"
         try:
-            cls = registry.backend_class(name)
+            cls = registry.load(group, name)
         except (ImportError, GamespecError) as err:
             table.add_row(name, "", f"[red]no[/red]: cannot load ({_escape(str(err))})")
             continue
@@ -487,7 +489,9 @@ def backends() -> None:
         details = [f"{status}: {_escape(avail.reason)}"]
         if cls.features:
             details.append(f"features: {', '.join(sorted(cls.features))}")
-        details.append(f"from {registry.distribution('gamespec.backends', name)}")
+        if group == "gamespec.studies":
+            details.append("a study: runs many solves, each on the file's ocp_backend")
+        details.append(f"from {registry.distribution(group, name)}")
         table.add_row(
             name, "\n".join(_kinds_through_transforms(cls.kinds)), "\n".join(details), end_section=True
         )

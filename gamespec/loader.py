@@ -196,13 +196,13 @@ def check_backend_options(spec: SpecBase, source: str) -> None:
     for name, block in spec.solver.options.items():
         if name == NLP_OPTIONS:
             continue
-        known = registry.names("gamespec.backends")
+        known = registry.runner_names()
         if name not in known:
             near = difflib.get_close_matches(name, known, n=1)
             hint = f"; did you mean {near[0]!r}?" if near else f" (known: {', '.join(known)})"
             raise SpecError(f"unknown backend {name!r}{hint}", field=f"solver.options.{name}", source=source)
         try:
-            backend = registry.backend_class(name)
+            backend = registry.runner_class(name)
         except ImportError:
             continue
         backend.validate_options(block, source)

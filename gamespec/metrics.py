@@ -1,7 +1,7 @@
 """Typed metrics per kind (DESIGN.md, stage 4): what a Result's ``metrics`` hold, as pydantic models.
 
-Each kind registers its model in the ``gamespec.metrics`` entry-point group (the feature folder
-that writes the metrics defines it; a kind without one gets :class:`Metrics`). A model types the
+Each kind names its model in its :class:`~gamespec.registry.Kind` (``metrics``; the feature
+folder that writes the metrics defines it; a kind without one gets :class:`Metrics`). A model types the
 keys that plotters and summaries read, allows the others (``extra="allow"``: keys not typed yet
 pass unchanged), and its :meth:`Metrics.check` checks the arrays those readers index by the
 metrics (names, dimensions, lengths). :func:`validated` applies the kind's model to a Result, so a
@@ -24,8 +24,6 @@ from gamespec.errors import BackendError, SpecError
 
 if TYPE_CHECKING:
     from gamespec.result import Result
-
-GROUP = "gamespec.metrics"
 
 Finite = Annotated[float, Field(allow_inf_nan=False)]
 """A finite number (JSON may spell NaN and Infinity; a coordinate or a radius may not be one)."""
@@ -53,10 +51,8 @@ class Metrics(BaseModel):
 
 
 def metrics_model(kind: str) -> type[Metrics]:
-    """The metrics model registered for ``kind`` (:class:`Metrics` when none is)."""
-    if kind not in registry.names(GROUP):
-        return Metrics
-    return registry.load(GROUP, kind)
+    """The metrics model of ``kind`` (:class:`Metrics` when the kind names none or is not installed)."""
+    return registry.kind_part(kind, "metrics") or Metrics
 
 
 def validated(result: Result, source: str = "<result>") -> Result:

@@ -1,8 +1,9 @@
 """Plots of ``optimal_control`` Results: states, controls and, for declared planar pairs, the path;
 the boundaries between the phases of a ``multiphase_optimal_control`` Result are marked.
 
-Plotters read Results only (never solver objects) and are registered per kind in the
-``gamespec.plotters`` entry-point group; :func:`plot_result` dispatches on ``result.kind``. The
+Plotters read Results only (never solver objects); each kind names its own (its
+:class:`~gamespec.registry.Kind`'s ``plot``) and each transform its figures (its ``plot``), and
+:func:`plot_result` draws the kind's then those of the transforms the Result went through. The
 planar pairs, units and path constraints come from ``metrics["plot"]`` (the file's ``plot``
 section, :mod:`gamespec.specs.plot`); a plane is drawn only when the file declares one.
 """
@@ -12,8 +13,9 @@ from __future__ import annotations
 from pathlib import Path
 
 from gamespec import registry
+from gamespec.errors import BackendError
 from gamespec.metrics import validated
-from gamespec.obstacles import circles
+from gamespec.rcs.circles import circles
 from gamespec.result import Result
 
 LEGEND_RIGHT = {"loc": "upper left", "bbox_to_anchor": (1.02, 1.0), "borderaxespad": 0.0, "fontsize": "small"}
@@ -74,14 +76,6 @@ def plot_trajectories(result: Result, output_dir: Path, *, animate: bool = False
     pairs = [tuple(p) for p in hint.get("planar", [])]
     if pairs:
         paths.append(plot_plane(result, pairs, output_dir / f"{result.problem}_path.png"))
-    if "desensitization" in result.metrics:
-        from gamespec.desensitize.plotting import plot_desensitized
-
-        paths += plot_desensitized(result, output_dir)
-    if "rcs" in result.metrics:
-        from gamespec.rcs.plotting import plot_rcs
-
-        paths += plot_rcs(result, output_dir)
     return paths
 
 
@@ -103,7 +97,7 @@ def _mark_phases(result: Result, axes) -> None:
 
 def plot_plane(result: Result, pairs: list[tuple[str, str]], path: Path) -> Path:
     """The path of each planar pair (start ``o``, end ``s``) with the circular path constraints over
-    it: obstacles as grey disks, keep-in circles as dashed outlines (:mod:`gamespec.obstacles`)."""
+    it: obstacles as grey disks, keep-in circles as dashed outlines (:mod:`gamespec.rcs.circles`)."""
     plt = _pyplot()
     hint = result.metrics.get("plot", {})
     units = hint.get("units", {})
@@ -136,8 +130,15 @@ def plot_plane(result: Result, pairs: list[tuple[str, str]], path: Path) -> Path
 
 
 def plot_result(result: Result, output_dir: Path, *, animate: bool = False) -> list[Path]:
-    """Dispatch to the plotter registered for the Result's kind, with the Result's metrics
-    validated by the kind's schema (:func:`gamespec.metrics.validated`): a plotter reads only
-    metrics and arrays of the types and shapes that schema promises."""
-    plotter = registry.load("gamespec.plotters", result.kind)
-    return plotter(validated(result, result.problem or "<result>"), output_dir, animate=animate)
+    """The figures of the Result's kind, then those of each transform its chain applied
+    (:func:`~gamespec.registry.transform_parts`), with the Result's metrics validated by the kind's
+    schema (:func:`gamespec.metrics.validated`): a plotter reads only metrics and arrays of the
+    types and shapes that schema promises."""
+    plotter = registry.kind(result.kind).part("plot")
+    if plotter is None:
+        raise BackendError(f"kind {result.kind!r} has no plotter")
+    typed = validated(result, result.problem or "<result>")
+    paths = plotter(typed, output_dir, animate=animate)
+    for plot in registry.transform_parts(result.provenance.transforms, "plot"):
+        paths += plot(typed, output_dir)
+    return paths

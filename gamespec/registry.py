@@ -1,17 +1,20 @@
 """Lazy plugin registries read from entry points (after pluggy's ``_importlib_metadata``).
 
-Groups: ``gamespec.kinds`` (spec classes by ``kind``), ``gamespec.backends`` (backend classes by
-name), ``gamespec.transforms`` (spec → spec reductions), ``gamespec.plotters`` (plot functions by
-kind), ``gamespec.summaries`` (the rows that lead a kind's solve summary), ``gamespec.metrics``
-(the typed metrics of a kind's Results), ``gamespec.executors``
-(how a study runs its points) and ``gamespec.commands`` (Typer apps mounted as ``gamespec NAME``).
-Nothing is imported until it is asked for, so ``import gamespec`` stays light; the installed
-distributions' entry points are read in one pass, the first time any group is asked for.
+Groups: ``gamespec.kinds`` (one :class:`Kind` per problem kind: a kind is one plugin),
+``gamespec.backends`` (backend classes by name), ``gamespec.studies`` (the
+:class:`~gamespec.compiling.study_protocol.Study` plugins that run a study kind's many solves),
+``gamespec.transforms`` (spec →
+spec reductions, each owning its plot and summary rows), ``gamespec.executors`` (how a study runs
+its points) and ``gamespec.commands`` (Typer apps mounted as ``gamespec NAME``). Nothing is
+imported until it is asked for, so ``import gamespec`` stays light; the installed distributions'
+entry points are read in one pass, the first time any group is asked for.
 """
 
 from __future__ import annotations
 
+from dataclasses import dataclass
 from functools import cache
+from importlib import import_module
 from importlib.metadata import EntryPoint, EntryPoints, entry_points
 from typing import Any
 
@@ -20,13 +23,55 @@ from gamespec.errors import BackendError, SpecError
 GROUPS = (
     "gamespec.kinds",
     "gamespec.backends",
+    "gamespec.studies",
     "gamespec.transforms",
-    "gamespec.plotters",
-    "gamespec.summaries",
-    "gamespec.metrics",
     "gamespec.executors",
     "gamespec.commands",
 )
+
+Ref = Any
+"""An object, or the ``"module:attribute"`` text that names it (imported only when asked for, so
+that declaring a kind does not import its plotter)."""
+
+
+def resolved(ref: Ref) -> Any:
+    """``ref`` itself, or the object its ``"module:attribute"`` text names."""
+    if not isinstance(ref, str):
+        return ref
+    module, _, attribute = ref.partition(":")
+    return getattr(import_module(module), attribute)
+
+
+@dataclass(frozen=True)
+class Kind:
+    """One problem kind, everything about it in one entry point of ``gamespec.kinds``
+    (``docs/architecture.md``: a kind is one plugin).
+
+    ``spec`` is its pydantic model (a :class:`~gamespec.specs.base.SpecBase` with a ``kind``
+    literal); ``default_backend`` the backend that solves it when a file names none, or, for a study
+    kind, ``study`` the :class:`~gamespec.compiling.study_protocol.Study` plugin that runs it
+    (exactly one of the two); ``plot`` its plotter ``(result, output_dir, *, animate) ->
+    list[Path]``, ``summary`` its rows ``(result) -> list[(label, value)]`` that lead ``gamespec
+    solve``'s table, ``metrics`` the :class:`~gamespec.metrics.Metrics` model of its Results'
+    ``metrics`` (None: the common one).
+    The parts other than ``spec`` may be ``"module:attribute"`` texts, imported when first used.
+    """
+
+    spec: Ref
+    default_backend: str | None = None
+    study: str | None = None
+    plot: Ref | None = None
+    summary: Ref | None = None
+    metrics: Ref | None = None
+
+    def __post_init__(self) -> None:
+        if (self.default_backend is None) == (self.study is None):
+            raise BackendError("a kind names either a default backend or the study that runs it")
+
+    def part(self, name: str) -> Any:
+        """The kind's ``spec``, ``plot``, ``summary`` or ``metrics``, imported (None if it has none)."""
+        ref = getattr(self, name)
+        return None if ref is None else resolved(ref)
 
 
 _IN_PROCESS: dict[str, dict[str, Any]] = {group: {} for group in GROUPS}
@@ -89,11 +134,55 @@ def load(group: str, name: str) -> Any:
     return ep.load()
 
 
-def spec_class(kind: str) -> type:
-    """The spec model registered for ``kind``."""
-    return load("gamespec.kinds", kind)
+def kind(name: str) -> Kind:
+    """The :class:`Kind` registered as ``name`` (a SpecError naming the ``kind`` field if none is)."""
+    return load("gamespec.kinds", name)
+
+
+def kind_part(name: str, part: str) -> Any:
+    """The ``part`` of kind ``name`` (:meth:`Kind.part`), None when no kind ``name`` is installed (a
+    Result read from a folder may name one that is not)."""
+    return kind(name).part(part) if name in names("gamespec.kinds") else None
+
+
+def spec_class(name: str) -> type:
+    """The spec model of kind ``name``."""
+    return kind(name).part("spec")
 
 
 def backend_class(name: str) -> type:
     """The backend class registered as ``name``."""
     return load("gamespec.backends", name)
+
+
+RUNNERS = ("gamespec.backends", "gamespec.studies")
+"""What ``solver.backend``, ``solver.options.<name>`` and ``--backend`` may name: a backend, or the
+study that runs a study kind."""
+
+
+def runner_names() -> list[str]:
+    """The installed backends and studies, sorted."""
+    return sorted({name for group in RUNNERS for name in names(group)})
+
+
+def runner_group(name: str) -> str:
+    """``gamespec.studies`` when ``name`` is a study, else ``gamespec.backends``."""
+    return "gamespec.studies" if name in names("gamespec.studies") else "gamespec.backends"
+
+
+def runner_class(name: str) -> type:
+    """The study or backend class registered as ``name`` (a BackendError naming both if neither)."""
+    group = runner_group(name)
+    if group == "gamespec.backends" and name not in names(group):
+        raise BackendError(f"unknown backend {name!r} (known: {', '.join(runner_names())})")
+    return load(group, name)
+
+
+def transform_parts(transforms: list[str], part: str) -> list[Any]:
+    """The ``plot`` or ``summary`` of each of ``transforms`` (the names a Result's chain applied,
+    ``result.provenance.transforms``) that is installed and declares one, in order, imported: a
+    transform owns its figures and summary rows, so a kind's plotter and summary need not know
+    which transforms ran."""
+    installed = names("gamespec.transforms")
+    refs = [getattr(load("gamespec.transforms", name), part) for name in transforms if name in installed]
+    return [resolved(ref) for ref in refs if ref is not None]

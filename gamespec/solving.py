@@ -26,7 +26,8 @@ from pathlib import Path
 from typing import Any
 
 from gamespec import registry
-from gamespec.backend import Backend, CompiledModel, Inputs
+from gamespec.compiling import Backend, CompiledModel, Inputs
+from gamespec.compiling.study_protocol import Study
 from gamespec.errors import BackendError, ExpressionError, SpecError, UnsupportedFeature
 from gamespec.loader import load, spec_hash, with_values
 from gamespec.result import Provenance, Result, Status
@@ -62,9 +63,9 @@ def _core_versions() -> dict[str, str]:
     return found
 
 
-def _versions(backend: Backend) -> dict[str, str]:
+def _versions(backend: Backend | Study) -> dict[str, str]:
     return _core_versions() | {
-        f"backend:{backend.name}": registry.distribution("gamespec.backends", backend.name)
+        f"backend:{backend.name}": registry.distribution(registry.runner_group(backend.name), backend.name)
     }
 
 
@@ -206,10 +207,11 @@ def _better(candidate: Result, best: Result | None, sense: str) -> bool:
 
 @dataclass
 class Solver:
-    """A spec compiled for one backend; call :meth:`solve` as often as needed (see module doc)."""
+    """A spec compiled for one backend (or, for a study kind, by its study); call :meth:`solve` as
+    often as needed (see module doc)."""
 
     spec: SpecBase
-    backend: Backend
+    backend: Backend | Study
     steps: list[Step]
     compiled: CompiledModel
     build_time_s: float
@@ -346,6 +348,9 @@ def compile_spec(
     """Load (if a path), pick the backend, apply the transforms, and build its model once."""
     if not isinstance(spec, SpecBase):
         spec = load(spec)
+    study = registry.kind(spec.kind).study
+    if study is not None:
+        return _study(spec, backend or spec.solver.backend or study, options)
     name = backend_name(spec, backend)
     instance = get_backend(name)
     start = time.perf_counter()
@@ -354,6 +359,22 @@ def compile_spec(
     compiled = instance.compile(target, instance.options(target, options))
     build = time.perf_counter() - start
     return Solver(spec, instance, steps, compiled, build)
+
+
+def _study(spec: SpecBase, name: str, options: dict[str, Any] | None) -> Solver:
+    """A study kind compiled by the :class:`~gamespec.compiling.study_protocol.Study` plugin
+    ``name`` (the one its kind names, unless the caller or the file names another study), which
+    drives the solves of its points itself; no transform applies to a study kind."""
+    if name not in registry.names("gamespec.studies"):
+        studies = ", ".join(registry.names("gamespec.studies"))
+        raise UnsupportedFeature(
+            f"kind {spec.kind!r} is a study, run by a study plugin ({studies}), not by backend "
+            f"{name!r}; its points' backend is the file's ocp_backend"
+        )
+    study = registry.load("gamespec.studies", name)()
+    start = time.perf_counter()
+    compiled = study.compile(spec, study.options(spec, options))
+    return Solver(spec, study, [], compiled, time.perf_counter() - start)
 
 
 def solve(

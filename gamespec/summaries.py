@@ -1,6 +1,7 @@
 """What ``gamespec solve`` prints first: the outcome of a Result in the terms of its kind.
 
-A kind registers a summary function in the ``gamespec.summaries`` entry-point group:
+A kind names a summary function in its :class:`~gamespec.registry.Kind` (``summary``), and so may
+each transform (its ``summary``, :class:`~gamespec.transforms.base.Transform`):
 ``summary(result) -> list[tuple[str, object]]``, rows that lead the solve table (capture time and
 capturing set, arcs, per-evader captures, terminal statistics against the target) and ``hint``
 rows that point to a better backend where one exists. It reads the Result only. Every kind's rows
@@ -18,15 +19,13 @@ Rows = list[tuple[str, object]]
 
 
 def outcome(result: Result) -> Rows:
-    """The kind's summary rows of ``result`` (none when the kind registers no summary), the rows of
-    each transform the chain applied that registers one under its own name (the desensitization's
-    sensitivities and Monte Carlo, the RCS collision probability), then the failed and the
-    left-out checks."""
-    registered = registry.names("gamespec.summaries")
-    rows = []
-    for name in [result.kind, *result.provenance.transforms]:
-        if name in registered:
-            rows += registry.load("gamespec.summaries", name)(result)
+    """The kind's summary rows of ``result`` (none when the kind names no summary or is not
+    installed), the rows of each transform the chain applied that names one (the desensitization's
+    sensitivities and Monte Carlo, the RCS collision probability), then the failed and the left-out
+    checks."""
+    own = registry.kind_part(result.kind, "summary")
+    summaries = [own, *registry.transform_parts(result.provenance.transforms, "summary")]
+    rows = [row for summary in summaries if summary is not None for row in summary(result)]
     return rows + check_rows(result)
 
 

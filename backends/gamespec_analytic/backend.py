@@ -21,7 +21,7 @@ from __future__ import annotations
 import time
 from typing import ClassVar
 
-from gamespec.backend import Backend, CompiledModel, Inputs, refuse_inputs
+from gamespec.compiling import Backend, CompiledModel, Inputs, refuse_inputs
 from gamespec.loader import with_values
 from gamespec.pursuit import constant_bearing, pure_pursuit
 from gamespec.pursuit.reduced import observe, reduce

@@ -22,8 +22,8 @@ from typing import Any, ClassVar
 import numpy as np
 from pydantic import Field
 
-from gamespec.backend.lq import LQBackend, LQCompiledModel, LQSolverOptions
 from gamespec.best_response import Settings, StepReport
+from gamespec.compiling.lq import LQBackend, LQCompiledModel, LQSolverOptions
 from gamespec.errors import BackendError
 from gamespec.lqgame.covariance import CONTROLLER, STOPPER, algorithm_2, gains_to_vector
 from gamespec.lqgame.scaling import ControllerScaling, QPScaling

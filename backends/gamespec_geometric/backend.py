@@ -12,7 +12,7 @@ from typing import ClassVar, Literal
 
 from pydantic import Field
 
-from gamespec.backend import Backend, CompiledModel, Inputs, refuse_inputs
+from gamespec.compiling import Backend, CompiledModel, Inputs, refuse_inputs
 from gamespec.loader import with_values
 from gamespec.result import Result, Status
 from gamespec.specs.base import SpecBase, StrictModel

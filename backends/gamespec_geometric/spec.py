@@ -23,6 +23,7 @@ from pydantic import (
 
 from gamespec.errors import ExpressionError, SpecError
 from gamespec.limits import MAX_SIMULATION_VALUES
+from gamespec.registry import Kind
 from gamespec.specs.base import Coordinate, Number, SpecBase, Speed, StrictModel
 from gamespec.symbolic.language import parse
 
@@ -167,8 +168,6 @@ class PursuitScenarioSpec(SpecBase):
     horizon: PositiveFloat = 50.0
     allocation: Literal["auto", "avaa", "a2"] = "auto"
 
-    default_backend: ClassVar[str] = "geometric"
-
     def runtime_parameters(self) -> dict[str, float]:
         """The simulation's capture radius, time step and horizon (what a compiled scenario re-runs
         with)."""
@@ -236,3 +235,13 @@ class PursuitScenarioSpec(SpecBase):
             return self.allocation
         homogeneous = np.ptp(self.pursuers.speeds()) == 0 and np.ptp(self.evaders.speeds()) == 0
         return "avaa" if homogeneous else "a2"
+
+
+KIND = Kind(
+    PursuitScenarioSpec,
+    default_backend="geometric",
+    plot="gamespec_geometric.plot:plot_scenario",
+    summary="gamespec_geometric.report:scenario_summary",
+    metrics="gamespec_geometric.metrics:ScenarioMetrics",
+)
+"""The ``PursuitScenarioSpec`` kind as one plugin (:class:`~gamespec.registry.Kind`)."""

@@ -3,7 +3,7 @@
 Each solves the reachability stage, kind ``flow_reachability`` (:mod:`.reachability`: level sets
 of eq. 5.22 in NumPy or JAX, or extremal shooting, then the nominal paths), and the covariance game
 about its nominal paths, kind ``flow_covariance_game`` (:mod:`.game`, the same for all three). A
-``flow_field_game`` reaches them through the staged transform :mod:`gamespec.transforms.flow_game`:
+``flow_field_game`` reaches them through the staged transform :mod:`gamespec.flowfield.transform`:
 the solving layer solves its reachability stage on the backend the caller chose, and that backend
 then solves the game, so ``--backend extremals`` picks the reachability method as before.
 """
@@ -12,9 +12,9 @@ from __future__ import annotations
 
 from typing import ClassVar
 
-from gamespec.backend import Availability, Backend, CompiledModel
+from gamespec.compiling import Availability, Backend, CompiledModel
 from gamespec.specs.base import SpecBase, StrictModel
-from gamespec.specs.flow_game import FlowCovarianceGameSpec, FlowReachabilitySpec
+from gamespec.flowfield.spec import FlowCovarianceGameSpec, FlowReachabilitySpec
 from gamespec_levelset.game import CovarianceGameModel
 from gamespec_levelset.options import FlowGameOptions
 from gamespec_levelset.reachability import ReachabilityModel

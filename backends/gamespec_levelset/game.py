@@ -20,7 +20,7 @@ from typing import Any
 
 import numpy as np
 
-from gamespec.backend import CompiledModel, Inputs, refuse_inputs
+from gamespec.compiling import CompiledModel, Inputs, refuse_inputs
 from gamespec.best_response import Outcome, Settings, iterate
 from gamespec.flowfield.capture_probability import capture_probabilities
 from gamespec.flowfield.concepts import saddle_gap, solution_concept
@@ -30,7 +30,7 @@ from gamespec.flowfield.problem import CovarianceGameData, evaluate_game
 from gamespec.flowfield.simulation import simulate
 from gamespec.montecarlo import proportion
 from gamespec.result import Result, Status
-from gamespec.specs.flow_game import FlowCovarianceGameSpec
+from gamespec.flowfield.spec import FlowCovarianceGameSpec
 from gamespec_levelset.options import FlowGameOptions
 from gamespec_levelset.players import (
     EvaderStep,

@@ -21,7 +21,7 @@ from typing import Any
 
 import numpy as np
 
-from gamespec.backend import CompiledModel, Inputs, refuse_inputs
+from gamespec.compiling import CompiledModel, Inputs, refuse_inputs
 from gamespec.flowfield.covariance_game import PLAYERS
 from gamespec.flowfield.extremals import capture_by_extremals
 from gamespec.flowfield.grid import Grid
@@ -36,7 +36,7 @@ from gamespec.flowfield.nominal import NominalPaths, from_extremals, from_level_
 from gamespec.flowfield.problem import FlowGameData, evaluate
 from gamespec.flowfield.stages import reachability_key
 from gamespec.result import Result, Status
-from gamespec.specs.flow_game import FlowReachabilitySpec
+from gamespec.flowfield.spec import FlowReachabilitySpec
 from gamespec_levelset.verdicts import verdicts
 
 GRID_ERROR_STEPS = 0.05

@@ -19,8 +19,8 @@ from typing import Any, ClassVar, Literal
 import numpy as np
 from pydantic import Field, ValidationInfo, field_validator
 
-from gamespec.backend import Availability, Inputs
-from gamespec.backend.collocation import IPOPT_DEFAULTS, CollocationBackend, CollocationModel
+from gamespec.compiling import Availability, Inputs
+from gamespec.compiling.collocation import IPOPT_DEFAULTS, CollocationBackend, CollocationModel
 from gamespec.errors import BackendError
 from gamespec.ocp.transcription import Bounds, Transcription
 from gamespec.result import Result, Status

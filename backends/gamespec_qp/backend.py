@@ -21,7 +21,7 @@ from typing import TYPE_CHECKING, ClassVar
 import numpy as np
 from scipy.sparse import csc_matrix
 
-from gamespec.backend.lq import LQBackend, LQCompiledModel, LQSolverOptions
+from gamespec.compiling.lq import LQBackend, LQCompiledModel, LQSolverOptions
 from gamespec.lqgame.solution import MeanOutcome, fallback_mean
 from gamespec.result import Result, Status
 from gamespec.specs.base import StrictModel

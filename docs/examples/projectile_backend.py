@@ -12,7 +12,7 @@ import numpy as np
 from pydantic import Field
 
 from gamespec import registry
-from gamespec.backend import Backend, CompiledModel, Inputs, refuse_inputs
+from gamespec.compiling import Backend, CompiledModel, Inputs, refuse_inputs
 from gamespec.result import Result, Status
 from gamespec.specs.base import StrictModel
 

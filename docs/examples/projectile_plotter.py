@@ -1,8 +1,11 @@
 """A new plotter: the flight of a ``projectile`` Result. A plotter reads the Result only and
-returns the paths it wrote; ``gamespec plot`` and ``gamespec solve --plot`` call it by kind."""
+returns the paths it wrote; it is the ``plot`` of the kind's :class:`~gamespec.registry.Kind`, so
+``gamespec plot`` and ``gamespec solve --plot`` call it by kind (an installed package names it in
+its one ``Kind``: ``plot="gamespec_projectile.plotter:plot_projectile"``)."""
 
 from __future__ import annotations
 
+from dataclasses import replace
 from pathlib import Path
 
 import matplotlib
@@ -31,4 +34,4 @@ def plot_projectile(result: Result, output_dir: Path, *, animate: bool = False) 
     return [path]
 
 
-registry.register("gamespec.plotters", "projectile", plot_projectile)
+registry.register("gamespec.kinds", "projectile", replace(registry.kind("projectile"), plot=plot_projectile))

@@ -13,12 +13,12 @@ import numpy as np
 
 from gamespec.desensitize.augment import initial_values
 from gamespec.desensitize.simulate import Trajectories, cost, evaluate, rk4
+from gamespec.desensitize.spec import MonteCarloOptions
 from gamespec.desensitize.tracking import linearization, riccati_gains
 from gamespec.montecarlo import Distribution, Normal, Uniform, proportion, sample, summarize
 from gamespec.ocp.control_signal import TranscribedSignal, transcribed_signal
 from gamespec.ocp.symbolic import SymbolicOcp
 from gamespec.result import Result
-from gamespec.specs.desensitize import MonteCarloOptions
 from gamespec.specs.uncertainty import UncertainParameter
 from gamespec.symbolic.language import symbol
 

@@ -4,7 +4,7 @@ The nominal objective and the sensitivity cost it was traded against (eq. 6.26's
 final sensitivities ``S(t_f)`` (eqs. 6.24, 6.50) and the measure ``∫ Sᵀ S dt``, and the Monte Carlo
 of the open-loop control about the nominal (§6.3.1): each original state's final mean and standard
 deviation, the LQR-tracking closed loop's (eqs. 6.27–6.29) and its control energy, where it ran.
-Registered in ``gamespec.summaries`` under the transform's name (``desensitize``) and read from the
+The ``desensitize`` transform names it as its ``summary``; it reads the
 Result alone.
 """
 

@@ -1,4 +1,4 @@
-"""Pursuit-evasion in stochastic flow fields (chapter 5): the numerics.
+"""Pursuit-evasion in stochastic flow fields (chapter 5): the kind (:mod:`.spec`) and the numerics.
 
 The flow field (:mod:`.field`), forward reachability by level sets on a grid (:mod:`.grid`,
 :mod:`.upwind`, :mod:`.tvd_rk`, :mod:`.hamiltonian`, :mod:`.band`, :mod:`.scratch`,

@@ -12,7 +12,7 @@ from gamespec.flowfield.covariance_game import Feedforward, Payoff, PlayerBounds
 from gamespec.flowfield.field import FlowField
 from gamespec.flowfield.grid import Grid
 from gamespec.flowfield.nominal import NominalPaths
-from gamespec.specs.flow_game import FlowCovarianceGameSpec, FlowGameSpec, PlayerValues
+from gamespec.flowfield.spec import FlowCovarianceGameSpec, FlowGameSpec, PlayerValues
 
 
 @dataclass(frozen=True)

@@ -1,4 +1,4 @@
-"""Chapter 5 as two stages: what :mod:`gamespec.transforms.flow_game` writes and reads.
+"""Chapter 5 as two stages: what :mod:`gamespec.flowfield.transform` writes and reads.
 
 Stage 1, reachability (section 5.2): the ``flow_field_game`` without its diffusion (the
 disturbance term is ignored, so the flow is the drift alone) and without a Monte Carlo, as a
@@ -21,7 +21,7 @@ from typing import Any
 
 from gamespec.flowfield.problem import FlowGameData, evaluate
 from gamespec.result import Result
-from gamespec.specs.flow_game import FlowCovarianceGameSpec, FlowGameSpec, FlowReachabilitySpec
+from gamespec.flowfield.spec import FlowCovarianceGameSpec, FlowGameSpec, FlowReachabilitySpec
 
 NOMINAL_ARRAYS = ("nominal_time", "nominal_positions", "nominal_directions")
 """The arrays of the nominal paths in a reachability Result (the directions only feed the game)."""

@@ -16,22 +16,17 @@ from typing import ClassVar
 
 import numpy as np
 
-from gamespec.backend import Backend, CompiledModel, Inputs, refuse_inputs
+from gamespec.compiling import Backend, CompiledModel, Inputs, refuse_inputs
 from gamespec.games.equilibrium import GameModel, GameSolution, equilibrium_report, status_of
 from gamespec.games.existence import existence
 from gamespec.games.feedback import LQGame
 from gamespec.games.feedback_game import feedback_equilibrium
 from gamespec.games.lq_structure import LQForm, lq_form, lq_game
 from gamespec.games.problems import initial_state
-from gamespec.games.simulate import TrueSystem, control_signal, grid_of
+from gamespec.games.simulate import TrueSystem, control_signal, grid_of, true_parameters
 from gamespec.result import Result, Status
 from gamespec.specs.base import SpecBase, StrictModel
 from gamespec.specs.differential_game import DifferentialGameSpec
-
-
-def true_parameters(model: GameModel) -> dict[str, float]:
-    """The game's parameter values with every uncertain one at its true value."""
-    return dict(model.parameters) | {n: u.actual for n, u in model.game.problem.uncertain.items()}
 
 
 def open_loop(model: GameModel) -> Result:

@@ -33,10 +33,9 @@ import numpy as np
 
 from gamespec import terminal
 from gamespec.errors import SpecError
-from gamespec.games.backend import true_parameters
 from gamespec.games.equilibrium import GameModel, GameSolution
 from gamespec.games.problems import initial_state, predicted_states
-from gamespec.games.simulate import TrueSystem, control_signal, grid_of
+from gamespec.games.simulate import TrueSystem, control_signal, grid_of, true_parameters
 from gamespec.result import Result, Status
 from gamespec.specs.differential_game import DifferentialGameSpec, intervals_per_step, sensitivity_name
 from gamespec.symbolic.calculus import numeric_function

@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import itertools
 from collections.abc import Callable, Mapping
+from typing import TYPE_CHECKING
 
 import numpy as np
 from scipy.integrate import solve_ivp
@@ -22,7 +23,15 @@ from gamespec.specs.ocp import MethodSpec
 from gamespec.symbolic.calculus import numeric_function
 from gamespec.symbolic.language import parse, symbol
 
+if TYPE_CHECKING:
+    from gamespec.games.equilibrium import GameModel
+
 Signal = Callable[[float], float]
+
+
+def true_parameters(model: GameModel) -> dict[str, float]:
+    """The game's parameter values with every uncertain one at its true value."""
+    return dict(model.parameters) | {n: u.actual for n, u in model.game.problem.uncertain.items()}
 
 
 def grid_of(method: MethodSpec) -> Grid:

@@ -3,7 +3,7 @@
 A backend supplies the mean steering solution (a QP, section 4.3) and the covariance gains
 (eq. 4.59 or Algorithm 2, section 4.4); :func:`assemble` joins them by Props. 7–8
 (``U = Ū + K y``), recomputes the terminal statistics, the closed-form gap, the Monte Carlo check,
-and packs the Result. :mod:`gamespec.backend.lq` drives these steps for every backend.
+and packs the Result. :mod:`gamespec.compiling.lq` drives these steps for every backend.
 """
 
 from __future__ import annotations

@@ -1,6 +1,5 @@
-"""Metrics of ``engagement`` and ``pursuit_suboptimal_study`` Results: what
-:mod:`gamespec.pursuit.plotting`, :mod:`gamespec.pursuit.study_plot`, the engagement summary and
-``gamespec pursuit study`` read."""
+"""Metrics of ``engagement`` Results: what :mod:`gamespec.pursuit.plotting` and the engagement
+summary read."""
 
 from __future__ import annotations
 
@@ -70,31 +69,3 @@ class EngagementMetrics(Metrics):
         for name in result.arrays:
             if name.startswith("path_") and name != "path_time":
                 array(result, name, 2, last=2)
-
-
-class TableRow(BaseModel):
-    """One row of a ``pursuit_suboptimal_study``'s ``metrics.table`` (Table 2.1)."""
-
-    model_config = ConfigDict(extra="allow")
-
-    v: Finite = Field(description="Evader speed.")
-    points: int | None = None
-    solved: int | None = None
-    average_variation_percent: float | None
-    maximum_variation_percent: float | None
-
-
-class SuboptimalStudyMetrics(Metrics):
-    """Metrics of a ``pursuit_suboptimal_study`` Result."""
-
-    table: list[TableRow] = Field(description="One row per speed.")
-    points: int | None = None
-    solved: int | None = None
-    computed: int | None = None
-    store: str | None = None
-
-    def check(self, result: Result) -> None:
-        v = array(result, "v", 1)
-        array(result, "variation_percent", 1, rows=len(v))
-        if len(result.arrays["variation_percent"]) != len(v):
-            raise ValueError("arrays.v and arrays.variation_percent differ in length")

@@ -42,7 +42,7 @@ def check_obstacles(result: Result, obstacles: dict[str, float]) -> None:
 
 
 class StudyRow(BaseModel):
-    """One row of ``metrics.table`` of the §6.4.4 study (:func:`gamespec.rcs.study.summarize`)."""
+    """One row of ``metrics.table`` of the §6.4.4 study (:func:`gamespec.rcs.study_points.summarize`)."""
 
     model_config = ConfigDict(extra="allow")
 

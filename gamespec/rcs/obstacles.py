@@ -14,7 +14,7 @@ from collections.abc import Mapping
 
 import sympy as sp
 
-from gamespec.specs.rcs import Obstacle
+from gamespec.rcs.spec import Obstacle
 from gamespec.symbolic.language import TIME
 
 

@@ -15,8 +15,8 @@ import sympy as sp
 from gamespec.plotting import LEGEND_RIGHT, headline
 from gamespec.rcs.obstacles import avoidance
 from gamespec.rcs.relevance import relevance
+from gamespec.rcs.spec import Obstacle
 from gamespec.result import Result
-from gamespec.specs.rcs import Obstacle
 from gamespec.symbolic.calculus import numeric_function
 from gamespec.symbolic.language import TIME, parse, symbol
 

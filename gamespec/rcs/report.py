@@ -2,8 +2,8 @@
 
 Chapter 6's headline for the RCS regularizer (§6.4) is the probability that the uncertain
 obstacles hit the solved path, estimated by Monte Carlo over the uncertain parameters with its
-confidence interval, next to the regularizer's weight and power. Registered in
-``gamespec.summaries`` under the transform's name (``rcs``) and read from the Result alone.
+confidence interval, next to the regularizer's weight and power. The ``rcs``
+transform names it as its ``summary``; it reads the Result alone.
 """
 
 from __future__ import annotations

@@ -29,14 +29,15 @@ Speed = Annotated[Number, Field(ge=0, le=MAX_SPEED)]
 def _known_backend(name: str) -> str:
     from gamespec import registry
 
-    known = registry.names("gamespec.backends")
+    known = registry.runner_names()
     if name not in known:
         raise ValueError(f"unknown backend {name!r} (known: {', '.join(known)})")
     return name
 
 
 BackendName = Annotated[str, AfterValidator(_known_backend)]
-"""The name of an installed backend (an entry point of ``gamespec.backends``), checked at load."""
+"""The name of an installed backend or study (an entry point of ``gamespec.backends`` or
+``gamespec.studies``), checked at load."""
 
 
 class StrictModel(BaseModel):
@@ -97,10 +98,17 @@ class SpecBase(StrictModel):
         description="Requested transforms, [{name: {options}}], applied in order before the solve.",
     )
 
-    default_backend: ClassVar[str] = ""
     guess_fields: ClassVar[tuple[str, ...]] = ()
     _source: str = PrivateAttr("<spec>")
     _file_hash: str = PrivateAttr("")
+
+    @property
+    def default_backend(self) -> str:
+        """The backend that solves this kind when a file names none (its :class:`~gamespec.registry.
+        Kind`'s; empty for a study kind, which its study runs)."""
+        from gamespec import registry
+
+        return registry.kind(self.kind).default_backend or ""
 
     @property
     def source(self) -> str:

@@ -28,6 +28,7 @@ from pydantic import Field, PrivateAttr, model_validator
 
 from gamespec.errors import ExpressionError, SpecError
 from gamespec.limits import MAX_BEST_RESPONSES, MAX_GAME_STATE, MAX_RECEDING_STEPS
+from gamespec.registry import Kind
 from gamespec.specs.base import Number, ProblemParameters, RequestedTransforms, SpecBase, StrictModel, Value
 from gamespec.specs.ocp import ControlSpec, MethodSpec, StateSpec, _ordered, is_time_varying
 from gamespec.specs.uncertainty import UncertainParameter
@@ -400,8 +401,6 @@ class DifferentialGameSpec(ProblemParameters, SpecBase):
     game: GameSettings = Field(default_factory=GameSettings)
     receding_horizon: RecedingHorizonSpec | None = None
 
-    default_backend = "best_response"
-
     @model_validator(mode="after")
     def _receding_horizon(self) -> DifferentialGameSpec:
         """The receding-horizon section against the problem: names of players and states, its
@@ -467,3 +466,13 @@ def intervals_per_step(step: float, horizon: float, intervals: int) -> int:
             field="receding_horizon.step",
         )
     return round(per_step)
+
+
+KIND = Kind(
+    DifferentialGameSpec,
+    default_backend="best_response",
+    plot="gamespec.games.plotting:plot_game",
+    summary="gamespec.games.report:game_summary",
+    metrics="gamespec.games.metrics:GameMetrics",
+)
+"""The ``DifferentialGameSpec`` kind as one plugin (:class:`~gamespec.registry.Kind`)."""

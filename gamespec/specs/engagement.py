@@ -16,6 +16,7 @@ from typing import Literal
 import numpy as np
 from pydantic import Field, model_validator
 
+from gamespec.registry import Kind
 from gamespec.specs.base import Coordinate, Number, SpecBase, Speed, StrictModel
 from gamespec.specs.ocp import MethodSpec
 
@@ -63,7 +64,6 @@ class EngagementSpec(SpecBase):
         "guess; default: the best constant heading (eq. 2.27 for pure pursuit), see gamespec.pursuit.guess.",
     )
 
-    default_backend = "casadi"
     guess_fields = ("guess_heading",)
 
     def runtime_parameters(self) -> dict[str, float]:
@@ -132,3 +132,13 @@ class EngagementSpec(SpecBase):
             return self.frame
         lead_pp = self.pursuers[0].strategy == "pp"
         return "line_of_sight" if lead_pp and len(self.pursuers) == 2 else "fixed"
+
+
+KIND = Kind(
+    EngagementSpec,
+    default_backend="casadi",
+    plot="gamespec.pursuit.plotting:plot_engagement",
+    summary="gamespec.pursuit.report:engagement_summary",
+    metrics="gamespec.pursuit.metrics:EngagementMetrics",
+)
+"""The ``EngagementSpec`` kind as one plugin (:class:`~gamespec.registry.Kind`)."""

@@ -24,6 +24,7 @@ from pydantic import Discriminator, Field, Tag, field_validator, model_validator
 from gamespec.best_response import Settings
 from gamespec.errors import ExpressionError, SpecError
 from gamespec.limits import MAX_INTERVALS, MAX_LQ_ENTRY, MAX_SAMPLE_VALUES, MAX_SAMPLES
+from gamespec.registry import Kind
 from gamespec.specs.base import Number, ProblemParameters, SpecBase, StrictModel, Value
 from gamespec.specs.lq_model import LQGame, zero_order_hold
 from gamespec.symbolic.grammar import RESERVED, numeric_value
@@ -199,8 +200,6 @@ class LQGameSpec(ProblemParameters, SpecBase):
     kind: Literal["lq_stochastic_game"] = "lq_stochastic_game"
     problem: LQGameProblem
     method: LQMethodSpec = Field(default_factory=LQMethodSpec)
-
-    default_backend = "cvxpy"
 
     @model_validator(mode="after")
     def _evaluates(self) -> LQGameSpec:
@@ -432,3 +431,13 @@ def _open_loop_bounded(A: np.ndarray, D: np.ndarray, Sigma0: np.ndarray) -> None
                     f"{k + 1}: the model is too unstable (or too noisy) for this horizon",
                     field="problem.horizon",
                 )
+
+
+KIND = Kind(
+    LQGameSpec,
+    default_backend="cvxpy",
+    plot="gamespec.lqgame.plotting:plot",
+    summary="gamespec.lqgame.report:lq_summary",
+    metrics="gamespec.lqgame.metrics:LqGameMetrics",
+)
+"""The ``LQGameSpec`` kind as one plugin (:class:`~gamespec.registry.Kind`)."""

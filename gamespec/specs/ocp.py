@@ -21,6 +21,7 @@ from pydantic import Field, field_validator, model_validator
 
 from gamespec.errors import ExpressionError, SpecError
 from gamespec.limits import MAX_INTERVALS
+from gamespec.registry import Kind
 from gamespec.specs.base import Number, ProblemParameters, SpecBase, StrictModel, Value
 from gamespec.specs.plot import PlotHint
 from gamespec.specs.uncertainty import UncertainParameter
@@ -615,7 +616,6 @@ class OptimalControlSpec(OcpFamily, SpecBase):
     guess: GuessSpec = Field(default_factory=GuessSpec)
     plot: PlotHint = Field(default_factory=PlotHint)
 
-    default_backend = "casadi"
     guess_fields = ("guess", "problem.time.guess")
 
     @model_validator(mode="after")
@@ -647,3 +647,13 @@ class OptimalControlSpec(OcpFamily, SpecBase):
         if p.design:
             needed.add("design_parameters")
         return frozenset(needed)
+
+
+KIND = Kind(
+    OptimalControlSpec,
+    default_backend="casadi",
+    plot="gamespec.plotting:plot_trajectories",
+    summary="gamespec.summaries:optimal_control_summary",
+    metrics="gamespec.ocp.metrics:OcpMetrics",
+)
+"""The ``OptimalControlSpec`` kind as one plugin (:class:`~gamespec.registry.Kind`)."""

@@ -13,7 +13,7 @@ from typing import Any, ClassVar
 
 from pydantic import BaseModel, Field, ValidationError
 
-from gamespec.backend import Backend, CompiledModel, Inputs, refuse_inputs
+from gamespec.compiling import Availability, CompiledModel, Inputs, refuse_inputs, validated_options
 from gamespec.errors import SpecError, UnsupportedFeature
 from gamespec.loader import spec_hash
 from gamespec.result import Result
@@ -34,7 +34,7 @@ SCHEDULER_FROM_FILE = (
 
 
 class StudyOptions(StrictModel):
-    """Options of the point-study backends (``solver.options.study``, ``solver.options.rcs_study``)
+    """Options of the point studies (``solver.options.study``, ``solver.options.rcs_study``)
     that a problem file may give; the scheduler is not one of them (:data:`USER_CHOICES`)."""
 
     workers: int = Field(1, ge=1, description="Worker processes (1: everything in this process).")
@@ -124,12 +124,20 @@ class PointStudyModel(CompiledModel):
         return result.model_copy(update={"message": message, "solve_time_s": time.perf_counter() - tic})
 
 
-class PointStudyBackend(Backend):
-    """A backend that runs a point study: checks that its ``ocp_backend`` is there, then builds
-    :attr:`model`."""
+class PointStudy:
+    """A :class:`~gamespec.compiling.study_protocol.Study` of independent points: checks that the
+    file's ``ocp_backend`` is there, then builds :attr:`model`."""
 
+    name: ClassVar[str]
+    kinds: ClassVar[frozenset[str]]
+    features: ClassVar[frozenset[str]] = frozenset()
     options_model: ClassVar[type[StrictModel]] = StudyOptions
     model: ClassVar[type[PointStudyModel]]
+
+    @classmethod
+    def available(cls) -> Availability:
+        """Always: a point study needs only gamespec (its points' backend is checked at compile)."""
+        return Availability(True, "needs nothing beyond gamespec's dependencies")
 
     @classmethod
     def validate_options(cls, raw: Mapping[str, Any], source: str = "<spec>") -> StrictModel:
@@ -137,20 +145,23 @@ class PointStudyBackend(Backend):
         for name in USER_CHOICES:
             if name in raw:
                 raise SpecError(SCHEDULER_FROM_FILE, field=f"solver.options.{cls.name}.{name}", source=source)
-        return super().validate_options(raw, source)
+        return validated_options(cls.options_model, cls.name, raw, source)
 
     def options(self, spec: SpecBase, overrides: dict[str, Any] | None = None) -> StudyRunOptions:
         """The file's options (:meth:`validate_options`) with the caller's ``overrides``, which
         alone may say where the study runs (``scheduler``, ``insecure_scheduler``)."""
         chosen = dict(overrides or {})
         where = {name: chosen.pop(name) for name in USER_CHOICES if name in chosen}
-        given = super().options(spec, chosen)
+        given = self.validate_options({**spec.solver.options.get(self.name, {}), **chosen}, spec.source)
         try:
             return StudyRunOptions.model_validate(given.model_dump() | where)
         except ValidationError as err:
             raise SpecError(_first_error(err), field="options", source=spec.source) from None
 
-    def _compile(self, spec: SpecBase, options: StudyOptions) -> PointStudyModel:
+    def compile(self, spec: SpecBase, options: StrictModel) -> PointStudyModel:
+        """The study of ``spec`` ready to run; UnsupportedFeature for a kind it does not run."""
+        if spec.kind not in self.kinds:
+            raise UnsupportedFeature(f"study {self.name!r} does not run kind {spec.kind!r}")
         get_backend(spec.ocp_backend)
         return self.model(spec, options)
 

@@ -20,7 +20,9 @@ change.
 *Requested* transforms (``requested = True``: same kind to same kind, applied when a file lists them
 under ``transforms:``, with options validated by ``options_model``) come first, in the file's
 order; then *lowering* transforms, found by kind (:func:`lowering_path`). Transforms register in
-the ``gamespec.transforms`` entry-point group under their ``name``.
+the ``gamespec.transforms`` entry-point group under their ``name``. A transform owns the figures and
+summary rows of what it adds to a Result (``plot``, ``summary``: ``"module:function"`` texts, imported
+when a Result that went through it is plotted or summarized; :func:`gamespec.registry.transform_parts`).
 """
 
 from __future__ import annotations
@@ -31,7 +33,7 @@ from dataclasses import dataclass
 from typing import Any, ClassVar
 
 from gamespec import registry
-from gamespec.backend import NoOptions
+from gamespec.compiling import NoOptions
 from gamespec.result import Result
 from gamespec.specs.base import SpecBase, StrictModel
 from gamespec.specs.requested import entry, transform_class, validated_options
@@ -54,6 +56,12 @@ class Transform(ABC):
     target_kind: ClassVar[str]
     requested: ClassVar[bool] = False
     options_model: ClassVar[type[StrictModel]] = NoOptions
+    plot: ClassVar[str | None] = None
+    """``"module:function"``: ``plot(result, output_dir) -> list[Path]``, the figures of what this
+    transform adds to a Result (None: none)."""
+    summary: ClassVar[str | None] = None
+    """``"module:function"``: ``summary(result) -> list[(label, value)]``, its rows in ``gamespec
+    solve``'s table (None: none)."""
 
     def accepts(self, spec: SpecBase) -> bool:
         """Whether this transform applies to ``spec`` (by default: any spec of ``source_kind``)."""

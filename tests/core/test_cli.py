@@ -10,7 +10,7 @@ import yaml
 
 import gamespec
 from gamespec import registry
-from gamespec.backend import Availability
+from gamespec.compiling import Availability
 from gamespec.loader import spec_from_dict
 from gamespec.specs.schema import json_schema
 from tests.conftest import PROBLEMS

@@ -13,7 +13,7 @@ from scipy.integrate import quad
 from scipy.optimize import fsolve
 
 import gamespec
-from gamespec.backend.refinement import refined_mesh, trajectory_of
+from gamespec.compiling.refinement import refined_mesh, trajectory_of
 from gamespec.loader import spec_from_dict
 from gamespec.ocp.checks import hamiltonian
 from gamespec.ocp.transcription import Transcription

@@ -11,7 +11,7 @@ import pytest
 import sympy as sp
 
 import gamespec
-from gamespec.backend.refinement import refined_mesh
+from gamespec.compiling.refinement import refined_mesh
 from gamespec.errors import ExpressionError, SpecError
 from gamespec.loader import spec_from_dict
 from gamespec.ocp.symbolic import SymbolicOcp

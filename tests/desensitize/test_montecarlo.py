@@ -7,9 +7,9 @@ import pytest
 import yaml
 
 from gamespec.desensitize.montecarlo import monte_carlo
+from gamespec.desensitize.spec import MonteCarloOptions
 from gamespec.desensitize.tracking import CONTROL_WEIGHT, riccati_gains
 from gamespec.ocp.symbolic import SymbolicOcp
-from gamespec.specs.desensitize import MonteCarloOptions
 from tests.desensitize.helpers import FINAL, TRAJECTORY, FileSolver, file_solver
 
 

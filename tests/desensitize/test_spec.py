@@ -7,10 +7,10 @@ import copy
 import pytest
 import yaml
 
+from gamespec.desensitize.spec import DesensitizeOptions
+from gamespec.desensitize.transform import Desensitize
 from gamespec.errors import SpecError
 from gamespec.loader import spec_from_dict
-from gamespec.specs.desensitize import DesensitizeOptions
-from gamespec.transforms.desensitize import Desensitize
 from tests.desensitize.helpers import FINAL, TRAJECTORY
 
 

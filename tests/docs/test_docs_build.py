@@ -40,7 +40,7 @@ def test_mkdocs_build_strict(tmp_path) -> None:
         fields = registry.spec_class(kind).model_json_schema()["properties"]
         assert all(name in page for name in fields), kind
         assert "Worked example" in page, kind
-    for name in registry.names("gamespec.backends"):
-        options = registry.backend_class(name).options_model.model_json_schema().get("properties", {})
+    for name in registry.runner_names():
+        options = registry.runner_class(name).options_model.model_json_schema().get("properties", {})
         assert all(option in text["backends"] for option in options), name
     assert "spec_from_dict" in text["api"] and "class ProjectileToOcp" in text["extending"]

@@ -1,4 +1,4 @@
-"""Chapter 5 as a staged chain (:mod:`gamespec.transforms.flow_game`): the reachability stage
+"""Chapter 5 as a staged chain (:mod:`gamespec.flowfield.transform`): the reachability stage
 solved once by the solving layer, the covariance game it writes (``gamespec show --transformed``),
 and re-solves with a new noise level that reuse the stage (a call counter on the reachability
 solve) and equal a fresh compile."""
@@ -14,7 +14,7 @@ from gamespec_levelset import reachability
 
 from gamespec.loader import load, spec_from_dict
 from gamespec.solving import compile_spec, solve
-from gamespec.specs.flow_game import FlowCovarianceGameSpec
+from gamespec.flowfield.spec import FlowCovarianceGameSpec
 from tests.flowfield.test_flow_game import SPEC, T_EXACT
 
 

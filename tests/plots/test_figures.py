@@ -169,7 +169,7 @@ def test_a_circular_obstacle_is_drawn_as_a_disk(tmp_path: Path) -> None:
 
 
 def test_a_keep_in_circle_is_an_outline() -> None:
-    from gamespec.obstacles import circle_of
+    from gamespec.rcs.circles import circle_of
 
     inside = circle_of("x**2 + y**2 <= 4", ("x", "y"), ["x", "y"], {})
     assert inside.center == pytest.approx((0.0, 0.0)) and inside.radius == pytest.approx(2.0)

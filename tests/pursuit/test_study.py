@@ -10,11 +10,12 @@ import numpy as np
 import pytest
 
 import gamespec
-from gamespec.pursuit import regions, study
-from gamespec.pursuit.study import StudyPoint
+from gamespec.pursuit import regions
 from gamespec.result import Result
-from gamespec.studies import suboptimal_study
 from gamespec.studies.store import ResultStore
+from gamespec.suboptimal_study import points as study
+from gamespec.suboptimal_study import study as suboptimal_study
+from gamespec.suboptimal_study.points import StudyPoint
 from gamespec.summaries import outcome
 from tests.conftest import PROBLEMS
 

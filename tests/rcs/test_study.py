@@ -6,9 +6,9 @@ import json
 import pytest
 import yaml
 
-from gamespec.rcs.study import layout
+from gamespec.rcs.study_points import layout
+from gamespec.rcs.study_spec import RcsStudySpec
 from gamespec.result import Result
-from gamespec.specs.rcs_study import RcsStudySpec
 from gamespec.summaries import outcome
 from tests.conftest import PROBLEMS
 

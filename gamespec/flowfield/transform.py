@@ -22,7 +22,7 @@ from gamespec.flowfield.stages import (
 )
 from gamespec.result import Result
 from gamespec.specs.base import StrictModel
-from gamespec.specs.flow_game import FlowCovarianceGameSpec, FlowGameSpec
+from gamespec.flowfield.spec import FlowCovarianceGameSpec, FlowGameSpec
 from gamespec.transforms.base import Stage, Transform
 
 

@@ -31,7 +31,9 @@ import numpy as np
 import sympy as sp
 
 from gamespec.desensitize.augment import NewState, sensitivity_functions
+from gamespec.desensitize.penalized import InverseData, Penalty, augmented_spec, report
 from gamespec.desensitize.simulate import dense_integral, evaluate, values_at
+from gamespec.desensitize.spec import DesensitizeOptions
 from gamespec.errors import ExpressionError, SpecError
 from gamespec.ocp.symbolic import SymbolicOcp
 from gamespec.ocp.transcription import Transcription
@@ -44,15 +46,13 @@ from gamespec.rcs.sensitivity import (
     state_sensitivity,
     weighted_square,
 )
+from gamespec.rcs.spec import MovingObstaclesOptions, RcsOptions
 from gamespec.result import Result, Status
 from gamespec.specs.base import SpecBase
-from gamespec.specs.desensitize import DesensitizeOptions
 from gamespec.specs.ocp import GuessSpec, OptimalControlSpec
-from gamespec.specs.rcs import MovingObstaclesOptions, RcsOptions
 from gamespec.symbolic.language import TIME, parse, symbol
 from gamespec.symbolic.printer import to_text
 from gamespec.transforms.base import OcpRewrite
-from gamespec.transforms.desensitize import InverseData, Penalty, augmented_spec, report
 
 
 def _parser(spec: OptimalControlSpec, field: str, running: bool = False):
@@ -137,6 +137,8 @@ class Rcs(OcpRewrite):
     """Relevant constraint sensitivity (eqs. 6.31-6.36), or eq. 6.32 with ``relevant: false``."""
 
     name: ClassVar[str] = "rcs"
+    plot: ClassVar[str] = "gamespec.rcs.plotting:plot_rcs"
+    summary: ClassVar[str] = "gamespec.rcs.report:rcs_summary"
     options_model: ClassVar[type[RcsOptions]] = RcsOptions
 
     def apply(

@@ -42,7 +42,7 @@ from gamespec.symbolic.printer import to_text
 from gamespec.symbolic.translate import numeric
 
 if TYPE_CHECKING:
-    from gamespec.specs.multiphase import MultiPhaseSpec, PhaseSpec
+    from gamespec.multiphase.spec import MultiPhaseSpec, PhaseSpec
 
 SEPARATOR = "__"
 """Joins a name and a phase name in the lowered problem (``x__boost``); refused in user names."""

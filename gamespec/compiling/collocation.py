@@ -9,7 +9,7 @@ from abc import abstractmethod
 from collections.abc import Mapping
 from typing import Any, ClassVar
 
-from gamespec.backend import Backend, CompiledModel, Inputs
+from gamespec.compiling import Backend, CompiledModel, Inputs
 from gamespec.ocp.inputs import InputGrid
 from gamespec.ocp.transcription import Transcription
 from gamespec.result import Result
@@ -70,11 +70,11 @@ class CollocationModel(CompiledModel):
         self, parameters: dict[str, float] | None = None, guess: Result | None = None, inputs: Inputs = None
     ) -> Result:
         """One solve on this mesh, then adaptive refinement when ``method.refine`` asks for it
-        (:mod:`gamespec.backend.refinement`)."""
+        (:mod:`gamespec.compiling.refinement`)."""
         result = self.solve_once(parameters, guess, inputs)
         if self.tr.spec.method.refine is None:
             return result
-        from gamespec.backend.refinement import refined
+        from gamespec.compiling.refinement import refined
 
         return refined(self, result, parameters, inputs)
 

@@ -2,19 +2,20 @@
 
 The suboptimal constant heading of eq. 2.27 against the optimal evasion of Proposition 1, two
 identical pure-pursuit pursuers, over a grid of initial conditions per evader speed (see
-:mod:`gamespec.pursuit.study`). The ``study`` backend runs it; every finished point is saved under
-``store`` as it completes, so solving the same file again resumes where it stopped.
+:mod:`gamespec.suboptimal_study.points`). The ``study`` study runs it; every finished point is
+saved under ``store`` as it completes, so solving the same file again resumes where it stopped.
 """
 
 from __future__ import annotations
 
 from pathlib import Path
-from typing import ClassVar, Literal
+from typing import Literal
 
 from pydantic import Field, ValidationError, ValidationInfo, field_validator, model_validator
 
 from gamespec.errors import SpecError
 from gamespec.limits import MAX_STUDY_POINTS
+from gamespec.registry import Kind
 from gamespec.specs.base import BackendName, Number, SpecBase, StrictModel
 from gamespec.specs.ocp import MethodSpec
 
@@ -23,7 +24,7 @@ MethodChange = dict[str, int | float | str]
 
 
 class StudyGrid(StrictModel):
-    """The grid of (r2(0), ψ(0)) per speed (see :mod:`gamespec.pursuit.study`)."""
+    """The grid of (r2(0), ψ(0)) per speed (see :mod:`gamespec.suboptimal_study.points`)."""
 
     angles: int = Field(16, ge=1, description="Values of psi(0), evenly spread, none on P1's ray.")
     fractions: int = Field(9, ge=1, description="Values of r2(0) per angle, between F and E.")
@@ -54,8 +55,6 @@ class SuboptimalStudySpec(SpecBase):
         description="Folder of the per-point records (relative to the current directory); "
         "solving the file again skips the points it holds.",
     )
-
-    default_backend: ClassVar[str] = "study"
 
     @model_validator(mode="after")
     def _grid_fits(self) -> SuboptimalStudySpec:
@@ -108,3 +107,13 @@ class SuboptimalStudySpec(SpecBase):
         base = self.method.model_dump()
         steps = [self.method, *(MethodSpec.model_validate(base | r) for r in self.refinements)]
         return tuple(m.model_dump_json() for m in steps)
+
+
+KIND = Kind(
+    SuboptimalStudySpec,
+    study="study",
+    plot="gamespec.suboptimal_study.plotting:plot_study",
+    summary="gamespec.studies.report:study_summary",
+    metrics="gamespec.suboptimal_study.metrics:SuboptimalStudyMetrics",
+)
+"""The ``SuboptimalStudySpec`` kind as one plugin (:class:`~gamespec.registry.Kind`)."""

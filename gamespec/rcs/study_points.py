@@ -1,5 +1,5 @@
 """The points of the §6.4.4 trade-off study and what each one keeps (see
-:mod:`gamespec.specs.rcs_study` for the layout and the reading of σ).
+:mod:`gamespec.rcs.study_spec` for the layout and the reading of σ).
 
 Each point (N, α) is an ``optimal_control`` problem with the ``moving_obstacles`` and ``rcs``
 transforms, solved from every initial guess of ``guesses`` (a homotopy class each); the best
@@ -14,7 +14,7 @@ from typing import Any
 
 import numpy as np
 
-from gamespec.specs.rcs_study import RcsStudySpec
+from gamespec.rcs.study_spec import RcsStudySpec
 
 
 @dataclass(frozen=True)

@@ -13,7 +13,7 @@ drop; a state not named there is continuous). The Mayer term and ``boundary_cons
 start and end, and ``t_0``, ``t_f`` for its start and end times.
 
 The kind is lowered to one ``optimal_control`` problem by the ``phases`` transform
-(:mod:`gamespec.specs.phase_lowering` says how); loading a file lowers it once, so every
+(:mod:`gamespec.multiphase.lowering` says how); loading a file lowers it once, so every
 expression is checked at load with the field that holds it.
 """
 
@@ -25,6 +25,8 @@ from pydantic import Field, field_validator, model_validator
 
 from gamespec.errors import ExpressionError, SpecError
 from gamespec.limits import MAX_INTERVALS
+from gamespec.multiphase.lowering import SEPARATOR, lower
+from gamespec.registry import Kind
 from gamespec.specs.base import Number, SpecBase, StrictModel, Value
 from gamespec.specs.ocp import (
     NORMALIZED_TIME,
@@ -37,7 +39,6 @@ from gamespec.specs.ocp import (
     OcpFamily,
     StateSpec,
 )
-from gamespec.specs.phase_lowering import SEPARATOR, lower
 from gamespec.specs.plot import PlotHint
 from gamespec.symbolic.language import RESERVED
 
@@ -184,8 +185,6 @@ class MultiPhaseSpec(OcpFamily, SpecBase):
     method: MethodSpec = Field(default_factory=MethodSpec)
     plot: PlotHint = Field(default_factory=PlotHint)
 
-    default_backend = "casadi"
-
     @model_validator(mode="after")
     def _lowers(self) -> MultiPhaseSpec:
         """The phases lower to one ``optimal_control`` problem; an expression the lowering generates
@@ -199,3 +198,13 @@ class MultiPhaseSpec(OcpFamily, SpecBase):
                 f"the phases do not lower to one problem: {err}", field="problem.phases"
             ) from None
         return self
+
+
+KIND = Kind(
+    MultiPhaseSpec,
+    default_backend="casadi",
+    plot="gamespec.plotting:plot_trajectories",
+    summary="gamespec.summaries:multiphase_summary",
+    metrics="gamespec.ocp.metrics:OcpMetrics",
+)
+"""The ``MultiPhaseSpec`` kind as one plugin (:class:`~gamespec.registry.Kind`)."""

@@ -28,7 +28,7 @@ import numpy as np
 
 from gamespec.pursuit.regions import classify
 from gamespec.specs.engagement import EngagementSpec
-from gamespec.specs.suboptimal_study import SuboptimalStudySpec
+from gamespec.suboptimal_study.spec import SuboptimalStudySpec
 
 DEFECT_TOL = 1e-3
 """Largest re-integrated defect (``checks.max_defect``) of an accepted optimal solution."""

@@ -35,7 +35,7 @@ from gamespec.ocp.checks import Trajectory, relative_defects
 from gamespec.result import Result
 
 if TYPE_CHECKING:
-    from gamespec.backend.collocation import CollocationModel
+    from gamespec.compiling.collocation import CollocationModel
     from gamespec.ocp.transcription import Transcription
     from gamespec.specs.ocp import RefineSpec
 

@@ -1,9 +1,9 @@
 """``multiphase_optimal_control`` → ``optimal_control``: the phases as one NLP.
 
-:meth:`PhasesToOcp.apply` is :func:`gamespec.specs.phase_lowering.lower` (each phase's copy of the
+:meth:`PhasesToOcp.apply` is :func:`gamespec.multiphase.lowering.lower` (each phase's copy of the
 states and controls on a common normalized time, each duration a design variable or a parameter,
 the links boundary constraints); :meth:`PhasesToOcp.invert` is
-:func:`gamespec.ocp.phases.split_by_phase` (the trajectories end to end on the real time, phase
+:func:`gamespec.multiphase.split.split_by_phase` (the trajectories end to end on the real time, phase
 boundaries in ``metrics["phases"]``, checks per phase). Both are pure; the fixed durations are
 parameters of the lowered problem, so a compiled model re-solves for new parameter values.
 """
@@ -12,12 +12,12 @@ from __future__ import annotations
 
 from typing import ClassVar
 
-from gamespec.ocp.phases import split_by_phase
+from gamespec.multiphase.lowering import Lowering, lower
+from gamespec.multiphase.spec import MultiPhaseSpec
+from gamespec.multiphase.split import split_by_phase
 from gamespec.result import Result
 from gamespec.specs.base import StrictModel
-from gamespec.specs.multiphase import MultiPhaseSpec
 from gamespec.specs.ocp import OptimalControlSpec
-from gamespec.specs.phase_lowering import Lowering, lower
 from gamespec.transforms.base import Transform
 
 

@@ -18,7 +18,7 @@ Validation at load evaluates every entry through the symbolic layer only (SymPy 
 (:func:`gamespec.flowfield.problem.evaluate`).
 
 The chapter's two stages have specs of their own, which the staged transform
-:mod:`gamespec.transforms.flow_game` writes: ``flow_reachability`` (:class:`FlowReachabilitySpec`,
+:mod:`gamespec.flowfield.transform` writes: ``flow_reachability`` (:class:`FlowReachabilitySpec`,
 section 5.2: the game without its diffusion, solved for ``T̂``, ``x_f`` and the nominal paths; the
 solving layer's upstream stage, not a kind of file) and the kind ``flow_covariance_game``
 (:class:`FlowCovarianceGameSpec`, section 5.3: the chance-constrained covariance game about those
@@ -37,6 +37,7 @@ from pydantic import Field, FiniteFloat, PositiveFloat, model_validator
 
 from gamespec.errors import ExpressionError, SpecError
 from gamespec.limits import MAX_EXTREMAL_VALUES, MAX_GRID_CELL_STEPS, MAX_SAMPLE_STEPS
+from gamespec.registry import Kind
 from gamespec.specs.base import ProblemParameters, SpecBase, StrictModel, Value
 from gamespec.symbolic.calculus import jacobian, numeric_function
 from gamespec.symbolic.language import RESERVED, parse, symbol
@@ -243,8 +244,6 @@ class FlowGameSpec(ProblemParameters, SpecBase):
     problem: FlowGameProblem
     method: FlowGameMethod
 
-    default_backend = "levelset"
-
     @property
     def objective_sense(self) -> str:
         """``saddle``: the objective is the game's value, which the pursuer minimizes and the
@@ -339,14 +338,12 @@ class CovarianceGameMethod(StrictModel):
 class FlowCovarianceGameSpec(ProblemParameters, SpecBase):
     """The chance-constrained covariance game of section 5.3 (eqs. 5.27–5.36) about given nominal
     paths: the backend linearizes the flow along them (eqs. 5.5–5.8), lifts the model (eq. 5.10)
-    and solves the game; what :mod:`gamespec.transforms.flow_game` makes of a ``flow_field_game``
+    and solves the game; what :mod:`gamespec.flowfield.transform` makes of a ``flow_field_game``
     once its reachability stage is solved. Its runtime parameters are the flow game's."""
 
     kind: Literal["flow_covariance_game"] = "flow_covariance_game"
     problem: CovarianceGameProblem
     method: CovarianceGameMethod = Field(default_factory=CovarianceGameMethod)
-
-    default_backend = "levelset"
 
     @property
     def objective_sense(self) -> str:
@@ -522,3 +519,17 @@ class _Evaluator:
             grid_upper=m.grid.upper,
             grid_nodes=m.grid.nodes,
         )
+
+
+KIND = Kind(
+    FlowGameSpec,
+    default_backend="levelset",
+    plot="gamespec.flowfield.plotting:plot",
+    summary="gamespec.flowfield.report:flow_game_summary",
+    metrics="gamespec.flowfield.metrics:FlowGameMetrics",
+)
+"""The ``FlowGameSpec`` kind as one plugin (:class:`~gamespec.registry.Kind`)."""
+
+COVARIANCE_GAME_KIND = Kind(FlowCovarianceGameSpec, default_backend="levelset")
+"""The ``FlowCovarianceGameSpec`` kind (what the staged lowering writes; no plotter or summary of its
+own: its Results are mapped back to the ``flow_field_game`` that asked for them)."""

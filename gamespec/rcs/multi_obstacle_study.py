@@ -1,8 +1,8 @@
-"""The ``rcs_study`` backend: runs an ``rcs_multi_obstacle_study`` (Fig. 6.11) point by point
+"""The ``rcs_study`` study: runs an ``rcs_multi_obstacle_study`` (Fig. 6.11) point by point
 through :func:`gamespec.studies.runner.run_study` into a :class:`~gamespec.studies.store.ResultStore`
 at the spec's ``store`` (points already stored are reused, so solving again resumes).
 
-The Result: ``metrics.table`` (one row per (N, α), :func:`gamespec.rcs.study.summarize`),
+The Result: ``metrics.table`` (one row per (N, α), :func:`gamespec.rcs.study_points.summarize`),
 ``metrics.layout`` (the obstacles' x_i, y_i(0) and directions per N), ``arrays`` the kept paths.
 Status ``optimal`` when every point solved, ``feasible`` when some did not, ``error`` when none did.
 """
@@ -17,12 +17,11 @@ from pydantic import BaseModel, ConfigDict, model_validator
 
 from gamespec.loader import spec_from_dict
 from gamespec.metrics import Finite
-from gamespec.rcs import study
-from gamespec.rcs.study import StudyPoint, point_problem
+from gamespec.rcs.study_points import StudyPoint, arrays, layout, point_problem, study_points, summarize
+from gamespec.rcs.study_spec import RcsStudySpec
 from gamespec.result import Result, Status
 from gamespec.solving import solve
-from gamespec.specs.rcs_study import RcsStudySpec
-from gamespec.studies.point_study import PointStudyBackend, PointStudyModel
+from gamespec.studies.point_study import PointStudy, PointStudyModel
 from gamespec.studies.runner import StudyRun
 
 
@@ -96,7 +95,7 @@ class RcsStudyModel(PointStudyModel):
     row_model = StoredRow
 
     def points(self) -> dict[str, Any]:
-        return study.study_points(self.spec)
+        return study_points(self.spec)
 
     def point_function(self) -> Callable[[Any], dict[str, Any]]:
         return evaluate
@@ -111,15 +110,15 @@ class RcsStudyModel(PointStudyModel):
         return Result(
             status=status,
             message=message,
-            arrays=study.arrays(rows),
+            arrays=arrays(rows),
             metrics={
-                "table": study.summarize(rows),
+                "table": summarize(rows),
                 "points": len(rows),
                 "solved": solved,
                 "sigma": self.spec.std,
                 "sigma_is": self.spec.sigma_is,
                 "radius": self.spec.radius,
-                "layout": {str(n): study.layout(self.spec, n) for n in self.spec.obstacles},
+                "layout": {str(n): layout(self.spec, n) for n in self.spec.obstacles},
                 "seconds": {f"N={r['obstacles']},alpha={r['alpha']:g}": r["seconds"] for r in rows},
                 "computed": run.computed,
                 "store": str(self.spec.store),
@@ -127,7 +126,7 @@ class RcsStudyModel(PointStudyModel):
         )
 
 
-class RcsStudyBackend(PointStudyBackend):
+class RcsStudy(PointStudy):
     """Runs the §6.4.4 study (see module doc); each point's OCP is solved on ``ocp_backend``."""
 
     name: ClassVar[str] = "rcs_study"

@@ -29,9 +29,9 @@ from collections.abc import Iterable, Mapping
 
 from pydantic import Field, field_validator
 
+from gamespec.desensitize.spec import MonteCarloOptions
 from gamespec.errors import ExpressionError, SpecError
 from gamespec.specs.base import StrictModel, Value
-from gamespec.specs.desensitize import MonteCarloOptions
 from gamespec.specs.ocp import GuessSpec
 from gamespec.symbolic.grammar import FLOATS, expression, unknowns
 

@@ -18,7 +18,7 @@ from typing import Any, ClassVar
 
 from pydantic import Field
 
-from gamespec.backend import Availability, Backend, CompiledModel, Inputs, refuse_inputs
+from gamespec.compiling import Availability, Backend, CompiledModel, Inputs, refuse_inputs
 from gamespec.errors import BackendError, SpecError
 from gamespec.lqgame.solution import (
     CovarianceOutcome,

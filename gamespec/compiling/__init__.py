@@ -57,6 +57,21 @@ def refuse_inputs(inputs: Inputs, kind: str) -> None:
         )
 
 
+def validated_options(
+    model: type[StrictModel], name: str, raw: Mapping[str, Any], source: str = "<spec>"
+) -> StrictModel:
+    """The block ``solver.options.<name>`` validated into ``model``; a SpecError naming the file, the
+    field ``solver.options.<name>.<key>`` and the reason (the nearest valid key for a misspelled one)."""
+    from gamespec.loader import format_validation_error
+
+    try:
+        return model.model_validate(dict(raw))
+    except ValidationError as err:
+        found = format_validation_error(err, model, source, raw)
+        field = ".".join(p for p in ("solver.options", name, found.field) if p)
+        raise SpecError(found.reason, field=field, source=source) from None
+
+
 class Backend(ABC):
     """A solver backend plugin, registered in the ``gamespec.backends`` entry-point group."""
 
@@ -87,16 +102,8 @@ class Backend(ABC):
 
     @classmethod
     def validate_options(cls, raw: Mapping[str, Any], source: str = "<spec>") -> StrictModel:
-        """``raw`` validated into :attr:`options_model`; a SpecError naming the file, the field
-        ``solver.options.<backend>.<key>`` and the reason (the nearest valid key for a misspelled one)."""
-        from gamespec.loader import format_validation_error
-
-        try:
-            return cls.options_model.model_validate(dict(raw))
-        except ValidationError as err:
-            found = format_validation_error(err, cls.options_model, source, raw)
-            field = ".".join(p for p in ("solver.options", cls.name, found.field) if p)
-            raise SpecError(found.reason, field=field, source=source) from None
+        """``raw`` validated into :attr:`options_model` (:func:`validated_options`)."""
+        return validated_options(cls.options_model, cls.name, raw, source)
 
     def shared_options(self, spec: SpecBase) -> dict[str, Any]:
         """Option values that blocks other than this backend's own give it (none by default; the

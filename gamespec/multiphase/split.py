@@ -1,4 +1,4 @@
-"""A Result of a lowered multi-phase problem (:mod:`gamespec.specs.phase_lowering`) split back by phase.
+"""A Result of a lowered multi-phase problem (:mod:`gamespec.multiphase.lowering`) split back by phase.
 
 Each phase's copy of the states, controls and costates goes onto its own time ``t = S_k + D_k s``
 and the phases are laid end to end: ``time``, ``states``, ``control_time``, ``controls`` and the
@@ -26,12 +26,12 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from gamespec.multiphase.lowering import LoweredPhase, Lowering
 from gamespec.ocp.checks import Trajectory, hamiltonian, mayer_slope, solution_checks
 from gamespec.ocp.symbolic import SymbolicOcp
 from gamespec.ocp.transcription import Transcription
 from gamespec.result import Result
 from gamespec.specs.ocp import TimeSpec
-from gamespec.specs.phase_lowering import LoweredPhase, Lowering
 from gamespec.symbolic.grammar import dependencies
 
 OVERALL_CHECKS = ("max_constraint_violation", "max_defect", "max_defect_relative", "chattering")

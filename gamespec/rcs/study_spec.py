@@ -10,19 +10,20 @@ just when a straight-line agent at full speed gets there: every obstacle blocks 
 The Monte Carlo draws ρ_i = ρ̂ + Δρ_i, Δρ_i ~ N(0, σ²). §6.4.4 writes "σ² = 0.1": ``sigma`` is σ
 when ``sigma_is: std`` (the default, so ``--set sigma=0.1`` means σ = 0.1) and σ² when
 ``sigma_is: variance`` (``--set sigma_is=variance`` reads the thesis literally: σ ≈ 0.316).
-The ``rcs_study`` backend saves each (N, α) point under ``store`` as it finishes; solving the file
+The ``rcs_study`` study saves each (N, α) point under ``store`` as it finishes; solving the file
 again resumes.
 """
 
 from __future__ import annotations
 
 from pathlib import Path
-from typing import Annotated, ClassVar, Literal
+from typing import Annotated, Literal
 
 from pydantic import Field, model_validator
 
 from gamespec.errors import SpecError
 from gamespec.limits import MAX_RCS_OBSTACLES, MAX_SAMPLE_VALUES, MAX_STUDY_POINTS
+from gamespec.registry import Kind
 from gamespec.specs.base import BackendName, Number, SpecBase
 from gamespec.specs.ocp import MethodSpec
 
@@ -53,8 +54,6 @@ class RcsStudySpec(SpecBase):
     ocp_backend: BackendName = "casadi"
     store: Path = Field(Path("runs/rcs_multi_obstacle/points"), description="Folder of per-point records.")
 
-    default_backend: ClassVar[str] = "rcs_study"
-
     @model_validator(mode="after")
     def _work_bounded(self) -> RcsStudySpec:
         """The solves (points times guesses) within :data:`~gamespec.limits.MAX_STUDY_POINTS` and one
@@ -79,3 +78,13 @@ class RcsStudySpec(SpecBase):
     def std(self) -> float:
         """σ, whichever way ``sigma`` is given."""
         return float(self.sigma if self.sigma_is == "std" else self.sigma**0.5)
+
+
+KIND = Kind(
+    RcsStudySpec,
+    study="rcs_study",
+    plot="gamespec.rcs.plotting:plot_study",
+    summary="gamespec.studies.report:study_summary",
+    metrics="gamespec.rcs.metrics:RcsStudyMetrics",
+)
+"""The ``RcsStudySpec`` kind as one plugin (:class:`~gamespec.registry.Kind`)."""

@@ -1,6 +1,6 @@
-"""The ``study`` backend: runs a ``pursuit_suboptimal_study`` (Table 2.1, §2.4.4) point by point.
+"""The ``study`` study: runs a ``pursuit_suboptimal_study`` (Table 2.1, §2.4.4) point by point.
 
-Every point of :func:`gamespec.pursuit.study.study_points` is solved by :func:`evaluate` (the
+Every point of :func:`gamespec.suboptimal_study.points.study_points` is solved by :func:`evaluate` (the
 generated eq. 2.21 OCP compiled once per speed and process) and goes through
 :func:`gamespec.studies.runner.run_study` into a :class:`~gamespec.studies.store.ResultStore` at the
 spec's ``store`` folder, through an executor plugin (``serial``, ``process`` or ``dask``, see
@@ -24,19 +24,19 @@ import numpy as np
 from pydantic import BaseModel, ConfigDict, model_validator
 
 from gamespec.metrics import Finite
-from gamespec.pursuit import pure_pursuit, study
+from gamespec.pursuit import pure_pursuit
 from gamespec.pursuit.ocp_generation import to_ocp, trajectory_guess
 from gamespec.pursuit.ocp_report import heading_law
 from gamespec.pursuit.pursuit_curve import constant_heading_pursuit
 from gamespec.pursuit.reduced import reduce
 from gamespec.pursuit.report import capture_gap
 from gamespec.pursuit.simulation import Players, simulate_to_capture
-from gamespec.pursuit.study import DEFECT_TOL, StudyPoint, point_engagement
 from gamespec.result import Result, Status
 from gamespec.solving import get_backend
-from gamespec.studies.point_study import PointStudyBackend, PointStudyModel
+from gamespec.studies.point_study import PointStudy, PointStudyModel
 from gamespec.studies.runner import StudyRun
 from gamespec.studies.store import ResultStore
+from gamespec.suboptimal_study.points import DEFECT_TOL, StudyPoint, point_engagement, study_points, summarize
 
 POINT_ARRAYS = ("v", "r2", "psi", "t_suboptimal", "t_optimal", "variation_percent")
 """Per-point values copied into ``Result.arrays`` (the plot's scatter)."""
@@ -138,7 +138,7 @@ class StudyModel(PointStudyModel):
     row_model = StoredRow
 
     def points(self) -> dict[str, Any]:
-        return study.study_points(self.spec)
+        return study_points(self.spec)
 
     def point_function(self) -> Callable[[Any], dict[str, Any]]:
         return evaluate
@@ -155,7 +155,7 @@ class StudyModel(PointStudyModel):
             arrays={name: np.array([r.get(name, np.nan) for r in rows]) for name in POINT_ARRAYS},
             checks={name: max((r[key] for r in solved), default=None) for name, key in POINT_CHECKS.items()},
             metrics={
-                "table": study.summarize(rows),
+                "table": summarize(rows),
                 "points": len(rows),
                 "solved": len(solved),
                 "computed": run.computed,
@@ -171,12 +171,12 @@ def _outcome(points: int, solved: int) -> tuple[Status, str]:
         left_out = points - solved
         return Status.FEASIBLE, (
             f"{left_out} of {points} points left out of the averages "
-            f"(no optimum with a defect below {study.DEFECT_TOL:g})"
+            f"(no optimum with a defect below {DEFECT_TOL:g})"
         )
     return Status.ERROR, f"none of the {points} points solved"
 
 
-class StudyBackend(PointStudyBackend):
+class SuboptimalStudy(PointStudy):
     """Runs the Table 2.1 study (see module doc); each point's OCP is solved on ``ocp_backend``."""
 
     name: ClassVar[str] = "study"

@@ -348,7 +348,7 @@ def compile_spec(
     """Load (if a path), pick the backend, apply the transforms, and build its model once."""
     if not isinstance(spec, SpecBase):
         spec = load(spec)
-    study = registry.kind(spec.kind).study
+    study = registry.kind(spec.kind).study if spec.kind in registry.names("gamespec.kinds") else None
     if study is not None:
         return _study(spec, backend or spec.solver.backend or study, options)
     name = backend_name(spec, backend)

@@ -13,8 +13,8 @@ from __future__ import annotations
 from typing import ClassVar
 
 from gamespec.compiling import Availability, Backend, CompiledModel
-from gamespec.specs.base import SpecBase, StrictModel
 from gamespec.flowfield.spec import FlowCovarianceGameSpec, FlowReachabilitySpec
+from gamespec.specs.base import SpecBase, StrictModel
 from gamespec_levelset.game import CovarianceGameModel
 from gamespec_levelset.options import FlowGameOptions
 from gamespec_levelset.reachability import ReachabilityModel

@@ -20,17 +20,17 @@ from typing import Any
 
 import numpy as np
 
-from gamespec.compiling import CompiledModel, Inputs, refuse_inputs
 from gamespec.best_response import Outcome, Settings, iterate
+from gamespec.compiling import CompiledModel, Inputs, refuse_inputs
 from gamespec.flowfield.capture_probability import capture_probabilities
 from gamespec.flowfield.concepts import saddle_gap, solution_concept
 from gamespec.flowfield.covariance_game import PLAYERS, CovarianceGame, Strategy
 from gamespec.flowfield.linearize import DiscreteModel, lifted, zero_order_hold
 from gamespec.flowfield.problem import CovarianceGameData, evaluate_game
 from gamespec.flowfield.simulation import simulate
+from gamespec.flowfield.spec import FlowCovarianceGameSpec
 from gamespec.montecarlo import proportion
 from gamespec.result import Result, Status
-from gamespec.flowfield.spec import FlowCovarianceGameSpec
 from gamespec_levelset.options import FlowGameOptions
 from gamespec_levelset.players import (
     EvaderStep,

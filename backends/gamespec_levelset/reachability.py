@@ -34,9 +34,9 @@ from gamespec.flowfield.levelset import (
 )
 from gamespec.flowfield.nominal import NominalPaths, from_extremals, from_level_sets
 from gamespec.flowfield.problem import FlowGameData, evaluate
+from gamespec.flowfield.spec import FlowReachabilitySpec
 from gamespec.flowfield.stages import reachability_key
 from gamespec.result import Result, Status
-from gamespec.flowfield.spec import FlowReachabilitySpec
 from gamespec_levelset.verdicts import verdicts
 
 GRID_ERROR_STEPS = 0.05

@@ -59,5 +59,5 @@ def flow_game_summary(result: Result) -> list[tuple[str, object]]:
     rows.append(
         ("solution concept (closed loop)", f"{concept} (method.game.scheme = {m.get('game_scheme')})")
     )
-    rows.append(("game converged", m["game_converged"]))
+    rows.append(("game converged", m.get("game_converged")))
     return rows

@@ -274,6 +274,11 @@ class FlowReachabilitySpec(FlowGameSpec):
 
     kind: Literal["flow_reachability"] = "flow_reachability"  # type: ignore[assignment]
 
+    @property
+    def default_backend(self) -> str:
+        """``levelset``: a stage spec has no :class:`~gamespec.registry.Kind` entry of its own."""
+        return "levelset"
+
 
 class NominalPath(StrictModel):
     """One agent's nominal path (eqs. 5.23–5.26) at the nodes ``nominal.times``: the positions
@@ -530,6 +535,11 @@ KIND = Kind(
 )
 """The ``FlowGameSpec`` kind as one plugin (:class:`~gamespec.registry.Kind`)."""
 
-COVARIANCE_GAME_KIND = Kind(FlowCovarianceGameSpec, default_backend="levelset")
-"""The ``FlowCovarianceGameSpec`` kind (what the staged lowering writes; no plotter or summary of its
-own: its Results are mapped back to the ``flow_field_game`` that asked for them)."""
+COVARIANCE_GAME_KIND = Kind(
+    FlowCovarianceGameSpec,
+    default_backend="levelset",
+    plot="gamespec.plotting:plot_trajectories",
+    summary="gamespec.flowfield.report:flow_game_summary",
+)
+"""The ``FlowCovarianceGameSpec`` kind (what the staged lowering writes): its trajectories, and the rows
+of the flow game's summary its metrics hold."""

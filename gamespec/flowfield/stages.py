@@ -20,8 +20,8 @@ from __future__ import annotations
 from typing import Any
 
 from gamespec.flowfield.problem import FlowGameData, evaluate
-from gamespec.result import Result
 from gamespec.flowfield.spec import FlowCovarianceGameSpec, FlowGameSpec, FlowReachabilitySpec
+from gamespec.result import Result
 
 NOMINAL_ARRAYS = ("nominal_time", "nominal_positions", "nominal_directions")
 """The arrays of the nominal paths in a reachability Result (the directions only feed the game)."""

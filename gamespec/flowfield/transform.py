@@ -14,6 +14,7 @@ from dataclasses import dataclass
 from typing import Any, ClassVar
 
 from gamespec.flowfield.problem import evaluate
+from gamespec.flowfield.spec import FlowCovarianceGameSpec, FlowGameSpec
 from gamespec.flowfield.stages import (
     covariance_game_spec,
     flow_game_result,
@@ -22,7 +23,6 @@ from gamespec.flowfield.stages import (
 )
 from gamespec.result import Result
 from gamespec.specs.base import StrictModel
-from gamespec.flowfield.spec import FlowCovarianceGameSpec, FlowGameSpec
 from gamespec.transforms.base import Stage, Transform
 
 

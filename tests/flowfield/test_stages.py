@@ -12,9 +12,9 @@ import pytest
 import yaml
 from gamespec_levelset import reachability
 
+from gamespec.flowfield.spec import FlowCovarianceGameSpec
 from gamespec.loader import load, spec_from_dict
 from gamespec.solving import compile_spec, solve
-from gamespec.flowfield.spec import FlowCovarianceGameSpec
 from tests.flowfield.test_flow_game import SPEC, T_EXACT
 
 

@@ -4,7 +4,8 @@ Groups: ``gamespec.kinds`` (spec classes by ``kind``), ``gamespec.backends`` (ba
 name), ``gamespec.transforms`` (spec → spec reductions), ``gamespec.plotters`` (plot functions by
 kind), ``gamespec.summaries`` (the rows that lead a kind's solve summary), ``gamespec.metrics``
 (the typed metrics of a kind's Results), ``gamespec.executors``
-(how a study runs its points) and ``gamespec.commands`` (Typer apps mounted as ``gamespec NAME``).
+(how a study runs its points), ``gamespec.commands`` (Typer apps mounted as ``gamespec NAME``) and
+``gamespec.analyses`` (a kind's analyses, :mod:`gamespec.analyses`).
 Nothing is imported until it is asked for, so ``import gamespec`` stays light; the installed
 distributions' entry points are read in one pass, the first time any group is asked for.
 """
@@ -26,6 +27,7 @@ GROUPS = (
     "gamespec.metrics",
     "gamespec.executors",
     "gamespec.commands",
+    "gamespec.analyses",
 )
 
 

@@ -6,7 +6,7 @@ dotted location and the nearest valid key (see :func:`gamespec.loader.format_val
 
 from __future__ import annotations
 
-from typing import Annotated, Any, ClassVar
+from typing import Annotated, Any, ClassVar, Literal
 
 from pydantic import AfterValidator, BaseModel, ConfigDict, Field, FiniteFloat, PrivateAttr, model_validator
 
@@ -75,6 +75,18 @@ class ProblemParameters:
         return f"problem.parameters.{name}" if name in self.problem.parameters else name
 
 
+def _known_analyses(names: list[str]) -> list[str]:
+    from gamespec.analyses import unknown
+
+    reason = unknown(names)
+    if reason is not None:
+        raise ValueError(reason)
+    return names
+
+
+AnalysisNames = Annotated[list[str], Field(min_length=1), AfterValidator(_known_analyses)]
+"""Names of analyses a transform or kind declares (:mod:`gamespec.analyses`), checked at load."""
+
 RequestedTransforms = list[dict[str, dict[str, Any]]]
 """The ``transforms:`` section: ``[{<transform name>: {<options>}}, ...]``, applied in order."""
 
@@ -95,6 +107,11 @@ class SpecBase(StrictModel):
     transforms: RequestedTransforms = Field(
         default_factory=list,
         description="Requested transforms, [{name: {options}}], applied in order before the solve.",
+    )
+    analyses: Literal["all", "none"] | AnalysisNames | None = Field(
+        None,
+        description="Which analyses of the solution run (Monte Carlo, re-simulation, LQR tracking ...): "
+        "all, none, or a list of names; omitted: all (a study passes it on to its points).",
     )
 
     default_backend: ClassVar[str] = ""

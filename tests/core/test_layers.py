@@ -12,7 +12,7 @@ import gamespec
 LAYERS = [
     {"errors", "result", "registry", "best_response", "limits", "reading", "terminal", "metrics", "npyfile"},
     {"symbolic"},
-    {"specs", "loader"},
+    {"specs", "loader", "analyses"},
     {"ocp", "lqgame", "pursuit", "flowfield", "desensitize", "rcs", "montecarlo", "obstacles", "plotting"},
     {"backend"},
     {"transforms"},

@@ -135,6 +135,23 @@ def parse_selection(text: str) -> Selection:
     return names
 
 
+def as_override(text: str) -> str:
+    """``--analyses TEXT`` as the ``--set`` assignment of the file's ``analyses:`` key (so it is
+    validated, hashed and carried to a study's or a sweep's workers like any other field)."""
+    chosen = parse_selection(text)
+    return f"analyses={chosen if isinstance(chosen, str) else '[' + ', '.join(chosen) + ']'}"
+
+
+def for_study(chosen: Selection | None, needed: Sequence[str]) -> Selection:
+    """The analyses a study's points run: the ``needed`` ones its table is made of, and those the
+    study file (or ``--analyses``) chooses on top (``all``: every one; ``none`` or nothing: only
+    the needed ones)."""
+    if chosen == "all":
+        return "all"
+    extra = [] if chosen is None or chosen == "none" else list(chosen)
+    return [*needed, *(name for name in extra if name not in needed)]
+
+
 def selected(declared: Sequence[Analysis], selection: Selection) -> list[Analysis]:
     """The analyses of ``declared`` that ``selection`` picks, with those they need, in declared
     order."""

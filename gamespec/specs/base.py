@@ -6,7 +6,7 @@ dotted location and the nearest valid key (see :func:`gamespec.loader.format_val
 
 from __future__ import annotations
 
-from typing import Annotated, Any, ClassVar, Literal
+from typing import Annotated, Any, ClassVar
 
 from pydantic import AfterValidator, BaseModel, ConfigDict, Field, FiniteFloat, PrivateAttr, model_validator
 
@@ -75,17 +75,25 @@ class ProblemParameters:
         return f"problem.parameters.{name}" if name in self.problem.parameters else name
 
 
-def _known_analyses(names: list[str]) -> list[str]:
+def _analyses_choice(choice: str | list[str]) -> str | list[str]:
+    """``all``, ``none``, or a non-empty list of the names of declared analyses."""
+    if isinstance(choice, str):
+        if choice not in ("all", "none"):
+            raise ValueError(f"give all, none or a list of analysis names, not {choice!r}")
+        return choice
+    if not choice:
+        raise ValueError("give all, none or a list of analysis names, not an empty list")
     from gamespec.analyses import unknown
 
-    reason = unknown(names)
+    reason = unknown(choice)
     if reason is not None:
         raise ValueError(reason)
-    return names
+    return choice
 
 
-AnalysisNames = Annotated[list[str], Field(min_length=1), AfterValidator(_known_analyses)]
-"""Names of analyses a transform or kind declares (:mod:`gamespec.analyses`), checked at load."""
+AnalysesChoice = Annotated[str | list[str], AfterValidator(_analyses_choice)]
+"""Which analyses run (:mod:`gamespec.analyses`): ``all``, ``none`` or names declared by an
+installed transform or kind, checked at load."""
 
 RequestedTransforms = list[dict[str, dict[str, Any]]]
 """The ``transforms:`` section: ``[{<transform name>: {<options>}}, ...]``, applied in order."""
@@ -108,7 +116,7 @@ class SpecBase(StrictModel):
         default_factory=list,
         description="Requested transforms, [{name: {options}}], applied in order before the solve.",
     )
-    analyses: Literal["all", "none"] | AnalysisNames | None = Field(
+    analyses: AnalysesChoice | None = Field(
         None,
         description="Which analyses of the solution run (Monte Carlo, re-simulation, LQR tracking ...): "
         "all, none, or a list of names; omitted: all (a study passes it on to its points).",

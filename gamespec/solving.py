@@ -275,7 +275,7 @@ class Solver:
                 result = self._verified(step, result, values, inputs, multistart=last)
             elif last:
                 result = self._restarted(step, values, inputs) or result
-        result = run_analyses(result, kind_analyses(spec.kind), self.analyses, spec)
+        result = self._kind_analysed(spec, result)
         provenance = Provenance(
             spec_hash=spec_hash(spec),
             source=self.spec.source,
@@ -302,11 +302,19 @@ class Solver:
         declared = step.transform.analyses()
         return run_analyses(back, declared, self.analyses, step.source, step.inverse, step.options)
 
+    def _kind_analysed(self, spec: SpecBase, result: Result) -> Result:
+        """``result`` with the selected analyses of its kind, not verified when a skipped one
+        decides a check."""
+        declared = kind_analyses(spec.kind)
+        result = run_analyses(result, declared, self.analyses, spec)
+        skipped = skipped_checks(declared, self.analyses)
+        return _not_verified(result, _skipped(skipped)) if skipped and result.ok else result
+
     def _unverifiable(self, step: Step) -> str | None:
         """Why ``step.transform.verify`` cannot judge a Result here: the checks it reads that the
         skipped analyses decide (None when every such analysis runs)."""
         skipped = skipped_checks(step.transform.analyses(), self.analyses)
-        return f"check(s) {', '.join(skipped)} skipped ({SKIPPED})" if skipped else None
+        return _skipped(skipped) if skipped else None
 
     def _restarted(self, step: Step, values: dict[str, float] | None, inputs: Inputs) -> Result | None:
         """Multi-start: the best verified Result among re-solves of the compiled model from the
@@ -349,6 +357,10 @@ class Solver:
         if better is not None:
             return better
         return _not_verified(result, failed)
+
+
+def _skipped(checks: list[str]) -> str:
+    return f"check(s) {', '.join(checks)} skipped ({SKIPPED})"
 
 
 def _not_verified(result: Result, why: str) -> Result:

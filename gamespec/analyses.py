@@ -13,7 +13,8 @@ Who declares them:
 - a transform, in :meth:`gamespec.transforms.base.Transform.analyses`; they run on the Result that
   transform's ``invert`` returns, with its source spec and inverse data;
 - a kind, in the ``gamespec.analyses`` entry-point group (name: the kind; object: a sequence of
-  analyses); they run on the final Result of that kind, with the spec and no inverse data.
+  analyses); they run on every Result of that kind along the chain (the compiled model's, and
+  each one a transform maps back), with its spec and no inverse data.
 
 A :data:`Selection` picks among them: ``"all"`` (the default for ``solve``), ``"none"``, or a list
 of names (each closed over its ``needs``). A name no installed transform or kind declares is a

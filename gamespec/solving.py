@@ -15,11 +15,12 @@ or the solve fails, the same compiled model is re-solved from that transform's `
 (multi-start) with the caller's parameters and inputs, and the best verified Result is kept.
 
 After each transform's ``invert``, and before its ``verify``, the solving layer runs the analyses
-the transform declares that the Solver's selection picks, then those of the source kind on the
-final Result (:mod:`gamespec.analyses`; ``analyses=`` of :func:`compile_spec`, else the file's
-``analyses:`` key, else all). When a skipped analysis decides a check ``verify`` reads, the Result
-is not verified: it is ``feasible``, not ``optimal``, and ``metrics["checks_skipped"]`` names the
-check (``docs/statuses.md``).
+the transform declares that the Solver's selection picks, and a kind's analyses on every Result of
+that kind along the chain (the compiled model's, each mapped-back one) (:mod:`gamespec.analyses`;
+``analyses=`` of :func:`compile_spec`, else the file's ``analyses:`` key, else all). When a
+skipped analysis decides a check (one ``verify`` reads), the Result is not verified: it is
+``feasible``, not ``optimal``, and ``metrics["checks_skipped"]`` names the check
+(``docs/statuses.md``).
 """
 
 from __future__ import annotations
@@ -267,6 +268,7 @@ class Solver:
         last = steps[-1] if steps else None
         start = guess if guess is not None or last is None else last.transform.guess(last.inverse)
         result = self.compiled.solve(parameters=values, guess=start, inputs=inputs)
+        result = self._kind_analysed(target, result)
         for index in reversed(range(len(steps))):
             step = steps[index]
             result = self._mapped(step, result)
@@ -275,7 +277,6 @@ class Solver:
                 result = self._verified(step, result, values, inputs, multistart=last)
             elif last:
                 result = self._restarted(step, values, inputs) or result
-        result = self._kind_analysed(spec, result)
         provenance = Provenance(
             spec_hash=spec_hash(spec),
             source=self.spec.source,
@@ -297,10 +298,12 @@ class Solver:
         )
 
     def _mapped(self, step: Step, result: Result) -> Result:
-        """``result`` mapped back through ``step``: its ``invert``, then its selected analyses."""
+        """``result`` mapped back through ``step``: its ``invert``, then the selected analyses of the
+        transform and of the source's kind."""
         back = step.transform.invert(result, step.source, step.inverse)
         declared = step.transform.analyses()
-        return run_analyses(back, declared, self.analyses, step.source, step.inverse, step.options)
+        back = run_analyses(back, declared, self.analyses, step.source, step.inverse, step.options)
+        return self._kind_analysed(step.source, back)
 
     def _kind_analysed(self, spec: SpecBase, result: Result) -> Result:
         """``result`` with the selected analyses of its kind, not verified when a skipped one
@@ -325,7 +328,7 @@ class Solver:
         guesses = step.transform.restarts(step.source, step.inverse)
         for number, start in enumerate(guesses, 1):
             raw = self.compiled.solve(parameters=values, guess=start, inputs=inputs)
-            candidate = self._mapped(step, raw)
+            candidate = self._mapped(step, self._kind_analysed(step.target, raw))
             if not candidate.ok:
                 continue
             if not unverifiable and step.transform.verify(candidate, step.source, step.inverse) is not None:

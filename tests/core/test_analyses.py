@@ -24,6 +24,7 @@ from gamespec.pursuit.ocp_report import heading_law
 from gamespec.pursuit.simulation import simulate_to_capture
 from gamespec.result import Status
 from gamespec.solving import compile_spec, solve
+from gamespec.specs.desensitize import MonteCarloOptions
 from gamespec.transforms import desensitize
 from tests.conftest import PROBLEMS
 
@@ -53,7 +54,7 @@ def test_default_writes_what_the_monte_carlo_engine_computes(boat, boat_all) -> 
     source = compile_spec(boat, analyses="none").steps[0].source
     ocp, uncertain = SymbolicOcp(source), source.problem.uncertain
     options = boat.transforms[0]["desensitize"]["monte_carlo"]
-    carlo = montecarlo.MonteCarloOptions.model_validate(options)
+    carlo = MonteCarloOptions.model_validate(options)
     open_loop, bundle = montecarlo.monte_carlo(ocp, boat_all, uncertain, carlo)
     closed, closed_bundle = montecarlo.tracking(ocp, boat_all, uncertain, carlo)
     assert boat_all.status is Status.OPTIMAL

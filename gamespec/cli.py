@@ -22,6 +22,7 @@ from typing import TYPE_CHECKING, Annotated
 import typer
 
 from gamespec import registry
+from gamespec.commands.options import AnalysesOpt, with_analyses
 from gamespec.errors import GamespecError
 
 if TYPE_CHECKING:
@@ -156,6 +157,7 @@ def solve(
     plot: Annotated[bool, typer.Option("--plot", help="Also write plots (into --out or .).")] = False,
     scheduler: StudySchedulerOpt = None,
     insecure_scheduler: InsecureOpt = False,
+    analyses: AnalysesOpt = None,
 ) -> None:
     """Solve a problem file and print a summary (or the Result as JSON); a study kind runs on the
     Dask ``--scheduler`` when one is given."""
@@ -163,7 +165,7 @@ def solve(
     from gamespec.result import writable_folder
     from gamespec.solving import solve as run_solve
 
-    spec = load(file, set_ or [])
+    spec = load(file, with_analyses(set_, analyses))
     if out is not None:
         writable_folder(out)
     options = _where_it_runs(spec, backend, scheduler, insecure_scheduler)
@@ -303,6 +305,7 @@ def sweep(
     insecure_scheduler: InsecureOpt = False,
     set_: SetOpt = None,
     json_: JsonOpt = False,
+    analyses: AnalysesOpt = None,
 ) -> None:
     """Solve a file over a grid of parameter values; one row per point, saved as it finishes."""
     from gamespec.loader import load
@@ -311,11 +314,12 @@ def sweep(
     from gamespec.studies.sweep import parse_range
     from gamespec.studies.sweep import sweep as run_sweep
 
-    load(file, set_ or [])
+    overrides = with_analyses(set_, analyses)
+    load(file, overrides)
     ranges = [parse_range(p) for p in param]
     writable_folder(out)
     runner = make_executor(executor, workers, scheduler, insecure=insecure_scheduler)
-    run = run_sweep(file, ranges, out=out, overrides=tuple(set_ or []), backend=backend, executor=runner)
+    run = run_sweep(file, ranges, out=out, overrides=tuple(overrides), backend=backend, executor=runner)
     rows = list(run.values.values())
     if json_:
         sys.stdout.write(json.dumps(rows, indent=2) + "\n")

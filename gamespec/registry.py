@@ -53,7 +53,8 @@ class Kind:
     (exactly one of the two); ``plot`` its plotter ``(result, output_dir, *, animate) ->
     list[Path]``, ``summary`` its rows ``(result) -> list[(label, value)]`` that lead ``gamespec
     solve``'s table, ``metrics`` the :class:`~gamespec.metrics.Metrics` model of its Results'
-    ``metrics`` (None: the common one).
+    ``metrics`` (None: the common one), ``analyses`` the list of
+    :class:`~gamespec.analyses.Analysis` its Results get (:mod:`gamespec.analyses`; None: none).
     The parts other than ``spec`` may be ``"module:attribute"`` texts, imported when first used.
     """
 
@@ -63,13 +64,15 @@ class Kind:
     plot: Ref | None = None
     summary: Ref | None = None
     metrics: Ref | None = None
+    analyses: Ref | None = None
 
     def __post_init__(self) -> None:
         if (self.default_backend is None) == (self.study is None):
             raise BackendError("a kind names either a default backend or the study that runs it")
 
     def part(self, name: str) -> Any:
-        """The kind's ``spec``, ``plot``, ``summary`` or ``metrics``, imported (None if it has none)."""
+        """The kind's ``spec``, ``plot``, ``summary``, ``metrics`` or ``analyses``, imported (None
+        if it has none)."""
         ref = getattr(self, name)
         return None if ref is None else resolved(ref)
 

@@ -13,6 +13,14 @@ and re-solves the compiled model with the target's values — cvxpy's ``update_p
 last transform's :meth:`~gamespec.transforms.base.Transform.verify` rejects the mapped-back Result,
 or the solve fails, the same compiled model is re-solved from that transform's ``restarts``
 (multi-start) with the caller's parameters and inputs, and the best verified Result is kept.
+
+After each transform's ``invert``, and before its ``verify``, the solving layer runs the analyses
+the transform declares that the Solver's selection picks, and a kind's analyses on every Result of
+that kind along the chain (the compiled model's, each mapped-back one) (:mod:`gamespec.analyses`;
+``analyses=`` of :func:`compile_spec`, else the file's ``analyses:`` key, else all). When a
+skipped analysis decides a check (one ``verify`` reads), the Result is not verified: it is
+``feasible``, not ``optimal``, and ``metrics["checks_skipped"]`` names the check
+(``docs/statuses.md``).
 """
 
 from __future__ import annotations
@@ -26,6 +34,7 @@ from pathlib import Path
 from typing import Any
 
 from gamespec import registry
+from gamespec.analyses import SKIPPED, Selection, check_names, kind_analyses, run_analyses, skipped_checks
 from gamespec.compiling import Backend, CompiledModel, Inputs
 from gamespec.compiling.study_protocol import Study
 from gamespec.errors import BackendError, ExpressionError, SpecError, UnsupportedFeature
@@ -215,6 +224,8 @@ class Solver:
     steps: list[Step]
     compiled: CompiledModel
     build_time_s: float
+    analyses: Selection = "all"
+    """Which analyses every solve of it runs (:mod:`gamespec.analyses`)."""
 
     @property
     def target_spec(self) -> SpecBase:
@@ -277,9 +288,10 @@ class Solver:
         last = steps[-1] if steps else None
         start = guess if guess is not None or last is None else last.transform.guess(last.inverse)
         result = self.compiled.solve(parameters=values, guess=start, inputs=inputs)
+        result = self._kind_analysed(target, result)
         for index in reversed(range(len(steps))):
             step = steps[index]
-            result = step.transform.invert(result, step.source, step.inverse)
+            result = self._mapped(step, result)
             last = index == len(steps) - 1
             if result.ok:
                 result = self._verified(step, result, values, inputs, multistart=last)
@@ -305,20 +317,47 @@ class Solver:
             }
         )
 
+    def _mapped(self, step: Step, result: Result) -> Result:
+        """``result`` mapped back through ``step``: its ``invert``, then the selected analyses of the
+        transform and of the source's kind."""
+        back = step.transform.invert(result, step.source, step.inverse)
+        declared = step.transform.analyses()
+        back = run_analyses(back, declared, self.analyses, step.source, step.inverse, step.options)
+        return self._kind_analysed(step.source, back)
+
+    def _kind_analysed(self, spec: SpecBase, result: Result) -> Result:
+        """``result`` with the selected analyses of its kind, not verified when a skipped one
+        decides a check."""
+        declared = kind_analyses(spec.kind)
+        result = run_analyses(result, declared, self.analyses, spec)
+        skipped = skipped_checks(declared, self.analyses)
+        return _not_verified(result, _skipped(skipped)) if skipped and result.ok else result
+
+    def _unverifiable(self, step: Step) -> str | None:
+        """Why ``step.transform.verify`` cannot judge a Result here: the checks it reads that the
+        skipped analyses decide (None when every such analysis runs)."""
+        skipped = skipped_checks(step.transform.analyses(), self.analyses)
+        return _skipped(skipped) if skipped else None
+
     def _restarted(self, step: Step, values: dict[str, float] | None, inputs: Inputs) -> Result | None:
         """Multi-start: the best verified Result among re-solves of the compiled model from the
-        step's restarts (None if none verifies)."""
+        step's restarts (None if none verifies); with the verifying analyses off, the best usable
+        one, not verified."""
         best = None
+        unverifiable = self._unverifiable(step)
         guesses = step.transform.restarts(step.source, step.inverse)
         for number, start in enumerate(guesses, 1):
             raw = self.compiled.solve(parameters=values, guess=start, inputs=inputs)
-            candidate = step.transform.invert(raw, step.source, step.inverse)
-            if not candidate.ok or step.transform.verify(candidate, step.source, step.inverse) is not None:
+            candidate = self._mapped(step, self._kind_analysed(step.target, raw))
+            if not candidate.ok:
+                continue
+            if not unverifiable and step.transform.verify(candidate, step.source, step.inverse) is not None:
                 continue
             if _better(candidate, best, step.source.objective_sense):
-                note = f"verified after a re-solve from starting point {number} of {len(guesses)}"
+                verb = "solved" if unverifiable else "verified"
+                note = f"{verb} after a re-solve from starting point {number} of {len(guesses)}"
                 best = candidate.model_copy(update={"message": f"{candidate.message}; {note}"})
-        return best
+        return best if best is None or not unverifiable else _not_verified(best, unverifiable)
 
     def _verified(
         self,
@@ -329,28 +368,46 @@ class Solver:
         multistart: bool,
     ) -> Result:
         """``result`` if the step verifies it; else the best verified multi-start Result (only the
-        last step's restarts start the compiled model), else ``result`` marked not verified."""
+        last step's restarts start the compiled model), else ``result`` marked not verified; and
+        marked not verified, without a multi-start, when the analyses that verify it are off."""
+        unverifiable = self._unverifiable(step)
+        if unverifiable:
+            return _not_verified(result, unverifiable)
         failed = step.transform.verify(result, step.source, step.inverse)
         if failed is None:
             return result
         better = self._restarted(step, values, inputs) if multistart else None
         if better is not None:
             return better
-        status = Status.FEASIBLE if result.status is Status.OPTIMAL else result.status
-        return result.model_copy(update={"status": status, "message": f"not verified optimal: {failed}"})
+        return _not_verified(result, failed)
+
+
+def _skipped(checks: list[str]) -> str:
+    return f"check(s) {', '.join(checks)} skipped ({SKIPPED})"
+
+
+def _not_verified(result: Result, why: str) -> Result:
+    """``result`` without an optimality claim (``feasible`` for ``optimal``), the message saying why."""
+    status = Status.FEASIBLE if result.status is Status.OPTIMAL else result.status
+    return result.model_copy(update={"status": status, "message": f"not verified optimal: {why}"})
 
 
 def compile_spec(
     spec: SpecBase | str | Path,
     backend: str | None = None,
     options: dict[str, Any] | None = None,
+    *,
+    analyses: Selection | None = None,
 ) -> Solver:
-    """Load (if a path), pick the backend, apply the transforms, and build its model once."""
+    """Load (if a path), pick the backend, apply the transforms, and build its model once;
+    ``analyses``: which analyses its solves run (None: the file's ``analyses:`` key, else all)."""
     if not isinstance(spec, SpecBase):
         spec = load(spec)
+    selection = analyses if analyses is not None else spec.analyses or "all"
+    check_names(selection, spec.source)
     study = registry.kind(spec.kind).study if spec.kind in registry.names("gamespec.kinds") else None
     if study is not None:
-        return _study(spec, backend or spec.solver.backend or study, options)
+        return _study(spec, backend or spec.solver.backend or study, options, selection)
     name = backend_name(spec, backend)
     instance = get_backend(name)
     start = time.perf_counter()
@@ -358,10 +415,10 @@ def compile_spec(
     target = steps[-1].target if steps else spec
     compiled = instance.compile(target, instance.options(target, options))
     build = time.perf_counter() - start
-    return Solver(spec, instance, steps, compiled, build)
+    return Solver(spec, instance, steps, compiled, build, selection)
 
 
-def _study(spec: SpecBase, name: str, options: dict[str, Any] | None) -> Solver:
+def _study(spec: SpecBase, name: str, options: dict[str, Any] | None, selection: Selection) -> Solver:
     """A study kind compiled by the :class:`~gamespec.compiling.study_protocol.Study` plugin
     ``name`` (the one its kind names, unless the caller or the file names another study), which
     drives the solves of its points itself; no transform applies to a study kind."""
@@ -374,7 +431,7 @@ def _study(spec: SpecBase, name: str, options: dict[str, Any] | None) -> Solver:
     study = registry.load("gamespec.studies", name)()
     start = time.perf_counter()
     compiled = study.compile(spec, study.options(spec, options))
-    return Solver(spec, study, [], compiled, time.perf_counter() - start)
+    return Solver(spec, study, [], compiled, time.perf_counter() - start, selection)
 
 
 def solve(
@@ -385,6 +442,9 @@ def solve(
     guess: Result | None = None,
     inputs: Inputs = None,
     options: dict[str, Any] | None = None,
+    analyses: Selection | None = None,
 ) -> Result:
-    """Solve a spec (or problem file) once on ``backend`` and return its Result."""
-    return compile_spec(spec, backend, options).solve(parameters=parameters, guess=guess, inputs=inputs)
+    """Solve a spec (or problem file) once on ``backend`` and return its Result (``analyses`` as
+    in :func:`compile_spec`)."""
+    solver = compile_spec(spec, backend, options, analyses=analyses)
+    return solver.solve(parameters=parameters, guess=guess, inputs=inputs)

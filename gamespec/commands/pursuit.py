@@ -10,6 +10,8 @@ from typing import Annotated
 
 import typer
 
+from gamespec.commands.options import AnalysesOpt, with_analyses
+
 pursuit_app = typer.Typer(no_args_is_help=True, help="Pursuit-evasion studies (thesis ch. 2–3).")
 
 TABLE_COLUMNS = ("v", "points", "solved", "average_variation_percent", "maximum_variation_percent")
@@ -47,6 +49,7 @@ def study(
         list[str] | None, typer.Option("--set", help="Override a value: dotted.path=value (repeatable).")
     ] = None,
     json_: Annotated[bool, typer.Option("--json", help="Print the table as JSON on stdout.")] = False,
+    analyses: AnalysesOpt = None,
 ) -> None:
     """Table 2.1: `gamespec solve` on a pursuit_suboptimal_study file, printed as the table.
 
@@ -60,7 +63,7 @@ def study(
     from gamespec.solving import solve
     from gamespec.terminal import console
 
-    overrides = [*(set_ or []), *([f"store={out / 'points'}"] if out is not None else [])]
+    overrides = [*with_analyses(set_, analyses), *([f"store={out / 'points'}"] if out is not None else [])]
     spec = load(file, overrides)
     if spec.kind != "pursuit_suboptimal_study":
         reason = f"expected kind 'pursuit_suboptimal_study', got {spec.kind!r}"

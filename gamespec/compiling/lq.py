@@ -99,16 +99,9 @@ class LQCompiledModel(CompiledModel):
                 status=Status.ERROR, message=self.failure, metrics=self.model.assumptions.as_metrics()
             )
         else:
-            carlo = self.spec.method.monte_carlo
             mean, cov = self.solve_mean(guess), self._solve_covariance(guess)
             result = assemble(
-                self.model,
-                mean,
-                cov,
-                self.spec.state_names,
-                carlo.samples,
-                carlo.seed,
-                tolerance=self.spec.method.tolerance,
+                self.model, mean, cov, self.spec.state_names, tolerance=self.spec.method.tolerance
             )
         return result.model_copy(
             update={"parameters": values, "solver_stats": {"solver": self.options.solver}}

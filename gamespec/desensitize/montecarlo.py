@@ -1,12 +1,14 @@
 """Monte Carlo check of a desensitized solution (§6.3.1, §6.5.2): draw the uncertain parameters,
-re-simulate the solution's open-loop control (and, when asked, the LQR-tracking closed loop of
-eqs. 6.27-6.29) for every sample at once, and summarize final states, costs and path-constraint
-violations. It only re-simulates; it never solves.
+re-simulate the solution's open-loop control (:func:`monte_carlo`) or the LQR-tracking closed loop
+of eqs. 6.27-6.29 (:func:`tracking`, the same draws) for every sample at once, and summarize final
+states, costs and path-constraint violations. It only re-simulates; it never solves. The two are
+the ``monte_carlo`` and ``lqr_tracking`` analyses of the desensitize and rcs transforms.
 """
 
 from __future__ import annotations
 
 from collections.abc import Mapping
+from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
@@ -51,36 +53,59 @@ def initial_state(ocp: SymbolicOcp, result: Result, params: Mapping[Any, Any], s
     return x0
 
 
+@dataclass(frozen=True)
+class Draws:
+    """The sampled parameters of a Monte Carlo run and what every re-simulation of it starts from."""
+
+    drawn: dict[str, np.ndarray]
+    nominal: dict[str, float]
+    params: dict[Any, Any]
+    x0: np.ndarray
+    controls: TranscribedSignal
+    inputs: TranscribedSignal | None
+    t0: float
+    tf: float
+
+
+def draws(
+    ocp: SymbolicOcp, result: Result, uncertain: Mapping[str, UncertainParameter], options: MonteCarloOptions
+) -> Draws:
+    """``options.samples`` draws (seed ``options.seed``) of the uncertain parameters about the
+    Result's values, the initial states and the Result's control (and grid inputs) as signals."""
+    nominal = {k: float(v) for k, v in result.parameters.items()}
+    drawn = sample(distributions(uncertain, nominal), options.samples, options.seed)
+    params = {symbol(k): drawn.get(k, v) for k, v in nominal.items()}
+    return Draws(
+        drawn,
+        nominal,
+        params,
+        initial_state(ocp, result, params, options.samples),
+        transcribed_signal(result, ocp.controls),
+        transcribed_signal(result, ocp.inputs) if ocp.inputs else None,
+        float(result.time[0]),
+        float(result.t_final),
+    )
+
+
 def monte_carlo(
     ocp: SymbolicOcp, result: Result, uncertain: Mapping[str, UncertainParameter], options: MonteCarloOptions
 ) -> tuple[dict[str, Any], dict[str, np.ndarray]]:
-    """``metrics.monte_carlo`` for the open-loop control of ``result`` (with ``tracking`` when asked),
-    and the trajectories of the first :data:`BUNDLE` samples (``monte_carlo_<state>``, and
-    ``tracking_<state>``, (steps+1, samples) each, on ``monte_carlo_time``) for plots."""
-    nominal = {k: float(v) for k, v in result.parameters.items()}
-    n = options.samples
-    drawn = sample(distributions(uncertain, nominal), n, options.seed)
-    params = {symbol(k): drawn.get(k, v) for k, v in nominal.items()}
-    t0, tf = float(result.time[0]), float(result.t_final)
-    x0 = initial_state(ocp, result, params, n)
-    u_star = transcribed_signal(result, ocp.controls)
-    signals = transcribed_signal(result, ocp.inputs) if ocp.inputs else None
-    run = rk4(ocp, x0, u_star, params, t0, tf, options.steps, keep=BUNDLE, inputs=signals)
-    spread = summarize(drawn)
+    """``metrics.monte_carlo`` for the open-loop control of ``result``, and the trajectories of the
+    first :data:`BUNDLE` samples (``monte_carlo_<state>``, (steps+1, samples) each, on
+    ``monte_carlo_time``) for plots."""
+    d = draws(ocp, result, uncertain, options)
+    run = rk4(ocp, d.x0, d.controls, d.params, d.t0, d.tf, options.steps, keep=BUNDLE, inputs=d.inputs)
+    spread = summarize(d.drawn)
     metrics = {
-        "samples": n,
+        "samples": options.samples,
         "seed": options.seed,
         "parameters": {
             k: {"mean": v.mean, "std": v.std, "min": v.min, "max": v.max} for k, v in spread.items()
         },
     }
-    metrics.update(_outcome(ocp, x0, run, params))
+    metrics.update(_outcome(ocp, d.x0, run, d.params))
     metrics["control_energy_mean"] = float(run.energy.mean())
-    arrays = {"monte_carlo_time": run.t} | _bundle("monte_carlo", ocp, run)
-    if options.tracking:
-        metrics["tracking"], closed = _tracking(ocp, result, params, nominal, (u_star, signals), options, x0)
-        arrays |= _bundle("tracking", ocp, closed)
-    return metrics, arrays
+    return metrics, {"monte_carlo_time": run.t} | _bundle("monte_carlo", ocp, run)
 
 
 def _bundle(prefix: str, ocp: SymbolicOcp, run: Trajectories) -> dict[str, np.ndarray]:
@@ -108,30 +133,27 @@ def _outcome(
     return out
 
 
-def _tracking(
-    ocp: SymbolicOcp,
-    result: Result,
-    params: Mapping[Any, Any],
-    nominal: Mapping[str, float],
-    signals: tuple[TranscribedSignal, TranscribedSignal | None],
-    options: MonteCarloOptions,
-    x0: np.ndarray,
-) -> tuple[dict[str, Any], Trajectories]:
-    """The closed loop ``u = u* - K(t)(x - x*(t))`` of eqs. 6.27-6.29 for the same samples."""
-    t0, tf = float(result.time[0]), float(result.t_final)
-    nominal_params = {symbol(k): v for k, v in nominal.items()}
+def tracking(
+    ocp: SymbolicOcp, result: Result, uncertain: Mapping[str, UncertainParameter], options: MonteCarloOptions
+) -> tuple[dict[str, Any], dict[str, np.ndarray]]:
+    """``metrics.monte_carlo.tracking``: the closed loop ``u = u* - K(t)(x - x*(t))`` of eqs.
+    6.27-6.29 for the draws of :func:`monte_carlo` (the same seed), and its first :data:`BUNDLE`
+    trajectories (``tracking_<state>``)."""
+    d = draws(ocp, result, uncertain, options)
+    nominal_params = {symbol(k): v for k, v in d.nominal.items()}
     x0_nominal = initial_state(ocp, result, nominal_params, 1)
-    u_star, inputs = signals
-    reference = rk4(ocp, x0_nominal, u_star, nominal_params, t0, tf, options.steps, inputs=inputs)
-    A, B = linearization(ocp, reference, nominal_params, inputs)
+    reference = rk4(ocp, x0_nominal, d.controls, nominal_params, d.t0, d.tf, options.steps, inputs=d.inputs)
+    A, B = linearization(ocp, reference, nominal_params, d.inputs)
     K = riccati_gains(reference.t, A, B)
     x_ref = reference.x[:, :, 0]
 
     def law(k: int, x: np.ndarray) -> np.ndarray:
         return -K[k] @ (x - x_ref[k][:, None])
 
-    run = rk4(ocp, x0, u_star, params, t0, tf, options.steps, keep=BUNDLE, inputs=inputs, feedback=law)
-    out = _outcome(ocp, x0, run, params)
+    run = rk4(
+        ocp, d.x0, d.controls, d.params, d.t0, d.tf, options.steps, keep=BUNDLE, inputs=d.inputs, feedback=law
+    )
+    out = _outcome(ocp, d.x0, run, d.params)
     energy = summarize({"energy": run.energy})["energy"]
     out["control_energy_mean"], out["control_energy_std"] = energy.mean, energy.std
-    return out, run
+    return out, _bundle("tracking", ocp, run)

@@ -4,10 +4,12 @@ transform's eqs. 6.16–6.18 and the ``rcs`` transform's eqs. 6.31–6.36 both a
 then split the objective and sample the parameters the same way).
 
 :func:`augmented_spec` builds the new spec (pure, every expression printed from SymPy);
-:func:`report` keeps the added states in the Result, splits the objective into
+:func:`report` keeps the added states in the Result and splits the objective into
 ``metrics.nominal_objective`` and ``metrics.sensitivity_cost`` (the solver's own quadrature, so they
-add up to the objective) and re-simulates the control under sampled parameters
-(``metrics.monte_carlo``).
+add up to the objective). The analyses both rewrites declare (:data:`ANALYSES`) re-simulate the
+control under sampled parameters: ``monte_carlo`` (``metrics.monte_carlo``, open loop) and
+``lqr_tracking`` (``metrics.monte_carlo.tracking``, eqs. 6.27-6.29), each when the file's
+``monte_carlo`` options ask for it.
 """
 
 from __future__ import annotations
@@ -18,8 +20,9 @@ from typing import Any
 import numpy as np
 import sympy as sp
 
+from gamespec.analyses import Analysis, Outputs
 from gamespec.desensitize.augment import Augmentation
-from gamespec.desensitize.montecarlo import monte_carlo
+from gamespec.desensitize.montecarlo import monte_carlo, tracking
 from gamespec.desensitize.simulate import dense_integral, evaluate
 from gamespec.desensitize.spec import DesensitizeOptions
 from gamespec.errors import SpecError
@@ -111,8 +114,8 @@ def _equation(residual: sp.Expr) -> str:
 
 
 def report(result: Result, spec: OptimalControlSpec, inverse: InverseData) -> Result:
-    """The Result with the desensitization metrics and the Monte Carlo summary (pure: re-simulates only)."""
-    metrics, arrays = dict(result.metrics), dict(result.arrays)
+    """The Result with the desensitization metrics (pure: evaluates the penalty terms only)."""
+    metrics = dict(result.metrics)
     metrics["desensitization"] = {
         "method": inverse.augmentation.method,
         "original_states": inverse.original_states,
@@ -131,14 +134,45 @@ def report(result: Result, spec: OptimalControlSpec, inverse: InverseData) -> Re
         metrics["nominal_objective"] = (
             None if result.objective is None else result.objective - ocp.sign * sensitivity
         )
-        if inverse.options.monte_carlo.samples:
-            metrics["monte_carlo"], bundle = monte_carlo(
-                ocp, result, spec.problem.uncertain, inverse.options.monte_carlo
-            )
-            arrays |= bundle
-    return result.model_copy(
-        update={"metrics": metrics, "arrays": arrays, "kind": spec.kind, "problem": spec.name}
+    return result.model_copy(update={"metrics": metrics, "kind": spec.kind, "problem": spec.name})
+
+
+def open_loop_monte_carlo(result: Result, spec: OptimalControlSpec, inverse: InverseData) -> Outputs:
+    """The ``monte_carlo`` analysis: :func:`gamespec.desensitize.montecarlo.monte_carlo` with the
+    file's ``monte_carlo`` options (nothing when it asks for no samples)."""
+    carlo = inverse.options.monte_carlo
+    if not carlo.samples or result.time is None:
+        return Outputs()
+    metrics, arrays = monte_carlo(SymbolicOcp(spec), result, spec.problem.uncertain, carlo)
+    return Outputs(metrics={"monte_carlo": metrics}, arrays=arrays)
+
+
+def lqr_tracking(result: Result, spec: OptimalControlSpec, inverse: InverseData) -> Outputs:
+    """The ``lqr_tracking`` analysis: :func:`gamespec.desensitize.montecarlo.tracking` into
+    ``metrics.monte_carlo.tracking`` (nothing unless ``monte_carlo.tracking`` asks for it)."""
+    carlo = inverse.options.monte_carlo
+    if not (carlo.samples and carlo.tracking) or "monte_carlo" not in result.metrics:
+        return Outputs()
+    metrics, arrays = tracking(SymbolicOcp(spec), result, spec.problem.uncertain, carlo)
+    return Outputs(
+        metrics={"monte_carlo": {**result.metrics["monte_carlo"], "tracking": metrics}}, arrays=arrays
     )
+
+
+ANALYSES = (
+    Analysis(
+        "monte_carlo",
+        open_loop_monte_carlo,
+        "re-simulates the open-loop control under sampled uncertain parameters (§6.3.1)",
+    ),
+    Analysis(
+        "lqr_tracking",
+        lqr_tracking,
+        "the LQR-tracking closed loop for the same samples (eqs. 6.27-6.29)",
+        needs=("monte_carlo",),
+    ),
+)
+"""The desensitize transform's analyses (neither decides a check of the status)."""
 
 
 def _penalty_value(spec: OptimalControlSpec, result: Result, penalty: Penalty) -> float:

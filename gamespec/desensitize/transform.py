@@ -10,8 +10,12 @@ compiled model. A ``maximize`` objective subtracts the penalty.
 :meth:`Desensitize.invert` (:func:`gamespec.desensitize.penalized.report`, which the ``rcs``
 transform shares) keeps the added states in the Result (``S_x1_rho``, ``Phi_*``,
 ``lambda_*``, ``mu_*``), splits the objective into ``metrics.nominal_objective`` and
-``metrics.sensitivity_cost`` (the solver's own quadrature, so they add up to the objective), records
-the state counts, and re-simulates the control under sampled parameters (``metrics.monte_carlo``).
+``metrics.sensitivity_cost`` (the solver's own quadrature, so they add up to the objective) and
+records the state counts. Its analyses (:meth:`Desensitize.analyses`,
+:data:`gamespec.desensitize.penalized.ANALYSES`) re-simulate the control under sampled parameters:
+``monte_carlo`` (``metrics.monte_carlo``, open loop) and ``lqr_tracking``
+(``metrics.monte_carlo.tracking``, eqs. 6.27-6.29), each when the file's ``monte_carlo`` options ask
+for it.
 """
 
 from __future__ import annotations
@@ -20,8 +24,9 @@ from typing import ClassVar
 
 import sympy as sp
 
+from gamespec.analyses import Analysis
 from gamespec.desensitize.augment import METHODS, Augmentation
-from gamespec.desensitize.penalized import FIELD, InverseData, Penalty, augmented_spec, report
+from gamespec.desensitize.penalized import ANALYSES, FIELD, InverseData, Penalty, augmented_spec, report
 from gamespec.desensitize.spec import DesensitizeOptions, Weights
 from gamespec.errors import ExpressionError, SpecError
 from gamespec.ocp.symbolic import SymbolicOcp
@@ -48,6 +53,9 @@ class Desensitize(OcpRewrite):
 
     def invert(self, result: Result, spec: SpecBase, inverse_data: InverseData) -> Result:
         return report(result, spec, inverse_data)
+
+    def analyses(self) -> list[Analysis]:
+        return list(ANALYSES)
 
 
 def desensitize(

@@ -1,5 +1,7 @@
 """Monte Carlo check of a solution: sample ``x_0`` and the noise, run the closed loop, and compare the
-sample mean and covariance with the propagated ones (eq. 4.18 and 4.54).
+sample mean and covariance with the propagated ones (eq. 4.18 and 4.54). It is the
+``lq_stochastic_game`` kind's ``monte_carlo`` analysis (:data:`ANALYSES`, in the
+``gamespec.analyses`` entry-point group), run on the Result after the solve.
 
 The players use ``u_k = ū_k + K_k y_k``, ``v_k = v̄_k + L_k y_k`` with ``y`` the noise-only state of
 eq. 4.52, simulated alongside ``x`` with the same draws. The draws come from the Monte Carlo engine
@@ -12,7 +14,10 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from gamespec.analyses import Analysis, Outputs
 from gamespec.montecarlo import MultivariateNormal, Normal, sample
+from gamespec.result import Result
+from gamespec.specs.lq_game import LQGameSpec
 from gamespec.specs.lq_model import LQGame, Strategies
 
 
@@ -63,3 +68,36 @@ def agreement(trajectories: np.ndarray, mean: np.ndarray, covariance: np.ndarray
         mean_z=float(np.max(np.abs(sample_mean - mean) / mean_se)),
         covariance_z=float(np.max(np.abs(sample_cov - covariance) / cov_se)),
     )
+
+
+def closed_loop_check(result: Result, spec: LQGameSpec, inverse: None = None) -> Outputs:
+    """The ``monte_carlo`` analysis: ``method.monte_carlo.samples`` closed-loop trajectories under
+    the Result's strategies (``u{i}``, ``v{j}``, ``arrays.K``, ``arrays.L``) for the game at its
+    parameters, and their agreement with ``arrays.mean`` and ``arrays.covariance`` in standard
+    errors (``checks.monte_carlo_mean_z``, ``checks.monte_carlo_covariance_z``); nothing for
+    fewer than two samples."""
+    carlo = spec.method.monte_carlo
+    if carlo.samples <= 1 or "K" not in result.arrays:
+        return Outputs()
+    game = spec.game(result.parameters)
+    U = np.column_stack([result.controls[f"u{i + 1}"] for i in range(game.m)])
+    V = np.column_stack([result.controls[f"v{j + 1}"] for j in range(game.ell)])
+    trajectories = simulate(
+        game, Strategies(U, V, result.arrays["K"], result.arrays["L"]), carlo.samples, carlo.seed
+    )
+    fit = agreement(trajectories, result.arrays["mean"], result.arrays["covariance"])
+    return Outputs(
+        metrics={"monte_carlo": {"samples": carlo.samples, "seed": carlo.seed}},
+        checks={"monte_carlo_mean_z": fit.mean_z, "monte_carlo_covariance_z": fit.covariance_z},
+        arrays={"samples": trajectories},
+    )
+
+
+ANALYSES = (
+    Analysis(
+        "monte_carlo",
+        closed_loop_check,
+        "closed-loop samples against the propagated mean and covariance (eqs. 4.18, 4.54)",
+    ),
+)
+"""The ``lq_stochastic_game`` kind's analyses (the z-scores have no tolerance: no check of the status)."""

@@ -2,8 +2,10 @@
 
 A backend supplies the mean steering solution (a QP, section 4.3) and the covariance gains
 (eq. 4.59 or Algorithm 2, section 4.4); :func:`assemble` joins them by Props. 7–8
-(``U = Ū + K y``), recomputes the terminal statistics, the closed-form gap, the Monte Carlo check,
-and packs the Result. :mod:`gamespec.compiling.lq` drives these steps for every backend.
+(``U = Ū + K y``), recomputes the terminal statistics and the closed-form gap, and packs the
+Result; the Monte Carlo check is the kind's ``monte_carlo`` analysis
+(:data:`gamespec.lqgame.montecarlo.ANALYSES`). :mod:`gamespec.compiling.lq` drives these steps for
+every backend.
 """
 
 from __future__ import annotations
@@ -17,7 +19,6 @@ from gamespec.lqgame.covariance import CovarianceGame, vector_to_gains
 from gamespec.lqgame.equilibrium import report
 from gamespec.lqgame.lifting import Lifted, lift
 from gamespec.lqgame.mean_steering import MeanGame
-from gamespec.lqgame.montecarlo import agreement, simulate
 from gamespec.result import Result, Status
 from gamespec.specs.lq_model import LQGame, Strategies
 
@@ -121,8 +122,6 @@ def assemble(
     mean: MeanOutcome,
     cov: CovarianceOutcome,
     state_names: list[str],
-    samples: int,
-    seed: int,
     tolerance: float = 1e-5,
 ) -> Result:
     """The Result of one solve, with checks recomputed from the strategies (not from the solver),
@@ -179,13 +178,6 @@ def assemble(
         metrics["min_covariance_scaling"] = cov.min_covariance_scaling
     if cov.history:
         arrays["convergence_history"] = np.array(cov.history)
-    if samples > 1:
-        trajectories = simulate(game, strategies, samples, seed)
-        fit = agreement(trajectories, means, covariances)
-        checks["monte_carlo_mean_z"] = fit.mean_z
-        checks["monte_carlo_covariance_z"] = fit.covariance_z
-        metrics["monte_carlo"] = {"samples": samples, "seed": seed}
-        arrays["samples"] = trajectories
     time = np.arange(N + 1) * game.dt
     controls = {f"u{i + 1}": strategies.U[:, i] for i in range(game.m)}
     controls |= {f"v{i + 1}": strategies.V[:, i] for i in range(game.ell)}

@@ -1,19 +1,25 @@
 """An OCP solution of an engagement's reduced problem, reported as the engagement's Result.
 
-The OCP's heading is turned into a law (:func:`heading_law`), the true dynamics are re-simulated
-under it and :func:`gamespec.pursuit.report.engagement_report` adds the engagement metrics: capture
-time, capturing set, simultaneous-capture gap, region of P2, and for relay pursuit the three arcs
-and the switching condition (eqs. 2.41, 2.46).
+:func:`ocp_report` adds the engagement metrics read from the solution
+(:func:`gamespec.pursuit.report.terminal_metrics`): capture time, capturing set,
+simultaneous-capture gap, region of P2, and for relay pursuit the three arcs and the switching
+condition (eqs. 2.41, 2.46). :func:`resimulation` (the ``resimulation`` analysis of the
+``engagement_to_ocp`` transform) turns the OCP's heading into a law (:func:`heading_law`),
+re-simulates the true dynamics (eq. 2.1) under it and reports what
+:func:`gamespec.pursuit.verification.verify` judges the solution by
+(:func:`gamespec.pursuit.report.simulation_report`).
 """
 
 from __future__ import annotations
+
+from typing import Any
 
 import numpy as np
 
 from gamespec.ocp.control_signal import transcribed_signal
 from gamespec.pursuit.reduced import Reduction
 from gamespec.pursuit.relay import detect_arcs
-from gamespec.pursuit.report import engagement_report
+from gamespec.pursuit.report import simulation_report, terminal_metrics
 from gamespec.pursuit.simulation import HeadingLaw, Players, simulate_to_capture
 from gamespec.result import Result
 from gamespec.specs.engagement import EngagementSpec
@@ -54,18 +60,18 @@ def relay_arcs(red: Reduction, players: Players, result: Result) -> dict[str, fl
 
 
 def ocp_report(result: Result, spec: EngagementSpec, red: Reduction, players: Players) -> Result:
-    """``result`` (of the reduced OCP) with the engagement metrics, checks and paths of its
-    re-simulation."""
+    """``result`` (of the reduced OCP) with the engagement metrics read from it (no simulation)."""
     terminal = np.array([result.states[red.distance[i]][-1] for i in range(len(players.names))])
-    traj = simulate_to_capture(players, heading_law(red, result))
-    metrics, checks, arrays = engagement_report(spec, players, terminal, result.t_final, traj)
+    metrics = terminal_metrics(spec, players, terminal, result.t_final)
     if spec.is_relay and int(np.sum(~players.active)) == 1:
         metrics["arcs"] = relay_arcs(red, players, result)
     metrics["frame"] = red.frame
-    return result.model_copy(
-        update={
-            "metrics": {**result.metrics, **metrics},
-            "checks": {**result.checks, **checks},
-            "arrays": {**result.arrays, **arrays},
-        }
-    )
+    return result.model_copy(update={"metrics": {**result.metrics, **metrics}})
+
+
+def resimulation(
+    result: Result, spec: EngagementSpec, red: Reduction, players: Players
+) -> tuple[dict[str, Any], dict[str, float | None], dict[str, np.ndarray]]:
+    """The metrics, checks and paths of the re-simulation of ``result`` under its heading."""
+    traj = simulate_to_capture(players, heading_law(red, result))
+    return simulation_report(spec, players, result.t_final, traj)

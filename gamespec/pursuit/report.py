@@ -43,19 +43,27 @@ def region_of_p2(spec: EngagementSpec, players: Players) -> str | None:
     return str(regions.classify(players.strategies[0], p1, p2, players.evader, u1, u2, players.v))
 
 
-def engagement_report(
-    spec: EngagementSpec, players: Players, terminal: np.ndarray, t_final: float, traj: Trajectory
-) -> tuple[dict[str, Any], dict[str, float | None], dict[str, np.ndarray]]:
-    """Metrics, checks and path arrays of a solution with terminal distances ``terminal``."""
-    metrics: dict[str, Any] = {
+def terminal_metrics(
+    spec: EngagementSpec, players: Players, terminal: np.ndarray, t_final: float
+) -> dict[str, Any]:
+    """The metrics of a solution read from its terminal distances ``terminal`` (no simulation)."""
+    return {
         "capture_time": t_final,
         "capturing_set": capturing_set(players, terminal),
         "simultaneous_capture_gap": capture_gap(players, terminal),
         "terminal_distances": dict(zip(players.names, map(float, terminal), strict=True)),
         "region": region_of_p2(spec, players),
-        "initial_heading": float(traj.heading[0]),
         "engagement": spec.model_dump(mode="json", include={"pursuers", "evader", "capture_radius"}),
     }
+
+
+def simulation_report(
+    spec: EngagementSpec, players: Players, t_final: float, traj: Trajectory
+) -> tuple[dict[str, Any], dict[str, float | None], dict[str, np.ndarray]]:
+    """Metrics, checks and path arrays of the re-simulation ``traj`` of a solution ending at
+    ``t_final``: its initial heading, re-simulated capture time (and its error), the Voronoi margin
+    for relay pursuit (eq. 2.28), the players' paths."""
+    metrics: dict[str, Any] = {"initial_heading": float(traj.heading[0])}
     checks: dict[str, float | None] = {
         "resimulated_capture_time": traj.capture_time if traj.captured else None,
         "resimulated_capture_time_error": abs(traj.capture_time - t_final) if traj.captured else None,
@@ -65,6 +73,15 @@ def engagement_report(
     arrays = {"path_time": traj.time, "path_evader": traj.evader}
     arrays |= {f"path_{name}": traj.pursuers[:, i] for i, name in enumerate(players.names)}
     return metrics, checks, arrays
+
+
+def engagement_report(
+    spec: EngagementSpec, players: Players, terminal: np.ndarray, t_final: float, traj: Trajectory
+) -> tuple[dict[str, Any], dict[str, float | None], dict[str, np.ndarray]]:
+    """Metrics, checks and path arrays of a solution with terminal distances ``terminal`` and
+    re-simulation ``traj`` (:func:`terminal_metrics` and :func:`simulation_report`)."""
+    metrics, checks, arrays = simulation_report(spec, players, t_final, traj)
+    return terminal_metrics(spec, players, terminal, t_final) | metrics, checks, arrays
 
 
 def engagement_summary(result: Result) -> list[tuple[str, object]]:

@@ -15,6 +15,7 @@ from typing import Any, ClassVar
 
 from pydantic import BaseModel, ConfigDict, model_validator
 
+from gamespec.analyses import for_study
 from gamespec.loader import spec_from_dict
 from gamespec.metrics import Finite
 from gamespec.rcs.study_points import StudyPoint, arrays, layout, point_problem, study_points, summarize
@@ -23,6 +24,9 @@ from gamespec.result import Result, Status
 from gamespec.solving import solve
 from gamespec.studies.point_study import PointStudy, PointStudyModel
 from gamespec.studies.runner import StudyRun
+
+TABLE_ANALYSES = ("monte_carlo",)
+"""What the table needs of each point's analyses: the collision probability."""
 
 
 def evaluate(point: StudyPoint) -> dict[str, Any]:
@@ -33,7 +37,9 @@ def evaluate(point: StudyPoint) -> dict[str, Any]:
     tried = []
     for amplitude in spec.guesses:
         data = point_problem(spec, point.obstacles, point.alpha, amplitude)
-        result = solve(spec_from_dict(data), spec.ocp_backend)
+        result = solve(
+            spec_from_dict(data), spec.ocp_backend, analyses=for_study(spec.analyses, TABLE_ANALYSES)
+        )
         tried.append({"guess": amplitude, "status": result.status.value, "objective": result.objective})
         if result.ok and (best is None or result.objective < best[0]):
             best = (result.objective, result)

@@ -8,10 +8,12 @@ obstacles' positions along the solution in the Result (``obstacle_<name>_x``/``_
 zero ones left out) and the cost ``∫‖vec S_r‖²_Q`` with ``S_r = R S_g`` (eqs. 6.31-6.36), or
 ``∫‖vec S_g‖²_Q`` (eq. 6.32) with ``relevant: false``. On the way back it reports through the
 desensitize transform's report (``metrics.sensitivity_cost`` is the RCS cost,
-``metrics.nominal_objective`` the rest), adds ``S_g<i>_<ρ>`` and ``S_r<i>_<ρ>`` along the solution,
-and ``metrics.monte_carlo.collision_probability``: the share of sampled speeds for which the
+``metrics.nominal_objective`` the rest) and adds ``S_g<i>_<ρ>`` and ``S_r<i>_<ρ>`` along the
+solution. Its ``monte_carlo`` analysis (:meth:`Rcs.analyses`) adds
+``metrics.monte_carlo.collision_probability``: the share of sampled speeds for which the
 open-loop re-simulation (RK4, ``monte_carlo.steps`` steps, agent and obstacles together) breaks a
-path constraint somewhere on that fine grid, with its Wilson interval (``gamespec.montecarlo.proportion``).
+path constraint somewhere on that fine grid, with its Wilson interval (``gamespec.montecarlo.proportion``);
+``lqr_tracking`` is the desensitize transform's.
 
 With ``cost_state: true`` the cost is integrated as a state ``rcs_cost`` (its end value in the
 objective), so the defect check re-integrates it between the collocation points and
@@ -30,8 +32,16 @@ from typing import Any, ClassVar
 import numpy as np
 import sympy as sp
 
+from gamespec.analyses import Analysis, Outputs
 from gamespec.desensitize.augment import NewState, sensitivity_functions
-from gamespec.desensitize.penalized import InverseData, Penalty, augmented_spec, report
+from gamespec.desensitize.penalized import (
+    InverseData,
+    Penalty,
+    augmented_spec,
+    lqr_tracking,
+    open_loop_monte_carlo,
+    report,
+)
 from gamespec.desensitize.simulate import dense_integral, evaluate, values_at
 from gamespec.desensitize.spec import DesensitizeOptions
 from gamespec.errors import ExpressionError, SpecError
@@ -148,6 +158,9 @@ class Rcs(OcpRewrite):
 
     def invert(self, result: Result, spec: SpecBase, inverse_data: RcsData) -> Result:
         return rcs_report(result, spec, inverse_data)
+
+    def analyses(self) -> list[Analysis]:
+        return list(ANALYSES)
 
     def verify(self, result: Result, spec: SpecBase, inverse_data: RcsData) -> str | None:
         """The first check of the Result that fails its tolerance (``metrics.checks_passed``; with
@@ -267,13 +280,37 @@ def rcs_report(result: Result, spec: OptimalControlSpec, data: RcsData) -> Resul
         arrays |= along(result, spec, data)
         if data.options.cost_state:
             metrics["sensitivity_measure"] = dense_integral(result, SymbolicOcp(spec), data.unit)
-        mc = metrics.get("monte_carlo")
-        if mc is not None and "violation_probability" in mc:
-            mc = dict(mc)
-            mc["collision_probability"] = mc["violation_probability"]
-            mc["collision_probability_ci"] = mc["violation_probability_ci"]
-            metrics["monte_carlo"] = mc
     return result.model_copy(update={"metrics": metrics, "arrays": arrays})
+
+
+def collision_monte_carlo(result: Result, spec: OptimalControlSpec, data: RcsData) -> Outputs:
+    """The ``monte_carlo`` analysis of rcs: the desensitize transform's, with the violation
+    probability read as the collision probability (see module doc)."""
+    out = open_loop_monte_carlo(result, spec, data.report)
+    mc = out.metrics.get("monte_carlo")
+    if mc is None or "violation_probability" not in mc:
+        return out
+    mc = mc | {
+        "collision_probability": mc["violation_probability"],
+        "collision_probability_ci": mc["violation_probability_ci"],
+    }
+    return Outputs(metrics={"monte_carlo": mc}, arrays=out.arrays)
+
+
+ANALYSES = (
+    Analysis(
+        "monte_carlo",
+        collision_monte_carlo,
+        "re-simulates the open-loop control under sampled uncertain parameters; the collision probability",
+    ),
+    Analysis(
+        "lqr_tracking",
+        lambda result, spec, data: lqr_tracking(result, spec, data.report),
+        "the LQR-tracking closed loop for the same samples (eqs. 6.27-6.29)",
+        needs=("monte_carlo",),
+    ),
+)
+"""The rcs transform's analyses (neither decides a check of the status)."""
 
 
 def along(result: Result, spec: OptimalControlSpec, data: RcsData) -> dict[str, Any]:

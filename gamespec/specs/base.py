@@ -76,6 +76,26 @@ class ProblemParameters:
         return f"problem.parameters.{name}" if name in self.problem.parameters else name
 
 
+def _analyses_choice(choice: str | list[str]) -> str | list[str]:
+    """``all``, ``none``, or a non-empty list of the names of declared analyses."""
+    if isinstance(choice, str):
+        if choice not in ("all", "none"):
+            raise ValueError(f"give all, none or a list of analysis names, not {choice!r}")
+        return choice
+    if not choice:
+        raise ValueError("give all, none or a list of analysis names, not an empty list")
+    from gamespec.analyses import unknown
+
+    reason = unknown(choice)
+    if reason is not None:
+        raise ValueError(reason)
+    return choice
+
+
+AnalysesChoice = Annotated[str | list[str], AfterValidator(_analyses_choice)]
+"""Which analyses run (:mod:`gamespec.analyses`): ``all``, ``none`` or names declared by an
+installed transform or kind, checked at load."""
+
 RequestedTransforms = list[dict[str, dict[str, Any]]]
 """The ``transforms:`` section: ``[{<transform name>: {<options>}}, ...]``, applied in order."""
 
@@ -96,6 +116,11 @@ class SpecBase(StrictModel):
     transforms: RequestedTransforms = Field(
         default_factory=list,
         description="Requested transforms, [{name: {options}}], applied in order before the solve.",
+    )
+    analyses: AnalysesChoice | None = Field(
+        None,
+        description="Which analyses of the solution run (Monte Carlo, re-simulation, LQR tracking ...): "
+        "all, none, or a list of names; omitted: all (a study passes it on to its points).",
     )
 
     guess_fields: ClassVar[tuple[str, ...]] = ()

@@ -439,5 +439,6 @@ KIND = Kind(
     plot="gamespec.lqgame.plotting:plot",
     summary="gamespec.lqgame.report:lq_summary",
     metrics="gamespec.lqgame.metrics:LqGameMetrics",
+    analyses="gamespec.lqgame.montecarlo:ANALYSES",
 )
 """The ``LQGameSpec`` kind as one plugin (:class:`~gamespec.registry.Kind`)."""

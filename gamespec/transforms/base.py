@@ -10,7 +10,11 @@ needs solving is asked of the solving layer (:mod:`gamespec.solving`):
 - a transform whose mapped-back Result can fail a check of the source problem says so in
   :meth:`Transform.verify` and offers other starting points in :meth:`Transform.restarts`; the
   solving layer re-solves the same compiled model from them (multi-start) when the check fails or
-  the solve does, and keeps the best verified Result.
+  the solve does, and keeps the best verified Result;
+- what is computed *about* a mapped-back Result (a Monte Carlo, a re-simulation, LQR tracking) is
+  not ``invert``'s: a transform declares it in :meth:`Transform.analyses`
+  (:mod:`gamespec.analyses`), and the solving layer runs the selected ones after ``invert`` and
+  before ``verify``.
 
 Runtime parameters go through the chain as in cvxpy's ``update_parameters``: the solving layer
 re-applies the (pure) transforms to the source spec with new values and hands the compiled model
@@ -33,6 +37,7 @@ from dataclasses import dataclass
 from typing import Any, ClassVar
 
 from gamespec import registry
+from gamespec.analyses import Analysis
 from gamespec.compiling import NoOptions
 from gamespec.result import Result
 from gamespec.specs.base import SpecBase, StrictModel
@@ -79,8 +84,14 @@ class Transform(ABC):
         :meth:`stage`'s spec when it names one, whatever its status (check ``upstream.ok``)."""
 
     def invert(self, result: Result, spec: SpecBase, inverse_data: Any) -> Result:
-        """Map a Result of the transformed spec back to the original ``spec`` (default: relabel)."""
+        """Map a Result of the transformed spec back to the original ``spec`` (default: relabel);
+        names only, never an analysis (:meth:`analyses`)."""
         return result.model_copy(update={"kind": spec.kind, "problem": spec.name})
+
+    def analyses(self) -> list[Analysis]:
+        """The analyses of a Result :meth:`invert` returns, run (when selected) with ``spec`` and the
+        inverse data before :meth:`verify`, in this order (the default: none)."""
+        return []
 
     def guess(self, inverse_data: Any) -> Result | None:
         """A starting point of the target spec (a Result in its names) the solving layer passes to

@@ -4,8 +4,11 @@
 from the engagement (speeds, initial distances and angles, ε, the final-time bound) is a parameter
 of the OCP, so the solving layer re-solves one compiled OCP for new positions and speeds.
 :meth:`EngagementToOcp.invert` reports the OCP's solution as the engagement's
-(:func:`gamespec.pursuit.ocp_report.ocp_report`); :meth:`EngagementToOcp.verify` is
-:func:`gamespec.pursuit.verification.verify`. When it fails and the file gives no ``guess_heading``
+(:func:`gamespec.pursuit.ocp_report.ocp_report`); its ``resimulation`` analysis
+(:data:`RESIMULATION`: :func:`gamespec.pursuit.ocp_report.resimulation`) re-simulates the true
+dynamics under the solution's heading, and :meth:`EngagementToOcp.verify`
+(:func:`gamespec.pursuit.verification.verify`) judges the solution by it; with the analysis off,
+the solving layer does not claim ``optimal``. When it fails and the file gives no ``guess_heading``
 (an explicit one is the user's choice of starting point, kept as it is),
 :meth:`EngagementToOcp.restarts` offers the :data:`RETRIES` best simulated constant headings other
 than the guess (eq. 2.28 respected), from which the solving layer re-solves the same compiled OCP.
@@ -17,9 +20,10 @@ from typing import ClassVar
 
 import numpy as np
 
+from gamespec.analyses import Analysis, Outputs
 from gamespec.pursuit.guess import ranked_simulated_headings
 from gamespec.pursuit.ocp_generation import EngagementInverse, heading_guess, to_ocp
-from gamespec.pursuit.ocp_report import ocp_report
+from gamespec.pursuit.ocp_report import ocp_report, resimulation
 from gamespec.pursuit.verification import verify
 from gamespec.result import Result
 from gamespec.specs.base import StrictModel
@@ -29,6 +33,22 @@ from gamespec.transforms.base import Transform
 
 RETRIES = 4
 """Constant headings :meth:`EngagementToOcp.restarts` offers when a solution fails verification."""
+
+
+def _resimulated(result: Result, spec: EngagementSpec, inverse_data: EngagementInverse) -> Outputs:
+    if result.t_final is None:
+        return Outputs()
+    metrics, checks, arrays = resimulation(result, spec, inverse_data.reduction, inverse_data.players)
+    return Outputs(metrics, checks, arrays)
+
+
+RESIMULATION = Analysis(
+    "resimulation",
+    _resimulated,
+    "re-simulates the true dynamics (eq. 2.1) under the solution's heading: the capture time verify checks",
+    checks=("resimulated_capture_time",),
+)
+"""The engagement's re-simulation; :meth:`EngagementToOcp.verify` reads its checks."""
 
 
 class EngagementToOcp(Transform):
@@ -48,6 +68,9 @@ class EngagementToOcp(Transform):
         if not result.ok or result.t_final is None:
             return result
         return ocp_report(result, spec, inverse_data.reduction, inverse_data.players)
+
+    def analyses(self) -> list[Analysis]:
+        return [RESIMULATION]
 
     def guess(self, inverse_data: EngagementInverse) -> Result:
         return inverse_data.guess

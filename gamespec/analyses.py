@@ -42,14 +42,11 @@ from pydantic import BaseModel
 
 from gamespec import registry
 from gamespec.errors import SpecError
-from gamespec.loader import spec_hash
 from gamespec.result import Result
+from gamespec.specs.hashing import spec_hash
 
 Selection = Literal["all", "none"] | list[str]
 """Which analyses run: all of them, none, or those named (with what they need)."""
-
-GROUP = "gamespec.analyses"
-"""The entry-point group of a kind's analyses (name: the kind)."""
 
 SKIPPED = "analyses off"
 """The reason ``metrics["checks_skipped"]`` gives for a check whose analysis was not selected."""

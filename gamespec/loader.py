@@ -208,12 +208,6 @@ def check_backend_options(spec: SpecBase, source: str) -> None:
         backend.validate_options(block, source)
 
 
-def spec_hash(spec: SpecBase) -> str:
-    """A stable hash of a spec's content (provenance of Results)."""
-    text = json.dumps(spec.model_dump(mode="json"), sort_keys=True)
-    return hashlib.sha256(text.encode()).hexdigest()[:16]
-
-
 def refuse_undeclared_parameters(data: Mapping[str, Any], assignments: Iterable[str]) -> None:
     """A SpecError (with the nearest declared name) for a ``--set problem.parameters.NAME=...`` whose
     NAME the file does not declare: a misspelled parameter would otherwise be added unused and change

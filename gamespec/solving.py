@@ -38,9 +38,10 @@ from gamespec.analyses import SKIPPED, Selection, check_names, kind_analyses, ru
 from gamespec.compiling import Backend, CompiledModel, Inputs
 from gamespec.compiling.study_protocol import Study
 from gamespec.errors import BackendError, ExpressionError, SpecError, UnsupportedFeature
-from gamespec.loader import load, spec_hash, with_values
+from gamespec.loader import load, with_values
 from gamespec.result import Provenance, Result, Status
 from gamespec.specs.base import SpecBase, StrictModel
+from gamespec.specs.hashing import spec_hash
 from gamespec.transforms.base import Transform, lowering_path, requested_steps
 
 

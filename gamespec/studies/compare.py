@@ -91,7 +91,7 @@ def reference_objective(objectives: list[float], sense: str) -> float:
 
 def _store_rows(spec: SpecBase, rows: list[dict[str, Any]], out: Path) -> None:
     """The comparison as a study store in ``out``: one record per backend label."""
-    from gamespec.loader import spec_hash
+    from gamespec.specs.hashing import spec_hash
 
     store = ResultStore(out)
     labels = [row["backend"] for row in rows]

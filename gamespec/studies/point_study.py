@@ -15,10 +15,10 @@ from pydantic import BaseModel, Field, ValidationError
 
 from gamespec.compiling import Availability, CompiledModel, Inputs, refuse_inputs, validated_options
 from gamespec.errors import SpecError, UnsupportedFeature
-from gamespec.loader import spec_hash
 from gamespec.result import Result
 from gamespec.solving import get_backend
 from gamespec.specs.base import SpecBase, StrictModel
+from gamespec.specs.hashing import spec_hash
 from gamespec.studies.executors import SCHEDULER_ENV, executor
 from gamespec.studies.runner import StudyRun, run_study
 from gamespec.studies.store import ResultStore

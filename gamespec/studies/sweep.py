@@ -105,8 +105,9 @@ def sweep(
     show_progress: bool = True,
 ) -> StudyRun:
     """Solve ``path`` on the Cartesian product of ``ranges``; the run's values in grid order."""
-    from gamespec.loader import load, spec_hash, with_values
+    from gamespec.loader import load, with_values
     from gamespec.solving import backend_name
+    from gamespec.specs.hashing import spec_hash
 
     total = math.prod(len(values) for _, values in ranges)
     if total > MAX_SWEEP_POINTS:

@@ -8,6 +8,7 @@ and an ODE re-simulation of the engagement under the solution's heading (eq. 2.1
 
 from __future__ import annotations
 
+import dataclasses
 import json
 
 import numpy as np
@@ -154,7 +155,7 @@ def fresh_registry():
     registry.load.cache_clear()
 
 
-def test_a_kind_declares_analyses_in_its_entry_point_group(monkeypatch, fresh_registry) -> None:
+def test_a_kind_declares_analyses_in_its_kind(monkeypatch, fresh_registry) -> None:
     seen = []
 
     def final_x(result, spec, inverse) -> Outputs:
@@ -162,7 +163,9 @@ def test_a_kind_declares_analyses_in_its_entry_point_group(monkeypatch, fresh_re
         return Outputs(metrics={"final_x": float(result.states["x1"][-1])}, checks={"final_x_error": 0.0})
 
     declared = [Analysis("final_x", final_x, "the final x", checks=("final_x_error",))]
-    monkeypatch.setitem(registry._IN_PROCESS["gamespec.analyses"], "optimal_control", declared)
+    kind = dataclasses.replace(registry.kind("optimal_control"), analyses=declared)
+    monkeypatch.setitem(registry._IN_PROCESS["gamespec.kinds"], "optimal_control", kind)
+    registry.load.cache_clear()
     on = solve(ZERMELO, analyses=["final_x"])
     assert on.metrics["final_x"] == pytest.approx(on.states["x1"][-1]) and seen == [None]
     off = solve(ZERMELO, analyses="none")

@@ -19,7 +19,7 @@ from pathlib import Path
 
 import gamespec
 from gamespec.errors import GamespecError
-from gamespec.loader import spec_hash
+from gamespec.specs.hashing import spec_hash
 
 ROOT = Path(__file__).resolve().parents[2]
 PROBLEMS = ROOT / "problems"

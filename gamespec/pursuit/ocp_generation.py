@@ -11,13 +11,13 @@ and sampled as the :func:`fitted_guess` Result the solving layer starts the comp
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 import sympy as sp
 
 from gamespec.pursuit.guess import default_heading, fit_polynomial, polynomial
-from gamespec.pursuit.reduced import Reduction, observe, reduce
+from gamespec.pursuit.reduced import Reduction, final_time_bound, observe, parameter_values, reduce
 from gamespec.pursuit.simulation import Players, Trajectory, simulate_to_capture
 from gamespec.result import Result, Status
 from gamespec.specs.engagement import EngagementSpec
@@ -80,12 +80,39 @@ def _control_bounds(red: Reduction) -> ControlSpec:
     return ControlSpec(lower=to_text(ref - sp.pi), upper=to_text(ref + sp.pi))
 
 
+def ocp_parameters(red: Reduction) -> dict[str, float]:
+    """The runtime parameters of the OCP :func:`to_ocp` writes for ``red``."""
+    return {**red.parameters, "t_max": red.t_max}
+
+
+def _guess_trajectory(spec: EngagementSpec, players: Players) -> tuple[float, Trajectory]:
+    """The guess heading (the file's, else :func:`default_heading`) and its simulation to capture."""
+    heading = default_heading(players) if spec.guess_heading is None else spec.guess_heading
+    return heading, simulate_to_capture(players, heading)
+
+
+def remapped(spec: EngagementSpec, inverse: EngagementInverse) -> tuple[dict[str, float], EngagementInverse]:
+    """The OCP's runtime parameters and the inverse data for ``spec``, an engagement of the same
+    structure as the one ``inverse`` was made for (the same pursuers, strategies and frame): what
+    :func:`to_ocp` gives, without writing the OCP again: the reduction's numbers
+    (:func:`~gamespec.pursuit.reduced.parameter_values`) and the guess heading simulated to capture."""
+    players = Players.from_spec(spec)
+    red = replace(
+        inverse.reduction,
+        parameters=parameter_values(players, inverse.reduction.frame),
+        t_max=final_time_bound(players),
+    )
+    heading, traj = _guess_trajectory(spec, players)
+    return ocp_parameters(red), EngagementInverse(
+        red, players, heading, traj.capture_time, fitted_guess(red, traj)
+    )
+
+
 def to_ocp(spec: EngagementSpec) -> tuple[OptimalControlSpec, EngagementInverse]:
     """The reduced-state OCP of ``spec`` and the data to map its Result back (see module doc)."""
     red = reduce(spec)
     players = Players.from_spec(spec)
-    heading = default_heading(players) if spec.guess_heading is None else spec.guess_heading
-    traj = simulate_to_capture(players, heading)
+    heading, traj = _guess_trajectory(spec, players)
     tau = traj.time / traj.time[-1]
     observed = observe(red, traj)
     capture = set(red.capture_states)
@@ -94,7 +121,7 @@ def to_ocp(spec: EngagementSpec) -> tuple[OptimalControlSpec, EngagementInverse]
         for name in red.dynamics
     }
     problem = OcpProblem(
-        parameters={**red.parameters, "t_max": red.t_max},
+        parameters=ocp_parameters(red),
         states=states,
         controls={red.control: _control_bounds(red)},
         dynamics=red.dynamics,

@@ -33,7 +33,7 @@ from gamespec.specs.desensitize import DesensitizeOptions, Weights
 from gamespec.specs.ocp import OptimalControlSpec
 from gamespec.symbolic.language import TIME, parse, symbol
 from gamespec.symbolic.printer import to_text
-from gamespec.transforms.base import OcpRewrite
+from gamespec.transforms.base import KeepsParameters, OcpRewrite
 
 FIELD = "transforms.desensitize"
 
@@ -60,8 +60,10 @@ class InverseData:
     augmented_states: int
 
 
-class Desensitize(OcpRewrite):
-    """Desensitized optimal control (chapter 6) by sensitivity functions, Seywald's method or C-DOC."""
+class Desensitize(KeepsParameters, OcpRewrite):
+    """Desensitized optimal control (chapter 6) by sensitivity functions, Seywald's method or C-DOC;
+    the weights and sensitivities are expressions of the parameters, so every parameter maps to
+    itself (:class:`~gamespec.transforms.base.KeepsParameters`)."""
 
     name: ClassVar[str] = "desensitize"
     options_model: ClassVar[type[DesensitizeOptions]] = DesensitizeOptions

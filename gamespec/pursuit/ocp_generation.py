@@ -16,9 +16,10 @@ from dataclasses import dataclass, replace
 import numpy as np
 import sympy as sp
 
+from gamespec.pursuit.constant_heading import constant_heading_chase
 from gamespec.pursuit.guess import default_heading, fit_polynomial, polynomial
 from gamespec.pursuit.reduced import Reduction, final_time_bound, observe, parameter_values, reduce
-from gamespec.pursuit.simulation import Players, Trajectory, simulate_to_capture
+from gamespec.pursuit.simulation import Players, Trajectory
 from gamespec.result import Result, Status
 from gamespec.specs.engagement import EngagementSpec
 from gamespec.specs.ocp import (
@@ -59,17 +60,17 @@ def fitted_guess(red: Reduction, traj: Trajectory) -> Result:
     trajectory — sampled at the trajectory's times, as a guess Result (the smooth fit, not the
     trajectory itself, is what the NLP starts well from)."""
     tau = traj.time / traj.time[-1]
-    fitted = {
-        name: np.polynomial.polynomial.polyval(tau, fit_polynomial(tau, values))
-        for name, values in observe(red, traj).items()
-    }
+    observed = observe(red, traj)
+    coefficients = fit_polynomial(tau, np.column_stack(list(observed.values())))
+    fitted = dict(zip(observed, np.polynomial.polynomial.polyval(tau, coefficients), strict=True))
     control = fitted.pop(red.control)
     return Result(status=Status.FEASIBLE, time=traj.time, states=fitted, controls={red.control: control})
 
 
 def heading_guess(red: Reduction, players: Players, heading: float) -> Result:
-    """The constant ``heading`` simulated to capture, as the fitted guess Result of the reduced OCP."""
-    return fitted_guess(red, simulate_to_capture(players, heading))
+    """The constant ``heading`` simulated to capture (:func:`constant_heading_chase`), as the fitted
+    guess Result of the reduced OCP."""
+    return fitted_guess(red, constant_heading_chase(players, heading))
 
 
 def _control_bounds(red: Reduction) -> ControlSpec:
@@ -88,7 +89,7 @@ def ocp_parameters(red: Reduction) -> dict[str, float]:
 def _guess_trajectory(spec: EngagementSpec, players: Players) -> tuple[float, Trajectory]:
     """The guess heading (the file's, else :func:`default_heading`) and its simulation to capture."""
     heading = default_heading(players) if spec.guess_heading is None else spec.guess_heading
-    return heading, simulate_to_capture(players, heading)
+    return heading, constant_heading_chase(players, heading)
 
 
 def remapped(spec: EngagementSpec, inverse: EngagementInverse) -> tuple[dict[str, float], EngagementInverse]:

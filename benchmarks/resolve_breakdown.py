@@ -1,5 +1,6 @@
 """Where the time of a re-solve goes: a 20-point ``evader.speed`` sweep of the two-on-one
-constant-bearing engagement, compiled once, with timers around the parts of each re-solve.
+constant-bearing engagement, compiled once, with timers around the parts of each re-solve (CPU
+time of the process, which other work on a shared machine does not inflate as it does wall time).
 
 Run: ``python -m benchmarks.resolve_breakdown [--points 20] [--repeat 3]`` (seconds; not part of
 the test suite). The timers wrap, by name and only where they exist (so the script also measures
@@ -29,18 +30,18 @@ FILE = Path(__file__).resolve().parents[1] / "problems" / "ch2" / "constant_bear
 
 
 class Timers:
-    """Accumulated wall-clock seconds per label, of wrapped callables."""
+    """Accumulated CPU seconds (this process, all its threads) per label, of wrapped callables."""
 
     def __init__(self) -> None:
         self.seconds: dict[str, float] = defaultdict(float)
 
     def wrap(self, label: str, function: Callable[..., Any]) -> Callable[..., Any]:
         def timed(*args: Any, **kwargs: Any) -> Any:
-            start = time.perf_counter()
+            start = time.process_time()
             try:
                 return function(*args, **kwargs)
             finally:
-                self.seconds[label] += time.perf_counter() - start
+                self.seconds[label] += time.process_time() - start
 
         return timed
 
@@ -60,16 +61,16 @@ def instrument(timers: Timers) -> None:
 
 
 def sweep(timers: Timers, points: int, analyses: bool) -> tuple[float, dict[str, float], list[float]]:
-    """Per-point wall time, per-point seconds by label and the capture times of one sweep."""
+    """Per-point CPU time, per-point CPU seconds by label and the capture times of one sweep."""
     keyword = {} if analyses else {"analyses": "none"}
     solver = gamespec.compile_spec(gamespec.load(FILE), **keyword)
     solver.solve(parameters={"evader.speed": 0.45})
     timers.seconds.clear()
     solver.compiled.solve = timers.wrap("CompiledModel.solve", solver.compiled.solve)
     speeds = [float(v) for v in np.linspace(0.3, 0.6, points)]
-    start = time.perf_counter()
+    start = time.process_time()
     answers = [solver.solve(parameters={"evader.speed": v}).t_final for v in speeds]
-    total = (time.perf_counter() - start) / points
+    total = (time.process_time() - start) / points
     return total, {k: v / points for k, v in timers.seconds.items()}, answers
 
 
@@ -88,7 +89,7 @@ def main() -> None:
         if best is None or run[0] < best[0]:
             best = run
     total, parts, answers = best
-    print(f"{args.points} points, per point {1e3 * total:.2f} ms")
+    print(f"{args.points} points, per point {1e3 * total:.2f} ms of CPU")
     for label, seconds in sorted(parts.items(), key=lambda kv: -kv[1]):
         print(f"  {label:28s} {1e3 * seconds:8.2f} ms  {100 * seconds / total:5.1f} %")
     inside = parts["CompiledModel.solve"]

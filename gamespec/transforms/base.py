@@ -114,23 +114,36 @@ class Transform(ABC):
 def with_parameter_values(spec: SpecT, values: Mapping[str, float]) -> SpecT:
     """``spec`` with its runtime parameters (by :meth:`~SpecBase.runtime_parameters`' names) set to
     ``values``, copied without re-validation: for a parameter map's target, whose values the
-    validated source determines (every other field, its source and file hash kept)."""
+    validated source determines (every other field, its source and file hash kept). Each model
+    on the way is copied once, however many of its parameters change."""
+    tree: dict[str, Any] = {}
     for name, value in values.items():
-        spec = _replaced(spec, spec.parameter_path(name).split("."), value)
-    return spec
+        *parents, last = spec.parameter_path(name).split(".")
+        node = tree
+        for part in parents:
+            node = node.setdefault(part, {})
+        node[last] = _Set(value)
+    return _updated(spec, tree)
 
 
-def _replaced(node: Any, path: list[str], value: Any) -> Any:
-    """A copy of ``node`` with the value at ``path`` replaced (models, dicts, lists and tuples)."""
-    if not path:
-        return value
-    head, rest = path[0], path[1:]
+@dataclass(frozen=True)
+class _Set:
+    """A leaf of :func:`with_parameter_values`' tree of changes: the new value."""
+
+    value: Any
+
+
+def _updated(node: Any, changes: dict[str, Any] | _Set) -> Any:
+    """A copy of ``node`` with ``changes`` (a tree by field name, key or index) applied."""
+    if isinstance(changes, _Set):
+        return changes.value
     if isinstance(node, BaseModel):
-        return node.model_copy(update={head: _replaced(getattr(node, head), rest, value)})
+        return node.model_copy(update={k: _updated(getattr(node, k), c) for k, c in changes.items()})
     if isinstance(node, dict):
-        return {**node, head: _replaced(node[head], rest, value)}
+        return {**node, **{k: _updated(node[k], c) for k, c in changes.items()}}
     items = list(node)
-    items[int(head)] = _replaced(items[int(head)], rest, value)
+    for key, change in changes.items():
+        items[int(key)] = _updated(items[int(key)], change)
     return type(node)(items)
 
 

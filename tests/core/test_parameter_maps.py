@@ -26,6 +26,7 @@ from gamespec.errors import SpecError
 from gamespec.loader import with_values
 from gamespec.solving import build_steps
 from tests.conftest import PROBLEMS
+from tests.core.test_chain import MAX_RANGE, _with_transforms, test_transforms  # noqa: F401 (a fixture)
 
 POINTS = 10
 SPREAD = 0.05
@@ -119,3 +120,19 @@ def test_mapped_chain_hands_the_backend_what_reapplying_would(path: Path, monkey
         assert target.runtime_parameters() == pytest.approx(fresh.runtime_parameters(), rel=1e-12)
         assert target.structure() == fresh.structure()
     assert expected[0].runtime_parameters() != expected[1].runtime_parameters()
+
+
+@pytest.mark.usefixtures("test_transforms")
+def test_a_transform_without_a_map_is_reapplied(tmp_path, monkeypatch) -> None:
+    """``weighted_lagrange`` has no parameter map (every parameter unmapped): a new ``rho`` re-applies
+    it, once per re-solve, and the re-solve still equals a fresh compile."""
+    file = _with_transforms(MAX_RANGE, tmp_path, [{"weighted_lagrange": {"term": "-u**2", "weight": 0.2}}])
+    solver = gamespec.compile_spec(file, options=COLD)
+    applied = []
+    real = solving._applied
+    monkeypatch.setattr(solving, "_applied", lambda *a, **k: applied.append(a[0].name) or real(*a, **k))
+    again = solver.solve(parameters={"rho": 9.0})
+    assert applied == ["weighted_lagrange"]
+    fresh = gamespec.compile_spec(gamespec.load(file, ["problem.parameters.rho=9"]), options=COLD).solve()
+    assert again.status == fresh.status == gamespec.Status.OPTIMAL
+    assert again.objective == pytest.approx(fresh.objective, rel=1e-8)

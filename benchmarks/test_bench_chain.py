@@ -1,6 +1,6 @@
 """Runtime parameters through the chain: a sweep of 20 evader speeds of the two-on-one
-constant-bearing engagement, compiled once and re-solved 20 times (the engagement → OCP transform
-re-applied, the CasADi NLP reused) against 20 fresh solves (load, transform, build, solve).
+constant-bearing engagement, compiled once and re-solved 20 times (the engagement → OCP transform's
+parameter map, the CasADi NLP reused) against 20 fresh solves (load, transform, build, solve).
 
 Both start each NLP from the same guess, so the answers are the same; the speed-up (goal: ≥ 3×) is
 the baseline's time over the compiled sweep's, measured in the same run and written to the

@@ -7,9 +7,13 @@ upstream stage of any staged transform; it compiles the target once and returns 
 
 :meth:`Solver.solve` takes runtime parameters by the **source** spec's names (every field a user
 can see, by dotted path, and a kind's short names such as an ``optimal_control`` parameter): it sets
-them as ``--set`` would and re-validates the source spec, re-applies the (pure) transforms, checks
-that the target changed in runtime parameter values only (else a SpecError naming the parameters),
-and re-solves the compiled model with the target's values — cvxpy's ``update_parameters``. When the
+them as ``--set`` would and re-validates the source spec, maps the new values through each step's
+parameter map to the target's (cvxpy's ``apply_parameters``: no transform re-applied), and re-solves
+the compiled model with the target's values. Only what the maps cannot take re-applies transforms
+(:meth:`Solver.mapped_steps`): a parameter a transform lists as unmapped, a staged step, or a
+dotted field that is no runtime parameter; the re-applied chain must then end in the compiled
+target's structure, else a SpecError naming the parameters (the design's choice: a structural
+change is a new compile, which the caller asks for with :func:`compile_spec`). When the
 last transform's :meth:`~gamespec.transforms.base.Transform.verify` rejects the mapped-back Result,
 or the solve fails, the same compiled model is re-solved from that transform's ``restarts``
 (multi-start) with the caller's parameters and inputs, and the best verified Result is kept.
@@ -28,7 +32,7 @@ from __future__ import annotations
 import datetime as _dt
 import time
 from dataclasses import dataclass
-from functools import cache
+from functools import cache, cached_property
 from importlib.metadata import PackageNotFoundError, version
 from pathlib import Path
 from typing import Any
@@ -42,7 +46,7 @@ from gamespec.loader import load, with_values
 from gamespec.result import Provenance, Result, Status
 from gamespec.specs.base import SpecBase, StrictModel
 from gamespec.specs.hashing import spec_hash
-from gamespec.transforms.base import Transform, lowering_path, requested_steps
+from gamespec.transforms.base import Transform, lowering_path, requested_steps, with_parameter_values
 
 
 def get_backend(name: str) -> Backend:
@@ -140,6 +144,20 @@ def _from_file(
             raise
         inner = f"{err.field}: " if err.field else ""
         raise SpecError(f"{transform.name}: {inner}{err.reason}", field=field, source=source) from None
+
+
+def _changed(old: SpecBase, new: SpecBase) -> frozenset[str]:
+    """The runtime parameters whose values differ between two specs of the same structure."""
+    before, after = old.runtime_parameters(), new.runtime_parameters()
+    return frozenset(n for n, v in after.items() if before.get(n) != v)
+
+
+def _mapped(step: Step, source: SpecBase) -> Step:
+    """``step`` for ``source``, its compiled source with other runtime parameter values, by the
+    transform's parameter map: the target's values set on the compiled target, new inverse data."""
+    values, inverse = step.transform.parameter_map(source, step.inverse)
+    target = with_parameter_values(step.target, values)
+    return Step(step.transform, step.options, source, target, inverse, step.upstream)
 
 
 def _unrequested(spec: SpecBase) -> SpecBase:
@@ -254,20 +272,46 @@ class Solver:
         names: list[str] | None = None,
     ) -> Result:
         """Solve ``spec``, the compiled source spec with other runtime parameter values, on the
-        compiled model; a SpecError (naming ``names``, the parameters that were set) when its target
-        differs from the compiled one in more than those values — or in its starting point, when
-        neither the caller nor the last transform gives the compiled model one."""
-        requested = [options for _, options in requested_steps(spec)]
-        steps = []
+        compiled model (see :meth:`mapped_steps`); a SpecError (naming ``names``, the parameters
+        that were set) when its target differs from the compiled one in more than those values — or
+        in its starting point, when neither the caller nor the last transform gives the compiled
+        model one."""
+        return self._solve(spec, self.mapped_steps(spec, guess is not None, names), guess, inputs)
+
+    def mapped_steps(
+        self, spec: SpecBase, guessed: bool = False, names: list[str] | None = None
+    ) -> list[Step]:
+        """The compiled steps for ``spec`` (cvxpy's ``apply_parameters``): when ``spec`` differs
+        from the compiled source in runtime parameter values only, each step's
+        :meth:`~gamespec.transforms.base.Transform.parameter_map` gives its target's values and
+        inverse data, a step whose source values did not change is kept as compiled, and only a
+        step one of whose :meth:`~gamespec.transforms.base.Transform.unmapped` parameters changed,
+        or a staged one (its upstream stage is solved again), is re-applied, with every step after
+        it. When ``spec`` differs in more (a dotted field that
+        is no runtime parameter, a requested transform's option, a starting point), every step is
+        re-applied. A re-applied chain must end in the compiled target's structure (``guessed``:
+        the caller gives the compiled model a starting point), else a SpecError naming ``names``."""
         current = _unrequested(spec)
-        for index, old in enumerate(self.steps):
+        steps: list[Step] = []
+        if self._same_structure(spec, names):
+            for old in self.steps:
+                changed = _changed(old.source, current)
+                if old.upstream is not None or changed & old.transform.unmapped(current):
+                    break
+                steps.append(_mapped(old, current) if changed else old)
+                current = steps[-1].target
+            else:
+                return steps
+        requested = [options for _, options in requested_steps(spec)]
+        for index in range(len(steps), len(self.steps)):
+            old = self.steps[index]
             options = requested[index] if index < len(requested) else old.options
             steps.append(_applied(old.transform, options, current, old.upstream))
             current = steps[-1].target
         last = steps[-1] if steps else None
-        started = guess is not None or (last is not None and last.transform.guess(last.inverse) is not None)
+        started = guessed or (last is not None and last.transform.guess(last.inverse) is not None)
         difference = _first_difference(
-            current.structure(with_guess=not started), self.target_spec.structure(with_guess=not started)
+            current.structure(with_guess=not started), self._target_structure(with_guess=not started)
         )
         if difference is not None:
             what = ", ".join(names) if names else "the new values"
@@ -277,7 +321,27 @@ class Solver:
                 field=", ".join(names or []),
                 source=self.spec.source,
             )
-        return self._solve(spec, steps, guess, inputs)
+        return steps
+
+    def _same_structure(self, spec: SpecBase, names: list[str] | None) -> bool:
+        """Whether ``spec`` differs from the compiled source in runtime parameter values only: by
+        ``names`` when they are given (each one a runtime parameter), else by its structure."""
+        if names is not None:
+            paths = {self.spec.parameter_path(n) for n in self.spec.runtime_parameters()}
+            return all(self.spec.parameter_path(n) in paths for n in names)
+        return spec.structure(with_guess=True) == self._source_structure
+
+    @cached_property
+    def _source_structure(self) -> dict[str, Any]:
+        return self.spec.structure(with_guess=True)
+
+    def _target_structure(self, with_guess: bool) -> dict[str, Any]:
+        return self._target_structures[with_guess]
+
+    @cached_property
+    def _target_structures(self) -> dict[bool, dict[str, Any]]:
+        """The compiled target's structure with and without its starting point, dumped once."""
+        return {flag: self.target_spec.structure(with_guess=flag) for flag in (False, True)}
 
     def _solve(self, spec: SpecBase, steps: list[Step], guess: Result | None, inputs: Inputs) -> Result:
         """Solve the compiled model and map the Result back through ``steps``; its ``solve_time_s``

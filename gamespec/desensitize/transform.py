@@ -34,11 +34,13 @@ from gamespec.result import Result
 from gamespec.specs.base import SpecBase
 from gamespec.specs.ocp import OptimalControlSpec
 from gamespec.symbolic.language import parse, symbol
-from gamespec.transforms.base import OcpRewrite
+from gamespec.transforms.base import KeepsParameters, OcpRewrite
 
 
-class Desensitize(OcpRewrite):
-    """Desensitized optimal control (chapter 6) by sensitivity functions, Seywald's method or C-DOC."""
+class Desensitize(KeepsParameters, OcpRewrite):
+    """Desensitized optimal control (chapter 6) by sensitivity functions, Seywald's method or C-DOC;
+    the weights and sensitivities are expressions of the parameters, so every parameter maps to
+    itself (:class:`~gamespec.transforms.base.KeepsParameters`)."""
 
     name: ClassVar[str] = "desensitize"
     plot: ClassVar[str] = "gamespec.desensitize.plotting:plot_desensitized"

@@ -5,11 +5,13 @@ states and controls on a common normalized time, each duration a design variable
 the links boundary constraints); :meth:`PhasesToOcp.invert` is
 :func:`gamespec.multiphase.split.split_by_phase` (the trajectories end to end on the real time, phase
 boundaries in ``metrics["phases"]``, checks per phase). Both are pure; the fixed durations are
-parameters of the lowered problem, so a compiled model re-solves for new parameter values.
+parameters of the lowered problem, so a compiled model re-solves for new parameter values, which
+:meth:`PhasesToOcp.parameter_map` sets without lowering again.
 """
 
 from __future__ import annotations
 
+from dataclasses import replace
 from typing import ClassVar
 
 from gamespec.multiphase.lowering import Lowering, lower
@@ -18,7 +20,7 @@ from gamespec.multiphase.split import split_by_phase
 from gamespec.result import Result
 from gamespec.specs.base import StrictModel
 from gamespec.specs.ocp import OptimalControlSpec
-from gamespec.transforms.base import Transform
+from gamespec.transforms.base import Transform, with_parameter_values
 
 
 class PhasesToOcp(Transform):
@@ -33,6 +35,22 @@ class PhasesToOcp(Transform):
     ) -> tuple[OptimalControlSpec, Lowering]:
         lowering = lower(spec)
         return lowering.target, lowering
+
+    def unmapped(self, spec: MultiPhaseSpec) -> frozenset[str]:
+        """None: the file's parameters are the lowered problem's, under the same names."""
+        return frozenset()
+
+    def parameter_map(
+        self, spec: MultiPhaseSpec, inverse_data: Lowering
+    ) -> tuple[dict[str, float], Lowering]:
+        """The file's parameter values, with the fixed durations, on the lowered problem and on each
+        phase's own problem (its checks)."""
+        values = spec.runtime_parameters()
+        phases = [
+            replace(ph, check_spec=with_parameter_values(ph.check_spec, values)) for ph in inverse_data.phases
+        ]
+        target = with_parameter_values(inverse_data.target, values)
+        return target.runtime_parameters(), replace(inverse_data, target=target, phases=phases)
 
     def invert(self, result: Result, spec: MultiPhaseSpec, inverse_data: Lowering) -> Result:
         result = super().invert(result, spec, inverse_data)

@@ -14,8 +14,9 @@ import numpy as np
 import sympy as sp
 
 from gamespec.pursuit import constant_bearing, pure_pursuit
+from gamespec.pursuit.constant_heading import constant_heading_chase
 from gamespec.pursuit.relay import voronoi_margin
-from gamespec.pursuit.simulation import Players, simulate_to_capture
+from gamespec.pursuit.simulation import Players
 from gamespec.symbolic.language import symbol
 from gamespec.symbolic.printer import to_text
 
@@ -27,7 +28,8 @@ NEGLIGIBLE = 1e-10
 
 
 def fit_polynomial(tau: np.ndarray, values: np.ndarray) -> np.ndarray:
-    """Coefficients (lowest degree first) of the least-squares polynomial of :data:`GUESS_DEGREE`."""
+    """Coefficients (lowest degree first) of the least-squares polynomial of :data:`GUESS_DEGREE`
+    (one column per column of ``values`` when it has two dimensions)."""
     return np.polynomial.polynomial.polyfit(tau, values, GUESS_DEGREE)
 
 
@@ -41,10 +43,11 @@ def polynomial(tau: np.ndarray, values: np.ndarray) -> str:
 def ranked_simulated_headings(players: Players, samples: int = 48) -> list[float]:
     """Constant headings on a grid of ``samples``, latest simulated capture first, keeping those that
     respect eq. 2.28 (pure evasion from the first active pursuer when none does); a coarse
-    integration is enough to rank them."""
+    integration is enough to rank them (constant-bearing teams have a closed form,
+    :func:`~gamespec.pursuit.constant_heading.constant_heading_chase`)."""
     scored = []
     for heading in np.linspace(-np.pi, np.pi, samples, endpoint=False):
-        traj = simulate_to_capture(players, float(heading), rtol=1e-6)
+        traj = constant_heading_chase(players, float(heading), rtol=1e-6)
         if voronoi_margin(traj, players).max(initial=-np.inf) <= 0:
             scored.append((traj.capture_time, float(heading)))
     ranked = [h for _, h in sorted(scored, reverse=True)]

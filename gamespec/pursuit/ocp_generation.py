@@ -11,14 +11,15 @@ and sampled as the :func:`fitted_guess` Result the solving layer starts the comp
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 import sympy as sp
 
+from gamespec.pursuit.constant_heading import constant_heading_chase
 from gamespec.pursuit.guess import default_heading, fit_polynomial, polynomial
-from gamespec.pursuit.reduced import Reduction, observe, reduce
-from gamespec.pursuit.simulation import Players, Trajectory, simulate_to_capture
+from gamespec.pursuit.reduced import Reduction, final_time_bound, observe, parameter_values, reduce
+from gamespec.pursuit.simulation import Players, Trajectory
 from gamespec.result import Result, Status
 from gamespec.specs.engagement import EngagementSpec
 from gamespec.specs.ocp import (
@@ -59,17 +60,17 @@ def fitted_guess(red: Reduction, traj: Trajectory) -> Result:
     trajectory — sampled at the trajectory's times, as a guess Result (the smooth fit, not the
     trajectory itself, is what the NLP starts well from)."""
     tau = traj.time / traj.time[-1]
-    fitted = {
-        name: np.polynomial.polynomial.polyval(tau, fit_polynomial(tau, values))
-        for name, values in observe(red, traj).items()
-    }
+    observed = observe(red, traj)
+    coefficients = fit_polynomial(tau, np.column_stack(list(observed.values())))
+    fitted = dict(zip(observed, np.polynomial.polynomial.polyval(tau, coefficients), strict=True))
     control = fitted.pop(red.control)
     return Result(status=Status.FEASIBLE, time=traj.time, states=fitted, controls={red.control: control})
 
 
 def heading_guess(red: Reduction, players: Players, heading: float) -> Result:
-    """The constant ``heading`` simulated to capture, as the fitted guess Result of the reduced OCP."""
-    return fitted_guess(red, simulate_to_capture(players, heading))
+    """The constant ``heading`` simulated to capture (:func:`constant_heading_chase`), as the fitted
+    guess Result of the reduced OCP."""
+    return fitted_guess(red, constant_heading_chase(players, heading))
 
 
 def _control_bounds(red: Reduction) -> ControlSpec:
@@ -80,12 +81,39 @@ def _control_bounds(red: Reduction) -> ControlSpec:
     return ControlSpec(lower=to_text(ref - sp.pi), upper=to_text(ref + sp.pi))
 
 
+def ocp_parameters(red: Reduction) -> dict[str, float]:
+    """The runtime parameters of the OCP :func:`to_ocp` writes for ``red``."""
+    return {**red.parameters, "t_max": red.t_max}
+
+
+def _guess_trajectory(spec: EngagementSpec, players: Players) -> tuple[float, Trajectory]:
+    """The guess heading (the file's, else :func:`default_heading`) and its simulation to capture."""
+    heading = default_heading(players) if spec.guess_heading is None else spec.guess_heading
+    return heading, constant_heading_chase(players, heading)
+
+
+def remapped(spec: EngagementSpec, inverse: EngagementInverse) -> tuple[dict[str, float], EngagementInverse]:
+    """The OCP's runtime parameters and the inverse data for ``spec``, an engagement of the same
+    structure as the one ``inverse`` was made for (the same pursuers, strategies and frame): what
+    :func:`to_ocp` gives, without writing the OCP again: the reduction's numbers
+    (:func:`~gamespec.pursuit.reduced.parameter_values`) and the guess heading simulated to capture."""
+    players = Players.from_spec(spec)
+    red = replace(
+        inverse.reduction,
+        parameters=parameter_values(players, inverse.reduction.frame),
+        t_max=final_time_bound(players),
+    )
+    heading, traj = _guess_trajectory(spec, players)
+    return ocp_parameters(red), EngagementInverse(
+        red, players, heading, traj.capture_time, fitted_guess(red, traj)
+    )
+
+
 def to_ocp(spec: EngagementSpec) -> tuple[OptimalControlSpec, EngagementInverse]:
     """The reduced-state OCP of ``spec`` and the data to map its Result back (see module doc)."""
     red = reduce(spec)
     players = Players.from_spec(spec)
-    heading = default_heading(players) if spec.guess_heading is None else spec.guess_heading
-    traj = simulate_to_capture(players, heading)
+    heading, traj = _guess_trajectory(spec, players)
     tau = traj.time / traj.time[-1]
     observed = observe(red, traj)
     capture = set(red.capture_states)
@@ -94,7 +122,7 @@ def to_ocp(spec: EngagementSpec) -> tuple[OptimalControlSpec, EngagementInverse]
         for name in red.dynamics
     }
     problem = OcpProblem(
-        parameters={**red.parameters, "t_max": red.t_max},
+        parameters=ocp_parameters(red),
         states=states,
         controls={red.control: _control_bounds(red)},
         dynamics=red.dynamics,

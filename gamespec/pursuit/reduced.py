@@ -63,11 +63,38 @@ def _angle_name(frame: str, index: int, n: int) -> str:
 V = symbol("v")
 
 
-def _initial(red: Reduction, state: str, value: float) -> None:
-    """``state(0)`` is the parameter ``<state>_init`` of value ``value``."""
-    start = symbol(f"{state}_init")
-    red.parameters[start.name] = value
-    red.initial[state] = to_text(start)
+def _initial(red: Reduction, state: str) -> None:
+    """``state(0)`` is the parameter ``<state>_init``."""
+    red.initial[state] = to_text(symbol(f"{state}_init"))
+
+
+def parameter_values(players: Players, frame: str) -> dict[str, float]:
+    """The values of a reduction's parameters in ``frame`` for ``players``: ``v``, ``eps``, and per
+    pursuer k its initial distance ``r<k>_init``, its speed ``u<k>`` (when it moves) and its angle:
+    the constant ``phi<k>`` (fixed frame, constant bearing), the initial ``phi<k>_init`` (fixed
+    frame, otherwise) or ``psi<k>_init`` (line-of-sight frame, k ≥ 2). Numbers only: what a new
+    engagement changes in its reduced problem (:func:`reduce` builds the rest once)."""
+    n = len(players.names)
+    r0, phi0 = players.distances(), players.los_angles()
+    values = {"v": players.v, "eps": players.eps}
+    for i, strategy in enumerate(players.strategies):
+        k = i + 1
+        values[f"r{k}_init"] = float(r0[i])
+        if strategy != "stationary":
+            values[f"u{k}"] = float(players.speeds[i])
+        angle = _angle_name(frame, i, n)
+        if frame == "fixed":
+            values[angle if strategy == "cb" else f"{angle}_init"] = float(phi0[i])
+        elif i > 0:
+            values[f"{angle}_init"] = float(np.angle(np.exp(1j * (np.pi - phi0[0] + phi0[i]))))
+    return values
+
+
+def final_time_bound(players: Players) -> float:
+    """``t_max``: :data:`T_MAX_FACTOR` times the latest possible capture min_i (r_i(0) − ε)/(u_i − v)."""
+    active = players.active
+    latest = (players.distances()[active] - players.eps) / (players.speeds[active] - players.v)
+    return T_MAX_FACTOR * float(np.min(latest))
 
 
 def reduce(spec: EngagementSpec) -> Reduction:
@@ -75,9 +102,7 @@ def reduce(spec: EngagementSpec) -> Reduction:
     players = Players.from_spec(spec)
     frame = spec.resolved_frame
     n = len(players.names)
-    r0, phi0 = players.distances(), players.los_angles()
     red = Reduction(frame=frame, control="theta_E" if frame == "fixed" else "theta")
-    red.parameters.update(v=players.v, eps=players.eps)
     control = symbol(red.control)
     for i, strategy in enumerate(players.strategies):
         k = i + 1
@@ -85,19 +110,17 @@ def reduce(spec: EngagementSpec) -> Reduction:
         red.distance[i] = r.name
         if frame == "fixed" or i > 0:
             red.angle[i] = ang.name
-        _initial(red, r.name, float(r0[i]))
+        _initial(red, r.name)
         speed = symbol(f"u{k}")
         if strategy != "stationary":
-            red.parameters[speed.name] = float(players.speeds[i])
             red.capture_states.append(r.name)
         closing = speed if strategy == "pp" else sp.Integer(0)
         if frame == "fixed":
-            dynamics = _fixed_frame(red, strategy, r, ang, speed, closing, control, float(phi0[i]))
+            dynamics = _fixed_frame(red, strategy, r, ang, speed, closing, control)
         elif i == 0:
             dynamics = {r: -speed + V * sp.cos(control)}
         else:
-            psi0 = float(np.angle(np.exp(1j * (np.pi - phi0[0] + phi0[i]))))
-            _initial(red, ang.name, psi0)
+            _initial(red, ang.name)
             dynamics = _line_of_sight_frame(strategy, r, ang, speed, closing, control)
         red.dynamics.update({state.name: to_text(rate) for state, rate in dynamics.items()})
     active = [i for i, s in enumerate(players.strategies) if s != "stationary"]
@@ -106,8 +129,7 @@ def reduce(spec: EngagementSpec) -> Reduction:
         if strategy == "stationary":
             voronoi = sp.Rational(1, 2) * (guard**2 - symbol(red.distance[i]) ** 2)
             red.path_constraints.append(to_text(sp.Le(voronoi, 0)))
-    latest = (r0[active] - players.eps) / (players.speeds[active] - players.v)
-    return replace(red, t_max=T_MAX_FACTOR * float(np.min(latest)))
+    return replace(red, parameters=parameter_values(players, frame), t_max=final_time_bound(players))
 
 
 def _fixed_frame(
@@ -118,14 +140,12 @@ def _fixed_frame(
     speed: sp.Symbol,
     closing: sp.Expr,
     control: sp.Symbol,
-    phi0: float,
 ) -> dict[sp.Symbol, sp.Expr]:
     """Eqs. 2.8 (constant bearing: φ_i a parameter), 3.15–3.16 and 2.34b–c (φ_i a state)."""
     rel = control - ang
     if strategy == "cb":
-        red.parameters[ang.name] = phi0
         return {r: V * sp.cos(rel) - sp.sqrt(speed**2 - V**2 * sp.sin(rel) ** 2)}
-    _initial(red, ang.name, phi0)
+    _initial(red, ang.name)
     return {r: -closing + V * sp.cos(rel), ang: V * sp.sin(rel) / r}
 
 

@@ -62,7 +62,7 @@ from gamespec.specs.base import SpecBase
 from gamespec.specs.ocp import GuessSpec, OptimalControlSpec
 from gamespec.symbolic.language import TIME, parse, symbol
 from gamespec.symbolic.printer import to_text
-from gamespec.transforms.base import OcpRewrite
+from gamespec.transforms.base import KeepsParameters, OcpRewrite, with_parameter_values
 
 
 def _parser(spec: OptimalControlSpec, field: str, running: bool = False):
@@ -87,8 +87,9 @@ class ObstacleData:
     power: sp.Expr
 
 
-class MovingObstacles(OcpRewrite):
-    """Avoidance constraints of declared moving obstacles (§6.4.1-6.4.3)."""
+class MovingObstacles(KeepsParameters, OcpRewrite):
+    """Avoidance constraints of declared moving obstacles (§6.4.1-6.4.3); the obstacles are
+    expressions of the parameters and ``t``, so every parameter maps to itself."""
 
     name: ClassVar[str] = "moving_obstacles"
     options_model: ClassVar[type[MovingObstaclesOptions]] = MovingObstaclesOptions
@@ -143,8 +144,9 @@ class RcsData:
     """The integrand of the sensitivity measure (unit weights)."""
 
 
-class Rcs(OcpRewrite):
-    """Relevant constraint sensitivity (eqs. 6.31-6.36), or eq. 6.32 with ``relevant: false``."""
+class Rcs(KeepsParameters, OcpRewrite):
+    """Relevant constraint sensitivity (eqs. 6.31-6.36), or eq. 6.32 with ``relevant: false``;
+    every parameter maps to itself, the target kept for :meth:`restarts` taking the new values."""
 
     name: ClassVar[str] = "rcs"
     plot: ClassVar[str] = "gamespec.rcs.plotting:plot_rcs"
@@ -155,6 +157,10 @@ class Rcs(OcpRewrite):
         self, spec: SpecBase, options: RcsOptions | None = None, upstream: Result | None = None
     ) -> tuple[OptimalControlSpec, RcsData]:
         return regularized(spec, options or RcsOptions())
+
+    def parameter_map(self, spec: SpecBase, inverse_data: RcsData) -> tuple[dict[str, float], RcsData]:
+        values = spec.runtime_parameters()
+        return values, replace(inverse_data, target=with_parameter_values(inverse_data.target, values))
 
     def invert(self, result: Result, spec: SpecBase, inverse_data: RcsData) -> Result:
         return rcs_report(result, spec, inverse_data)

@@ -1,7 +1,8 @@
 """The ``study`` study: runs a ``pursuit_suboptimal_study`` (Table 2.1, §2.4.4) point by point.
 
 Every point of :func:`gamespec.suboptimal_study.points.study_points` is solved by :func:`evaluate` (the
-generated eq. 2.21 OCP compiled once per speed and process) and goes through
+engagement compiled once per speed and process through the chain, :func:`gamespec.compile_spec`,
+and re-solved for each point's P2 position by the parameter maps) and goes through
 :func:`gamespec.studies.runner.run_study` into a :class:`~gamespec.studies.store.ResultStore` at the
 spec's ``store`` folder, through an executor plugin (``serial``, ``process`` or ``dask``, see
 :mod:`gamespec.studies.executors`); points already stored are reused, so solving the file again
@@ -25,14 +26,11 @@ from pydantic import BaseModel, ConfigDict, model_validator
 
 from gamespec.metrics import Finite
 from gamespec.pursuit import pure_pursuit
-from gamespec.pursuit.ocp_generation import to_ocp, trajectory_guess
-from gamespec.pursuit.ocp_report import heading_law
+from gamespec.pursuit.ocp_generation import trajectory_guess
 from gamespec.pursuit.pursuit_curve import constant_heading_pursuit
-from gamespec.pursuit.reduced import reduce
-from gamespec.pursuit.report import capture_gap
-from gamespec.pursuit.simulation import Players, simulate_to_capture
+from gamespec.pursuit.simulation import Players
 from gamespec.result import Result, Status
-from gamespec.solving import get_backend
+from gamespec.solving import Solver, compile_spec
 from gamespec.studies.point_study import PointStudy, PointStudyModel
 from gamespec.studies.runner import StudyRun
 from gamespec.studies.store import ResultStore
@@ -53,34 +51,41 @@ POINT_CHECKS = {
 
 
 @cache
-def _model(v: float, r1: float, u: float, eps: float, method: str, backend: str):
-    """The eq. 2.21 OCP of one speed, compiled once per process (P2 far away only sets the bounds)."""
+def _solver(v: float, r1: float, u: float, eps: float, method: str, backend: str) -> Solver:
+    """The study's engagement at one speed through the chain, compiled once per process: P2's
+    position is a runtime parameter (:data:`MOVED`), far away at compile time (it sets nothing
+    but the values of the compiled OCP's parameters)."""
     reference = StudyPoint(v, 10 * r1, 0.5 * np.pi, r1, u, eps, (method,), backend)
-    ocp, _ = to_ocp(point_engagement(reference))
-    solver = get_backend(backend)
-    return solver.compile(ocp)
+    return compile_spec(point_engagement(reference), backend)
+
+
+MOVED = ("pursuers.1.position.0", "pursuers.1.position.1")
+"""The engagement's runtime parameters a study point sets: P2's position."""
 
 
 def _first_accepted(point: StudyPoint, parameters: dict[str, float], guess: Result) -> tuple[int, Result]:
     """Solve with each of the point's methods in turn; the first that passes the defect check (or
     the last one tried) and its index."""
     for attempt, method in enumerate(point.methods):
-        model = _model(point.v, point.r1, point.u, point.eps, method, point.backend)
-        result = model.solve(parameters=parameters, guess=guess)
+        solver = _solver(point.v, point.r1, point.u, point.eps, method, point.backend)
+        result = solver.solve(parameters=parameters, guess=guess)
         if result.ok and result.checks["max_defect"] < DEFECT_TOL:
             return attempt, result
     return len(point.methods) - 1, result
 
 
 def evaluate(point: StudyPoint) -> dict[str, Any]:
-    """Suboptimal and optimal capture times of one point (the row the store keeps)."""
+    """Suboptimal and optimal capture times of one point (the row the store keeps): the optimum is
+    the chain's re-solve of the engagement (its parameter map, the compiled OCP, its inverse map
+    with the re-simulation check), started from the suboptimal path in closed form."""
     spec = point_engagement(point)
     players = Players.from_spec(spec)
-    red = reduce(spec)
+    compiled = _solver(point.v, point.r1, point.u, point.eps, point.methods[0], point.backend)
+    red = compiled.steps[0].inverse.reduction  # the names and frame of every point's reduction
     choice = pure_pursuit.suboptimal_heading(players)
     traj = constant_heading_pursuit(players, choice.heading)
     guess = trajectory_guess(red, traj)
-    parameters = {k: red.parameters[k] for k in ("r2_init", "psi_init")}
+    parameters = dict(zip(MOVED, spec.pursuers[1].position, strict=True))
     attempt, result = _first_accepted(point, parameters, guess)
     row: dict[str, Any] = {
         "v": point.v,
@@ -95,13 +100,11 @@ def evaluate(point: StudyPoint) -> dict[str, Any]:
     }
     if not (result.ok and row["max_defect"] < DEFECT_TOL):
         return row
-    terminal = np.array([result.states[red.distance[i]][-1] for i in (0, 1)])
-    check = simulate_to_capture(players, heading_law(red, result))
     return row | {
         "t_optimal": result.t_final,
         "variation_percent": 100.0 * (result.t_final - traj.capture_time) / result.t_final,
-        "simultaneous_capture_gap": capture_gap(players, terminal),
-        "resimulated_capture_time_error": abs(check.capture_time - result.t_final),
+        "simultaneous_capture_gap": result.metrics["simultaneous_capture_gap"],
+        "resimulated_capture_time_error": result.checks["resimulated_capture_time_error"],
     }
 
 

@@ -16,10 +16,15 @@ needs solving is asked of the solving layer (:mod:`gamespec.solving`):
   (:mod:`gamespec.analyses`), and the solving layer runs the selected ones after ``invert`` and
   before ``verify``.
 
-Runtime parameters go through the chain as in cvxpy's ``update_parameters``: the solving layer
-re-applies the (pure) transforms to the source spec with new values and hands the compiled model
-the target's new parameter values, after checking the target's :meth:`~SpecBase.structure` did not
-change.
+Runtime parameters go through the chain as in cvxpy's ``apply_parameters``: cvxpy canonicalizes a
+parametrized problem once (its reductions keep the structure and the inverse data) and, for new
+parameter values, only maps them through the cached parametrized program to the solver's data. Here
+:meth:`Transform.parameter_map` maps the source's runtime parameter values to the target's and
+refreshes the inverse data, without re-applying the transform; the solving layer hands the compiled
+model the last target's values. A transform maps the parameters it can map cheaply; those in
+:meth:`Transform.unmapped` (by default all of them: a transform without a map is always correct)
+make the solving layer re-apply it, and every later step, and check that the target's
+:meth:`~SpecBase.structure` did not change.
 
 *Requested* transforms (``requested = True``: same kind to same kind, applied when a file lists them
 under ``transforms:``, with options validated by ``options_model``) come first, in the file's
@@ -33,8 +38,11 @@ from __future__ import annotations
 
 from abc import ABC, abstractmethod
 from collections import deque
+from collections.abc import Mapping
 from dataclasses import dataclass
-from typing import Any, ClassVar
+from typing import Any, ClassVar, TypeVar
+
+from pydantic import BaseModel
 
 from gamespec import registry
 from gamespec.analyses import Analysis
@@ -42,6 +50,8 @@ from gamespec.compiling import NoOptions
 from gamespec.result import Result
 from gamespec.specs.base import SpecBase, StrictModel
 from gamespec.specs.requested import entry, transform_class, validated_options
+
+SpecT = TypeVar("SpecT", bound=SpecBase)
 
 
 @dataclass(frozen=True)
@@ -108,6 +118,54 @@ class Transform(ABC):
         :meth:`verify` fails or the solve itself does not succeed (the default: none)."""
         return []
 
+    def unmapped(self, spec: SpecBase) -> frozenset[str]:
+        """The runtime parameters of ``spec`` that :meth:`parameter_map` cannot map: a new value of
+        one of them makes the solving layer re-apply this transform (the default: all of them)."""
+        return frozenset(spec.runtime_parameters())
+
+    def parameter_map(self, spec: SpecBase, inverse_data: Any) -> tuple[dict[str, float], Any]:
+        """The target's runtime parameter values and the inverse data for ``spec``, the compiled
+        source with new values of runtime parameters outside :meth:`unmapped` (the same structure),
+        as :meth:`apply` would give them, but cheaply (cvxpy's ``apply_parameters``).
+        ``inverse_data`` is the compiled step's. Called only when :meth:`unmapped` leaves room."""
+        raise NotImplementedError(f"transform {self.name!r} has no parameter map")
+
+
+def with_parameter_values(spec: SpecT, values: Mapping[str, float]) -> SpecT:
+    """``spec`` with its runtime parameters (by :meth:`~SpecBase.runtime_parameters`' names) set to
+    ``values``, copied without re-validation: for a parameter map's target, whose values the
+    validated source determines (every other field, its source and file hash kept). Each model
+    on the way is copied once, however many of its parameters change."""
+    tree: dict[str, Any] = {}
+    for name, value in values.items():
+        *parents, last = spec.parameter_path(name).split(".")
+        node = tree
+        for part in parents:
+            node = node.setdefault(part, {})
+        node[last] = _Set(value)
+    return _updated(spec, tree)
+
+
+@dataclass(frozen=True)
+class _Set:
+    """A leaf of :func:`with_parameter_values`' tree of changes: the new value."""
+
+    value: Any
+
+
+def _updated(node: Any, changes: dict[str, Any] | _Set) -> Any:
+    """A copy of ``node`` with ``changes`` (a tree by field name, key or index) applied."""
+    if isinstance(changes, _Set):
+        return changes.value
+    if isinstance(node, BaseModel):
+        return node.model_copy(update={k: _updated(getattr(node, k), c) for k, c in changes.items()})
+    if isinstance(node, dict):
+        return {**node, **{k: _updated(node[k], c) for k, c in changes.items()}}
+    items = list(node)
+    for key, change in changes.items():
+        items[int(key)] = _updated(items[int(key)], change)
+    return type(node)(items)
+
 
 def _lowering() -> list[Transform]:
     found = []
@@ -146,6 +204,18 @@ def lowering_path(spec: SpecBase, kinds: frozenset[str]) -> list[Transform] | No
             seen.add(t.target_kind)
             queue.append((t.target_kind, [*path, t]))
     return None
+
+
+class KeepsParameters:
+    """Mixin of a transform whose target has exactly the source's runtime parameters (what it
+    generates keeps them as symbols) and whose inverse data holds no value of theirs: every
+    parameter maps, to itself, and the inverse data stays as it is."""
+
+    def unmapped(self, spec: SpecBase) -> frozenset[str]:
+        return frozenset()
+
+    def parameter_map(self, spec: SpecBase, inverse_data: Any) -> tuple[dict[str, float], Any]:
+        return spec.runtime_parameters(), inverse_data
 
 
 class OcpRewrite(Transform, ABC):

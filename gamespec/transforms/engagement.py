@@ -2,7 +2,9 @@
 
 :meth:`EngagementToOcp.apply` is :func:`gamespec.pursuit.ocp_generation.to_ocp`; every value taken
 from the engagement (speeds, initial distances and angles, ε, the final-time bound) is a parameter
-of the OCP, so the solving layer re-solves one compiled OCP for new positions and speeds.
+of the OCP, so the solving layer re-solves one compiled OCP for new positions and speeds; its
+:meth:`EngagementToOcp.parameter_map` computes those numbers and the new guess without writing the
+OCP again.
 :meth:`EngagementToOcp.invert` reports the OCP's solution as the engagement's
 (:func:`gamespec.pursuit.ocp_report.ocp_report`); its ``resimulation`` analysis
 (:data:`RESIMULATION`: :func:`gamespec.pursuit.ocp_report.resimulation`) re-simulates the true
@@ -22,7 +24,7 @@ import numpy as np
 
 from gamespec.analyses import Analysis, Outputs
 from gamespec.pursuit.guess import ranked_simulated_headings
-from gamespec.pursuit.ocp_generation import EngagementInverse, heading_guess, to_ocp
+from gamespec.pursuit.ocp_generation import EngagementInverse, heading_guess, remapped, to_ocp
 from gamespec.pursuit.ocp_report import ocp_report, resimulation
 from gamespec.pursuit.verification import verify
 from gamespec.result import Result
@@ -62,6 +64,17 @@ class EngagementToOcp(Transform):
         self, spec: EngagementSpec, options: StrictModel, upstream: Result | None = None
     ) -> tuple[OptimalControlSpec, EngagementInverse]:
         return to_ocp(spec)
+
+    def unmapped(self, spec: EngagementSpec) -> frozenset[str]:
+        """None: every position, speed and the capture radius maps to the OCP's parameters."""
+        return frozenset()
+
+    def parameter_map(
+        self, spec: EngagementSpec, inverse_data: EngagementInverse
+    ) -> tuple[dict[str, float], EngagementInverse]:
+        """:func:`~gamespec.pursuit.ocp_generation.remapped`: the reduction's numbers and the guess
+        simulated again, the OCP not written again."""
+        return remapped(spec, inverse_data)
 
     def invert(self, result: Result, spec: EngagementSpec, inverse_data: EngagementInverse) -> Result:
         result = super().invert(result, spec, inverse_data)

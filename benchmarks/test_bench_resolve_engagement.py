@@ -6,11 +6,10 @@ the parameter maps, the inverse maps and the Result's bookkeeping.
 The share is a ratio within the same run: the CPU time inside ``CompiledModel.solve`` (timed by
 wrapping the compiled model's ``solve``) over the CPU time of the sweep's ``Solver.solve`` calls
 (CPU, not wall time: on a shared machine other work stretches the wall time of both parts by
-chance), written to the benchmark's ``extra_info`` and to the terminal. It needs the analyses out of the
-re-solve: the sweep compiles with ``analyses="none"`` where :func:`gamespec.compile_spec` takes that
-keyword (issue 24, item 2, which moves the re-simulation out of the engagement's ``invert``); where
-it does not, the re-simulation is still part of every re-solve, the share is reported with and
-without it, and the goal is an expected failure.
+chance), written to the benchmark's ``extra_info`` and to the terminal. The sweep compiles with
+``analyses="none"`` (issue 24, item 2: the re-simulation is the engagement's ``resimulation``
+analysis, not part of ``invert``); the share is also reported with the re-simulation's time
+subtracted, which must agree when the analysis is really off.
 
 Run: ``python -m pytest benchmarks/test_bench_resolve_engagement.py --benchmark-enable -s``; the
 per-part breakdown: ``python -m benchmarks.resolve_breakdown``.
@@ -18,11 +17,9 @@ per-part breakdown: ``python -m benchmarks.resolve_breakdown``.
 
 from __future__ import annotations
 
-import inspect
 import time
 
 import numpy as np
-import pytest
 
 import gamespec
 from gamespec.pursuit import ocp_report
@@ -31,9 +28,6 @@ from tests.conftest import PROBLEMS
 FILE = PROBLEMS / "ch2" / "constant_bearing_two_on_one.yaml"
 SPEEDS = [float(v) for v in np.linspace(0.3, 0.6, 20)]
 GOAL = 0.80
-ANALYSES_OFF = (
-    {"analyses": "none"} if "analyses" in inspect.signature(gamespec.compile_spec).parameters else None
-)
 
 
 def _timed(seconds: list[float], function):
@@ -49,7 +43,7 @@ def _timed(seconds: list[float], function):
 
 def test_resolve_time_is_solve_time(benchmark, monkeypatch) -> None:
     benchmark.group = "re-solve: 20 evader speeds"
-    solver = gamespec.compile_spec(gamespec.load(FILE), **(ANALYSES_OFF or {}))
+    solver = gamespec.compile_spec(gamespec.load(FILE), analyses="none")
     solver.solve(parameters={"evader.speed": 0.45})
     inside: list[float] = []
     resimulation: list[float] = []
@@ -80,6 +74,5 @@ def test_resolve_time_is_solve_time(benchmark, monkeypatch) -> None:
         f"\nper point {1e3 * total / len(SPEEDS):.2f} ms of CPU, inside CompiledModel.solve "
         f"{100 * share:.1f} %, {100 * without:.1f} % with the re-simulation in invert subtracted"
     )
-    if ANALYSES_OFF is None:
-        pytest.xfail("compile_spec takes no analyses= here: the re-simulation is still in invert")
+    assert sum(resimulation) == 0.0, "the re-simulation ran with the analyses off"
     assert share >= GOAL

@@ -54,9 +54,10 @@ POINT_CHECKS = {
 def _solver(v: float, r1: float, u: float, eps: float, method: str, backend: str) -> Solver:
     """The study's engagement at one speed through the chain, compiled once per process: P2's
     position is a runtime parameter (:data:`MOVED`), far away at compile time (it sets nothing
-    but the values of the compiled OCP's parameters)."""
+    but the values of the compiled OCP's parameters). Its solves run the ``resimulation`` analysis,
+    the one whose check (:data:`POINT_CHECKS`) the table reads."""
     reference = StudyPoint(v, 10 * r1, 0.5 * np.pi, r1, u, eps, (method,), backend)
-    return compile_spec(point_engagement(reference), backend)
+    return compile_spec(point_engagement(reference), backend, analyses=["resimulation"])
 
 
 MOVED = ("pursuers.1.position.0", "pursuers.1.position.1")

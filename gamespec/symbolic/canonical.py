@@ -35,7 +35,7 @@ from typing import Any
 
 from gamespec.errors import ExpressionError
 from gamespec.limits import MAX_MAGNITUDE
-from gamespec.symbolic.grammar import FLOATS, Refused, expression, relation, unknown
+from gamespec.symbolic.grammar import FLOATS, Refused, expression, relation, syntax_tree, unknown
 
 SCREEN_LIMIT = MAX_MAGNITUDE * 2.0**-64
 """The largest bound the screen settles: far enough below the range of a double that its own
@@ -45,6 +45,9 @@ EXACT_INTEGERS = 2**53
 TOTAL_FUNCTIONS = frozenset({"sin", "cos", "exp", "tanh", "atan", "abs", "min", "max", "sign", "heaviside"})
 """The whitelisted functions defined, finite and real for every real argument (and so is their
 derivative where SymPy writes one: ``abs`` → ``sign``, ``max`` → ``heaviside``)."""
+ATOM_FUNCTIONS = frozenset({"log", "sqrt", "tan", "asin", "acos"})
+"""The whitelisted functions SymPy keeps, with their derivatives, as functions of ``c*name`` (a real
+symbol of unknown sign: ``log(-2*x)``, ``sqrt(-x)``, ``tan(x)``)."""
 
 
 class Undecided(Exception):
@@ -56,19 +59,24 @@ class Bounded:
     """A value of the :class:`Screen`: ``bound`` is at least the magnitude of every number SymPy's
     canonical form of it, and of each of its parts, can hold; ``value`` its float when it is made
     of numbers only (None when it depends on a name), ``exact`` when that float is SymPy's number
-    itself (a literal, ``pi``, their negation)."""
+    itself (a literal, ``pi``, their negation). ``power`` is ``k`` when SymPy's form is
+    ``c*name**k`` for an exact nonzero ``c`` and a nonzero integer ``k`` (so never a number and never
+    zero, whatever the name's value), else 0."""
 
     bound: float
     value: float | None = None
     exact: bool = False
+    power: int = 0
 
 
 class Screen:
-    """The grammar's walk proving, without SymPy, that an expression's SymPy form is defined: it
-    raises :class:`Undecided` at an operation that could be undefined for some argument (a division
-    by anything but a nonzero literal, ``log``, ``sqrt``, ``tan``, ``atan2``, ``asin``, ``acos``, a
-    power by anything but a nonnegative integer literal, a function of numbers other than literals)
-    and at a bound beyond :data:`SCREEN_LIMIT`."""
+    """The grammar's walk proving, without SymPy, that an expression's SymPy form and its derivatives
+    are defined: it raises :class:`Undecided` at an operation that could be undefined for some
+    argument — a division by anything but a nonzero literal or ``c*name**k``; ``log``, ``sqrt``,
+    ``tan``, ``asin`` or ``acos`` of anything but ``c*name``; ``atan2``; a power of ``c*name`` by
+    anything but a literal, of ``c*name**k`` by anything but an integer literal, of anything else by
+    anything but a nonnegative integer literal; a function of numbers other than literals — and at a
+    bound beyond :data:`SCREEN_LIMIT`."""
 
     def number(self, value: int | float) -> Bounded:
         try:
@@ -82,11 +90,13 @@ class Screen:
         return Bounded(math.pi, math.pi, exact=True)
 
     @staticmethod
-    def _bounded(bound: float, value: float | None = None, exact: bool = False, *parts: Bounded) -> Bounded:
+    def _bounded(
+        bound: float, value: float | None = None, exact: bool = False, *parts: Bounded, power: int = 0
+    ) -> Bounded:
         bound = max(bound, *(p.bound for p in parts)) if parts else bound
         if not bound <= SCREEN_LIMIT or (value is not None and not abs(value) <= SCREEN_LIMIT):
             raise Undecided
-        return Bounded(bound, value, exact)
+        return Bounded(bound, value, exact, power)
 
     @staticmethod
     def _float(build: Any, *args: Any) -> float:
@@ -97,43 +107,59 @@ class Screen:
         except (Refused, ArithmeticError, ValueError, TypeError):
             raise Undecided from None
 
+    @staticmethod
+    def _nonzero_literal(value: Bounded) -> bool:
+        return value.exact and bool(value.value)
+
     def binary(self, op: type[ast.operator], left: Bounded, right: Bounded) -> Bounded:
+        power = 0
         if op is ast.Div:
-            if not (right.exact and right.value):
+            if not (self._nonzero_literal(right) or right.power):
                 raise Undecided
-            bound = left.bound * max(1.0, 1.0 / abs(right.value))
+            bound = left.bound * right.bound * (1.0 / abs(right.value) if right.value else 1.0)
+            power = left.power if self._nonzero_literal(right) else 0
         elif op is ast.Mult:
             bound = left.bound * right.bound
+            if self._nonzero_literal(left) or self._nonzero_literal(right):
+                power = left.power or right.power
         else:
             bound = left.bound + right.bound
         value = None
         if left.value is not None and right.value is not None:
             value = self._float(FLOATS.binary, op, left.value, right.value)
-        return self._bounded(bound, value, False, left, right)
+        return self._bounded(bound, value, False, left, right, power=power)
 
     def negate(self, value: Bounded) -> Bounded:
-        return Bounded(value.bound, None if value.value is None else -value.value, value.exact)
+        number = None if value.value is None else -value.value
+        return Bounded(value.bound, number, value.exact, value.power)
 
     def power(self, base: Bounded, exponent: Bounded) -> Bounded:
         e = exponent.value
-        if base.value is not None and base.exact and exponent.exact and e is not None:
+        if e is None or not exponent.exact:
+            raise Undecided
+        if base.value is not None:
+            if not base.exact:
+                raise Undecided
             value = self._float(FLOATS.power, base.value, e)
             return self._bounded(max(1.0, abs(value)), value, False, base, exponent)
-        if base.value is not None or not exponent.exact or e is None or e < 0 or not e.is_integer():
+        integer = e.is_integer()
+        if not (base.power == 1 or (base.power and integer) or (integer and e >= 0)):
             raise Undecided
         try:
-            bound = max(2.0, base.bound) ** e
+            bound = max(2.0, base.bound) ** abs(e)
         except OverflowError:
             raise Undecided from None
-        return self._bounded(bound, None, False, base, exponent)
+        power = int(base.power * e) if base.power and integer and e else 0
+        return self._bounded(bound, None, False, base, exponent, power=power)
 
     def call(self, name: str, args: list[Bounded]) -> Bounded:
         if all(a.value is not None and a.exact for a in args):
             value = self._float(FLOATS.call, name, [a.value for a in args])
             return self._bounded(max(1.0, abs(value)), value, False, *args)
-        if name not in TOTAL_FUNCTIONS:
+        atom = len(args) == 1 and args[0].power == 1
+        if name not in TOTAL_FUNCTIONS and not (atom and name in ATOM_FUNCTIONS):
             raise Undecided
-        largest = max(a.bound for a in args)
+        largest = max(math.pi, *(a.bound for a in args))
         value = None
         if all(a.value is not None for a in args):
             value = self._float(FLOATS.call, name, [a.value for a in args])
@@ -152,8 +178,8 @@ class Screen:
 
 
 SCREEN = Screen()
-NAME = Bounded(1.0)
-"""A name's value in the screen (a symbol: coefficient 1)."""
+NAME = Bounded(1.0, power=1)
+"""A name's value in the screen (a real symbol: ``1*name**1``)."""
 
 
 def check(
@@ -172,13 +198,26 @@ def check(
     derivatives finite and real."""
     values = dict(values or {})
     names = [*dict.fromkeys([*names, *values])]
-    definitions = dict(definitions or {})
+    definitions = _used(text, dict(definitions or {}))
     floats = {n: values[n] if n in values else unknown(n) for n in names}
     _walk(text, floats, FLOATS, constraint, definitions)
     try:
         _walk(text, dict.fromkeys(names, NAME), SCREEN, constraint, definitions)
     except Undecided:
         _check_in_sympy(text, names, constraint, definitions)
+
+
+def _used(text: str | float, definitions: dict[str, str | float]) -> dict[str, str | float]:
+    """The definitions ``text`` uses, directly or through other definitions, in their order."""
+    used = _names(text)
+    for name in reversed(definitions):
+        if name in used:
+            used |= _names(definitions[name])
+    return {n: raw for n, raw in definitions.items() if n in used}
+
+
+def _names(text: str | float) -> set[str]:
+    return {n.id for n in ast.walk(syntax_tree(text)) if isinstance(n, ast.Name)}
 
 
 def _walk(

@@ -247,3 +247,5 @@ def _check_in_sympy(
             SYMPY.finite(sp.diff(expr, name))
         except Refused as err:
             raise ExpressionError(str(text), f"its derivative in {name} {err}") from None
+        except RecursionError:
+            raise ExpressionError(str(text)[:40] + "...", "expression nested too deeply") from None

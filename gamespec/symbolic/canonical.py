@@ -47,7 +47,10 @@ TOTAL_FUNCTIONS = frozenset({"sin", "cos", "exp", "tanh", "atan", "abs", "min", 
 derivative where SymPy writes one: ``abs`` → ``sign``, ``max`` → ``heaviside``)."""
 ATOM_FUNCTIONS = frozenset({"log", "sqrt", "tan", "asin", "acos"})
 """The whitelisted functions SymPy keeps, with their derivatives, as functions of ``c*name`` (a real
-symbol of unknown sign: ``log(-2*x)``, ``sqrt(-x)``, ``tan(x)``)."""
+symbol of unknown sign: ``log(-2*x)``, ``sqrt(-x)``, ``tan(x)``), not known to be real there."""
+REAL_ARGUMENTS = frozenset({"abs", "sign", "min", "max", "heaviside"})
+"""The functions whose SymPy derivative is in the language only for an argument SymPy knows to be
+real (``abs(x)`` → ``sign(x)``; ``abs(asin(x))`` → ``re``, ``im``)."""
 
 
 class Undecided(Exception):
@@ -61,12 +64,14 @@ class Bounded:
     of numbers only (None when it depends on a name), ``exact`` when that float is SymPy's number
     itself (a literal, ``pi``, their negation). ``power`` is ``k`` when SymPy's form is
     ``c*name**k`` for an exact nonzero ``c`` and a nonzero integer ``k`` (so never a number and never
-    zero, whatever the name's value), else 0."""
+    zero, whatever the name's value), else 0. ``real`` when SymPy knows its form to be real for every
+    real value of the names."""
 
     bound: float
     value: float | None = None
     exact: bool = False
     power: int = 0
+    real: bool = True
 
 
 class Screen:
@@ -91,12 +96,17 @@ class Screen:
 
     @staticmethod
     def _bounded(
-        bound: float, value: float | None = None, exact: bool = False, *parts: Bounded, power: int = 0
+        bound: float,
+        value: float | None = None,
+        exact: bool = False,
+        *parts: Bounded,
+        power: int = 0,
+        real: bool = True,
     ) -> Bounded:
         bound = max(bound, *(p.bound for p in parts)) if parts else bound
         if not bound <= SCREEN_LIMIT or (value is not None and not abs(value) <= SCREEN_LIMIT):
             raise Undecided
-        return Bounded(bound, value, exact, power)
+        return Bounded(bound, value, exact, power, real and all(p.real for p in parts))
 
     @staticmethod
     def _float(build: Any, *args: Any) -> float:
@@ -112,12 +122,13 @@ class Screen:
         return value.exact and bool(value.value)
 
     def binary(self, op: type[ast.operator], left: Bounded, right: Bounded) -> Bounded:
-        power = 0
+        power, real = 0, True
         if op is ast.Div:
             if not (self._nonzero_literal(right) or right.power):
                 raise Undecided
             bound = left.bound * right.bound * (1.0 / abs(right.value) if right.value else 1.0)
             power = left.power if self._nonzero_literal(right) else 0
+            real = self._nonzero_literal(right)
         elif op is ast.Mult:
             bound = left.bound * right.bound
             if self._nonzero_literal(left) or self._nonzero_literal(right):
@@ -127,11 +138,11 @@ class Screen:
         value = None
         if left.value is not None and right.value is not None:
             value = self._float(FLOATS.binary, op, left.value, right.value)
-        return self._bounded(bound, value, False, left, right, power=power)
+        return self._bounded(bound, value, False, left, right, power=power, real=real)
 
     def negate(self, value: Bounded) -> Bounded:
         number = None if value.value is None else -value.value
-        return Bounded(value.bound, number, value.exact, value.power)
+        return Bounded(value.bound, number, value.exact, value.power, value.real)
 
     def power(self, base: Bounded, exponent: Bounded) -> Bounded:
         e = exponent.value
@@ -150,7 +161,7 @@ class Screen:
         except OverflowError:
             raise Undecided from None
         power = int(base.power * e) if base.power and integer and e else 0
-        return self._bounded(bound, None, False, base, exponent, power=power)
+        return self._bounded(bound, None, False, base, exponent, power=power, real=integer and e >= 0)
 
     def call(self, name: str, args: list[Bounded]) -> Bounded:
         if all(a.value is not None and a.exact for a in args):
@@ -158,6 +169,8 @@ class Screen:
             return self._bounded(max(1.0, abs(value)), value, False, *args)
         atom = len(args) == 1 and args[0].power == 1
         if name not in TOTAL_FUNCTIONS and not (atom and name in ATOM_FUNCTIONS):
+            raise Undecided
+        if name in REAL_ARGUMENTS and not all(a.real for a in args):
             raise Undecided
         largest = max(math.pi, *(a.bound for a in args))
         value = None
@@ -168,7 +181,7 @@ class Screen:
                 largest = math.exp(largest)
             except OverflowError:
                 raise Undecided from None
-        return self._bounded(largest, value, False, *args)
+        return self._bounded(largest, value, False, *args, real=name not in ATOM_FUNCTIONS)
 
     def scalar(self, value: Bounded) -> float | None:
         """An outer term of a chained constraint: a number the same in floats and in SymPy."""
@@ -235,17 +248,25 @@ def _check_in_sympy(
     text: str | float, names: list[str], constraint: bool, definitions: Mapping[str, str | float]
 ) -> None:
     """The SymPy form of ``text`` (refused there as :mod:`gamespec.symbolic.language` refuses), and
-    its first derivatives in each of its names, finite and real (SymPy's own derivatives: ``abs`` →
-    ``sign``, ``max(a, b)`` → ``heaviside(a - b)``)."""
+    its first derivatives in each of its names finite, real and in the language (SymPy's own
+    derivatives: ``abs`` → ``sign``, ``max(a, b)`` → ``heaviside(a - b)``; ``DiracDelta``, the
+    derivative of ``sign`` and ``heaviside``, as well; not ``re``, ``im`` or an unevaluated
+    ``Derivative``, which SymPy writes for ``abs(asin(x))``)."""
     import sympy as sp
 
-    from gamespec.symbolic.language import SYMPY, symbol
+    from gamespec.symbolic.language import FUNCTIONS, SYMPY, symbol
 
+    functions = (f for _, f in FUNCTIONS.values() if isinstance(f, type))
+    nodes = (sp.Symbol, sp.Number, sp.NumberSymbol, sp.Add, sp.Mul, sp.Pow, sp.DiracDelta, *functions)
     expr = _walk(text, {n: symbol(n) for n in names}, SYMPY, constraint, definitions)
     for name in sorted(expr.free_symbols, key=str):
         try:
-            SYMPY.finite(sp.diff(expr, name))
+            derivative = SYMPY.finite(sp.diff(expr, name))
+            foreign = next((n for n in sp.preorder_traversal(derivative) if not isinstance(n, nodes)), None)
         except Refused as err:
             raise ExpressionError(str(text), f"its derivative in {name} {err}") from None
         except RecursionError:
             raise ExpressionError(str(text)[:40] + "...", "expression nested too deeply") from None
+        if foreign is not None:
+            kind = type(foreign).__name__
+            raise ExpressionError(str(text), f"its derivative in {name} holds {kind}, not in the language")

@@ -150,7 +150,7 @@ class SymbolicOcp:
 
     @cached_property
     def running_structure(self) -> RunningTerms:
-        """The running terms as :class:`~gamespec.symbolic.grammar.Unknown` values (the names each
+        """The running terms as :class:`~gamespec.symbolic.grammar.Dependent` values (the names each
         depends on: :func:`~gamespec.symbolic.grammar.dependencies`), with the constraints' bounds."""
         return self.running_terms(unknowns(self.running_names), FLOATS)
 

@@ -33,7 +33,7 @@ from gamespec.desensitize.spec import MonteCarloOptions
 from gamespec.errors import ExpressionError, SpecError
 from gamespec.specs.base import StrictModel, Value
 from gamespec.specs.ocp import GuessSpec
-from gamespec.symbolic.grammar import FLOATS, expression, unknowns
+from gamespec.symbolic.canonical import check
 
 
 def check_values(
@@ -43,10 +43,10 @@ def check_values(
     the ``running`` names (states, controls, ``t``; none for a value of the parameters only), finite
     and real there: checked at load, so a bad centre or weight is one line naming its field, never
     an error of the transform or of a plot later."""
-    symbols = dict(parameters) | unknowns(running)
+    running = list(running)
     for field, value in items:
         try:
-            expression(value, symbols, FLOATS)
+            check(value, running, parameters)
         except ExpressionError as err:
             raise SpecError(str(err), field=field) from None
 

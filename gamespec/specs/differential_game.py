@@ -32,7 +32,8 @@ from gamespec.registry import Kind
 from gamespec.specs.base import Number, ProblemParameters, RequestedTransforms, SpecBase, StrictModel, Value
 from gamespec.specs.ocp import ControlSpec, MethodSpec, StateSpec, _ordered, is_time_varying
 from gamespec.specs.uncertainty import UncertainParameter
-from gamespec.symbolic.grammar import FLOATS, RESERVED, expression, numeric_value, relation, unknowns
+from gamespec.symbolic.canonical import check
+from gamespec.symbolic.grammar import RESERVED, numeric_value
 
 INITIAL_PREFIX = "initial_"
 """A generated player problem takes the initial state ``<state>`` as the parameter ``initial_<state>``."""
@@ -60,20 +61,15 @@ class GameValues:
 def checked_expression(
     text: float | str, names: list[str], values: Mapping[str, float], field: str, constraint: bool = False
 ) -> float | None:
-    """Check ``text`` over ``names`` (unknowns) and the parameters' ``values`` (numbers); its value
-    when it uses no name, else None. A SpecError naming ``field`` when it is outside the language, or
-    any part of it that only uses numbers is infinite, undefined, not real or out of range."""
-    symbols = dict(values) | unknowns(names)
+    """Check ``text`` over ``names`` and the parameters' ``values`` (numbers;
+    :func:`~gamespec.symbolic.canonical.check`); its value when it uses no name, else None. A
+    SpecError naming ``field`` when it is outside the language, or it is undefined, not real or out
+    of range there (:func:`~gamespec.symbolic.canonical.check`)."""
     try:
-        if constraint:
-            relation(str(text), symbols, FLOATS)
-            return None
-        if not names:
-            return numeric_value(text, values)
-        expression(text, symbols, FLOATS)
+        check(text, names, values, constraint=constraint)
+        return None if constraint or names else numeric_value(text, values)
     except ExpressionError as err:
         raise SpecError(str(err), field=field) from None
-    return None
 
 
 class PayoffSpec(StrictModel):

@@ -25,15 +25,14 @@ from gamespec.registry import Kind
 from gamespec.specs.base import Number, ProblemParameters, SpecBase, StrictModel, Value
 from gamespec.specs.plot import PlotHint
 from gamespec.specs.uncertainty import UncertainParameter
+from gamespec.symbolic.canonical import check
 from gamespec.symbolic.grammar import (
     FLOATS,
     RESERVED,
-    check,
     dependencies,
     expression,
     numeric_value,
     relation,
-    unknown,
     unknowns,
 )
 
@@ -376,7 +375,7 @@ class OcpProblem(StrictModel):
         numbers = self.parameter_values()
         for field, text, symbols, constraint in checks:
             try:
-                _check_at(text, symbols, numbers, constraint)
+                _check_at(text, symbols, numbers, constraint, self.definitions)
             except ExpressionError as err:
                 used = _inputs_in(constraint, text, symbols, inputs)
                 reason = (
@@ -389,16 +388,20 @@ class OcpProblem(StrictModel):
 
 
 def _check_at(
-    text: str | float, names: Mapping[str, object], numbers: Mapping[str, float], constraint: bool
+    text: str | float,
+    names: Mapping[str, object],
+    numbers: Mapping[str, float],
+    constraint: bool,
+    definitions: Mapping[str, str],
 ) -> None:
-    """:func:`~gamespec.symbolic.grammar.check` of ``text`` over ``names``, the parameters among them
-    at their ``numbers`` (the file's values): what is undefined, not real or out of range at those
-    values (``acos(xf)`` with ``xf = 2``, ``sqrt(-w)``) is refused at load, not met by the solver."""
-    symbols = {n: numbers[n] if n in numbers else unknown(n) for n in names}
-    if constraint:
-        relation(str(text), symbols, FLOATS)
-    else:
-        expression(text, symbols, FLOATS)
+    """:func:`~gamespec.symbolic.canonical.check` of ``text`` over ``names`` (those of
+    ``definitions`` standing for their expressions), the parameters among them at their ``numbers``
+    (the file's values): what is undefined, not real or out of range at those values (``acos(xf)``
+    with ``xf = 2``, ``sqrt(-w)``) is refused at load, not met by the solver."""
+    defined = {n: definitions[n] for n in names if n in definitions}
+    free = [n for n in names if n not in defined]
+    values = {n: numbers[n] for n in free if n in numbers}
+    check(text, free, values, constraint=constraint, definitions=defined)
 
 
 def parameter_values(

@@ -8,8 +8,9 @@ constant ``pi``; comparisons only in :func:`relation`, for constraints. Nothing 
 and the column.
 
 The walk builds its value in an :class:`Algebra`: SymPy (:mod:`gamespec.symbolic.language`, the
-form the transforms differentiate), floats (:data:`FLOATS`, the checks at load and the values of
-bounds and parameters, and the names each term depends on) or a backend's own expressions
+form the transforms differentiate, and the canonical form the check at load decides on,
+:mod:`gamespec.symbolic.canonical`), floats (:data:`FLOATS`, the values of bounds and parameters,
+and the names each term depends on) or a backend's own expressions
 (:class:`gamespec.symbolic.library.LibraryAlgebra`, a CasADi graph built straight from the file),
 so that one walker decides what an expression may be.
 """
@@ -19,7 +20,7 @@ from __future__ import annotations
 import ast
 import math
 import operator
-from collections.abc import Callable, Hashable, Iterable, Mapping
+from collections.abc import Callable, Iterable, Mapping
 from dataclasses import dataclass
 from functools import lru_cache
 from typing import Any, Protocol
@@ -130,101 +131,37 @@ FLOAT_FUNCTIONS: dict[str, Callable[..., float]] = {
 
 
 @dataclass(frozen=True)
-class Unknown:
-    """A value that depends on names without numbers: which ``names`` (through definitions too),
-    a ``key`` that is equal for equal sub-expressions (commutative operands in either order), and
-    a ``scale`` that bounds the numeric coefficient SymPy would fold into it (``x*1e300*1e300`` is
-    ``1e600*x``; terms add their scales). With them a check without SymPy refuses what parsing
-    into SymPy refuses: numbers out of range, and what cancels to a number (``x - x``, ``0*x``,
-    ``x/x``) is that number, so ``1/(x - x)`` and ``log(0*x)`` are undefined."""
+class Dependent:
+    """A value that depends on ``names`` (through definitions too), whose number is not known: what
+    a walk of :data:`FLOATS` gives where a name has no value. It tells the names each term depends
+    on (syntactically: ``x - x`` depends on ``x``) and is never refused; whether an expression is
+    defined is the load-time check's (:mod:`gamespec.symbolic.canonical`), on a computer-algebra
+    system's canonical form."""
 
-    key: Hashable
     names: frozenset[str]
-    scale: float = 1.0
 
 
-def unknown(name: str) -> Unknown:
-    """The :class:`Unknown` of a name."""
-    return Unknown(name, frozenset({name}))
+def unknown(name: str) -> Dependent:
+    """The :class:`Dependent` value of a name."""
+    return Dependent(frozenset({name}))
 
 
 def dependencies(value: Any) -> frozenset[str]:
     """The names a value of :data:`FLOATS` depends on (none for a number)."""
-    return value.names if isinstance(value, Unknown) else frozenset()
+    return value.names if isinstance(value, Dependent) else frozenset()
 
 
-COMMUTATIVE = frozenset({"+", "*", "min", "max"})
-BINARY_TAGS = {operator.add: "+", operator.sub: "-", operator.mul: "*", operator.truediv: "/"}
-
-
-Value = float | Unknown
+Value = float | Dependent
 """A value of :class:`FloatAlgebra`."""
 
 
-def _scale(value: Value) -> float:
-    return value.scale if isinstance(value, Unknown) else abs(value)
-
-
-def _key(value: Value) -> Hashable:
-    return value.key if isinstance(value, Unknown) else value
-
-
-def _cancelled(tag: str, args: tuple[Value, ...]) -> float | None:
-    """The number an operation on an unknown folds to in SymPy's canonical form, if any:
-    ``x - x``, ``x + (-x)``, ``0*x``, ``x/x``, ``0/x``, ``x**0``."""
-    keys = [_key(a) for a in args]
-    if tag == "-" and keys[0] == keys[1]:
-        return 0.0
-    if tag == "+" and (keys[1] == ("neg", keys[0]) or keys[0] == ("neg", keys[1])):
-        return 0.0
-    if tag == "*" and 0.0 in keys:
-        return 0.0
-    if tag == "/" and keys[0] == keys[1]:
-        return 1.0
-    if tag == "/" and keys[0] == 0.0:
-        return 0.0
-    if tag == "**" and keys[1] == 0.0:
-        return 1.0
-    return None
-
-
-def _unknown_result(tag: str, args: tuple[Value, ...]) -> Value:
-    """What ``tag`` (an operator or a function name) of ``args``, one of them unknown, gives."""
-    folded = _cancelled(tag, args)
-    if folded is not None:
-        return folded
-    scales = [_scale(a) for a in args]
-    if tag in ("+", "-"):
-        scale = scales[0] + scales[1]
-    elif tag == "*":
-        scale = scales[0] * scales[1]
-    elif tag == "/":
-        if scales[1] == 0:
-            raise Refused("is infinite, undefined or not real")
-        scale = scales[0] / scales[1]
-    elif tag == "**" and not isinstance(args[1], Unknown):
-        if scales[0] == 0 and args[1] < 0:
-            raise Refused("is infinite, undefined or not real")
-        try:
-            scale = scales[0] ** args[1]
-        except OverflowError:
-            raise Refused(f"number out of range (beyond {MAX_MAGNITUDE:g})") from None
-    else:
-        scale = 1.0
-    keys = tuple(_key(a) for a in args)
-    if tag in COMMUTATIVE:
-        keys = tuple(sorted(keys, key=repr))
-    names = frozenset().union(*map(dependencies, args))
-    return Unknown((tag, *keys), names, _checked(scale))
-
-
 class FloatAlgebra:
-    """Floats, with an :class:`Unknown` for a value that depends on names without numbers: a walk
-    over ``{name: unknown(name)}`` checks an expression without computing it (the checks at load)
-    and tells the names each term depends on; one over ``{name: float}`` computes it (bounds,
-    derived parameters). A number that is infinite, not real or beyond
-    :data:`~gamespec.limits.MAX_MAGNITUDE` (``1/0``, ``log(0)``, ``sqrt(-1)``, ``exp(1000)``,
-    ``x*1e300*1e300``, ``1/(x - x)``) is refused."""
+    """Floats, with a :class:`Dependent` for a value that depends on names without numbers: a walk
+    over ``{name: float}`` computes an expression (bounds, derived parameters), one over
+    ``{name: unknown(name)}`` computes the parts made of numbers only, as a backend's builder does
+    (:class:`~gamespec.symbolic.library.LibraryAlgebra`), and tells the names each term depends on.
+    A number that is infinite, not real or beyond :data:`~gamespec.limits.MAX_MAGNITUDE` (``1/0``,
+    ``log(0)``, ``sqrt(-1)``, ``exp(1000)``) is refused."""
 
     def number(self, value: int | float) -> float:
         try:
@@ -235,9 +172,9 @@ class FloatAlgebra:
     def constant(self, name: str) -> float:
         return math.pi
 
-    def _apply(self, tag: str, func: Callable[..., Any], *args: Value) -> Value:
-        if any(isinstance(a, Unknown) for a in args):
-            return _unknown_result(tag, args)
+    def _apply(self, func: Callable[..., Any], *args: Value) -> Value:
+        if any(isinstance(a, Dependent) for a in args):
+            return Dependent(frozenset().union(*map(dependencies, args)))
         try:
             value = func(*args)
         except (ZeroDivisionError, ValueError):
@@ -249,22 +186,19 @@ class FloatAlgebra:
         return _checked(float(value))
 
     def binary(self, op: type[ast.operator], left: Value, right: Value) -> Value:
-        func = BINARY[op]
-        return self._apply(BINARY_TAGS[func], func, left, right)
+        return self._apply(BINARY[op], left, right)
 
     def negate(self, value: Value) -> Value:
-        if isinstance(value, Unknown):
-            return Unknown(("neg", value.key), value.names, value.scale)
-        return -value
+        return value if isinstance(value, Dependent) else -value
 
     def power(self, base: Value, exponent: Value) -> Value:
-        return self._apply("**", operator.pow, base, exponent)
+        return self._apply(operator.pow, base, exponent)
 
     def call(self, name: str, args: list[Value]) -> Value:
-        return self._apply(name, FLOAT_FUNCTIONS[name], *args)
+        return self._apply(FLOAT_FUNCTIONS[name], *args)
 
     def scalar(self, value: Value) -> float | None:
-        return None if isinstance(value, Unknown) else value
+        return None if isinstance(value, Dependent) else value
 
 
 FLOATS = FloatAlgebra()
@@ -414,23 +348,14 @@ def relation(text: str, symbols: Mapping[str, Any], algebra: Algebra) -> Relatio
     raise walk.fail(node, "a constraint is one comparison or a chain lo <= expr <= hi")
 
 
-def unknowns(names: Iterable[str]) -> dict[str, Unknown]:
-    """Each name as its :class:`Unknown`: the values of a walk that checks, or finds dependencies."""
+def unknowns(names: Iterable[str]) -> dict[str, Dependent]:
+    """Each name as its :class:`Dependent` value: the values of a walk that finds dependencies."""
     return {n: unknown(n) for n in names}
-
-
-def check(text: str | float, names: Iterable[str], *, constraint: bool = False) -> None:
-    """Refuse ``text`` (an ExpressionError) unless it is an expression (a constraint when
-    ``constraint``) over ``names``, its number-only parts finite and real (:class:`FloatAlgebra`)."""
-    if constraint:
-        relation(str(text), unknowns(names), FLOATS)
-    else:
-        expression(text, unknowns(names), FLOATS)
 
 
 def numeric_value(text: str | float, values: Mapping[str, float]) -> float:
     """The value of a number-only expression over ``values`` (name → float)."""
     value = expression(text, values, FLOATS)
-    if isinstance(value, Unknown):
+    if isinstance(value, Dependent):
         raise ExpressionError(str(text), "is not a number here")
     return value

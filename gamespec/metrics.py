@@ -56,7 +56,8 @@ def metrics_model(kind: str) -> type[Metrics]:
     """The metrics model registered for ``kind`` (:class:`Metrics` when none is)."""
     if kind not in registry.names(GROUP):
         return Metrics
-    return registry.load(GROUP, kind)
+    model: type[Metrics] = registry.load(GROUP, kind)
+    return model
 
 
 def validated(result: Result, source: str = "<result>") -> Result:

@@ -11,8 +11,9 @@ distributions' entry points are read in one pass, the first time any group is as
 
 from __future__ import annotations
 
+import sys
 from functools import cache
-from importlib.metadata import EntryPoint, EntryPoints, entry_points
+from importlib.metadata import EntryPoint, entry_points
 from typing import Any
 
 from gamespec.errors import BackendError, SpecError
@@ -29,12 +30,18 @@ GROUPS = (
 )
 
 
+if sys.version_info >= (3, 12):
+    from importlib.metadata import EntryPoints as _AllEntryPoints
+else:
+    from importlib.metadata import SelectableGroups as _AllEntryPoints
+
+
 _IN_PROCESS: dict[str, dict[str, Any]] = {group: {} for group in GROUPS}
 """Objects registered with :func:`register` (scripts, notebooks, tests), ahead of entry points."""
 
 
 @cache
-def _installed() -> EntryPoints:
+def _installed() -> _AllEntryPoints:
     """Every installed distribution's entry points (one pass over their metadata; a pass per group
     would read all of it again for each)."""
     return entry_points()
@@ -89,11 +96,13 @@ def load(group: str, name: str) -> Any:
     return ep.load()
 
 
-def spec_class(kind: str) -> type:
-    """The spec model registered for ``kind``."""
+def spec_class(kind: str) -> Any:
+    """The spec model registered for ``kind`` (a :class:`~gamespec.specs.base.SpecBase` subclass;
+    typed by the caller, this layer knows no spec)."""
     return load("gamespec.kinds", kind)
 
 
-def backend_class(name: str) -> type:
-    """The backend class registered as ``name``."""
+def backend_class(name: str) -> Any:
+    """The backend class registered as ``name`` (a :class:`~gamespec.backend.Backend` subclass;
+    typed by the caller, this layer knows no backend)."""
     return load("gamespec.backends", name)

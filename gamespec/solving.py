@@ -23,7 +23,7 @@ from dataclasses import dataclass
 from functools import cache
 from importlib.metadata import PackageNotFoundError, version
 from pathlib import Path
-from typing import Any
+from typing import Any, Generic
 
 from gamespec import registry
 from gamespec.backend import Backend, CompiledModel, Inputs
@@ -31,12 +31,25 @@ from gamespec.errors import BackendError, ExpressionError, SpecError, Unsupporte
 from gamespec.loader import load, spec_hash, with_values
 from gamespec.result import Provenance, Result, Status
 from gamespec.specs.base import SpecBase, StrictModel
-from gamespec.transforms.base import Transform, lowering_path, requested_steps
+from gamespec.transforms.base import (
+    AnyTransform,
+    Dst,
+    Inverse,
+    Options,
+    Src,
+    Transform,
+    lowering_path,
+    requested_steps,
+)
+
+AnyBackend = Backend[Any, Any]
+"""A backend chosen by name at run time: its spec and options classes are known only to itself
+(:meth:`Backend.compile` checks the spec's kind before it reaches the typed ``_compile``)."""
 
 
-def get_backend(name: str) -> Backend:
+def get_backend(name: str) -> AnyBackend:
     """An instance of the installed, available backend ``name``; BackendError with the reason else."""
-    cls = registry.backend_class(name)
+    cls: type[AnyBackend] = registry.backend_class(name)
     availability = cls.available()
     if not availability.ok:
         raise BackendError(f"backend {name!r} is not available: {availability.reason}")
@@ -62,28 +75,36 @@ def _core_versions() -> dict[str, str]:
     return found
 
 
-def _versions(backend: Backend) -> dict[str, str]:
+def _versions(backend: AnyBackend) -> dict[str, str]:
     return _core_versions() | {
         f"backend:{backend.name}": registry.distribution("gamespec.backends", backend.name)
     }
 
 
 @dataclass(frozen=True)
-class Step:
+class Step(Generic[Src, Dst, Options, Inverse]):
     """One applied transform: ``source`` → ``target`` with ``options``; ``inverse`` is its inverse
-    data and ``upstream`` the compiled upstream stage it took a Result from (None if not staged)."""
+    data and ``upstream`` the compiled upstream stage it took a Result from (None if not staged).
+    Its classes are the transform's, so each step's ``invert(result, source, inverse)`` is checked."""
 
-    transform: Transform
-    options: StrictModel
-    source: SpecBase
-    target: SpecBase
-    inverse: Any
+    transform: Transform[Src, Dst, Options, Inverse]
+    options: Options
+    source: Src
+    target: Dst
+    inverse: Inverse
     upstream: Solver | None = None
 
 
+AnyStep = Step[Any, Any, Any, Any]
+"""A step of a chain, whose classes differ from step to step."""
+
+
 def _applied(
-    transform: Transform, options: StrictModel, spec: SpecBase, upstream: Solver | None = None
-) -> Step:
+    transform: Transform[Src, Dst, Options, Inverse],
+    options: Options,
+    spec: SpecBase,
+    upstream: Solver | None = None,
+) -> Step[Src, Dst, Options, Inverse]:
     """Apply one transform to ``spec`` (solving its upstream stage on ``upstream``, or compiling
     that stage first when ``upstream`` is None and the transform is staged)."""
     if not transform.accepts(spec):
@@ -101,8 +122,8 @@ def _applied(
 
 
 def _from_file(
-    transform: Transform, options: StrictModel, spec: SpecBase, source: str, field: str = ""
-) -> Step:
+    transform: AnyTransform, options: StrictModel, spec: SpecBase, source: str, field: str = ""
+) -> AnyStep:
     """:func:`_applied` on a spec read from ``source``: what the transform cannot build from the file
     (an expression it generates that is undefined or out of range, a spec it generates that is
     invalid) is a SpecError naming the file and ``field`` (``transforms.<i>`` for a requested one)."""
@@ -123,10 +144,10 @@ def _unrequested(spec: SpecBase) -> SpecBase:
     return spec.model_copy(update={"transforms": []}) if spec.transforms else spec
 
 
-def build_steps(spec: SpecBase, backend: Backend) -> list[Step]:
+def build_steps(spec: SpecBase, backend: AnyBackend) -> list[AnyStep]:
     """The requested transforms of ``spec`` in order, then the lowering ones to a kind ``backend``
     solves."""
-    steps: list[Step] = []
+    steps: list[AnyStep] = []
     current = _unrequested(spec)
     for index, (transform, options) in enumerate(requested_steps(spec)):
         steps.append(_from_file(transform, options, current, spec.source, f"transforms.{index}"))
@@ -191,8 +212,8 @@ class Solver:
     """A spec compiled for one backend; call :meth:`solve` as often as needed (see module doc)."""
 
     spec: SpecBase
-    backend: Backend
-    steps: list[Step]
+    backend: AnyBackend
+    steps: list[AnyStep]
     compiled: CompiledModel
     build_time_s: float
 
@@ -226,7 +247,7 @@ class Solver:
         differs from the compiled one in more than those values — or in its starting point, when
         neither the caller nor the last transform gives the compiled model one."""
         requested = [options for _, options in requested_steps(spec)]
-        steps = []
+        steps: list[AnyStep] = []
         current = _unrequested(spec)
         for index, old in enumerate(self.steps):
             options = requested[index] if index < len(requested) else old.options
@@ -247,7 +268,7 @@ class Solver:
             )
         return self._solve(spec, steps, guess, inputs)
 
-    def _solve(self, spec: SpecBase, steps: list[Step], guess: Result | None, inputs: Inputs) -> Result:
+    def _solve(self, spec: SpecBase, steps: list[AnyStep], guess: Result | None, inputs: Inputs) -> Result:
         """Solve the compiled model and map the Result back through ``steps``; its ``solve_time_s``
         is the wall-clock time of all of it (the solve, the checks, the inverse maps, multi-start),
         what the caller waited for, whatever the backend measured inside."""
@@ -260,10 +281,10 @@ class Solver:
         for index in reversed(range(len(steps))):
             step = steps[index]
             result = step.transform.invert(result, step.source, step.inverse)
-            last = index == len(steps) - 1
+            is_last = index == len(steps) - 1
             if result.ok:
-                result = self._verified(step, result, values, inputs, multistart=last)
-            elif last:
+                result = self._verified(step, result, values, inputs, multistart=is_last)
+            elif is_last:
                 result = self._restarted(step, values, inputs) or result
         provenance = Provenance(
             spec_hash=spec_hash(spec),
@@ -285,7 +306,7 @@ class Solver:
             }
         )
 
-    def _restarted(self, step: Step, values: dict[str, float] | None, inputs: Inputs) -> Result | None:
+    def _restarted(self, step: AnyStep, values: dict[str, float] | None, inputs: Inputs) -> Result | None:
         """Multi-start: the best verified Result among re-solves of the compiled model from the
         step's restarts (None if none verifies)."""
         best = None
@@ -302,7 +323,7 @@ class Solver:
 
     def _verified(
         self,
-        step: Step,
+        step: AnyStep,
         result: Result,
         values: dict[str, float] | None,
         inputs: Inputs,

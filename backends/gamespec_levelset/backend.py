@@ -44,7 +44,7 @@ from gamespec.flowfield.problem import FlowGameData, evaluate
 from gamespec.flowfield.simulation import simulate
 from gamespec.montecarlo import proportion
 from gamespec.result import Result, Status
-from gamespec.specs.base import SpecBase, StrictModel
+from gamespec.specs.base import StrictModel
 from gamespec.specs.flow_game import FlowGameSpec
 from gamespec_levelset.players import (
     EvaderStep,
@@ -520,13 +520,12 @@ def _evader_mixture(
     return [(1.0, last)]
 
 
-class _FlowGameBackend(Backend):
+class _FlowGameBackend(Backend[FlowGameSpec, FlowGameOptions]):
     kinds: ClassVar[frozenset[str]] = frozenset({"flow_field_game"})
     options_model = FlowGameOptions
     method: ClassVar[str]
 
-    def _compile(self, spec: SpecBase, options: StrictModel) -> CompiledModel:
-        assert isinstance(spec, FlowGameSpec) and isinstance(options, FlowGameOptions)
+    def _compile(self, spec: FlowGameSpec, options: FlowGameOptions) -> FlowGameModel:
         return FlowGameModel(spec, options, self.method)
 
 

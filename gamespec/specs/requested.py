@@ -11,7 +11,8 @@ dotted field, ``transforms.<i>.<name>.<key>``.
 from __future__ import annotations
 
 import difflib
-from typing import TYPE_CHECKING, Any
+from collections.abc import Iterable, Mapping
+from typing import TYPE_CHECKING, Any, Protocol, runtime_checkable
 
 from pydantic import ValidationError
 
@@ -24,7 +25,41 @@ if TYPE_CHECKING:
 GROUP = "gamespec.transforms"
 
 
-def transform_class(name: str, field: str = "transforms") -> type:
+class TransformClass(Protocol):
+    """What this module reads of a transform class (it sits below :mod:`gamespec.transforms`, so it
+    names the attributes of :class:`~gamespec.transforms.base.Transform` it needs)."""
+
+    requested: bool
+    source_kind: str
+    target_kind: str
+    options_model: type[StrictModel]
+
+
+@runtime_checkable
+class ChecksAgainstProblem(Protocol):
+    """Options that are checked against the problem at load (expressions of its parameters)."""
+
+    def check_against(self, parameters: Mapping[str, float], running: Iterable[str], field: str) -> None:
+        """A SpecError at ``field`` when the options do not fit the problem."""
+
+
+class _ProblemSection(Protocol):
+    @property
+    def states(self) -> Mapping[str, Any]: ...
+
+    @property
+    def controls(self) -> Mapping[str, Any]: ...
+
+    def parameter_values(self) -> dict[str, float]: ...
+
+
+@runtime_checkable
+class _WithProblem(Protocol):
+    @property
+    def problem(self) -> _ProblemSection: ...
+
+
+def transform_class(name: str, field: str = "transforms") -> Any:
     """The transform registered as ``name``; a SpecError at ``field`` with the nearest name else."""
     known = registry.names(GROUP)
     if name not in known:
@@ -45,7 +80,7 @@ def entry(item: dict[str, dict[str, Any]], index: int) -> tuple[str, dict[str, A
     return name, options or {}
 
 
-def validated_options(cls: type, name: str, options: dict[str, Any], index: int) -> StrictModel:
+def validated_options(cls: TransformClass, name: str, options: dict[str, Any], index: int) -> StrictModel:
     """``options`` validated by the transform's ``options_model``."""
     try:
         return cls.options_model.model_validate(options)
@@ -70,7 +105,7 @@ def check_requested(spec: SpecBase) -> None:
     options (see module doc); a SpecError naming the entry otherwise."""
     for index, item in enumerate(spec.transforms):
         name, options = entry(item, index)
-        cls = transform_class(name, field=f"transforms.{index}")
+        cls: TransformClass = transform_class(name, field=f"transforms.{index}")
         if not cls.requested:
             raise SpecError(
                 f"transform {name!r} lowers {cls.source_kind!r} to {cls.target_kind!r} and is found "
@@ -83,7 +118,7 @@ def check_requested(spec: SpecBase) -> None:
                 field=f"transforms.{index}",
             )
         checked = validated_options(cls, name, options, index)
-        if hasattr(checked, "check_against"):
+        if isinstance(checked, ChecksAgainstProblem) and isinstance(spec, _WithProblem):
             p = spec.problem
             running = [*p.states, *p.controls, "t"]
             checked.check_against(p.parameter_values(), running, f"transforms.{index}.{name}")

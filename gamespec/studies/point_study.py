@@ -124,15 +124,15 @@ class PointStudyModel(CompiledModel):
         return result.model_copy(update={"message": message, "solve_time_s": time.perf_counter() - tic})
 
 
-class PointStudyBackend(Backend):
+class PointStudyBackend(Backend[SpecBase, StudyOptions]):
     """A backend that runs a point study: checks that its ``ocp_backend`` is there, then builds
-    :attr:`model`."""
+    :attr:`model` (the study kinds share no spec class beyond :class:`SpecBase`)."""
 
-    options_model: ClassVar[type[StrictModel]] = StudyOptions
+    options_model = StudyOptions
     model: ClassVar[type[PointStudyModel]]
 
     @classmethod
-    def validate_options(cls, raw: Mapping[str, Any], source: str = "<spec>") -> StrictModel:
+    def validate_options(cls, raw: Mapping[str, Any], source: str = "<spec>") -> StudyOptions:
         """The file's block, refused with :data:`SCHEDULER_FROM_FILE` when it names a scheduler."""
         for name in USER_CHOICES:
             if name in raw:

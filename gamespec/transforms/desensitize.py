@@ -60,19 +60,22 @@ class InverseData:
     augmented_states: int
 
 
-class Desensitize(OcpRewrite):
+class Desensitize(OcpRewrite[DesensitizeOptions, InverseData]):
     """Desensitized optimal control (chapter 6) by sensitivity functions, Seywald's method or C-DOC."""
 
     name: ClassVar[str] = "desensitize"
-    options_model: ClassVar[type[DesensitizeOptions]] = DesensitizeOptions
+    options_model = DesensitizeOptions
 
     def apply(
-        self, spec: SpecBase, options: DesensitizeOptions | None = None, upstream: Result | None = None
+        self,
+        spec: OptimalControlSpec,
+        options: DesensitizeOptions | None = None,
+        upstream: Result | None = None,
     ) -> tuple[OptimalControlSpec, InverseData]:
         options = options or DesensitizeOptions()
         return desensitize(spec, options)
 
-    def invert(self, result: Result, spec: SpecBase, inverse_data: InverseData) -> Result:
+    def invert(self, result: Result, spec: OptimalControlSpec, inverse_data: InverseData) -> Result:
         return report(result, spec, inverse_data)
 
 
@@ -188,7 +191,7 @@ def _parse(raw: float | str, params: dict[str, sp.Symbol], spec: SpecBase, where
         raise SpecError(str(err), field=f"{FIELD}.{where}", source=spec.source) from None
 
 
-def _unit(weights: Weights | None, entries: dict[str, sp.Expr]) -> dict[str, float] | None:
+def _unit(weights: Weights | None, entries: dict[str, sp.Expr]) -> Weights | None:
     """Weight 1 on the entries ``weights`` names (all of them for a single weight)."""
     if weights is None:
         return None
@@ -277,5 +280,6 @@ def _end_values(result: Result) -> dict[sp.Symbol, float]:
     ends: dict[sp.Symbol, float] = {symbol(k): v for k, v in result.parameters.items()}
     for k, v in result.states.items():
         ends[symbol(f"{k}_0")], ends[symbol(f"{k}_f")] = float(v[0]), float(v[-1])
+    assert result.t_final is not None, "an optimal_control Result has a final time"
     ends[symbol("t_f")] = float(result.t_final)
     return ends

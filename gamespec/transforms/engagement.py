@@ -17,12 +17,12 @@ from typing import ClassVar
 
 import numpy as np
 
+from gamespec.backend import NoOptions
 from gamespec.pursuit.guess import ranked_simulated_headings
 from gamespec.pursuit.ocp_generation import EngagementInverse, heading_guess, to_ocp
 from gamespec.pursuit.ocp_report import ocp_report
 from gamespec.pursuit.verification import verify
 from gamespec.result import Result
-from gamespec.specs.base import StrictModel
 from gamespec.specs.engagement import EngagementSpec
 from gamespec.specs.ocp import OptimalControlSpec
 from gamespec.transforms.base import Transform
@@ -31,7 +31,7 @@ RETRIES = 4
 """Constant headings :meth:`EngagementToOcp.restarts` offers when a solution fails verification."""
 
 
-class EngagementToOcp(Transform):
+class EngagementToOcp(Transform[EngagementSpec, OptimalControlSpec, NoOptions, EngagementInverse]):
     """Generate the reduced-state OCP of an engagement (see module doc)."""
 
     name: ClassVar[str] = "engagement_to_ocp"
@@ -39,7 +39,7 @@ class EngagementToOcp(Transform):
     target_kind: ClassVar[str] = "optimal_control"
 
     def apply(
-        self, spec: EngagementSpec, options: StrictModel, upstream: Result | None = None
+        self, spec: EngagementSpec, options: NoOptions, upstream: Result | None = None
     ) -> tuple[OptimalControlSpec, EngagementInverse]:
         return to_ocp(spec)
 

@@ -12,16 +12,16 @@ from __future__ import annotations
 
 from typing import ClassVar
 
+from gamespec.backend import NoOptions
 from gamespec.ocp.phases import split_by_phase
 from gamespec.result import Result
-from gamespec.specs.base import StrictModel
 from gamespec.specs.multiphase import MultiPhaseSpec
 from gamespec.specs.ocp import OptimalControlSpec
 from gamespec.specs.phase_lowering import Lowering, lower
 from gamespec.transforms.base import Transform
 
 
-class PhasesToOcp(Transform):
+class PhasesToOcp(Transform[MultiPhaseSpec, OptimalControlSpec, NoOptions, Lowering]):
     """Lower a multi-phase problem to one ``optimal_control`` problem (see module doc)."""
 
     name: ClassVar[str] = "phases"
@@ -29,7 +29,7 @@ class PhasesToOcp(Transform):
     target_kind: ClassVar[str] = "optimal_control"
 
     def apply(
-        self, spec: MultiPhaseSpec, options: StrictModel, upstream: Result | None = None
+        self, spec: MultiPhaseSpec, options: NoOptions, upstream: Result | None = None
     ) -> tuple[OptimalControlSpec, Lowering]:
         lowering = lower(spec)
         return lowering.target, lowering

@@ -25,16 +25,6 @@ if TYPE_CHECKING:
 GROUP = "gamespec.transforms"
 
 
-class TransformClass(Protocol):
-    """What this module reads of a transform class (it sits below :mod:`gamespec.transforms`, so it
-    names the attributes of :class:`~gamespec.transforms.base.Transform` it needs)."""
-
-    requested: bool
-    source_kind: str
-    target_kind: str
-    options_model: type[StrictModel]
-
-
 @runtime_checkable
 class ChecksAgainstProblem(Protocol):
     """Options that are checked against the problem at load (expressions of its parameters)."""
@@ -60,7 +50,9 @@ class _WithProblem(Protocol):
 
 
 def transform_class(name: str, field: str = "transforms") -> Any:
-    """The transform registered as ``name``; a SpecError at ``field`` with the nearest name else."""
+    """The transform registered as ``name``; a SpecError at ``field`` with the nearest name else.
+    (A :class:`~gamespec.transforms.base.Transform` subclass: this layer, below the transforms,
+    reads its ``requested``, ``source_kind``, ``target_kind`` and ``options_model`` untyped.)"""
     known = registry.names(GROUP)
     if name not in known:
         near = difflib.get_close_matches(name, known, n=1)
@@ -80,10 +72,11 @@ def entry(item: dict[str, dict[str, Any]], index: int) -> tuple[str, dict[str, A
     return name, options or {}
 
 
-def validated_options(cls: TransformClass, name: str, options: dict[str, Any], index: int) -> StrictModel:
+def validated_options(cls: Any, name: str, options: dict[str, Any], index: int) -> StrictModel:
     """``options`` validated by the transform's ``options_model``."""
+    model: type[StrictModel] = cls.options_model
     try:
-        return cls.options_model.model_validate(options)
+        return model.model_validate(options)
     except ValidationError as err:
         errors = err.errors()
         first = next((e for e in errors if e["type"] == "extra_forbidden"), errors[0])
@@ -92,7 +85,7 @@ def validated_options(cls: TransformClass, name: str, options: dict[str, Any], i
         if first["type"] == "missing":
             reason = "required option is missing"
         elif first["type"] == "extra_forbidden":
-            keys = list(cls.options_model.model_fields)
+            keys = list(model.model_fields)
             near = difflib.get_close_matches(str(first["loc"][-1]), keys, n=1)
             reason = f"unknown option {first['loc'][-1]!r}" + (
                 f"; did you mean {near[0]!r}?" if near else f" (valid: {', '.join(keys) or 'none'})"
@@ -105,7 +98,7 @@ def check_requested(spec: SpecBase) -> None:
     options (see module doc); a SpecError naming the entry otherwise."""
     for index, item in enumerate(spec.transforms):
         name, options = entry(item, index)
-        cls: TransformClass = transform_class(name, field=f"transforms.{index}")
+        cls = transform_class(name, field=f"transforms.{index}")
         if not cls.requested:
             raise SpecError(
                 f"transform {name!r} lowers {cls.source_kind!r} to {cls.target_kind!r} and is found "

@@ -18,6 +18,11 @@ from typing import Any
 
 from gamespec.errors import BackendError, SpecError
 
+if sys.version_info >= (3, 12):
+    from importlib.metadata import EntryPoints as _AllEntryPoints
+else:  # entry_points() is a SelectableGroups (with .select) before 3.12
+    from importlib.metadata import SelectableGroups as _AllEntryPoints
+
 GROUPS = (
     "gamespec.kinds",
     "gamespec.backends",
@@ -28,12 +33,6 @@ GROUPS = (
     "gamespec.executors",
     "gamespec.commands",
 )
-
-
-if sys.version_info >= (3, 12):
-    from importlib.metadata import EntryPoints as _AllEntryPoints
-else:
-    from importlib.metadata import SelectableGroups as _AllEntryPoints
 
 
 _IN_PROCESS: dict[str, dict[str, Any]] = {group: {} for group in GROUPS}

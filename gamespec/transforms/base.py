@@ -82,7 +82,8 @@ class Transform(ABC, Generic[Src, Dst, Options, Inverse]):
 
     def accepts(self, spec: SpecBase) -> TypeGuard[Src]:
         """Whether this transform applies to ``spec`` (by default: any spec of ``source_kind``,
-        which is of class ``Src``: the registry maps a kind to one spec class)."""
+        which is of class ``Src``: the registry maps a kind to one spec class). An override returns
+        ``TypeGuard[...]`` of its ``Src`` too, and asks ``super().accepts(spec)`` first."""
         return spec.kind == self.source_kind
 
     def stage(self, spec: Src, options: Options) -> Stage | None:
@@ -159,8 +160,7 @@ def lowering_path(spec: SpecBase, kinds: frozenset[str]) -> list[AnyTransform] |
 
 class OcpRewrite(Transform["OptimalControlSpec", "OptimalControlSpec", Options, Inverse], ABC):
     """A requested ``optimal_control`` → ``optimal_control`` rewrite (chapter 6's desensitization
-    and regularizers): applied only when a file's ``transforms:`` list names it. (The spec class is
-    named by its string here so that importing the chain does not import the OCP kind.)"""
+    and regularizers): applied only when a file's ``transforms:`` list names it."""
 
     source_kind: ClassVar[str] = "optimal_control"
     target_kind: ClassVar[str] = "optimal_control"

@@ -25,12 +25,14 @@ from tests.conftest import ROOT
 PYPROJECT = ROOT / "pyproject.toml"
 
 NOT_YET_CHECKED = {
-    "gamespec/games/backend.py": "issue 26 (joint) adds its schemes there; Optional arrays unchecked",
-    "gamespec/studies/suboptimal_study.py": "issue 24 item 5 turns the studies into Study plugins",
-    "gamespec/studies/rcs_study.py": "issue 24 item 5 turns the studies into Study plugins",
-    "backends/gamespec_levelset/backend.py": "issue 24 item 4 moves chapter 5 into a staged chain",
+    "gamespec/games/backend.py": "issue 26 adds its schemes there (10 strict errors today)",
+    "gamespec/studies/suboptimal_study.py": "issue 24 item 5 makes the studies Study plugins (6 errors)",
+    "gamespec/studies/rcs_study.py": "issue 24 item 5 makes the studies Study plugins (10 errors)",
+    "backends/gamespec_levelset/backend.py": "issue 24 item 4 moves chapter 5 to a staged chain (23 errors)",
 }
-"""Plugin modules left out of the mypy configuration for now, each with the work that rewrites it."""
+"""Plugin modules left out of the mypy configuration for now, each with the work that is rewriting
+it (their backend classes are parameterized already); most of their errors are Optional values the
+code knows are set."""
 
 
 def _config() -> dict:
@@ -66,5 +68,5 @@ def test_every_plugin_contract_is_checked() -> None:
     covered = {f for f in plugins if any(f == c or f.startswith(c.rstrip("/") + "/") for c in checked)}
     missing = sorted(plugins - covered - set(NOT_YET_CHECKED))
     assert not missing, f"plugin modules not in [tool.mypy] files: {missing}"
-    stale = sorted(set(NOT_YET_CHECKED) & covered)
-    assert not stale, f"checked now, drop from NOT_YET_CHECKED: {stale}"
+    stale = sorted(set(NOT_YET_CHECKED) & covered | set(NOT_YET_CHECKED) - plugins)
+    assert not stale, f"checked now or no plugin any more, drop from NOT_YET_CHECKED: {stale}"

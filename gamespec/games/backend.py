@@ -16,7 +16,7 @@ from typing import ClassVar
 
 import numpy as np
 
-from gamespec.compiling import Backend, CompiledModel, Inputs, refuse_inputs
+from gamespec.compiling import Backend, CompiledModel, Inputs, NoOptions, refuse_inputs
 from gamespec.games.equilibrium import GameModel, GameSolution, equilibrium_report, status_of
 from gamespec.games.existence import existence
 from gamespec.games.feedback import LQGame
@@ -25,7 +25,6 @@ from gamespec.games.lq_structure import LQForm, lq_form, lq_game
 from gamespec.games.problems import initial_state
 from gamespec.games.simulate import TrueSystem, control_signal, grid_of, true_parameters
 from gamespec.result import Result, Status
-from gamespec.specs.base import SpecBase, StrictModel
 from gamespec.specs.differential_game import DifferentialGameSpec
 
 
@@ -143,12 +142,12 @@ class GameCompiled(CompiledModel):
         return open_loop(self.model)
 
 
-class BestResponseBackend(Backend):
+class BestResponseBackend(Backend[DifferentialGameSpec, NoOptions]):
     """Best responses of the players of a ``differential_game``, each an ``optimal_control`` problem
     compiled once on casadi or pyomo."""
 
     name: ClassVar[str] = "best_response"
     kinds: ClassVar[frozenset[str]] = frozenset({"differential_game"})
 
-    def _compile(self, spec: SpecBase, options: StrictModel) -> GameCompiled:
+    def _compile(self, spec: DifferentialGameSpec, options: NoOptions) -> GameCompiled:
         return GameCompiled(spec)

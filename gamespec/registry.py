@@ -182,8 +182,10 @@ def runner_group(name: str) -> str:
     return "gamespec.studies" if name in names("gamespec.studies") else "gamespec.backends"
 
 
-def runner_class(name: str) -> type:
-    """The study or backend class registered as ``name`` (a BackendError naming both if neither)."""
+def runner_class(name: str) -> Any:
+    """The study or backend class registered as ``name`` (a BackendError naming both if neither; a
+    :class:`~gamespec.compiling.study_protocol.Study` or :class:`~gamespec.compiling.Backend`
+    subclass, typed by the caller)."""
     group = runner_group(name)
     if group == "gamespec.backends" and name not in names(group):
         raise BackendError(f"unknown backend {name!r} (known: {', '.join(runner_names())})")

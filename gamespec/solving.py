@@ -35,7 +35,7 @@ from dataclasses import dataclass
 from functools import cache, cached_property
 from importlib.metadata import PackageNotFoundError, version
 from pathlib import Path
-from typing import Any, Generic
+from typing import Any, Generic, cast
 
 from gamespec import registry
 from gamespec.analyses import SKIPPED, Selection, check_names, kind_analyses, run_analyses, skipped_checks
@@ -487,7 +487,8 @@ def compile_spec(
     ``analyses``: which analyses its solves run (None: the file's ``analyses:`` key, else all)."""
     if not isinstance(spec, SpecBase):
         spec = load(spec)
-    selection = analyses if analyses is not None else spec.analyses or "all"
+    # the file's choice is "all", "none" or a list of names (checked at load: AnalysesChoice)
+    selection = analyses if analyses is not None else cast(Selection, spec.analyses or "all")
     check_names(selection, spec.source)
     study = registry.kind(spec.kind).study if spec.kind in registry.names("gamespec.kinds") else None
     if study is not None:

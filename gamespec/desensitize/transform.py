@@ -37,7 +37,9 @@ from gamespec.symbolic.language import parse, symbol
 from gamespec.transforms.base import KeepsParameters, OcpRewrite
 
 
-class Desensitize(KeepsParameters, OcpRewrite[DesensitizeOptions, InverseData]):
+class Desensitize(
+    KeepsParameters[OptimalControlSpec, InverseData], OcpRewrite[DesensitizeOptions, InverseData]
+):
     """Desensitized optimal control (chapter 6) by sensitivity functions, Seywald's method or C-DOC;
     the weights and sensitivities are expressions of the parameters, so every parameter maps to
     itself (:class:`~gamespec.transforms.base.KeepsParameters`)."""

@@ -88,7 +88,9 @@ class ObstacleData:
     power: sp.Expr
 
 
-class MovingObstacles(KeepsParameters, OcpRewrite[MovingObstaclesOptions, "ObstacleData"]):
+class MovingObstacles(
+    KeepsParameters[OptimalControlSpec, "ObstacleData"], OcpRewrite[MovingObstaclesOptions, "ObstacleData"]
+):
     """Avoidance constraints of declared moving obstacles (§6.4.1-6.4.3); the obstacles are
     expressions of the parameters and ``t``, so every parameter maps to itself."""
 
@@ -145,7 +147,7 @@ class RcsData:
     """The integrand of the sensitivity measure (unit weights)."""
 
 
-class Rcs(KeepsParameters, OcpRewrite[RcsOptions, "RcsData"]):
+class Rcs(KeepsParameters[OptimalControlSpec, "RcsData"], OcpRewrite[RcsOptions, "RcsData"]):
     """Relevant constraint sensitivity (eqs. 6.31-6.36), or eq. 6.32 with ``relevant: false``;
     every parameter maps to itself, the target kept for :meth:`restarts` taking the new values."""
 

@@ -167,7 +167,8 @@ def with_parameter_values(spec: SpecT, values: Mapping[str, float]) -> SpecT:
         for part in parents:
             node = node.setdefault(part, {})
         node[last] = _Set(value)
-    return _updated(spec, tree)
+    updated: SpecT = _updated(spec, tree)
+    return updated
 
 
 @dataclass(frozen=True)
@@ -234,15 +235,16 @@ def lowering_path(spec: SpecBase, kinds: frozenset[str]) -> list[AnyTransform] |
     return None
 
 
-class KeepsParameters:
+class KeepsParameters(Generic[Src, Inverse]):
     """Mixin of a transform whose target has exactly the source's runtime parameters (what it
     generates keeps them as symbols) and whose inverse data holds no value of theirs: every
-    parameter maps, to itself, and the inverse data stays as it is."""
+    parameter maps, to itself, and the inverse data stays as it is. Parameterized with the
+    transform's ``Src`` and ``Inverse``, so that its methods are the transform's."""
 
-    def unmapped(self, spec: SpecBase) -> frozenset[str]:
+    def unmapped(self, spec: Src) -> frozenset[str]:
         return frozenset()
 
-    def parameter_map(self, spec: SpecBase, inverse_data: Inverse) -> tuple[dict[str, float], Inverse]:
+    def parameter_map(self, spec: Src, inverse_data: Inverse) -> tuple[dict[str, float], Inverse]:
         return spec.runtime_parameters(), inverse_data
 
 

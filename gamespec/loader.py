@@ -20,7 +20,7 @@ from pydantic import BaseModel, ValidationError
 from gamespec import registry
 from gamespec.errors import SpecError
 from gamespec.reading import read_file, read_value
-from gamespec.specs.base import NLP_OPTIONS, SpecBase
+from gamespec.specs.base import NLP_OPTIONS, SpecBase, SpecT
 
 
 def override_path(key: str, source: str = "--set") -> list[str]:
@@ -45,6 +45,7 @@ def set_path(data: dict[str, Any], path: list[str], value: Any, *, create: bool,
     node: Any = data
     for i, part in enumerate(path):
         last = i == len(path) - 1
+        key: str | int = part
         if isinstance(node, list):
             if not part.isdigit() or int(part) >= len(node):
                 raise SpecError(
@@ -52,7 +53,7 @@ def set_path(data: dict[str, Any], path: list[str], value: Any, *, create: bool,
                     f"not {part!r}",
                     source=source,
                 )
-            part = int(part)
+            key = int(part)
         elif not isinstance(node, dict):
             raise SpecError(
                 f"cannot set {'.'.join(path)}: {'.'.join(path[:i])} is not a mapping or a list", source=source
@@ -60,11 +61,11 @@ def set_path(data: dict[str, Any], path: list[str], value: Any, *, create: bool,
         elif not create and part not in node:
             raise SpecError(f"cannot set {'.'.join(path)}: no field {'.'.join(path[: i + 1])}", source=source)
         if last:
-            node[part] = value
+            node[key] = value
             return
-        if isinstance(node, dict) and node.get(part) is None:
-            node[part] = {}
-        node = node[part]
+        if isinstance(node, dict) and node.get(key) is None:
+            node[key] = {}
+        node = node[key]
 
 
 def apply_overrides(data: dict[str, Any], assignments: Iterable[str]) -> dict[str, Any]:
@@ -76,9 +77,10 @@ def apply_overrides(data: dict[str, Any], assignments: Iterable[str]) -> dict[st
     return data
 
 
-def with_values(spec: SpecBase, values: Mapping[str, Any]) -> SpecBase:
+def with_values(spec: SpecT, values: Mapping[str, Any]) -> SpecT:
     """``spec`` with each runtime parameter or dotted field in ``values`` set, validated as at load
-    (the code path of ``--set``); an unknown name is a SpecError naming it and the nearest one."""
+    (the code path of ``--set``), of ``spec``'s class; an unknown name is a SpecError naming it and
+    the nearest one."""
     data = spec.model_dump(mode="json")
     for name, value in values.items():
         path = override_path(spec.parameter_path(name), source=spec.source)
@@ -91,7 +93,10 @@ def with_values(spec: SpecBase, values: Mapping[str, Any]) -> SpecBase:
             raise SpecError(
                 f"unknown parameter {name!r}: no such field{hint}", field=name, source=spec.source
             ) from None
-    return spec_from_dict(data, source=spec.source).with_source(spec.source, spec.file_hash)
+    new = spec_from_dict(data, source=spec.source).with_source(spec.source, spec.file_hash)
+    if not isinstance(new, type(spec)):
+        raise SpecError(f"a value changed the kind to {new.kind!r}", field="kind", source=spec.source)
+    return new
 
 
 def _valid_keys(model: type[BaseModel] | None, loc: tuple[Any, ...]) -> list[str]:
@@ -176,7 +181,7 @@ def spec_from_dict(data: Mapping[str, Any], source: str = "<spec>") -> SpecBase:
         known = ", ".join(registry.names("gamespec.kinds"))
         raise SpecError(f"missing or invalid 'kind' (one of: {known})", field="kind", source=source)
     try:
-        cls = registry.spec_class(kind)
+        cls: type[SpecBase] = registry.spec_class(kind)
     except SpecError as err:
         raise SpecError(err.reason, field="kind", source=source) from None
     try:

@@ -52,7 +52,8 @@ class Metrics(BaseModel):
 
 def metrics_model(kind: str) -> type[Metrics]:
     """The metrics model of ``kind`` (:class:`Metrics` when the kind names none or is not installed)."""
-    return registry.kind_part(kind, "metrics") or Metrics
+    model: type[Metrics] = registry.kind_part(kind, "metrics") or Metrics
+    return model
 
 
 def validated(result: Result, source: str = "<result>") -> Result:

@@ -12,13 +12,19 @@ entry points are read in one pass, the first time any group is asked for.
 
 from __future__ import annotations
 
+import sys
 from dataclasses import dataclass
 from functools import cache
 from importlib import import_module
-from importlib.metadata import EntryPoint, EntryPoints, entry_points
+from importlib.metadata import EntryPoint, entry_points
 from typing import Any
 
 from gamespec.errors import BackendError, SpecError
+
+if sys.version_info >= (3, 12):
+    from importlib.metadata import EntryPoints as _AllEntryPoints
+else:  # entry_points() is a SelectableGroups (with .select) before 3.12
+    from importlib.metadata import SelectableGroups as _AllEntryPoints
 
 GROUPS = (
     "gamespec.kinds",
@@ -82,7 +88,7 @@ _IN_PROCESS: dict[str, dict[str, Any]] = {group: {} for group in GROUPS}
 
 
 @cache
-def _installed() -> EntryPoints:
+def _installed() -> _AllEntryPoints:
     """Every installed distribution's entry points (one pass over their metadata; a pass per group
     would read all of it again for each)."""
     return entry_points()
@@ -139,7 +145,8 @@ def load(group: str, name: str) -> Any:
 
 def kind(name: str) -> Kind:
     """The :class:`Kind` registered as ``name`` (a SpecError naming the ``kind`` field if none is)."""
-    return load("gamespec.kinds", name)
+    found: Kind = load("gamespec.kinds", name)
+    return found
 
 
 def kind_part(name: str, part: str) -> Any:
@@ -148,13 +155,15 @@ def kind_part(name: str, part: str) -> Any:
     return kind(name).part(part) if name in names("gamespec.kinds") else None
 
 
-def spec_class(name: str) -> type:
-    """The spec model of kind ``name``."""
+def spec_class(name: str) -> Any:
+    """The spec model of kind ``name`` (a :class:`~gamespec.specs.base.SpecBase` subclass; typed by
+    the caller, this layer knows no spec)."""
     return kind(name).part("spec")
 
 
-def backend_class(name: str) -> type:
-    """The backend class registered as ``name``."""
+def backend_class(name: str) -> Any:
+    """The backend class registered as ``name`` (a :class:`~gamespec.compiling.Backend` subclass;
+    typed by the caller, this layer knows no backend)."""
     return load("gamespec.backends", name)
 
 
@@ -173,8 +182,10 @@ def runner_group(name: str) -> str:
     return "gamespec.studies" if name in names("gamespec.studies") else "gamespec.backends"
 
 
-def runner_class(name: str) -> type:
-    """The study or backend class registered as ``name`` (a BackendError naming both if neither)."""
+def runner_class(name: str) -> Any:
+    """The study or backend class registered as ``name`` (a BackendError naming both if neither; a
+    :class:`~gamespec.compiling.study_protocol.Study` or :class:`~gamespec.compiling.Backend`
+    subclass, typed by the caller)."""
     group = runner_group(name)
     if group == "gamespec.backends" and name not in names(group):
         raise BackendError(f"unknown backend {name!r} (known: {', '.join(runner_names())})")

@@ -158,11 +158,11 @@ class Result(BaseModel):
         return {k: np.asarray(a) for k, a in (v or {}).items()}
 
     @field_serializer("time", "control_time")
-    def _ser_array(self, v: np.ndarray | None) -> list | None:
+    def _ser_array(self, v: np.ndarray | None) -> list[Any] | None:
         return None if v is None else v.tolist()
 
     @field_serializer("states", "controls", "costates", "arrays")
-    def _ser_arrays(self, v: ArrayDict) -> dict[str, list]:
+    def _ser_arrays(self, v: ArrayDict) -> dict[str, list[Any]]:
         return {k: a.tolist() for k, a in v.items()}
 
     @property
@@ -221,7 +221,7 @@ class Result(BaseModel):
                 packed[field] = value
             elif isinstance(value, dict):
                 packed.update({f"{field}/{k}": a for k, a in value.items()})
-        np.savez_compressed(out / "arrays.npz", **packed)
+        np.savez_compressed(out / "arrays.npz", allow_pickle=False, **packed)
         return out
 
     @classmethod

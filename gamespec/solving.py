@@ -35,7 +35,7 @@ from dataclasses import dataclass
 from functools import cache, cached_property
 from importlib.metadata import PackageNotFoundError, version
 from pathlib import Path
-from typing import Any
+from typing import Any, Generic, cast
 
 from gamespec import registry
 from gamespec.analyses import SKIPPED, Selection, check_names, kind_analyses, run_analyses, skipped_checks
@@ -46,12 +46,26 @@ from gamespec.loader import load, with_values
 from gamespec.result import Provenance, Result, Status
 from gamespec.specs.base import SpecBase, StrictModel
 from gamespec.specs.hashing import spec_hash
-from gamespec.transforms.base import Transform, lowering_path, requested_steps, with_parameter_values
+from gamespec.transforms.base import (
+    AnyTransform,
+    Dst,
+    Inverse,
+    Options,
+    Src,
+    Transform,
+    lowering_path,
+    requested_steps,
+    with_parameter_values,
+)
+
+AnyBackend = Backend[Any, Any]
+"""A backend chosen by name at run time: its spec and options classes are known only to itself
+(:meth:`Backend.compile` checks the spec's kind before it reaches the typed ``_compile``)."""
 
 
-def get_backend(name: str) -> Backend:
+def get_backend(name: str) -> AnyBackend:
     """An instance of the installed, available backend ``name``; BackendError with the reason else."""
-    cls = registry.backend_class(name)
+    cls: type[AnyBackend] = registry.backend_class(name)
     availability = cls.available()
     if not availability.ok:
         raise BackendError(f"backend {name!r} is not available: {availability.reason}")
@@ -77,32 +91,37 @@ def _core_versions() -> dict[str, str]:
     return found
 
 
-def _versions(backend: Backend | Study) -> dict[str, str]:
+def _versions(backend: AnyBackend | Study) -> dict[str, str]:
     return _core_versions() | {
         f"backend:{backend.name}": registry.distribution(registry.runner_group(backend.name), backend.name)
     }
 
 
 @dataclass(frozen=True)
-class Step:
+class Step(Generic[Src, Dst, Options, Inverse]):
     """One applied transform: ``source`` → ``target`` with ``options``; ``inverse`` is its inverse
-    data and ``upstream`` the compiled upstream stage it took a Result from (None if not staged)."""
+    data and ``upstream`` the compiled upstream stage it took a Result from (None if not staged).
+    Its classes are the transform's, so each step's ``invert(result, source, inverse)`` is checked."""
 
-    transform: Transform
-    options: StrictModel
-    source: SpecBase
-    target: SpecBase
-    inverse: Any
+    transform: Transform[Src, Dst, Options, Inverse]
+    options: Options
+    source: Src
+    target: Dst
+    inverse: Inverse
     upstream: Solver | None = None
 
 
+AnyStep = Step[Any, Any, Any, Any]
+"""A step of a chain, whose classes differ from step to step."""
+
+
 def _applied(
-    transform: Transform,
-    options: StrictModel,
+    transform: Transform[Src, Dst, Options, Inverse],
+    options: Options,
     spec: SpecBase,
     upstream: Solver | None = None,
-    chosen: tuple[Backend, dict[str, Any] | None] | None = None,
-) -> Step:
+    chosen: tuple[AnyBackend, dict[str, Any] | None] | None = None,
+) -> Step[Src, Dst, Options, Inverse]:
     """Apply one transform to ``spec`` (solving its upstream stage on ``upstream``, or compiling
     that stage first when ``upstream`` is None and the transform is staged: on the stage's backend,
     else on the ``chosen`` backend (with its options) when that one solves the stage's kind, else
@@ -125,13 +144,13 @@ def _applied(
 
 
 def _from_file(
-    transform: Transform,
+    transform: AnyTransform,
     options: StrictModel,
     spec: SpecBase,
     source: str,
     field: str = "",
-    chosen: tuple[Backend, dict[str, Any] | None] | None = None,
-) -> Step:
+    chosen: tuple[AnyBackend, dict[str, Any] | None] | None = None,
+) -> AnyStep:
     """:func:`_applied` on a spec read from ``source``: what the transform cannot build from the file
     (an expression it generates that is undefined or out of range, a spec it generates that is
     invalid) is a SpecError naming the file and ``field`` (``transforms.<i>`` for a requested one)."""
@@ -152,7 +171,7 @@ def _changed(old: SpecBase, new: SpecBase) -> frozenset[str]:
     return frozenset(n for n, v in after.items() if before.get(n) != v)
 
 
-def _mapped(step: Step, source: SpecBase) -> Step:
+def _mapped(step: AnyStep, source: SpecBase) -> AnyStep:
     """``step`` for ``source``, its compiled source with other runtime parameter values, by the
     transform's parameter map: the target's values set on the compiled target, new inverse data."""
     values, inverse = step.transform.parameter_map(source, step.inverse)
@@ -167,13 +186,13 @@ def _unrequested(spec: SpecBase) -> SpecBase:
 
 
 def build_steps(
-    spec: SpecBase, backend: Backend, backend_options: dict[str, Any] | None = None
-) -> list[Step]:
+    spec: SpecBase, backend: AnyBackend, backend_options: dict[str, Any] | None = None
+) -> list[AnyStep]:
     """The requested transforms of ``spec`` in order, then the lowering ones to a kind ``backend``
     solves (a staged one's upstream stage on ``backend`` with ``backend_options`` where it solves
     that stage's kind)."""
     chosen = (backend, backend_options)
-    steps: list[Step] = []
+    steps: list[AnyStep] = []
     current = _unrequested(spec)
     for index, (transform, options) in enumerate(requested_steps(spec)):
         steps.append(_from_file(transform, options, current, spec.source, f"transforms.{index}", chosen))
@@ -239,8 +258,8 @@ class Solver:
     often as needed (see module doc)."""
 
     spec: SpecBase
-    backend: Backend | Study
-    steps: list[Step]
+    backend: AnyBackend | Study
+    steps: list[AnyStep]
     compiled: CompiledModel
     build_time_s: float
     analyses: Selection = "all"
@@ -280,7 +299,7 @@ class Solver:
 
     def mapped_steps(
         self, spec: SpecBase, guessed: bool = False, names: list[str] | None = None
-    ) -> list[Step]:
+    ) -> list[AnyStep]:
         """The compiled steps for ``spec`` (cvxpy's ``apply_parameters``): when ``spec`` differs
         from the compiled source in runtime parameter values only, each step's
         :meth:`~gamespec.transforms.base.Transform.parameter_map` gives its target's values and
@@ -292,7 +311,7 @@ class Solver:
         re-applied. A re-applied chain must end in the compiled target's structure (``guessed``:
         the caller gives the compiled model a starting point), else a SpecError naming ``names``."""
         current = _unrequested(spec)
-        steps: list[Step] = []
+        steps: list[AnyStep] = []
         if self._same_structure(spec, names):
             for old in self.steps:
                 changed = _changed(old.source, current)
@@ -343,7 +362,7 @@ class Solver:
         """The compiled target's structure with and without its starting point, dumped once."""
         return {flag: self.target_spec.structure(with_guess=flag) for flag in (False, True)}
 
-    def _solve(self, spec: SpecBase, steps: list[Step], guess: Result | None, inputs: Inputs) -> Result:
+    def _solve(self, spec: SpecBase, steps: list[AnyStep], guess: Result | None, inputs: Inputs) -> Result:
         """Solve the compiled model and map the Result back through ``steps``; its ``solve_time_s``
         is the wall-clock time of all of it (the solve, the checks, the inverse maps, multi-start),
         what the caller waited for, whatever the backend measured inside."""
@@ -357,10 +376,10 @@ class Solver:
         for index in reversed(range(len(steps))):
             step = steps[index]
             result = self._mapped(step, result)
-            last = index == len(steps) - 1
+            is_last = index == len(steps) - 1
             if result.ok:
-                result = self._verified(step, result, values, inputs, multistart=last)
-            elif last:
+                result = self._verified(step, result, values, inputs, multistart=is_last)
+            elif is_last:
                 result = self._restarted(step, values, inputs) or result
         provenance = Provenance(
             spec_hash=spec_hash(spec),
@@ -382,7 +401,7 @@ class Solver:
             }
         )
 
-    def _mapped(self, step: Step, result: Result) -> Result:
+    def _mapped(self, step: AnyStep, result: Result) -> Result:
         """``result`` mapped back through ``step``: its ``invert``, then the selected analyses of the
         transform and of the source's kind."""
         back = step.transform.invert(result, step.source, step.inverse)
@@ -398,13 +417,13 @@ class Solver:
         skipped = skipped_checks(declared, self.analyses)
         return _not_verified(result, _skipped(skipped)) if skipped and result.ok else result
 
-    def _unverifiable(self, step: Step) -> str | None:
+    def _unverifiable(self, step: AnyStep) -> str | None:
         """Why ``step.transform.verify`` cannot judge a Result here: the checks it reads that the
         skipped analyses decide (None when every such analysis runs)."""
         skipped = skipped_checks(step.transform.analyses(), self.analyses)
         return _skipped(skipped) if skipped else None
 
-    def _restarted(self, step: Step, values: dict[str, float] | None, inputs: Inputs) -> Result | None:
+    def _restarted(self, step: AnyStep, values: dict[str, float] | None, inputs: Inputs) -> Result | None:
         """Multi-start: the best verified Result among re-solves of the compiled model from the
         step's restarts (None if none verifies); with the verifying analyses off, the best usable
         one, not verified."""
@@ -426,7 +445,7 @@ class Solver:
 
     def _verified(
         self,
-        step: Step,
+        step: AnyStep,
         result: Result,
         values: dict[str, float] | None,
         inputs: Inputs,
@@ -468,7 +487,8 @@ def compile_spec(
     ``analyses``: which analyses its solves run (None: the file's ``analyses:`` key, else all)."""
     if not isinstance(spec, SpecBase):
         spec = load(spec)
-    selection = analyses if analyses is not None else spec.analyses or "all"
+    # the file's choice is "all", "none" or a list of names (checked at load: AnalysesChoice)
+    selection = analyses if analyses is not None else cast(Selection, spec.analyses or "all")
     check_names(selection, spec.source)
     study = registry.kind(spec.kind).study if spec.kind in registry.names("gamespec.kinds") else None
     if study is not None:

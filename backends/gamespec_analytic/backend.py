@@ -21,14 +21,14 @@ from __future__ import annotations
 import time
 from typing import ClassVar
 
-from gamespec.compiling import Backend, CompiledModel, Inputs, refuse_inputs
+from gamespec.compiling import Backend, CompiledModel, Inputs, NoOptions, refuse_inputs
 from gamespec.loader import with_values
 from gamespec.pursuit import constant_bearing, pure_pursuit
 from gamespec.pursuit.reduced import observe, reduce
 from gamespec.pursuit.report import engagement_report
-from gamespec.pursuit.simulation import Players, simulate_to_capture
+from gamespec.pursuit.simulation import HeadingLaw, Players, simulate_to_capture
 from gamespec.result import Result, Status
-from gamespec.specs.base import SpecBase, StrictModel
+from gamespec.specs.base import SpecBase
 from gamespec.specs.engagement import EngagementSpec
 
 
@@ -46,6 +46,7 @@ class AnalyticModel(CompiledModel):
         tic = time.perf_counter()
         spec = with_values(self.spec, parameters) if parameters else self.spec
         players = Players.from_spec(spec)
+        law: HeadingLaw | float
         if set(players.strategies) == {"cb"}:
             plan = constant_bearing.optimal_evasion(players)
             constant = constant_bearing.best_constant_heading(players)
@@ -93,7 +94,7 @@ class AnalyticModel(CompiledModel):
         )
 
 
-class AnalyticBackend(Backend):
+class AnalyticBackend(Backend[EngagementSpec, NoOptions]):
     """Closed forms and suboptimal strategies of :mod:`gamespec.pursuit` (see module doc)."""
 
     name: ClassVar[str] = "analytic"
@@ -101,9 +102,13 @@ class AnalyticBackend(Backend):
 
     def unsupported(self, spec: SpecBase) -> str | None:
         reason = super().unsupported(spec)
-        if reason is None and len({p.strategy for p in spec.pursuers}) != 1:
+        if (
+            reason is None
+            and isinstance(spec, EngagementSpec)
+            and len({p.strategy for p in spec.pursuers}) != 1
+        ):
             return "backend 'analytic' needs every pursuer on cb or every pursuer on pp (no relay)"
         return reason
 
-    def _compile(self, spec: EngagementSpec, options: StrictModel) -> AnalyticModel:
+    def _compile(self, spec: EngagementSpec, options: NoOptions) -> AnalyticModel:
         return AnalyticModel(spec)

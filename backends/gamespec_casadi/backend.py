@@ -85,7 +85,7 @@ def nlp_solver(nlp: Any, options: CasadiOptions) -> Any:
     # NaN in a function evaluation ends as the status numerical_error; CasADi's own warnings about it
     # (and about the parameter multipliers lam_p, which nothing reads) would be extra lines on stderr
     # (README, "Bad input": one line).
-    nlp_opts = {
+    nlp_opts: dict[str, Any] = {
         "ipopt": ipopt | IPOPT_DEFAULTS | options.ipopt,
         "print_time": False,
         "show_eval_warnings": False,
@@ -103,6 +103,8 @@ def nlp_solver(nlp: Any, options: CasadiOptions) -> Any:
 
 class CasadiModel(CollocationModel):
     """The NLP and its solver, built once."""
+
+    options: CasadiOptions
 
     def __init__(self, spec: OptimalControlSpec, options: CasadiOptions) -> None:
         import casadi as ca
@@ -193,7 +195,7 @@ class CasadiModel(CollocationModel):
         )
 
 
-class CasadiBackend(CollocationBackend):
+class CasadiBackend(CollocationBackend[CasadiOptions]):
     """Direct collocation (LGR or trapezoidal) on CasADi with IPOPT."""
 
     name: ClassVar[str] = "casadi"
@@ -208,7 +210,7 @@ class CasadiBackend(CollocationBackend):
             return Availability(False, f"casadi does not import: {err}")
         if not casadi.has_nlpsol("ipopt"):
             return Availability(False, "casadi was built without the ipopt plugin")
-        return Availability(True, f"casadi {casadi.__version__} with ipopt")
+        return Availability(True, f"casadi {casadi.CasadiMeta.version()} with ipopt")
 
     def _compile(self, spec: OptimalControlSpec, options: CasadiOptions) -> CasadiModel:
         return CasadiModel(spec, options)

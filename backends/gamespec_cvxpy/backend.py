@@ -29,7 +29,6 @@ from gamespec.lqgame.covariance import CONTROLLER, STOPPER, algorithm_2, gains_t
 from gamespec.lqgame.scaling import ControllerScaling, QPScaling
 from gamespec.lqgame.solution import CovarianceOutcome, GameModel, MeanOutcome, fallback_mean
 from gamespec.result import Result, Status
-from gamespec.specs.base import StrictModel
 
 STATUS_MAP = {
     "optimal": Status.OPTIMAL,
@@ -307,12 +306,12 @@ class CvxpyModel(LQCompiledModel):
         return self.players.solve(self.spec.method.settings(), self._start_gains(guess))
 
 
-class CvxpyBackend(LQBackend):
+class CvxpyBackend(LQBackend[CvxpyOptions]):
     """CVXPY with a conic solver chosen by name (``solver: CLARABEL``, ``SCS``, ...)."""
 
     name: ClassVar[str] = "cvxpy"
     features: ClassVar[frozenset[str]] = frozenset({"mean_steering", "covariance_constraint"})
-    options_model: ClassVar[type[StrictModel]] = CvxpyOptions
+    options_model = CvxpyOptions
     library: ClassVar[str] = "cvxpy"
     model_class: ClassVar[type[LQCompiledModel]] = CvxpyModel
 
@@ -323,12 +322,11 @@ class CvxpyBackend(LQBackend):
         return list(cp.installed_solvers())
 
     @classmethod
-    def probe_options(cls, options: LQSolverOptions) -> None:
+    def probe_options(cls, options: CvxpyOptions) -> None:
         """Solve ``min (x − 1)² s.t. x ≥ 0`` with the user's solver options; a fallback solver must be
         installed."""
         import cvxpy as cp
 
-        assert isinstance(options, CvxpyOptions)
         fallback = options.fallback_solver
         if fallback is not None and fallback.upper() not in cls.installed_solvers():
             raise BackendError(f"fallback_solver {fallback!r} is not installed for cvxpy")

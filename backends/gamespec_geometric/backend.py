@@ -15,7 +15,7 @@ from pydantic import Field
 from gamespec.compiling import Backend, CompiledModel, Inputs, refuse_inputs
 from gamespec.loader import with_values
 from gamespec.result import Result, Status
-from gamespec.specs.base import SpecBase, StrictModel
+from gamespec.specs.base import StrictModel
 from gamespec_geometric.simulation import Trajectories, simulate
 from gamespec_geometric.spec import PursuitScenarioSpec
 
@@ -101,13 +101,12 @@ def scenario_result(spec: PursuitScenarioSpec, run: Trajectories, seconds: float
     )
 
 
-class GeometricBackend(Backend):
+class GeometricBackend(Backend[PursuitScenarioSpec, GeometricOptions]):
     """Multi-agent simulation with Apollonius-based allocation (thesis chapter 3)."""
 
     name: ClassVar[str] = "geometric"
     kinds: ClassVar[frozenset[str]] = frozenset({"pursuit_scenario"})
-    options_model: ClassVar[type[StrictModel]] = GeometricOptions
+    options_model = GeometricOptions
 
-    def _compile(self, spec: SpecBase, options: StrictModel) -> CompiledModel:
-        assert isinstance(spec, PursuitScenarioSpec) and isinstance(options, GeometricOptions)
+    def _compile(self, spec: PursuitScenarioSpec, options: GeometricOptions) -> CompiledScenario:
         return CompiledScenario(spec, options)

@@ -14,22 +14,22 @@ from typing import ClassVar
 
 from gamespec.compiling import Availability, Backend, CompiledModel
 from gamespec.flowfield.spec import FlowCovarianceGameSpec, FlowReachabilitySpec
-from gamespec.specs.base import SpecBase, StrictModel
 from gamespec_levelset.game import CovarianceGameModel
 from gamespec_levelset.options import FlowGameOptions
 from gamespec_levelset.reachability import ReachabilityModel
 
+FlowStageSpec = FlowReachabilitySpec | FlowCovarianceGameSpec
+"""The two stage kinds of chapter 5's chain this backend solves (reachability, then the game)."""
 
-class _FlowGameBackend(Backend):
+
+class _FlowGameBackend(Backend[FlowStageSpec, FlowGameOptions]):
     kinds: ClassVar[frozenset[str]] = frozenset({"flow_reachability", "flow_covariance_game"})
     options_model = FlowGameOptions
     method: ClassVar[str]
 
-    def _compile(self, spec: SpecBase, options: StrictModel) -> CompiledModel:
-        assert isinstance(options, FlowGameOptions)
+    def _compile(self, spec: FlowStageSpec, options: FlowGameOptions) -> CompiledModel:
         if isinstance(spec, FlowReachabilitySpec):
             return ReachabilityModel(spec, self.method, options.cross_check)
-        assert isinstance(spec, FlowCovarianceGameSpec)
         return CovarianceGameModel(spec, options)
 
 

@@ -79,6 +79,8 @@ def _fix(var: Any, value: float) -> None:
 class PyomoModel(CollocationModel):
     """The Pyomo model and the solver that runs on it, built once."""
 
+    options: PyomoOptions
+
     def __init__(self, spec: OptimalControlSpec, options: PyomoOptions) -> None:
         import pyomo.environ as pyo
 
@@ -239,7 +241,7 @@ class PyomoModel(CollocationModel):
         )
 
 
-class PyomoBackend(CollocationBackend):
+class PyomoBackend(CollocationBackend[PyomoOptions]):
     """Direct collocation (LGR or trapezoidal) as a Pyomo model, solved by ripopt or ipopt."""
 
     name: ClassVar[str] = "pyomo"

@@ -24,7 +24,6 @@ from scipy.sparse import csc_matrix
 from gamespec.compiling.lq import LQBackend, LQCompiledModel, LQSolverOptions
 from gamespec.lqgame.solution import MeanOutcome, fallback_mean
 from gamespec.result import Result, Status
-from gamespec.specs.base import StrictModel
 
 if TYPE_CHECKING:
     import qpsolvers
@@ -79,8 +78,9 @@ def verdict(solution: qpsolvers.Solution) -> str:
     return "primal_feasible" if solution.primal_residual() < eps else "infeasible_point"
 
 
-def residuals(solution: qpsolvers.Solution) -> dict[str, float | None]:
-    """qpsolvers' primal and dual residuals and duality gap (None where undefined), and the scale."""
+def residuals(solution: qpsolvers.Solution, scale: float) -> dict[str, float | None]:
+    """qpsolvers' primal and dual residuals and duality gap (None where undefined), and the scale
+    (:func:`data_scale`)."""
 
     def finite(value: float) -> float | None:
         return float(value) if np.isfinite(value) else None
@@ -89,7 +89,7 @@ def residuals(solution: qpsolvers.Solution) -> dict[str, float | None]:
         "qp_primal_residual": finite(solution.primal_residual()),
         "qp_dual_residual": finite(solution.dual_residual()),
         "qp_duality_gap": finite(solution.duality_gap()),
-        "qp_data_scale": data_scale(solution),
+        "qp_data_scale": scale,
     }
 
 
@@ -115,8 +115,9 @@ class QpModel(LQCompiledModel):
     def _initial_controls(self, guess: Result | None) -> np.ndarray | None:
         """``guess``'s controller inputs stacked as ``Ū``, when they fit this game."""
         game = self.model.game
-        columns = [guess.controls.get(f"u{i + 1}") for i in range(game.m)] if guess is not None else []
-        if not columns or any(c is None or c.shape != (game.N,) for c in columns):
+        given = [guess.controls.get(f"u{i + 1}") for i in range(game.m)] if guess is not None else []
+        columns = [c for c in given if c is not None and c.shape == (game.N,)]
+        if not columns or len(columns) < len(given):
             return None
         return np.column_stack(columns).ravel()
 
@@ -133,8 +134,9 @@ class QpModel(LQCompiledModel):
         )
         seconds = time.perf_counter() - start
         key = verdict(solution)
-        status, checks = STATUS_MAP[key], residuals(solution)
-        eps = QP_TOLERANCE * checks["qp_data_scale"]
+        scale = data_scale(solution)
+        status, checks = STATUS_MAP[key], residuals(solution, scale)
+        eps = QP_TOLERANCE * scale
         message = _MESSAGES[key].format(solver=self.options.solver, eps=eps)
         if not status.ok:
             outcome = fallback_mean(self.model, status, message)
@@ -146,12 +148,12 @@ class QpModel(LQCompiledModel):
         )
 
 
-class QpBackend(LQBackend):
+class QpBackend(LQBackend[QpOptions]):
     """qpsolvers with a QP solver chosen by name (``solver: proxqp``, ``osqp``, ``clarabel``, ...)."""
 
     name: ClassVar[str] = "qp"
     features: ClassVar[frozenset[str]] = frozenset({"mean_steering"})
-    options_model: ClassVar[type[StrictModel]] = QpOptions
+    options_model = QpOptions
     library: ClassVar[str] = "qpsolvers"
     model_class: ClassVar[type[LQCompiledModel]] = QpModel
 
@@ -162,7 +164,7 @@ class QpBackend(LQBackend):
         return list(qpsolvers.available_solvers)
 
     @classmethod
-    def probe_options(cls, options: LQSolverOptions) -> None:
+    def probe_options(cls, options: QpOptions) -> None:
         """Solve ``min ½x² − x s.t. x ≤ ½`` with the user's solver options (constrained, so that
         qpsolvers hands it to the solver rather than to SciPy's least squares)."""
         import qpsolvers

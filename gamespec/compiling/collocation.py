@@ -7,13 +7,14 @@ from __future__ import annotations
 
 from abc import abstractmethod
 from collections.abc import Mapping
-from typing import Any, ClassVar
+from typing import Any, ClassVar, TypeVar
 
 from gamespec.compiling import Backend, CompiledModel, Inputs
 from gamespec.ocp.inputs import InputGrid
 from gamespec.ocp.transcription import Transcription
 from gamespec.result import Result
-from gamespec.specs.base import NLP_OPTIONS, SpecBase
+from gamespec.specs.base import NLP_OPTIONS, SpecBase, StrictModel
+from gamespec.specs.ocp import OptimalControlSpec
 
 IPOPT_DEFAULTS: dict[str, Any] = {"mumps_permuting_scaling": 0}
 """IPOPT options every collocation backend passes to IPOPT under the file's own (which override
@@ -25,7 +26,11 @@ negative eigenvalues for every Hessian shift from 1 to 1e6 where the matrix has 
 that step MUMPS counts right, IPOPT takes the shift ripopt takes (1) and converges in 17 iterations."""
 
 
-class CollocationBackend(Backend):
+NlpOptionsT = TypeVar("NlpOptionsT", bound=StrictModel)
+"""The options model of one collocation backend (its IPOPT pass-through block is ``nlp_field``)."""
+
+
+class CollocationBackend(Backend[OptimalControlSpec, NlpOptionsT]):
     """Base of the backends that solve ``optimal_control`` specs by direct collocation of a
     :class:`Transcription` (the same kinds and features for each of them). ``solver.options.nlp``
     holds IPOPT options for all of them: those the backend's options block names (``tol``,
@@ -61,6 +66,10 @@ class CollocationModel(CompiledModel):
 
     tr: Transcription
     options: Any
+
+    @abstractmethod
+    def __init__(self, spec: OptimalControlSpec, options: Any) -> None:
+        """Build the model of ``spec`` with the backend's ``options`` (refinement builds one per mesh)."""
 
     def input_grid(self, parameters: Mapping[str, float] | None = None) -> InputGrid:
         """Where ``solve(inputs=...)`` expects its values (see :meth:`Transcription.input_grid`)."""

@@ -14,7 +14,7 @@ from __future__ import annotations
 import importlib
 from abc import abstractmethod
 from collections.abc import Mapping
-from typing import Any, ClassVar
+from typing import Any, ClassVar, TypeVar
 
 from pydantic import Field
 
@@ -29,7 +29,7 @@ from gamespec.lqgame.solution import (
     unconstrained_covariance,
 )
 from gamespec.result import Result, Status
-from gamespec.specs.base import SpecBase, StrictModel
+from gamespec.specs.base import StrictModel
 from gamespec.specs.lq_game import LQGameSpec
 
 
@@ -108,7 +108,11 @@ class LQCompiledModel(CompiledModel):
         )
 
 
-class LQBackend(Backend):
+LQOptionsT = TypeVar("LQOptionsT", bound=LQSolverOptions)
+"""The options model of one LQ backend (a solver name and its keyword arguments, and more)."""
+
+
+class LQBackend(Backend[LQGameSpec, LQOptionsT]):
     """A backend of the ``lq_stochastic_game`` kind wrapping the solvers of one ``library``.
 
     Subclasses set ``name``, ``features``, ``options_model``, ``library``, ``model_class`` and
@@ -126,7 +130,7 @@ class LQBackend(Backend):
 
     @classmethod
     @abstractmethod
-    def probe_options(cls, options: LQSolverOptions) -> None:
+    def probe_options(cls, options: LQOptionsT) -> None:
         """Raise ``options.rejected(...)`` when the solver refuses ``options.solver_options`` (a
         one-variable problem at compile time, so no real solve needs an exception handler)."""
 
@@ -153,7 +157,7 @@ class LQBackend(Backend):
         return found[0]
 
     @classmethod
-    def validate_options(cls, raw: Mapping[str, Any], source: str = "<spec>") -> StrictModel:
+    def validate_options(cls, raw: Mapping[str, Any], source: str = "<spec>") -> LQOptionsT:
         """The options block, its ``solver`` an installed one (checked at load, naming the field)."""
         options = super().validate_options(raw, source)
         try:
@@ -164,8 +168,7 @@ class LQBackend(Backend):
             pass
         return options
 
-    def _compile(self, spec: SpecBase, options: StrictModel) -> CompiledModel:
-        assert isinstance(spec, LQGameSpec) and isinstance(options, LQSolverOptions)
+    def _compile(self, spec: LQGameSpec, options: LQOptionsT) -> CompiledModel:
         options = options.model_copy(update={"solver": self.installed_name(options.solver)})
         self.probe_options(options)
         return self.model_class(spec, options)

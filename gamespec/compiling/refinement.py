@@ -47,7 +47,8 @@ def trajectory_of(tr: Transcription, result: Result) -> tuple[Trajectory, dict[s
     U = np.array([result.controls[n] for n in tr.ocp.controls]).reshape(tr.n_u, k)
     Win = np.array([result.arrays[f"input/{n}"] for n in tr.ocp.inputs]).reshape(tr.n_w, k)
     values = dict(result.parameters) | result.metrics.get("design", {})
-    return Trajectory(X, U, Win, float(result.t_final) - tr.t0), values
+    assert result.t_final is not None, "a collocation Result has a final time"
+    return Trajectory(X, U, Win, result.t_final - tr.t0), values
 
 
 Interval = tuple[float, float]
@@ -61,7 +62,7 @@ def _decays_too_slowly(degree: int, defect: float, before: tuple[int, float] | N
         return False
     previous_degree, previous_defect = before
     predicted = max(previous_degree, 2) ** (-(degree - previous_degree) / 2)
-    return defect > previous_defect * predicted
+    return bool(defect > previous_defect * predicted)
 
 
 def refined_mesh(
@@ -110,13 +111,15 @@ def _entry(tr: Transcription, result: Result) -> dict[str, Any]:
 def refined(
     model: CollocationModel,
     first: Result,
-    parameters: Mapping[str, float] | None,
+    parameters: dict[str, float] | None,
     inputs: Any,
 ) -> Result:
     """Refine from ``first`` (a solve of ``model``) until the relative defect meets the tolerance;
     the last Result, with ``metrics["refinement"]`` (one entry per mesh) and
     ``metrics["refinement_converged"]``."""
     options = model.tr.spec.method.refine
+    if options is None:
+        return first
     current, result = model, first
     history = [_entry(current.tr, result)]
     before: dict[Interval, tuple[int, float]] = {}

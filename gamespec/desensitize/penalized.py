@@ -202,5 +202,6 @@ def _end_values(result: Result) -> dict[sp.Symbol, float]:
     ends: dict[sp.Symbol, float] = {symbol(k): v for k, v in result.parameters.items()}
     for k, v in result.states.items():
         ends[symbol(f"{k}_0")], ends[symbol(f"{k}_f")] = float(v[0]), float(v[-1])
+    assert result.t_final is not None, "an optimal_control Result has a final time"
     ends[symbol("t_f")] = float(result.t_final)
     return ends

@@ -37,7 +37,9 @@ from gamespec.symbolic.language import parse, symbol
 from gamespec.transforms.base import KeepsParameters, OcpRewrite
 
 
-class Desensitize(KeepsParameters, OcpRewrite):
+class Desensitize(
+    KeepsParameters[OptimalControlSpec, InverseData], OcpRewrite[DesensitizeOptions, InverseData]
+):
     """Desensitized optimal control (chapter 6) by sensitivity functions, Seywald's method or C-DOC;
     the weights and sensitivities are expressions of the parameters, so every parameter maps to
     itself (:class:`~gamespec.transforms.base.KeepsParameters`)."""
@@ -45,15 +47,18 @@ class Desensitize(KeepsParameters, OcpRewrite):
     name: ClassVar[str] = "desensitize"
     plot: ClassVar[str] = "gamespec.desensitize.plotting:plot_desensitized"
     summary: ClassVar[str] = "gamespec.desensitize.report:desensitization_summary"
-    options_model: ClassVar[type[DesensitizeOptions]] = DesensitizeOptions
+    options_model = DesensitizeOptions
 
     def apply(
-        self, spec: SpecBase, options: DesensitizeOptions | None = None, upstream: Result | None = None
+        self,
+        spec: OptimalControlSpec,
+        options: DesensitizeOptions | None = None,
+        upstream: Result | None = None,
     ) -> tuple[OptimalControlSpec, InverseData]:
         options = options or DesensitizeOptions()
         return desensitize(spec, options)
 
-    def invert(self, result: Result, spec: SpecBase, inverse_data: InverseData) -> Result:
+    def invert(self, result: Result, spec: OptimalControlSpec, inverse_data: InverseData) -> Result:
         return report(result, spec, inverse_data)
 
     def analyses(self) -> list[Analysis]:
@@ -117,7 +122,7 @@ def _parse(raw: float | str, params: dict[str, sp.Symbol], spec: SpecBase, where
         raise SpecError(str(err), field=f"{FIELD}.{where}", source=spec.source) from None
 
 
-def _unit(weights: Weights | None, entries: dict[str, sp.Expr]) -> dict[str, float] | None:
+def _unit(weights: Weights | None, entries: dict[str, sp.Expr]) -> Weights | None:
     """Weight 1 on the entries ``weights`` names (all of them for a single weight)."""
     if weights is None:
         return None

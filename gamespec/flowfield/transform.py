@@ -13,6 +13,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 from typing import Any, ClassVar
 
+from gamespec.compiling import NoOptions
 from gamespec.flowfield.problem import evaluate
 from gamespec.flowfield.spec import FlowCovarianceGameSpec, FlowGameSpec
 from gamespec.flowfield.stages import (
@@ -22,7 +23,6 @@ from gamespec.flowfield.stages import (
     reachability_spec,
 )
 from gamespec.result import Result
-from gamespec.specs.base import StrictModel
 from gamespec.transforms.base import Stage, Transform
 
 
@@ -35,18 +35,18 @@ class Reached:
     result: Result
 
 
-class FlowGameToCovarianceGame(Transform):
+class FlowGameToCovarianceGame(Transform[FlowGameSpec, FlowCovarianceGameSpec, NoOptions, Reached]):
     """A flow-field game as its covariance game about the nominal paths of its reachability stage."""
 
     name: ClassVar[str] = "flow_game_to_covariance_game"
     source_kind: ClassVar[str] = "flow_field_game"
     target_kind: ClassVar[str] = "flow_covariance_game"
 
-    def stage(self, spec: FlowGameSpec, options: StrictModel) -> Stage:
+    def stage(self, spec: FlowGameSpec, options: NoOptions) -> Stage:
         return Stage(reachability_spec(spec))
 
     def apply(
-        self, spec: FlowGameSpec, options: StrictModel, upstream: Result | None = None
+        self, spec: FlowGameSpec, options: NoOptions, upstream: Result | None = None
     ) -> tuple[FlowCovarianceGameSpec, Reached]:
         assert upstream is not None, "a staged transform: the solving layer passes the reachability"
         return covariance_game_spec(spec, upstream), Reached(reachability_key(evaluate(spec)), upstream)

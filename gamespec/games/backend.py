@@ -12,11 +12,11 @@ parameters are the game's ``problem.parameters``.
 
 from __future__ import annotations
 
-from typing import ClassVar
+from typing import Any, ClassVar
 
 import numpy as np
 
-from gamespec.compiling import Backend, CompiledModel, Inputs, refuse_inputs
+from gamespec.compiling import Backend, CompiledModel, Inputs, NoOptions, refuse_inputs
 from gamespec.games.equilibrium import GameModel, GameSolution, equilibrium_report, status_of
 from gamespec.games.existence import existence
 from gamespec.games.feedback import LQGame
@@ -25,7 +25,6 @@ from gamespec.games.lq_structure import LQForm, lq_form, lq_game
 from gamespec.games.problems import initial_state
 from gamespec.games.simulate import TrueSystem, control_signal, grid_of, true_parameters
 from gamespec.result import Result, Status
-from gamespec.specs.base import SpecBase, StrictModel
 from gamespec.specs.differential_game import DifferentialGameSpec
 
 
@@ -40,7 +39,7 @@ def open_loop(model: GameModel) -> Result:
     game = model.game
     exists = existence(model.lq, model.parameters)
     if exists.refused:
-        metrics = {
+        metrics: dict[str, Any] = {
             "existence": exists.as_metrics(),
             "solution_concept": "none",
             "sought_concept": model.concept(),
@@ -60,9 +59,10 @@ def open_loop(model: GameModel) -> Result:
             metrics={"best_response": _runs(solutions), "builds": model.builds},
         )
     first = solutions[0].states
+    assert first.time is not None and first.control_time is not None, "a best response has its grids"
     tc = first.control_time + t0
     controls = {c: own[p].controls_of(p)[c] for p, pl in game.problem.players.items() for c in pl.controls}
-    arrays = {}
+    arrays: dict[str, np.ndarray] = {}
     if len(solutions) == 1:
         time, states = first.time + t0, dict(first.states)
     else:
@@ -93,7 +93,7 @@ def _own(solutions: list[GameSolution], player: str) -> GameSolution:
     return next((s for s in solutions if s.view == player), solutions[0])
 
 
-def _runs(solutions: list[GameSolution]) -> dict:
+def _runs(solutions: list[GameSolution]) -> dict[str, Any]:
     return {s.view: s.run.as_metrics() for s in solutions}
 
 
@@ -102,6 +102,7 @@ def _simulated(
 ) -> tuple[np.ndarray, dict[str, np.ndarray]]:
     game = model.game
     grid = grid_of(game.method)
+    assert reference.time is not None, "a best response has its time grid"
     horizon = float(reference.time[-1] - reference.time[0])
     signals = {c: control_signal(grid, v, t0, horizon) for c, v in controls.items()}
     system = TrueSystem(game, true_parameters(model))
@@ -134,6 +135,7 @@ class GameCompiled(CompiledModel):
             from gamespec.games.iterative_lq import feedback_nash_nonlinear
 
             return feedback_nash_nonlinear(self.game, self.parameters)
+        assert self.model is not None, "an open-loop game has its model"
         if parameters:
             self.model.parameters = {**self.model.parameters, **parameters}
         if self.game.receding_horizon is not None:
@@ -143,12 +145,12 @@ class GameCompiled(CompiledModel):
         return open_loop(self.model)
 
 
-class BestResponseBackend(Backend):
+class BestResponseBackend(Backend[DifferentialGameSpec, NoOptions]):
     """Best responses of the players of a ``differential_game``, each an ``optimal_control`` problem
     compiled once on casadi or pyomo."""
 
     name: ClassVar[str] = "best_response"
     kinds: ClassVar[frozenset[str]] = frozenset({"differential_game"})
 
-    def _compile(self, spec: SpecBase, options: StrictModel) -> GameCompiled:
+    def _compile(self, spec: DifferentialGameSpec, options: NoOptions) -> GameCompiled:
         return GameCompiled(spec)

@@ -14,16 +14,16 @@ from __future__ import annotations
 from dataclasses import replace
 from typing import ClassVar
 
+from gamespec.compiling import NoOptions
 from gamespec.multiphase.lowering import Lowering, lower
 from gamespec.multiphase.spec import MultiPhaseSpec
 from gamespec.multiphase.split import split_by_phase
 from gamespec.result import Result
-from gamespec.specs.base import StrictModel
 from gamespec.specs.ocp import OptimalControlSpec
 from gamespec.transforms.base import Transform, with_parameter_values
 
 
-class PhasesToOcp(Transform):
+class PhasesToOcp(Transform[MultiPhaseSpec, OptimalControlSpec, NoOptions, Lowering]):
     """Lower a multi-phase problem to one ``optimal_control`` problem (see module doc)."""
 
     name: ClassVar[str] = "phases"
@@ -31,7 +31,7 @@ class PhasesToOcp(Transform):
     target_kind: ClassVar[str] = "optimal_control"
 
     def apply(
-        self, spec: MultiPhaseSpec, options: StrictModel, upstream: Result | None = None
+        self, spec: MultiPhaseSpec, options: NoOptions, upstream: Result | None = None
     ) -> tuple[OptimalControlSpec, Lowering]:
         lowering = lower(spec)
         return lowering.target, lowering

@@ -26,6 +26,7 @@ multi-start.
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass, replace
 from typing import Any, ClassVar
 
@@ -49,6 +50,7 @@ from gamespec.ocp.symbolic import SymbolicOcp
 from gamespec.ocp.transcription import Transcription
 from gamespec.rcs import obstacles as geometry
 from gamespec.rcs.sensitivity import (
+    Inequality,
     constraint_sensitivity,
     inequalities,
     nonzero,
@@ -58,14 +60,13 @@ from gamespec.rcs.sensitivity import (
 )
 from gamespec.rcs.spec import MovingObstaclesOptions, RcsOptions
 from gamespec.result import Result, Status
-from gamespec.specs.base import SpecBase
 from gamespec.specs.ocp import GuessSpec, OptimalControlSpec
 from gamespec.symbolic.language import TIME, parse, symbol
 from gamespec.symbolic.printer import to_text
 from gamespec.transforms.base import KeepsParameters, OcpRewrite, with_parameter_values
 
 
-def _parser(spec: OptimalControlSpec, field: str, running: bool = False):
+def _parser(spec: OptimalControlSpec, field: str, running: bool = False) -> Callable[[float | str], sp.Expr]:
     names = [*spec.problem.parameters, *(spec.problem.states if running else ())]
     symbols = {n: symbol(n) for n in names}
 
@@ -87,15 +88,17 @@ class ObstacleData:
     power: sp.Expr
 
 
-class MovingObstacles(KeepsParameters, OcpRewrite):
+class MovingObstacles(
+    KeepsParameters[OptimalControlSpec, "ObstacleData"], OcpRewrite[MovingObstaclesOptions, "ObstacleData"]
+):
     """Avoidance constraints of declared moving obstacles (§6.4.1-6.4.3); the obstacles are
     expressions of the parameters and ``t``, so every parameter maps to itself."""
 
     name: ClassVar[str] = "moving_obstacles"
-    options_model: ClassVar[type[MovingObstaclesOptions]] = MovingObstaclesOptions
+    options_model = MovingObstaclesOptions
 
     def apply(
-        self, spec: SpecBase, options: MovingObstaclesOptions, upstream: Result | None = None
+        self, spec: OptimalControlSpec, options: MovingObstaclesOptions, upstream: Result | None = None
     ) -> tuple[OptimalControlSpec, ObstacleData]:
         field = "transforms.moving_obstacles"
         read = _parser(spec, field)
@@ -111,12 +114,12 @@ class MovingObstacles(KeepsParameters, OcpRewrite):
         radii = {n: read(o.radius) for n, o in options.obstacles.items()}
         return new, ObstacleData(positions, radii, power)
 
-    def invert(self, result: Result, spec: SpecBase, inverse_data: ObstacleData) -> Result:
+    def invert(self, result: Result, spec: OptimalControlSpec, inverse_data: ObstacleData) -> Result:
         arrays, metrics = dict(result.arrays), dict(result.metrics)
         if result.time is not None:
             params = {symbol(k): v for k, v in result.parameters.items()}
             t = np.asarray(result.time)
-            values = {**params, TIME: t}
+            values: dict[sp.Symbol, np.ndarray | float] = {**params, TIME: t}
             for name, (px, py) in inverse_data.positions.items():
                 xy = evaluate([px, py], values, t.shape)
                 arrays[f"obstacle_{name}_x"], arrays[f"obstacle_{name}_y"] = xy[0], xy[1]
@@ -144,31 +147,33 @@ class RcsData:
     """The integrand of the sensitivity measure (unit weights)."""
 
 
-class Rcs(KeepsParameters, OcpRewrite):
+class Rcs(KeepsParameters[OptimalControlSpec, "RcsData"], OcpRewrite[RcsOptions, "RcsData"]):
     """Relevant constraint sensitivity (eqs. 6.31-6.36), or eq. 6.32 with ``relevant: false``;
     every parameter maps to itself, the target kept for :meth:`restarts` taking the new values."""
 
     name: ClassVar[str] = "rcs"
     plot: ClassVar[str] = "gamespec.rcs.plotting:plot_rcs"
     summary: ClassVar[str] = "gamespec.rcs.report:rcs_summary"
-    options_model: ClassVar[type[RcsOptions]] = RcsOptions
+    options_model = RcsOptions
 
     def apply(
-        self, spec: SpecBase, options: RcsOptions | None = None, upstream: Result | None = None
+        self, spec: OptimalControlSpec, options: RcsOptions | None = None, upstream: Result | None = None
     ) -> tuple[OptimalControlSpec, RcsData]:
         return regularized(spec, options or RcsOptions())
 
-    def parameter_map(self, spec: SpecBase, inverse_data: RcsData) -> tuple[dict[str, float], RcsData]:
+    def parameter_map(
+        self, spec: OptimalControlSpec, inverse_data: RcsData
+    ) -> tuple[dict[str, float], RcsData]:
         values = spec.runtime_parameters()
         return values, replace(inverse_data, target=with_parameter_values(inverse_data.target, values))
 
-    def invert(self, result: Result, spec: SpecBase, inverse_data: RcsData) -> Result:
+    def invert(self, result: Result, spec: OptimalControlSpec, inverse_data: RcsData) -> Result:
         return rcs_report(result, spec, inverse_data)
 
     def analyses(self) -> list[Analysis]:
         return list(ANALYSES)
 
-    def verify(self, result: Result, spec: SpecBase, inverse_data: RcsData) -> str | None:
+    def verify(self, result: Result, spec: OptimalControlSpec, inverse_data: RcsData) -> str | None:
         """The first check of the Result that fails its tolerance (``metrics.checks_passed``; with
         ``cost_state`` an under-resolved risk integral fails ``max_defect_relative``), or None."""
         failed = [name for name, passed in result.metrics.get("checks_passed", {}).items() if not passed]
@@ -177,7 +182,7 @@ class Rcs(KeepsParameters, OcpRewrite):
         value = result.checks.get(failed[0])
         return f"check {failed[0]} failed ({value:.3g})" if value is not None else f"check {failed[0]} failed"
 
-    def restarts(self, spec: SpecBase, inverse_data: RcsData) -> list[Result]:
+    def restarts(self, spec: OptimalControlSpec, inverse_data: RcsData) -> list[Result]:
         """The starting points of ``restarts`` (each a ``guess`` section of the file's problem) on
         the target's mesh, in the file's order."""
         return [starting_point(inverse_data.target, g) for g in inverse_data.options.restarts]
@@ -245,7 +250,7 @@ COST_STATE = "rcs_cost"
 ``q(t0) = 0``, free end, ``q(t_f)`` added to the objective)."""
 
 
-def _chosen(spec: OptimalControlSpec, ocp: SymbolicOcp, options: RcsOptions) -> list:
+def _chosen(spec: OptimalControlSpec, ocp: SymbolicOcp, options: RcsOptions) -> list[Inequality]:
     found = inequalities(ocp)
     if options.constraints is not None:
         indices = {q.index for q in found}

@@ -6,7 +6,8 @@ dotted location and the nearest valid key (see :func:`gamespec.loader.format_val
 
 from __future__ import annotations
 
-from typing import Annotated, Any, ClassVar
+from collections.abc import Mapping
+from typing import Annotated, Any, ClassVar, Protocol, TypeVar
 
 from pydantic import AfterValidator, BaseModel, ConfigDict, Field, FiniteFloat, PrivateAttr, model_validator
 
@@ -65,14 +66,24 @@ class SolverSection(StrictModel):
     )
 
 
+class _ParametersSection(Protocol):
+    @property
+    def parameters(self) -> Mapping[str, float]: ...
+
+
+class _WithParameters(Protocol):
+    @property
+    def problem(self) -> _ParametersSection: ...
+
+
 class ProblemParameters:
     """Mixin of the kinds whose runtime parameters are ``problem.parameters``, addressed by their
     short names (``rho`` for ``problem.parameters.rho``) as well as by the dotted path."""
 
-    def runtime_parameters(self) -> dict[str, float]:
+    def runtime_parameters(self: _WithParameters) -> dict[str, float]:
         return dict(self.problem.parameters)
 
-    def parameter_path(self, name: str) -> str:
+    def parameter_path(self: _WithParameters, name: str) -> str:
         return f"problem.parameters.{name}" if name in self.problem.parameters else name
 
 
@@ -197,3 +208,7 @@ class SpecBase(StrictModel):
                 node = node[int(part)] if isinstance(node, list) else node[part]
             node[int(last) if isinstance(node, list) else last] = None
         return data
+
+
+SpecT = TypeVar("SpecT", bound=SpecBase)
+"""A spec class (a backend's, or what :func:`gamespec.loader.with_values` returns: its argument's)."""

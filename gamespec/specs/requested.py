@@ -11,7 +11,8 @@ dotted field, ``transforms.<i>.<name>.<key>``.
 from __future__ import annotations
 
 import difflib
-from typing import TYPE_CHECKING, Any
+from collections.abc import Iterable, Mapping
+from typing import TYPE_CHECKING, Any, Protocol, runtime_checkable
 
 from pydantic import ValidationError
 
@@ -24,8 +25,34 @@ if TYPE_CHECKING:
 GROUP = "gamespec.transforms"
 
 
-def transform_class(name: str, field: str = "transforms") -> type:
-    """The transform registered as ``name``; a SpecError at ``field`` with the nearest name else."""
+@runtime_checkable
+class ChecksAgainstProblem(Protocol):
+    """Options that are checked against the problem at load (expressions of its parameters)."""
+
+    def check_against(self, parameters: Mapping[str, float], running: Iterable[str], field: str) -> None:
+        """A SpecError at ``field`` when the options do not fit the problem."""
+
+
+class _ProblemSection(Protocol):
+    @property
+    def states(self) -> Mapping[str, Any]: ...
+
+    @property
+    def controls(self) -> Mapping[str, Any]: ...
+
+    def parameter_values(self) -> dict[str, float]: ...
+
+
+@runtime_checkable
+class _WithProblem(Protocol):
+    @property
+    def problem(self) -> _ProblemSection: ...
+
+
+def transform_class(name: str, field: str = "transforms") -> Any:
+    """The transform registered as ``name``; a SpecError at ``field`` with the nearest name else.
+    (A :class:`~gamespec.transforms.base.Transform` subclass: this layer, below the transforms,
+    reads its ``requested``, ``source_kind``, ``target_kind`` and ``options_model`` untyped.)"""
     known = registry.names(GROUP)
     if name not in known:
         near = difflib.get_close_matches(name, known, n=1)
@@ -45,10 +72,11 @@ def entry(item: dict[str, dict[str, Any]], index: int) -> tuple[str, dict[str, A
     return name, options or {}
 
 
-def validated_options(cls: type, name: str, options: dict[str, Any], index: int) -> StrictModel:
+def validated_options(cls: Any, name: str, options: dict[str, Any], index: int) -> StrictModel:
     """``options`` validated by the transform's ``options_model``."""
+    model: type[StrictModel] = cls.options_model
     try:
-        return cls.options_model.model_validate(options)
+        return model.model_validate(options)
     except ValidationError as err:
         errors = err.errors()
         first = next((e for e in errors if e["type"] == "extra_forbidden"), errors[0])
@@ -57,7 +85,7 @@ def validated_options(cls: type, name: str, options: dict[str, Any], index: int)
         if first["type"] == "missing":
             reason = "required option is missing"
         elif first["type"] == "extra_forbidden":
-            keys = list(cls.options_model.model_fields)
+            keys = list(model.model_fields)
             near = difflib.get_close_matches(str(first["loc"][-1]), keys, n=1)
             reason = f"unknown option {first['loc'][-1]!r}" + (
                 f"; did you mean {near[0]!r}?" if near else f" (valid: {', '.join(keys) or 'none'})"
@@ -83,7 +111,7 @@ def check_requested(spec: SpecBase) -> None:
                 field=f"transforms.{index}",
             )
         checked = validated_options(cls, name, options, index)
-        if hasattr(checked, "check_against"):
+        if isinstance(checked, ChecksAgainstProblem) and isinstance(spec, _WithProblem):
             p = spec.problem
             running = [*p.states, *p.controls, "t"]
             checked.check_against(p.parameter_values(), running, f"transforms.{index}.{name}")

@@ -142,6 +142,8 @@ class ProcessExecutor:
                 self.__exit__()
 
     def _run(self, fn: Callable[[T], R], pending: Iterator[T]) -> Iterator[tuple[T, R]]:
+        pool = self._pool
+        assert pool is not None, "imap enters the executor before it runs"
         running: dict[Future[R], T] = {}
         lost: deque[T] = deque()
         restarts = 0
@@ -152,7 +154,7 @@ class ProcessExecutor:
                     if item is _END:
                         break
                     try:
-                        running[self._pool.submit(fn, item)] = item
+                        running[pool.submit(fn, item)] = item
                     except BrokenProcessPool:
                         lost.appendleft(item)
                         raise
@@ -168,8 +170,8 @@ class ProcessExecutor:
                     raise GamespecError(f"local workers died {restarts} times in one run") from None
                 lost.extend(running.values())
                 running = {}
-                self._pool.shutdown(wait=False, cancel_futures=True)
-                self._pool = self._start()
+                pool.shutdown(wait=False, cancel_futures=True)
+                self._pool = pool = self._start()
 
 
 _END: Any = object()
@@ -188,7 +190,8 @@ def executor(
         name = "dask" if scheduler else ("serial" if workers <= 1 else "process")
     if workers < 1:
         raise GamespecError(f"--workers must be at least 1, got {workers}")
-    return registry.load(GROUP, name).from_options(workers, scheduler, insecure)
+    chosen: Executor = registry.load(GROUP, name).from_options(workers, scheduler, insecure)
+    return chosen
 
 
 def ordered_map(runner: Executor) -> Callable[[Callable[[T], R], Sequence[T]], list[R]]:

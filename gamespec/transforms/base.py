@@ -32,6 +32,12 @@ order; then *lowering* transforms, found by kind (:func:`lowering_path`). Transf
 the ``gamespec.transforms`` entry-point group under their ``name``. A transform owns the figures and
 summary rows of what it adds to a Result (``plot``, ``summary``: ``"module:function"`` texts, imported
 when a Result that went through it is plotted or summarized; :func:`gamespec.registry.transform_parts`).
+
+:class:`Transform` is generic in its source spec class, its target spec class, its options model and
+its inverse data (``Transform[EngagementSpec, OptimalControlSpec, NoOptions, EngagementInverse]``),
+so each plugin's ``apply``/``invert``/``verify``/``restarts``/``parameter_map`` are typed with its
+own classes and mypy checks them against the contract; :meth:`Transform.accepts` is the run-time
+check that lets a spec of the chain (a :class:`SpecBase`) in as ``Src``.
 """
 
 from __future__ import annotations
@@ -40,7 +46,7 @@ from abc import ABC, abstractmethod
 from collections import deque
 from collections.abc import Mapping
 from dataclasses import dataclass
-from typing import Any, ClassVar, TypeVar
+from typing import TYPE_CHECKING, Any, ClassVar, Generic, TypeGuard, TypeVar, cast
 
 from pydantic import BaseModel
 
@@ -48,10 +54,13 @@ from gamespec import registry
 from gamespec.analyses import Analysis
 from gamespec.compiling import NoOptions
 from gamespec.result import Result
-from gamespec.specs.base import SpecBase, StrictModel
+from gamespec.specs.base import SpecBase, SpecT, StrictModel
 from gamespec.specs.requested import entry, transform_class, validated_options
 
-SpecT = TypeVar("SpecT", bound=SpecBase)
+if TYPE_CHECKING:
+    # Named by a string in OcpRewrite's base: importing the OCP kind at run time would cost the
+    # solving chain's import 0.1 s, and a lowering chain may never need it.
+    from gamespec.specs.ocp import OptimalControlSpec  # noqa: F401
 
 
 @dataclass(frozen=True)
@@ -63,14 +72,29 @@ class Stage:
     backend: str | None = None
 
 
-class Transform(ABC):
+Src = TypeVar("Src", bound=SpecBase)
+"""The spec class a transform takes (the class of its ``source_kind``)."""
+
+Dst = TypeVar("Dst", bound=SpecBase)
+"""The spec class a transform returns (the class of its ``target_kind``)."""
+
+Options = TypeVar("Options", bound=StrictModel)
+"""The options model of a transform (:class:`~gamespec.compiling.NoOptions` for one that takes none)."""
+
+Inverse = TypeVar("Inverse")
+"""The inverse data :meth:`Transform.apply` returns and the other methods receive."""
+
+
+class Transform(ABC, Generic[Src, Dst, Options, Inverse]):
     """One reduction step (see module doc)."""
 
     name: ClassVar[str]
     source_kind: ClassVar[str]
     target_kind: ClassVar[str]
     requested: ClassVar[bool] = False
-    options_model: ClassVar[type[StrictModel]] = NoOptions
+    options_model: type[Options] = cast("type[Options]", NoOptions)
+    """The model of the options; a transform that takes options sets it to the class it is
+    parameterized with (mypy checks that), one that takes none keeps ``NoOptions``."""
     plot: ClassVar[str | None] = None
     """``"module:function"``: ``plot(result, output_dir) -> list[Path]``, the figures of what this
     transform adds to a Result (None: none)."""
@@ -78,22 +102,22 @@ class Transform(ABC):
     """``"module:function"``: ``summary(result) -> list[(label, value)]``, its rows in ``gamespec
     solve``'s table (None: none)."""
 
-    def accepts(self, spec: SpecBase) -> bool:
-        """Whether this transform applies to ``spec`` (by default: any spec of ``source_kind``)."""
+    def accepts(self, spec: SpecBase) -> TypeGuard[Src]:
+        """Whether this transform applies to ``spec`` (by default: any spec of ``source_kind``,
+        which is of class ``Src``: the registry maps a kind to one spec class). An override returns
+        ``TypeGuard[...]`` of its ``Src`` too, and asks ``super().accepts(spec)`` first."""
         return spec.kind == self.source_kind
 
-    def stage(self, spec: SpecBase, options: StrictModel) -> Stage | None:
+    def stage(self, spec: Src, options: Options) -> Stage | None:
         """The upstream solve :meth:`apply` needs the Result of, or None (the default)."""
         return None
 
     @abstractmethod
-    def apply(
-        self, spec: SpecBase, options: StrictModel, upstream: Result | None = None
-    ) -> tuple[SpecBase, Any]:
+    def apply(self, spec: Src, options: Options, upstream: Result | None = None) -> tuple[Dst, Inverse]:
         """The new spec and the data :meth:`invert` needs; ``upstream`` is the Result of
         :meth:`stage`'s spec when it names one, whatever its status (check ``upstream.ok``)."""
 
-    def invert(self, result: Result, spec: SpecBase, inverse_data: Any) -> Result:
+    def invert(self, result: Result, spec: Src, inverse_data: Inverse) -> Result:
         """Map a Result of the transformed spec back to the original ``spec`` (default: relabel);
         names only, never an analysis (:meth:`analyses`)."""
         return result.model_copy(update={"kind": spec.kind, "problem": spec.name})
@@ -103,27 +127,27 @@ class Transform(ABC):
         inverse data before :meth:`verify`, in this order (the default: none)."""
         return []
 
-    def guess(self, inverse_data: Any) -> Result | None:
+    def guess(self, inverse_data: Inverse) -> Result | None:
         """A starting point of the target spec (a Result in its names) the solving layer passes to
         the compiled model when the caller gives none; None (the default) leaves it to the model."""
         return None
 
-    def verify(self, result: Result, spec: SpecBase, inverse_data: Any) -> str | None:
+    def verify(self, result: Result, spec: Src, inverse_data: Inverse) -> str | None:
         """The first check of the source problem a mapped-back ``result`` fails, or None when it
         passes (the default: nothing to check)."""
         return None
 
-    def restarts(self, spec: SpecBase, inverse_data: Any) -> list[Result]:
+    def restarts(self, spec: Src, inverse_data: Inverse) -> list[Result]:
         """Other starting points of the target spec, best first, to re-solve from when
         :meth:`verify` fails or the solve itself does not succeed (the default: none)."""
         return []
 
-    def unmapped(self, spec: SpecBase) -> frozenset[str]:
+    def unmapped(self, spec: Src) -> frozenset[str]:
         """The runtime parameters of ``spec`` that :meth:`parameter_map` cannot map: a new value of
         one of them makes the solving layer re-apply this transform (the default: all of them)."""
         return frozenset(spec.runtime_parameters())
 
-    def parameter_map(self, spec: SpecBase, inverse_data: Any) -> tuple[dict[str, float], Any]:
+    def parameter_map(self, spec: Src, inverse_data: Inverse) -> tuple[dict[str, float], Inverse]:
         """The target's runtime parameter values and the inverse data for ``spec``, the compiled
         source with new values of runtime parameters outside :meth:`unmapped` (the same structure),
         as :meth:`apply` would give them, but cheaply (cvxpy's ``apply_parameters``).
@@ -143,7 +167,8 @@ def with_parameter_values(spec: SpecT, values: Mapping[str, float]) -> SpecT:
         for part in parents:
             node = node.setdefault(part, {})
         node[last] = _Set(value)
-    return _updated(spec, tree)
+    updated: SpecT = _updated(spec, tree)
+    return updated
 
 
 @dataclass(frozen=True)
@@ -167,8 +192,12 @@ def _updated(node: Any, changes: dict[str, Any] | _Set) -> Any:
     return type(node)(items)
 
 
-def _lowering() -> list[Transform]:
-    found = []
+AnyTransform = Transform[Any, Any, Any, Any]
+"""A transform of the chain, its classes known only at run time (found by name or kind)."""
+
+
+def _lowering() -> list[AnyTransform]:
+    found: list[AnyTransform] = []
     for name in registry.names("gamespec.transforms"):
         cls = registry.load("gamespec.transforms", name)
         if not cls.requested:
@@ -176,9 +205,9 @@ def _lowering() -> list[Transform]:
     return found
 
 
-def requested_steps(spec: SpecBase) -> list[tuple[Transform, StrictModel]]:
+def requested_steps(spec: SpecBase) -> list[tuple[AnyTransform, StrictModel]]:
     """The transforms ``spec``'s ``transforms:`` section asks for, with their validated options."""
-    steps = []
+    steps: list[tuple[AnyTransform, StrictModel]] = []
     for index, item in enumerate(spec.transforms):
         name, options = entry(item, index)
         cls = transform_class(name, field=f"transforms.{index}")
@@ -186,13 +215,13 @@ def requested_steps(spec: SpecBase) -> list[tuple[Transform, StrictModel]]:
     return steps
 
 
-def lowering_path(spec: SpecBase, kinds: frozenset[str]) -> list[Transform] | None:
+def lowering_path(spec: SpecBase, kinds: frozenset[str]) -> list[AnyTransform] | None:
     """The shortest chain of lowering transforms taking ``spec`` to one of ``kinds`` (``[]`` if it
     is one already), its first step one that :meth:`~Transform.accepts` ``spec``; None if none."""
     if spec.kind in kinds:
         return []
     available = _lowering()
-    queue: deque[tuple[str, list[Transform]]] = deque([(spec.kind, [])])
+    queue: deque[tuple[str, list[AnyTransform]]] = deque([(spec.kind, [])])
     seen = {spec.kind}
     while queue:
         kind, path = queue.popleft()
@@ -206,19 +235,20 @@ def lowering_path(spec: SpecBase, kinds: frozenset[str]) -> list[Transform] | No
     return None
 
 
-class KeepsParameters:
+class KeepsParameters(Generic[Src, Inverse]):
     """Mixin of a transform whose target has exactly the source's runtime parameters (what it
     generates keeps them as symbols) and whose inverse data holds no value of theirs: every
-    parameter maps, to itself, and the inverse data stays as it is."""
+    parameter maps, to itself, and the inverse data stays as it is. Parameterized with the
+    transform's ``Src`` and ``Inverse``, so that its methods are the transform's."""
 
-    def unmapped(self, spec: SpecBase) -> frozenset[str]:
+    def unmapped(self, spec: Src) -> frozenset[str]:
         return frozenset()
 
-    def parameter_map(self, spec: SpecBase, inverse_data: Any) -> tuple[dict[str, float], Any]:
+    def parameter_map(self, spec: Src, inverse_data: Inverse) -> tuple[dict[str, float], Inverse]:
         return spec.runtime_parameters(), inverse_data
 
 
-class OcpRewrite(Transform, ABC):
+class OcpRewrite(Transform["OptimalControlSpec", "OptimalControlSpec", Options, Inverse], ABC):
     """A requested ``optimal_control`` → ``optimal_control`` rewrite (chapter 6's desensitization
     and regularizers): applied only when a file's ``transforms:`` list names it."""
 

@@ -23,12 +23,12 @@ from typing import ClassVar
 import numpy as np
 
 from gamespec.analyses import Analysis, Outputs
+from gamespec.compiling import NoOptions
 from gamespec.pursuit.guess import ranked_simulated_headings
 from gamespec.pursuit.ocp_generation import EngagementInverse, heading_guess, remapped, to_ocp
 from gamespec.pursuit.ocp_report import ocp_report, resimulation
 from gamespec.pursuit.verification import verify
 from gamespec.result import Result
-from gamespec.specs.base import StrictModel
 from gamespec.specs.engagement import EngagementSpec
 from gamespec.specs.ocp import OptimalControlSpec
 from gamespec.transforms.base import Transform
@@ -53,7 +53,7 @@ RESIMULATION = Analysis(
 """The engagement's re-simulation; :meth:`EngagementToOcp.verify` reads its checks."""
 
 
-class EngagementToOcp(Transform):
+class EngagementToOcp(Transform[EngagementSpec, OptimalControlSpec, NoOptions, EngagementInverse]):
     """Generate the reduced-state OCP of an engagement (see module doc)."""
 
     name: ClassVar[str] = "engagement_to_ocp"
@@ -61,7 +61,7 @@ class EngagementToOcp(Transform):
     target_kind: ClassVar[str] = "optimal_control"
 
     def apply(
-        self, spec: EngagementSpec, options: StrictModel, upstream: Result | None = None
+        self, spec: EngagementSpec, options: NoOptions, upstream: Result | None = None
     ) -> tuple[OptimalControlSpec, EngagementInverse]:
         return to_ocp(spec)
 

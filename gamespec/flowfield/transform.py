@@ -51,16 +51,6 @@ class FlowGameToCovarianceGame(Transform[FlowGameSpec, FlowCovarianceGameSpec, N
         assert upstream is not None, "a staged transform: the solving layer passes the reachability"
         return covariance_game_spec(spec, upstream), Reached(reachability_key(evaluate(spec)), upstream)
 
-    def parameter_map(
-        self, spec: FlowGameSpec, inverse: Reached
-    ) -> tuple[FlowCovarianceGameSpec, Reached] | None:
-        """The covariance game for ``spec`` (the compiled source with new runtime values) from the
-        kept reachability Result when the values it depends on are unchanged; None when they
-        changed (the reachability stage must be solved again)."""
-        if reachability_key(evaluate(spec)) != inverse.key:
-            return None
-        return self.apply(spec, self.options_model(), inverse.result)
-
     def invert(self, result: Result, spec: FlowGameSpec, inverse_data: Reached) -> Result:
         reach = inverse_data.result
         mapped = flow_game_result(result, reach)

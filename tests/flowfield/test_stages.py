@@ -109,25 +109,6 @@ def test_a_new_noise_re_solves_the_game_without_the_level_sets(counted) -> None:
     assert again.metrics["capture_probability_open_loop"] < first.metrics["capture_probability_open_loop"]
 
 
-def test_parameter_map_reuses_the_stage_only_when_it_cannot_change(counted) -> None:
-    """``parameter_map`` gives the re-applied covariance game from the kept reachability Result for
-    a parameter of the diffusion, and None (solve the stage again) for one of the drift."""
-    data = _spec(parameters={"noise": 0.05, "wind": 0.4})
-    data["problem"]["flow"]["drift"] = ["wind", -0.3]
-    solver = compile_spec(spec_from_dict(data))
-    step = solver.steps[0]
-    noisier = copy.deepcopy(data)
-    noisier["problem"]["parameters"]["noise"] = 0.1
-    target, inverse = step.transform.parameter_map(spec_from_dict(noisier), step.inverse)
-    assert inverse.result is step.inverse.result
-    assert target.structure() == step.target.structure()
-    assert target.problem.parameters == {"noise": 0.1, "wind": 0.4}
-    windier = copy.deepcopy(data)
-    windier["problem"]["parameters"]["wind"] = 0.5
-    assert step.transform.parameter_map(spec_from_dict(windier), step.inverse) is None
-    assert counted == [1, 0]
-
-
 def test_no_capture_is_an_infeasible_result() -> None:
     """Without a capture before ``max_time`` the stage has no nominal paths: the game is not played
     and the Result says why, in the stage's words."""

@@ -18,6 +18,7 @@ import numpy as np
 from gamespec.errors import UnsupportedFeature
 from gamespec.games.feedback import LQGame, best_response_improvements, feedback_nash
 from gamespec.games.lq_structure import LQForm, lq_game
+from gamespec.games.nash_gap import nash_gap
 from gamespec.result import Result, Status
 from gamespec.specs.differential_game import DifferentialGameSpec
 
@@ -46,14 +47,10 @@ def feedback_equilibrium(game: DifferentialGameSpec, form: LQForm, parameters: d
     signs = [1.0 if sense == "minimize" else -1.0 for sense in form.senses]
     payoffs = {p: s * v for p, s, v in zip(form.players, signs, solution.values, strict=True)}
     improvements = dict(zip(form.players, best_response_improvements(data, solution.gain), strict=True))
-    gap = max(improvements.values())
-    tolerance = game.game.tolerance * max(1.0, *(abs(v) for v in payoffs.values()))
-    passed = bool(gap <= tolerance)
+    gap = nash_gap(improvements, payoffs, game.game.tolerance)
     n = len(form.states)
     controls = [c for player in game.problem.players.values() for c in player.controls]
-    message = "the feedback equilibrium of the coupled Riccati equations"
-    if not passed:
-        message += f"; the Nash gap {gap:.3g} exceeds its tolerance {tolerance:.3g}"
+    message = gap.message("the feedback equilibrium of the coupled Riccati equations")
     return Result(
         status=Status.OPTIMAL,
         message=message,
@@ -62,15 +59,8 @@ def feedback_equilibrium(game: DifferentialGameSpec, form: LQForm, parameters: d
         time=solution.times,
         states={s: solution.x[:, i] for i, s in enumerate(form.states)},
         controls={c: solution.u[:, j] for j, c in enumerate(controls)},
-        checks={"saddle_gap": gap},
+        checks={"saddle_gap": gap.gap},
         metrics=base
-        | {
-            "solution_concept": concept,
-            "payoffs": payoffs,
-            "improvements": improvements,
-            "saddle_gap": gap,
-            "checks_passed": {"saddle_gap": passed},
-            "check_tolerances": {"saddle_gap": tolerance},
-            "gains": {c: np.asarray(solution.K[:, j, :n]).tolist() for j, c in enumerate(controls)},
-        },
+        | gap.metrics(concept, payoffs)
+        | {"gains": {c: np.asarray(solution.K[:, j, :n]).tolist() for j, c in enumerate(controls)}},
     )

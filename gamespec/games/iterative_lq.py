@@ -40,6 +40,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from gamespec.errors import UnsupportedFeature
+from gamespec.games.nash_gap import nash_gap
 from gamespec.games.problems import initial_state
 from gamespec.result import Result, Status
 from gamespec.specs.differential_game import DifferentialGameSpec
@@ -365,12 +366,8 @@ def feedback_nash_nonlinear(game: DifferentialGameSpec, parameters: dict[str, fl
         name: float(solution.costs[i] - best_reply(discrete, solution, i))
         for i, name in enumerate(discrete.players)
     }
-    gap = max(improvements.values())
-    tolerance = settings.tolerance * max(1.0, *(abs(v) for v in payoffs.values()))
-    passed = bool(gap <= tolerance)
-    message = "the feedback equilibrium of iterative LQ games"
-    if not passed:
-        message += f"; the Nash gap {gap:.3g} exceeds its tolerance {tolerance:.3g}"
+    gap = nash_gap(improvements, payoffs, settings.tolerance)
+    message = gap.message("the feedback equilibrium of iterative LQ games")
     times = solution.times
     return Result(
         status=Status.OPTIMAL,
@@ -382,16 +379,11 @@ def feedback_nash_nonlinear(game: DifferentialGameSpec, parameters: dict[str, fl
         states={s: solution.x[:, i] for i, s in enumerate(discrete.states)},
         controls={c: solution.u[:, j] for j, c in enumerate(discrete.controls)},
         iterations=solution.iterations,
-        checks={"saddle_gap": gap},
+        checks={"saddle_gap": gap.gap},
         metrics=base
+        | gap.metrics(concept, payoffs)
         | {
-            "solution_concept": concept,
-            "payoffs": payoffs,
-            "improvements": improvements,
-            "saddle_gap": gap,
             "iterative_lq": run,
-            "checks_passed": {"saddle_gap": passed},
-            "check_tolerances": {"saddle_gap": tolerance},
             "gains": {c: solution.P[:, j, :].tolist() for j, c in enumerate(discrete.controls)},
         },
     )

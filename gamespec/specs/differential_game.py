@@ -135,6 +135,12 @@ class GameProblem(StrictModel):
     payoff: PayoffSpec = Field(default_factory=PayoffSpec)
     terminal_constraints: list[str] = Field(default_factory=list)
     time: GameTime = Field(default_factory=GameTime)
+    capture: str | None = Field(
+        None,
+        description="The target set of a game of kind (capture), a relation over the states and "
+        "parameters such as 'x**2 + y**2 <= l**2': the minimizing players reach it, the maximizing "
+        "ones avoid it (read by the hji backend; the best-response schemes ignore it).",
+    )
 
     _values: GameValues = PrivateAttr()
 
@@ -214,6 +220,8 @@ class GameProblem(StrictModel):
         checks += [
             (f"terminal_constraints.{i}", c, ends, True) for i, c in enumerate(self.terminal_constraints)
         ]
+        if self.capture is not None:
+            checks += [("capture", self.capture, list(self.states), True)]
         for values in self.value_sets():
             for field, text, names, constraint in checks:
                 checked_expression(text, names, values, f"problem.{field}", constraint)

@@ -1,0 +1,324 @@
+"""The ``hji`` backend: the capture region of a two-state ``differential_game`` as the zero sublevel set
+of a Hamilton–Jacobi–Isaacs value function on a grid (a game of kind, Isaacs; as hj_reachability's
+backward reachable tube).
+
+With the target ``l(x) ≤ 0`` (the file's ``problem.capture``, ``g ≤ c`` read as ``l = g − c`` and
+``g ≥ c`` as ``l = c − g``), the value ``φ(x, τ) = min_pursuers max_evaders min_{s ≤ τ} l(x(s))``
+solves ``∂φ/∂τ = min(0, H(x, ∇φ))`` from ``φ(x, 0) = l(x)``, with the Isaacs Hamiltonian
+``H(x, p) = min_u max_d p · f(x, u, d)`` (u: the minimizing players' controls, d: the maximizing
+ones'); a node is captured within the horizon T when ``φ(x, T) ≤ 0``. The scheme is the project's
+level-set numerics (:mod:`gamespec.flowfield.upwind`: one-sided derivatives with ghost nodes by
+linear extrapolation; :mod:`gamespec.flowfield.tvd_rk`: TVD-RK3) with a local Lax–Friedrichs flux
+``Ĥ = H(x, (p⁻ + p⁺)/2) + Σ_i α_i (p⁺_i − p⁻_i)/2``, ``α_i ≥ max |f_i|`` over the controls, and the
+reach clamp ``φ ← min(φ, φ_before)`` after each step.
+
+The min and max over the control boxes are taken over samples: a control that enters the dynamics
+affinely (zero second derivative) is sampled at its two bounds (exact: a linear function's optimum
+over an interval is at a bound), any other at ``control_samples`` equally spaced values including the
+bounds (the optimum within the spacing). Where no component of the dynamics mixes a minimizer's and
+a maximizer's control (zero cross derivatives), the min and the max are taken separately (the
+samples add); otherwise over every pair (the samples multiply). The payoff is not used: this is the
+game of kind.
+
+Status: ``optimal`` when the grid-refinement check passes — the captured set's edge on the file's
+grid and on one with half the nodes per axis (the same box, every other node) are on average at most
+``refinement_tolerance`` coarse cells apart (:func:`boundary_shift`,
+``checks.capture_region_refinement``). ``metrics.capture_region`` holds the captured area, its share
+of the grid, and the area captured within half the horizon (equal when the region has stopped
+growing: every capture from it happens within T/2).
+"""
+
+from __future__ import annotations
+
+import itertools
+import math
+from dataclasses import dataclass
+from typing import ClassVar, Literal
+
+import numpy as np
+import sympy as sp
+from pydantic import Field, model_validator
+
+from gamespec.compiling import Backend, CompiledModel, Inputs, refuse_inputs
+from gamespec.errors import SpecError
+from gamespec.flowfield.grid import Grid
+from gamespec.flowfield.scratch import Scratch
+from gamespec.flowfield.tvd_rk import tvd_rk3_step
+from gamespec.flowfield.upwind import GHOSTS, extrapolate_ghosts, upwind_pair
+from gamespec.result import Result, Status
+from gamespec.specs.base import StrictModel
+from gamespec.specs.differential_game import DifferentialGameSpec
+from gamespec.symbolic.calculus import numeric_function
+from gamespec.symbolic.language import parse, parse_relation, symbol
+
+
+class HJIOptions(StrictModel):
+    """The grid, horizon and scheme of the ``hji`` backend (``solver.options.hji``)."""
+
+    lower: tuple[float, float] | None = Field(
+        None, description="The grid's lower corner (default: the states' lower bounds)."
+    )
+    upper: tuple[float, float] | None = Field(
+        None, description="The grid's upper corner (default: the states' upper bounds)."
+    )
+    nodes: int = Field(
+        101,
+        ge=9,
+        le=801,
+        description="Nodes per axis (odd: the refinement check's grid takes every other node).",
+    )
+    horizon: float | None = Field(
+        None, gt=0, description="How long the pursuers have to capture (default: the game's horizon)."
+    )
+    scheme: Literal["first_order", "eno2", "weno5"] = Field("eno2", description="The upwind scheme.")
+    cfl: float = Field(0.5, gt=0, le=1, description="The CFL number of the time step.")
+    control_samples: int = Field(
+        33, ge=3, le=257, description="Samples of a control that does not enter the dynamics affinely."
+    )
+    refinement_tolerance: float = Field(
+        1.0,
+        gt=0,
+        description="How far (in cells of the half-resolution grid) the captured set's edge may move "
+        "between the grid and the half-resolution one.",
+    )
+
+    @model_validator(mode="after")
+    def _ordered(self) -> HJIOptions:
+        if self.nodes % 2 == 0:
+            raise ValueError("nodes must be odd")
+        box = self.lower, self.upper
+        if None not in box and not all(lo < hi for lo, hi in zip(*box, strict=True)):  # type: ignore[arg-type]
+            raise ValueError("every lower corner coordinate must be below the upper one")
+        return self
+
+
+@dataclass(frozen=True)
+class SampledHamiltonian:
+    """The dynamics at every node for each sample of the controls: ``base`` f(x, u₀, d₀) (2, nx, ny);
+    separable: ``pursuer`` f(x, u_k, d₀) − base (K, 2, nx, ny) and ``evader`` f(x, u₀, d_m) − base
+    (M, 2, nx, ny); otherwise ``joint`` f(x, u_k, d_m) − base (K, M, 2, nx, ny). ``speed`` (2, nx, ny)
+    bounds ``|f_i|`` over the samples (the Lax–Friedrichs α)."""
+
+    base: np.ndarray
+    pursuer: np.ndarray | None
+    evader: np.ndarray | None
+    joint: np.ndarray | None
+    speed: np.ndarray
+
+    def __call__(self, p: np.ndarray) -> np.ndarray:
+        """``min_u max_d p · f`` at every node for the costate ``p`` (2, nx, ny)."""
+        value = np.einsum("i...,i...->...", p, self.base)
+        if self.joint is not None:
+            return value + np.einsum("i...,kmi...->km...", p, self.joint).max(axis=1).min(axis=0)
+        assert self.pursuer is not None and self.evader is not None, "a separable game has both"
+        value += np.einsum("i...,ki...->k...", p, self.pursuer).min(axis=0)
+        value += np.einsum("i...,ki...->k...", p, self.evader).max(axis=0)
+        return value
+
+
+def _samples(exprs: list[sp.Expr], names: list[str], bounds: dict[str, tuple[float, float]], n: int):
+    """Every combination of the controls' samples (two bounds for an affine control)."""
+    per = []
+    for name in names:
+        lo, hi = bounds[name]
+        affine = all(sp.diff(e, symbol(name), 2) == 0 for e in exprs)
+        per.append((lo, hi) if affine else tuple(np.linspace(lo, hi, n)))
+    return [dict(zip(names, combo, strict=True)) for combo in itertools.product(*per)]
+
+
+def sampled_hamiltonian(
+    game: DifferentialGameSpec, grid: Grid, samples: int, parameters: dict[str, float]
+) -> SampledHamiltonian:
+    """The dynamics of ``game`` sampled at ``grid``'s nodes over the players' control boxes (module doc)."""
+    p = game.problem
+    states = list(p.states)
+    table = {n: sp.Float(v) for n, v in parameters.items()} | {
+        n: symbol(n) for n in [*states, *(c for pl in p.players.values() for c in pl.controls)]
+    }
+    exprs = [sp.sympify(parse(p.dynamics[s], table)) for s in states]
+    minimizers = [c for pl in p.players.values() if pl.objective == "minimize" for c in pl.controls]
+    maximizers = [c for pl in p.players.values() if pl.objective == "maximize" for c in pl.controls]
+    bounds = {
+        c: (_number(ctl.lower, parameters), _number(ctl.upper, parameters))
+        for pl in p.players.values()
+        for c, ctl in pl.controls.items()
+    }
+    controls = [*minimizers, *maximizers]
+    f = numeric_function(exprs, [symbol(s) for s in states] + [symbol(c) for c in controls])
+    x, y = grid.points[..., 0], grid.points[..., 1]
+
+    def at(u: dict[str, float]) -> np.ndarray:
+        return np.broadcast_to(f(x, y, *(u[c] for c in controls)), (2, *x.shape)).astype(float)
+
+    us, ds = _samples(exprs, minimizers, bounds, samples), _samples(exprs, maximizers, bounds, samples)
+    u0, d0 = us[0], ds[0]
+    base = at(u0 | d0)
+    separable = all(
+        sp.diff(e, symbol(u), symbol(d)) == 0 for e in exprs for u in minimizers for d in maximizers
+    )
+    if separable:
+        pursuer = np.stack([at(u | d0) - base for u in us])
+        evader = np.stack([at(u0 | d) - base for d in ds])
+        speed = np.abs(base) + np.abs(pursuer).max(axis=0) + np.abs(evader).max(axis=0)
+        return SampledHamiltonian(base, pursuer, evader, None, speed)
+    joint = np.stack([np.stack([at(u | d) - base for d in ds]) for u in us])
+    speed = np.abs(joint + base).max(axis=(0, 1))
+    return SampledHamiltonian(base, None, None, joint, speed)
+
+
+def _number(raw: float | str | None, parameters: dict[str, float]) -> float:
+    if raw is None:
+        raise SpecError("the hji backend needs finite bounds on every control", field="problem.players")
+    value = float(sp.sympify(parse(raw, {n: sp.Float(v) for n, v in parameters.items()})))
+    if not math.isfinite(value):
+        raise SpecError("the hji backend needs finite bounds on every control", field="problem.players")
+    return value
+
+
+def target(game: DifferentialGameSpec, grid: Grid, parameters: dict[str, float]) -> np.ndarray:
+    """``l / |∇l|`` at the nodes: negative inside the capture set, the signed distance to its edge to
+    first order there (module doc), so the level set's slope is about one at the front."""
+    p = game.problem
+    assert p.capture is not None, "checked by the backend"
+    table = {n: sp.Float(v) for n, v in parameters.items()} | {s: symbol(s) for s in p.states}
+    rel = parse_relation(p.capture, table)
+    expr, names = sp.sympify(rel.expr), [symbol(s) for s in p.states]
+    if math.isfinite(rel.upper) and not math.isfinite(rel.lower):
+        level = expr - rel.upper
+    elif math.isfinite(rel.lower) and not math.isfinite(rel.upper):
+        level = rel.lower - expr
+    else:
+        raise SpecError("a capture set is one one-sided relation (g <= c or g >= c)", field="problem.capture")
+    gradient = sp.sqrt(sum(sp.diff(level, n) ** 2 for n in names))
+    f = numeric_function([level, gradient], names)
+    values = np.broadcast_to(f(grid.points[..., 0], grid.points[..., 1]), (2, *grid.shape)).astype(float)
+    floor = 1e-3 * float(np.abs(values[1]).max() or 1.0)
+    return values[0] / np.maximum(values[1], floor)
+
+
+def reach_value(
+    hamiltonian: SampledHamiltonian, grid: Grid, initial: np.ndarray, horizon: float, scheme: str, cfl: float
+) -> tuple[np.ndarray, int]:
+    """``φ(·, horizon)`` of ``∂φ/∂τ = min(0, H)`` from ``initial`` (module doc) and the steps taken."""
+    g = GHOSTS
+    nx, ny = grid.shape
+    dx = grid.spacing
+    rate_bound = float((hamiltonian.speed[0] / dx[0] + hamiltonian.speed[1] / dx[1]).max())
+    steps = max(1, math.ceil(horizon * rate_bound / cfl))
+    dt = horizon / steps
+    padded = [np.zeros((nx + 2 * g, ny + 2 * g)) for _ in range(3)]
+    inner = [a[g:-g, g:-g] for a in padded]
+    inner[0][...] = initial
+    scratch = Scratch((nx + 2 * g) * (ny + 2 * g))
+
+    def rate(k: int) -> np.ndarray:
+        extrapolate_ghosts(padded[k])
+        lx, rx = (a.copy() for a in upwind_pair(padded[k][:, g:-g], 0, dx[0], scheme, scratch))
+        ly, ry = (a.copy() for a in upwind_pair(padded[k][g:-g, :], 1, dx[1], scheme, scratch))
+        central = np.stack([(lx + rx) / 2, (ly + ry) / 2])
+        dissipation = hamiltonian.speed[0] * (rx - lx) / 2 + hamiltonian.speed[1] * (ry - ly) / 2
+        return hamiltonian(central) + dissipation
+
+    for _ in range(steps):
+        before = inner[0].copy()
+        tvd_rk3_step(inner[0], inner[1], inner[2], dt, rate)
+        np.minimum(inner[0], before, out=inner[0])
+    return inner[0].copy(), steps
+
+
+class HJIModel(CompiledModel):
+    """A compiled ``hji`` game: re-solved with new parameter values (the samples are recomputed)."""
+
+    def __init__(self, game: DifferentialGameSpec, options: HJIOptions) -> None:
+        self.game, self.options = game, options
+        self.parameters = dict(game.problem.parameters)
+        p = game.problem
+        lower = options.lower or tuple(_number(st.lower, self.parameters) for st in p.states.values())
+        upper = options.upper or tuple(_number(st.upper, self.parameters) for st in p.states.values())
+        self.box = (lower, upper)
+
+    def _region(
+        self, nodes: int, parameters: dict[str, float], horizon: float
+    ) -> tuple[Grid, np.ndarray, np.ndarray, int]:
+        """The grid, ``φ`` at the horizon and at half of it, and the steps taken."""
+        grid = Grid(self.box[0], self.box[1], (nodes, nodes))
+        ham = sampled_hamiltonian(self.game, grid, self.options.control_samples, parameters)
+        start = target(self.game, grid, parameters)
+        half, first = reach_value(ham, grid, start, horizon / 2, self.options.scheme, self.options.cfl)
+        value, second = reach_value(ham, grid, half, horizon / 2, self.options.scheme, self.options.cfl)
+        return grid, value, half, first + second
+
+    def solve(
+        self, parameters: dict[str, float] | None = None, guess: Result | None = None, inputs: Inputs = None
+    ) -> Result:
+        refuse_inputs(inputs, self.game.kind)
+        values = self.parameters | (parameters or {})
+        horizon = self.options.horizon or self.game.problem.evaluate(values).horizon
+        n = self.options.nodes
+        grid, value, half, steps = self._region(n, values, horizon)
+        coarse = self._region((n + 1) // 2, values, horizon)[1]
+        captured = value <= 0
+        shift = boundary_shift(captured, coarse <= 0, grid)
+        cell = float(np.prod(grid.spacing))
+        region = {
+            "area": float(captured.sum()) * cell,
+            "fraction": float(captured.mean()),
+            "area_at_half_horizon": float((half <= 0).sum()) * cell,
+            "horizon": horizon,
+            "nodes": n,
+            "lower": list(grid.lower),
+            "upper": list(grid.upper),
+            "states": list(self.game.problem.states),
+        }
+        tolerance = self.options.refinement_tolerance
+        return Result(
+            status=Status.OPTIMAL,
+            message=f"captured {region['fraction']:.1%} of the grid within T = {horizon:g} "
+            f"({region['area_at_half_horizon'] / max(region['area'], cell):.0%} of it within T/2)",
+            iterations=steps,
+            parameters=values,
+            arrays={"value": value, "grid_x": grid.axes[0], "grid_y": grid.axes[1]},
+            checks={"capture_region_refinement": shift},
+            metrics={
+                "capture_region": region,
+                "solution_concept": "value_function",
+                "information": "feedback",
+                "checks_passed": {"capture_region_refinement": shift <= tolerance},
+                "check_tolerances": {"capture_region_refinement": tolerance},
+            },
+        )
+
+
+def boundary_shift(fine: np.ndarray, coarse: np.ndarray, grid: Grid) -> float:
+    """How far the captured set's edge moves between ``grid`` and the grid of every other node, in
+    units of the coarse spacing: the area where the two disagree (at their common nodes) over the
+    fine set's perimeter (its cell edges between captured and free nodes)."""
+    dx, dy = grid.spacing
+    perimeter = np.sum(fine[1:] != fine[:-1]) * dy + np.sum(fine[:, 1:] != fine[:, :-1]) * dx
+    disagreement = np.sum(fine[::2, ::2] != coarse) * 4 * dx * dy
+    return float(disagreement / max(perimeter, 2 * dx) / (2 * max(dx, dy)))
+
+
+class HJIBackend(Backend[DifferentialGameSpec, HJIOptions]):
+    """The capture region of a two-state ``differential_game`` with a ``problem.capture`` set as the
+    zero sublevel set of its HJI value function on a grid (:mod:`gamespec_levelset.hji`)."""
+
+    name: ClassVar[str] = "hji"
+    kinds: ClassVar[frozenset[str]] = frozenset({"differential_game"})
+    options_model = HJIOptions
+
+    def unsupported(self, spec: object) -> str | None:
+        reason = super().unsupported(spec)  # type: ignore[arg-type]
+        if reason or not isinstance(spec, DifferentialGameSpec):
+            return reason
+        p = spec.problem
+        if len(p.states) != 2:
+            return "the hji backend solves games of two states (reduced coordinates)"
+        if p.capture is None:
+            return "the hji backend needs problem.capture (the target set)"
+        if spec.receding_horizon is not None:
+            return "the hji backend computes a value function, not a receding-horizon run"
+        return None
+
+    def _compile(self, spec: DifferentialGameSpec, options: HJIOptions) -> HJIModel:
+        return HJIModel(spec, options)

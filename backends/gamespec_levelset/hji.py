@@ -97,7 +97,7 @@ class SampledHamiltonian:
     """The dynamics at every node for each sample of the controls: ``base`` f(x, u₀, d₀) (2, nx, ny);
     separable: ``pursuer`` f(x, u_k, d₀) − base (K, 2, nx, ny) and ``evader`` f(x, u₀, d_m) − base
     (M, 2, nx, ny); otherwise ``joint`` f(x, u_k, d_m) − base (K, M, 2, nx, ny). ``speed`` (2, nx, ny)
-    bounds ``|f_i|`` over the samples (the Lax–Friedrichs α)."""
+    is ``max |f_i|`` over the samples (the Lax–Friedrichs α)."""
 
     base: np.ndarray
     pursuer: np.ndarray | None
@@ -159,7 +159,8 @@ def sampled_hamiltonian(
     if separable:
         pursuer = np.stack([at(u | d0) - base for u in us])
         evader = np.stack([at(u0 | d) - base for d in ds])
-        speed = np.abs(base) + np.abs(pursuer).max(axis=0) + np.abs(evader).max(axis=0)
+        highest = base + pursuer.max(axis=0) + evader.max(axis=0)
+        speed = np.maximum(highest, -(base + pursuer.min(axis=0) + evader.min(axis=0)))
         return SampledHamiltonian(base, pursuer, evader, None, speed)
     joint = np.stack([np.stack([at(u | d) - base for d in ds]) for u in us])
     speed = np.abs(joint + base).max(axis=(0, 1))

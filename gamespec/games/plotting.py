@@ -1,6 +1,7 @@
 """Figures of ``differential_game`` Results (Figs. 7.1–7.2): the players' paths, the obstacle where it
 truly is (filled) and where the pursuer believes it is (dashed), its initial position (dotted), and
-each step's look-ahead trajectories (green); with ``animate`` a GIF of the run, step by step.
+each step's look-ahead trajectories (green); with ``animate`` a GIF of the run, step by step. A
+value function (the ``hji`` backend) is drawn by :mod:`gamespec.games.capture_plot`.
 
 A receding-horizon Result names its position states in ``metrics.figure``; any other Result (an
 open-loop game) gets the ``optimal_control`` plots of its trajectories.
@@ -91,6 +92,10 @@ def _summary(result: Result) -> str:
 
 def plot_game(result: Result, output_dir: Path, *, animate: bool = False) -> list[Path]:
     """The figures of the module doc; the paths of the files written."""
+    if "value" in result.arrays:
+        from gamespec.games.capture_plot import plot_capture_region
+
+        return plot_capture_region(result, output_dir)
     if "figure" not in result.metrics:
         return plot_trajectories(result, output_dir, animate=animate)
     plt = _pyplot()

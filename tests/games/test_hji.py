@@ -103,3 +103,30 @@ def test_capture_field_is_checked(tmp_path):
     file.write_text(CHAUFFEUR.read_text().replace("x**2 + y**2 <= l**2", "x**2 + z <= l"))
     with pytest.raises(Exception, match="capture"):
         load(file)
+
+
+@pytest.mark.slow
+def test_the_switch_over_l_is_at_the_barrier_within_the_grid():
+    """On [−2, 2]² with 81 nodes (spacing 0.05) and T = 6: every ℓ whose captured set stops growing
+    lies below every ℓ whose set keeps growing, and Isaacs' threshold is within one spacing of the
+    switch."""
+    spacing = 0.05
+    model = compile_spec(
+        load(
+            CHAUFFEUR,
+            [
+                "problem.time.final=6.0",
+                "solver.options.hji.nodes=81",
+                "solver.options.hji.lower=[-2,-2]",
+                "solver.options.hji.upper=[2,2]",
+            ],
+        )
+    )
+    growing = {}
+    for ell in np.arange(0.20, 0.345, 0.02):
+        region = model.solve({"l": float(ell)}).metrics["capture_region"]
+        growing[float(ell)] = region["area"] > region["area_at_half_horizon"]
+    stops = [ell for ell, grows in growing.items() if not grows]
+    grows = [ell for ell, grows in growing.items() if grows]
+    assert stops and grows and max(stops) < min(grows), growing
+    assert max(stops) - spacing <= BARRIER <= min(grows) + spacing, growing

@@ -10,7 +10,9 @@ ones'); a node is captured within the horizon T when ``φ(x, T) ≤ 0``. The sch
 level-set numerics (:mod:`gamespec.flowfield.upwind`: one-sided derivatives with ghost nodes by
 linear extrapolation; :mod:`gamespec.flowfield.tvd_rk`: TVD-RK3) with a local Lax–Friedrichs flux
 ``Ĥ = H(x, (p⁻ + p⁺)/2) + Σ_i α_i (p⁺_i − p⁻_i)/2``, ``α_i ≥ max |f_i|`` over the controls, and the
-reach clamp ``φ ← min(φ, φ_before)`` after each step.
+reach clamp ``φ ← min(φ, φ_before)`` after each step. The ghost nodes extrapolate linearly, so what
+lies outside the box is guessed: the box must hold the manoeuvres that capture (a region too small
+for them stops growing early).
 
 The min and max over the control boxes are taken over samples: a control that enters the dynamics
 affinely (zero second derivative) is sampled at its two bounds (exact: a linear function's optimum
@@ -33,7 +35,7 @@ from __future__ import annotations
 import itertools
 import math
 from dataclasses import dataclass
-from typing import ClassVar, Literal
+from typing import Any, ClassVar, Literal
 
 import numpy as np
 import sympy as sp
@@ -107,22 +109,25 @@ class SampledHamiltonian:
 
     def __call__(self, p: np.ndarray) -> np.ndarray:
         """``min_u max_d p · f`` at every node for the costate ``p`` (2, nx, ny)."""
-        value = np.einsum("i...,i...->...", p, self.base)
+        value: np.ndarray = np.einsum("i...,i...->...", p, self.base)
         if self.joint is not None:
-            return value + np.einsum("i...,kmi...->km...", p, self.joint).max(axis=1).min(axis=0)
+            value += np.einsum("i...,kmi...->km...", p, self.joint).max(axis=1).min(axis=0)
+            return value
         assert self.pursuer is not None and self.evader is not None, "a separable game has both"
         value += np.einsum("i...,ki...->k...", p, self.pursuer).min(axis=0)
         value += np.einsum("i...,ki...->k...", p, self.evader).max(axis=0)
         return value
 
 
-def _samples(exprs: list[sp.Expr], names: list[str], bounds: dict[str, tuple[float, float]], n: int):
+def _samples(
+    exprs: list[sp.Expr], names: list[str], bounds: dict[str, tuple[float, float]], n: int
+) -> list[dict[str, float]]:
     """Every combination of the controls' samples (two bounds for an affine control)."""
-    per = []
+    per: list[tuple[float, ...]] = []
     for name in names:
         lo, hi = bounds[name]
         affine = all(sp.diff(e, symbol(name), 2) == 0 for e in exprs)
-        per.append((lo, hi) if affine else tuple(np.linspace(lo, hi, n)))
+        per.append((lo, hi) if affine else tuple(float(v) for v in np.linspace(lo, hi, n)))
     return [dict(zip(names, combo, strict=True)) for combo in itertools.product(*per)]
 
 
@@ -167,12 +172,20 @@ def sampled_hamiltonian(
     return SampledHamiltonian(base, None, None, joint, speed)
 
 
-def _number(raw: float | str | None, parameters: dict[str, float]) -> float:
-    if raw is None:
-        raise SpecError("the hji backend needs finite bounds on every control", field="problem.players")
-    value = float(sp.sympify(parse(raw, {n: sp.Float(v) for n, v in parameters.items()})))
+def _number(
+    raw: float | str | None,
+    parameters: dict[str, float],
+    field: str = "problem.players",
+    what: str = "finite bounds on every control",
+) -> float:
+    """The finite number ``raw`` stands for; a SpecError naming ``field`` when there is none."""
+    value = (
+        math.inf
+        if raw is None
+        else float(sp.sympify(parse(raw, {n: sp.Float(v) for n, v in parameters.items()})))
+    )
     if not math.isfinite(value):
-        raise SpecError("the hji backend needs finite bounds on every control", field="problem.players")
+        raise SpecError(f"the hji backend needs {what}", field=field)
     return value
 
 
@@ -194,7 +207,8 @@ def target(game: DifferentialGameSpec, grid: Grid, parameters: dict[str, float])
     f = numeric_function([level, gradient], names)
     values = np.broadcast_to(f(grid.points[..., 0], grid.points[..., 1]), (2, *grid.shape)).astype(float)
     floor = 1e-3 * float(np.abs(values[1]).max() or 1.0)
-    return values[0] / np.maximum(values[1], floor)
+    distance: np.ndarray = values[0] / np.maximum(values[1], floor)
+    return distance
 
 
 def reach_value(
@@ -218,7 +232,8 @@ def reach_value(
         ly, ry = (a.copy() for a in upwind_pair(padded[k][g:-g, :], 1, dx[1], scheme, scratch))
         central = np.stack([(lx + rx) / 2, (ly + ry) / 2])
         dissipation = hamiltonian.speed[0] * (rx - lx) / 2 + hamiltonian.speed[1] * (ry - ly) / 2
-        return hamiltonian(central) + dissipation
+        total: np.ndarray = hamiltonian(central) + dissipation
+        return total
 
     for _ in range(steps):
         before = inner[0].copy()
@@ -234,9 +249,18 @@ class HJIModel(CompiledModel):
         self.game, self.options = game, options
         self.parameters = dict(game.problem.parameters)
         p = game.problem
-        lower = options.lower or tuple(_number(st.lower, self.parameters) for st in p.states.values())
-        upper = options.upper or tuple(_number(st.upper, self.parameters) for st in p.states.values())
-        self.box = (lower, upper)
+
+        def corner(end: Literal["lower", "upper"]) -> tuple[float, float]:
+            given = getattr(options, end)
+            if given is not None:
+                return given  # type: ignore[no-any-return]
+            what = "finite state bounds or solver.options.hji.lower and upper"
+            x, y = (
+                _number(getattr(st, end), self.parameters, "problem.states", what) for st in p.states.values()
+            )
+            return x, y
+
+        self.box = (corner("lower"), corner("upper"))
 
     def _region(
         self, nodes: int, parameters: dict[str, float], horizon: float
@@ -261,7 +285,7 @@ class HJIModel(CompiledModel):
         captured = value <= 0
         shift = boundary_shift(captured, coarse <= 0, grid)
         cell = float(np.prod(grid.spacing))
-        region = {
+        region: dict[str, Any] = {
             "area": float(captured.sum()) * cell,
             "fraction": float(captured.mean()),
             "area_at_half_horizon": float((half <= 0).sum()) * cell,

@@ -341,6 +341,11 @@ class HJIBackend(Backend[DifferentialGameSpec, HJIOptions]):
             return "the hji backend solves games of two states (reduced coordinates)"
         if p.capture is None:
             return "the hji backend needs problem.capture (the target set)"
+        names = [*p.parameters, *p.uncertain, *p.states, "t"]
+        names += [c for pl in p.players.values() for c in pl.controls]
+        table = {n: symbol(n) for n in names}
+        if any(symbol("t") in sp.sympify(parse(text, table)).free_symbols for text in p.dynamics.values()):
+            return "the hji backend solves autonomous games (dynamics free of t)"
         if spec.receding_horizon is not None:
             return "the hji backend computes a value function, not a receding-horizon run"
         return None

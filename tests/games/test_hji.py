@@ -130,3 +130,13 @@ def test_the_switch_over_l_is_at_the_barrier_within_the_grid():
     grows = [ell for ell, grows in growing.items() if grows]
     assert stops and grows and max(stops) < min(grows), growing
     assert max(stops) - spacing <= BARRIER <= min(grows) + spacing, growing
+
+
+def test_games_it_cannot_solve_are_refused_with_the_reason(tmp_path):
+    from gamespec_levelset.hji import HJIBackend
+
+    five_states = load(PROBLEMS / "ch7" / "homicidal_chauffeur.yaml")
+    assert "two states" in HJIBackend().unsupported(five_states)
+    file = tmp_path / "timed.yaml"
+    file.write_text(CHAUFFEUR.read_text().replace("- w + gamma*w*cos(psi)", "- w*(1 + t) + gamma*w*cos(psi)"))
+    assert "autonomous" in HJIBackend().unsupported(load(file))

@@ -184,13 +184,16 @@ class MinimaxPursuerStep(_PlayerProblem):
     def respond(self, evader: Strategy) -> tuple[Strategy | None, StepReport]:
         import cvxpy as cp
 
-        if all(_distance(evader, e) > self.distinct for e in self.support):
+        added = all(_distance(evader, e) > self.distinct for e in self.support)
+        if added:
             self.support.append(evader)
         t = cp.Variable()
         bounds = self._payoff_constraints(t)
         problem = cp.Problem(cp.Minimize(t + self.proximal), [*self.constraints, *bounds])
         status = self.run(problem)
         if not status.ok:
+            if added:  # the support stays the one its weights belong to
+                self.support.pop()
             return None, StepReport(status, f"pursuer step: solver reported {problem.status}")
         step = 1 if self.game.payoff == "trace" else 2
         duals = np.array([float(np.sum(c.dual_value)) for c in bounds[::step]])

@@ -5,7 +5,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from gamespec.plotting import headline
+from gamespec.plotting import LEGEND_RIGHT, headline
 from gamespec.result import Result
 
 
@@ -29,7 +29,7 @@ def plot_capture_region(result: Result, output_dir: Path) -> list[Path]:
     ax.set_ylim(y[0], y[-1])
     ax.set_aspect("equal")
     ax.grid(alpha=0.3)
-    ax.legend(loc="upper right", fontsize="small")
+    ax.legend(**LEGEND_RIGHT)
     ax.set_title(f"{headline(result)}\ncaptured area {region['area']:.4g}", fontsize="medium")
     path = output_dir / "capture_region.png"
     fig.savefig(path, dpi=120, bbox_inches="tight")

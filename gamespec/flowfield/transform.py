@@ -10,32 +10,16 @@ game's, in the ``flow_field_game``'s names. The numerics stay in :mod:`gamespec.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
-from typing import Any, ClassVar
+from typing import ClassVar
 
 from gamespec.compiling import NoOptions
-from gamespec.flowfield.problem import evaluate
 from gamespec.flowfield.spec import FlowCovarianceGameSpec, FlowGameSpec
-from gamespec.flowfield.stages import (
-    covariance_game_spec,
-    flow_game_result,
-    reachability_key,
-    reachability_spec,
-)
+from gamespec.flowfield.stages import covariance_game_spec, flow_game_result, reachability_spec
 from gamespec.result import Result
 from gamespec.transforms.base import Stage, Transform
 
 
-@dataclass(frozen=True)
-class Reached:
-    """The inverse data: the reachability Result and the values it was computed for
-    (:func:`~gamespec.flowfield.stages.reachability_key`)."""
-
-    key: tuple[Any, ...]
-    result: Result
-
-
-class FlowGameToCovarianceGame(Transform[FlowGameSpec, FlowCovarianceGameSpec, NoOptions, Reached]):
+class FlowGameToCovarianceGame(Transform[FlowGameSpec, FlowCovarianceGameSpec, NoOptions, Result]):
     """A flow-field game as its covariance game about the nominal paths of its reachability stage."""
 
     name: ClassVar[str] = "flow_game_to_covariance_game"
@@ -47,11 +31,11 @@ class FlowGameToCovarianceGame(Transform[FlowGameSpec, FlowCovarianceGameSpec, N
 
     def apply(
         self, spec: FlowGameSpec, options: NoOptions, upstream: Result | None = None
-    ) -> tuple[FlowCovarianceGameSpec, Reached]:
+    ) -> tuple[FlowCovarianceGameSpec, Result]:
         assert upstream is not None, "a staged transform: the solving layer passes the reachability"
-        return covariance_game_spec(spec, upstream), Reached(reachability_key(evaluate(spec)), upstream)
+        return covariance_game_spec(spec, upstream), upstream
 
-    def invert(self, result: Result, spec: FlowGameSpec, inverse_data: Reached) -> Result:
-        reach = inverse_data.result
+    def invert(self, result: Result, spec: FlowGameSpec, inverse_data: Result) -> Result:
+        reach = inverse_data
         mapped = flow_game_result(result, reach)
         return mapped.model_copy(update={"kind": spec.kind, "problem": spec.name, "t_final": reach.t_final})

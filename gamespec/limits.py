@@ -37,6 +37,9 @@ MAX_INTERVALS = 10_000
 """Most intervals of a grid: collocation intervals of an ``optimal_control`` transcription (and of the
 OCP an ``engagement`` becomes), steps of an ``lq_stochastic_game`` horizon."""
 
+MAX_VECTOR_SIZE = 1_000
+"""Most components of one vector state or control (``size:``)."""
+
 MAX_SIMULATION_VALUES = 2_000_000
 """Most positions a ``pursuit_scenario`` simulation records: time steps (``horizon / time_step``)
 times players."""

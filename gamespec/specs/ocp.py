@@ -25,6 +25,7 @@ from gamespec.registry import Kind
 from gamespec.specs.base import Number, ProblemParameters, SpecBase, StrictModel, Value
 from gamespec.specs.plot import PlotHint
 from gamespec.specs.uncertainty import UncertainParameter
+from gamespec.specs.vectors import lower_problem
 from gamespec.symbolic.canonical import check
 from gamespec.symbolic.grammar import (
     FLOATS,
@@ -42,7 +43,9 @@ NORMALIZED_TIME = "tau"
 
 
 class StateSpec(StrictModel):
-    """One state: its bounds and its initial/final values (``None`` means free)."""
+    """One state: its bounds and its initial/final values (``None`` means free). A vector state
+    (``size: N``, values as lists of N or one value for all) is lowered at load to its components
+    ``NAME__0 ...`` (:mod:`gamespec.specs.vectors`)."""
 
     initial: Value | None = None
     final: Value | None = None
@@ -54,7 +57,8 @@ class StateSpec(StrictModel):
 
 
 class ControlSpec(StrictModel):
-    """One control: its bounds."""
+    """One control: its bounds. A vector control (``size: N``, bounds as lists of N or one value for
+    all) is lowered at load to its components ``NAME__0 ...`` (:mod:`gamespec.specs.vectors`)."""
 
     lower: Value | None = None
     upper: Value | None = None
@@ -620,6 +624,20 @@ class OptimalControlSpec(OcpFamily, SpecBase):
     plot: PlotHint = Field(default_factory=PlotHint)
 
     guess_fields = ("guess", "problem.time.guess")
+
+    @model_validator(mode="before")
+    @classmethod
+    def _lower_vectors(cls, data: object) -> object:
+        """Vector states and controls as their components (:mod:`gamespec.specs.vectors`)."""
+        if not isinstance(data, dict) or not isinstance(data.get("problem"), dict):
+            return data
+        problem, guess = lower_problem(data["problem"])
+        if problem is data["problem"]:
+            return data
+        lowered = {**data, "problem": problem}
+        if isinstance(data.get("guess"), dict):
+            lowered["guess"] = guess(data["guess"], "guess")
+        return lowered
 
     @model_validator(mode="after")
     def _guess_names(self) -> OptimalControlSpec:

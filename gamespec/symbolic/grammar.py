@@ -89,6 +89,20 @@ class Algebra(Protocol):
         """``value`` as a float when it is a number (no symbols), else None."""
 
 
+class VectorAlgebra(Algebra, Protocol):
+    """An :class:`Algebra` with vectors (:mod:`gamespec.symbolic.vectors`): it also builds
+    ``v[i]``, the list ``[a, b, c]`` and its own functions (``dot``, ``cross``, ``norm``)."""
+
+    functions: Mapping[str, int]
+    """The algebra's own functions and their arities, beside :data:`FUNCTION_ARITY`."""
+
+    def index(self, value: Any, i: int) -> Any:
+        """Component ``i`` of the vector ``value``."""
+
+    def vector(self, items: list[Any]) -> Any:
+        """The vector of ``items``."""
+
+
 def _checked(value: float) -> float:
     """``value`` when it is a real number within :data:`~gamespec.limits.MAX_MAGNITUDE`."""
     if math.isnan(value):
@@ -271,16 +285,52 @@ class _Walker:
             return self.call(node)
         if isinstance(node, ast.Compare):
             raise self.fail(node, "comparisons are only allowed in constraints")
+        if isinstance(node, ast.Attribute):
+            return self.dotted(node)
+        if isinstance(node, ast.Subscript | ast.List):
+            return self.structured(node)
         raise self.fail(node, f"{type(node).__name__} is not allowed")
+
+    def dotted(self, node: ast.Attribute) -> Any:
+        """A dotted name (``phases.ascent.x_f``) declared as a whole in the symbols."""
+        parts: list[str] = []
+        part: ast.expr = node
+        while isinstance(part, ast.Attribute):
+            parts.append(part.attr)
+            part = part.value
+        if not isinstance(part, ast.Name):
+            raise self.fail(node, "only dotted names are allowed (phases.NAME.x_f)")
+        name = ".".join([part.id, *reversed(parts)])
+        if name not in self.symbols:
+            raise self.fail(node, f"undefined symbol {name!r}")
+        return self.symbols[name]
+
+    def structured(self, node: ast.Subscript | ast.List) -> Any:
+        """``v[i]`` (``i`` an integer literal) or ``[a, b, c]``: only where the algebra has vectors
+        (vector states and controls, ``size:``)."""
+        algebra = self.algebra
+        if not hasattr(algebra, "index"):
+            what = "indexing" if isinstance(node, ast.Subscript) else "a list"
+            raise self.fail(node, f"{what} is only allowed over vector states and controls (size: N)")
+        if isinstance(node, ast.List):
+            return self.apply(node, algebra.vector, [self(e) for e in node.elts])
+        index = node.slice
+        negative = isinstance(index, ast.UnaryOp) and isinstance(index.op, ast.USub)
+        literal = index.operand if isinstance(index, ast.UnaryOp) and negative else index
+        if not (isinstance(literal, ast.Constant) and type(literal.value) is int):
+            raise self.fail(node, "an index must be an integer literal (r[0])")
+        i = -literal.value if negative else literal.value
+        return self.apply(node, algebra.index, self(node.value), i)
 
     def call(self, node: ast.Call) -> Any:
         if not isinstance(node.func, ast.Name):
             raise self.fail(node, "only calls of the whitelisted functions by name are allowed")
-        if node.func.id not in FUNCTION_ARITY:
+        arities = {**FUNCTION_ARITY, **getattr(self.algebra, "functions", {})}
+        if node.func.id not in arities:
             raise self.fail(node, f"unknown function {node.func.id!r}")
         if node.keywords:
             raise self.fail(node, "keyword arguments are not allowed")
-        arity = FUNCTION_ARITY[node.func.id]
+        arity = arities[node.func.id]
         if len(node.args) != arity:
             raise self.fail(node, f"{node.func.id} takes {arity} argument(s), got {len(node.args)}")
         return self.apply(node, self.algebra.call, node.func.id, [self(a) for a in node.args])

@@ -1,0 +1,284 @@
+"""Vector states and controls of an ``optimal_control`` file, lowered to their components at load.
+
+A state or control with ``size: N`` (``r: {size: 3, initial: [1, 0, 0]}``) stands for ``N``
+scalar components ``r__0 ... r__{N-1}``; every expression of the file is read in the vector
+language of :mod:`gamespec.symbolic.vectors` (``r[0]``, ``dot(r, v)``, ``cross(r, v)``,
+``norm(r)``, ``-mu*r/norm(r)**3``, ``[a, b, c]``) and written back as the scalar expressions of the
+components through SymPy's printer, so that everything after loading (the checks at load, every
+backend, the Result's arrays) sees an ordinary scalar problem and the vector problem equals its
+scalar form by construction:
+
+- ``initial``, ``final``, ``lower``, ``upper``, ``scale`` and a guess are a list of ``N`` values or
+  one value for every component (an expression may give a vector: ``initial: "[r0, 0, 0]"``);
+- the dynamics of a vector state is a vector expression of its size (or a list of ``N``);
+- a definition may be a vector (``g: -mu*r/norm(r)**3``: definitions ``g__0 ... g__2``);
+- end values are vectors too (``r_f``, ``v_0``: ``norm(r_f) == 1``), and a vector constraint is one
+  constraint per component (``r_f == [1, 0, 0]``, ``-1 <= u <= 1``); a chained one becomes two
+  one-sided constraints.
+
+A file without ``size:`` is returned unchanged (its expressions are not re-printed).
+"""
+
+from __future__ import annotations
+
+import ast
+import copy
+import math
+from collections.abc import Callable, Mapping
+from typing import Any
+
+import sympy as sp
+
+from gamespec.errors import ExpressionError, SpecError
+from gamespec.limits import MAX_VECTOR_SIZE
+from gamespec.symbolic.grammar import Relation, syntax_tree
+from gamespec.symbolic.language import symbol
+from gamespec.symbolic.printer import to_text
+from gamespec.symbolic.vectors import Vector, is_vector, parse_vector, parse_vector_relation
+
+COMPONENT = "__"
+"""Joins a vector's name and a component's index (``r__0``)."""
+
+
+def component(name: str, i: int) -> str:
+    """The scalar name of component ``i`` of vector ``name``."""
+    return f"{name}{COMPONENT}{i}"
+
+
+def _sizes(group: Mapping[str, Any], where: str) -> dict[str, int]:
+    sizes = {}
+    for name, spec in group.items():
+        if isinstance(spec, Mapping) and spec.get("size") is not None:
+            n = spec["size"]
+            if type(n) is not int or not 1 <= n <= MAX_VECTOR_SIZE:
+                raise SpecError(f"size must be an integer from 1 to {MAX_VECTOR_SIZE}", field=f"{where}.{name}.size")
+            sizes[name] = n
+    return sizes
+
+
+def _vector(name: str, n: int, suffix: str = "") -> Vector:
+    return Vector([symbol(component(name, i) + suffix) for i in range(n)])
+
+
+class _Lowering:
+    """The vector reading of one problem (module doc); each method's ``where`` is the field of the
+    value it reads, named by a SpecError."""
+
+    def __init__(self, problem: Mapping[str, Any], sizes: dict[str, int]) -> None:
+        self.sizes = sizes
+        scalars = [
+            *problem.get("parameters", {}),
+            *problem.get("design", {}),
+            *problem.get("inputs", {}),
+            *(n for n in problem.get("states", {}) if n not in sizes),
+            *(n for n in problem.get("controls", {}) if n not in sizes),
+        ]
+        self.params = {n: symbol(n) for n in [*problem.get("parameters", {}), *problem.get("design", {})]}
+        self.running: dict[str, Any] = {n: symbol(n) for n in [*scalars, "t"]}
+        self.running |= {n: _vector(n, k) for n, k in sizes.items()}
+        variables = [*problem.get("states", {}), *problem.get("controls", {})]
+        self.ends: dict[str, Any] = dict(self.params) | {"t_f": symbol("t_f")}
+        for name in variables:
+            for end in ("_0", "_f"):
+                k = sizes.get(name)
+                self.ends[name + end] = symbol(name + end) if k is None else _vector(name, k, end)
+        self.timed = self.params | {"t": symbol("t"), "tau": symbol("tau")}
+        self.inputs = set(problem.get("inputs", {}))
+        self.scalar_variables = [
+            m for n in variables for m in ([n] if n not in sizes else [component(n, i) for i in range(sizes[n])])
+        ]
+
+    def fail(self, err: ExpressionError, where: str) -> SpecError:
+        return SpecError(str(err), field=where)
+
+    def value(self, text: Any, symbols: Mapping[str, Any], where: str) -> Any:
+        """``text`` read over ``symbols``: a SymPy scalar or vector."""
+        try:
+            return parse_vector(text, symbols)
+        except ExpressionError as err:
+            raise self.fail(err, where) from None
+
+    def scalar(self, text: Any, symbols: Mapping[str, Any], where: str) -> Any:
+        """``text`` as the language's text of a scalar (numbers stay numbers)."""
+        if not isinstance(text, str):
+            return text
+        value = self.value(text, symbols, where)
+        if is_vector(value):
+            raise SpecError("is a vector where a scalar is needed", field=where)
+        return to_text(value)
+
+    def components(self, raw: Any, n: int, symbols: Mapping[str, Any], where: str) -> list[Any]:
+        """``n`` component values of ``raw``: a list of ``n``, a vector expression of size ``n``, or
+        one value for every component (a number, ``linear``, a scalar expression)."""
+        if isinstance(raw, list):
+            if len(raw) != n:
+                raise SpecError(f"has {len(raw)} values for a vector of size {n}", field=where)
+            return [self.scalar(v, symbols, f"{where}.{i}") for i, v in enumerate(raw)]
+        if not isinstance(raw, str) or raw == "linear":
+            return [raw] * n
+        value = self.value(raw, symbols, where)
+        if not is_vector(value):
+            return [to_text(value)] * n
+        if value.shape[0] != n:
+            raise SpecError(f"is a vector of size {value.shape[0]}, not {n}", field=where)
+        return [to_text(c) for c in value]
+
+    def relations(self, text: str, symbols: Mapping[str, Any], where: str) -> list[str]:
+        """The scalar constraints of ``text`` (module doc)."""
+        try:
+            found = parse_vector_relation(text, symbols)
+        except ExpressionError as err:
+            raise self.fail(err, where) from None
+        return [t for r in found for t in _relation_texts(r)]
+
+    def variables(self, group: dict[str, Any], keys: tuple[str, ...], where: str) -> dict[str, Any]:
+        """``group`` (states or controls) with each vector replaced by its components."""
+        lowered: dict[str, Any] = {}
+        for name, spec in group.items():
+            n = self.sizes.get(name)
+            if n is None:
+                lowered[name] = spec
+                continue
+            spec = {k: v for k, v in spec.items() if k != "size"}
+            values = {
+                k: self.components(v, n, self.timed, f"{where}.{name}.{k}")
+                for k, v in spec.items()
+                if k in keys
+            }
+            other = {k: v for k, v in spec.items() if k not in keys}
+            for i in range(n):
+                lowered[component(name, i)] = other | {k: v[i] for k, v in values.items()}
+        return lowered
+
+    def definitions(self, raw: Mapping[str, Any], where: str, start: float) -> dict[str, Any]:
+        """Each definition as text, a vector one as one definition per component; the running
+        symbols then know each definition (a vector one as the vector of its components), and the
+        end symbols its values at the ends (``h_0``, ``h_f``: the definition over the states and
+        controls at ``t_0 = start`` and ``t_f``, eq. (end-point definitions) of GPOPS-II's events)."""
+        lowered: dict[str, Any] = {}
+        inlined = dict(self.running)
+        for name, text in raw.items():
+            inlined[name] = self.value(text, inlined, f"{where}.{name}")
+            self._at_ends(name, inlined[name], start)
+            value = self.value(text, self.running, f"{where}.{name}")
+            if is_vector(value):
+                n = value.shape[0]
+                lowered |= {component(name, i): to_text(c) for i, c in enumerate(value)}
+                self.running[name] = _vector(name, n)
+            else:
+                lowered[name] = to_text(value) if isinstance(text, str) else text
+                self.running[name] = symbol(name)
+        return lowered
+
+    def _at_ends(self, name: str, value: Any, start: float) -> None:
+        """``name_0`` and ``name_f`` among the end symbols: ``value`` (a definition with the earlier
+        ones substituted) over the end values at ``t_0 = start`` and ``t_f``; none for a definition
+        of grid inputs, which have no end values."""
+        if {str(s) for s in sp.sympify(value).free_symbols} & self.inputs:
+            return
+        for end, time in (("_0", _number(start)), ("_f", symbol("t_f"))):
+            mapping = {symbol(v): symbol(v + end) for v in self.scalar_variables} | {symbol("t"): time}
+            self.ends[name + end] = value.xreplace(mapping)
+
+    def dynamics(self, raw: Mapping[str, Any], where: str) -> dict[str, Any]:
+        lowered: dict[str, Any] = {}
+        for name, text in raw.items():
+            n = self.sizes.get(name)
+            if n is None:
+                lowered[name] = self.scalar(text, self.running, f"{where}.{name}")
+                continue
+            values = self.components(text, n, self.running, f"{where}.{name}")
+            lowered |= {component(name, i): v for i, v in enumerate(values)}
+        return lowered
+
+
+def _uses_end_definitions(problem: Mapping[str, Any]) -> bool:
+    """Whether the Mayer term or a boundary constraint names a definition at an end (``h_f``)."""
+    definitions = problem.get("definitions")
+    if not isinstance(definitions, Mapping) or not definitions:
+        return False
+    wanted = {f"{d}{end}" for d in definitions for end in ("_0", "_f")}
+    objective = problem.get("objective")
+    texts = [objective.get("mayer") if isinstance(objective, Mapping) else None]
+    boundary = problem.get("boundary_constraints")
+    texts += list(boundary) if isinstance(boundary, list) else []
+    for text in texts:
+        if isinstance(text, str):
+            try:
+                tree = syntax_tree(text)
+            except ExpressionError:
+                continue
+            if any(isinstance(n, ast.Name) and n.id in wanted for n in ast.walk(tree)):
+                return True
+    return False
+
+
+def _relation_texts(found: Relation) -> list[str]:
+    """``lower <= expr <= upper`` as the language's constraints (a chain as two one-sided ones)."""
+    expr, lo, hi = found.expr, found.lower, found.upper
+    if lo == hi:
+        return [to_text(sp.Eq(expr, sp.Float(lo) if lo != int(lo) else sp.Integer(int(lo)), evaluate=False))]
+    texts = []
+    if math.isfinite(lo):
+        texts.append(to_text(sp.Ge(expr, _number(lo), evaluate=False)))
+    if math.isfinite(hi):
+        texts.append(to_text(sp.Le(expr, _number(hi), evaluate=False)))
+    return texts
+
+
+def _number(value: float) -> sp.Expr:
+    return sp.Integer(int(value)) if value == int(value) else sp.Float(value)
+
+
+def lower_problem(
+    problem: dict[str, Any], field: str = "problem"
+) -> tuple[dict[str, Any], Callable[[dict[str, Any], str], dict[str, Any]]]:
+    """``problem`` (an ``optimal_control`` problem mapping) with its vectors lowered (module doc),
+    and the lowering of a guess mapping (``states``/``controls`` values) of the same problem."""
+    sizes = _sizes(problem.get("states", {}), f"{field}.states") | _sizes(
+        problem.get("controls", {}), f"{field}.controls"
+    )
+    if not sizes and not _uses_end_definitions(problem):
+        return problem, lambda guess, where: guess
+    low = _Lowering(problem, sizes)
+    out = copy.copy(problem)
+    ends = ("initial", "final", "lower", "upper", "scale")
+    out["states"] = low.variables(problem["states"], ends, f"{field}.states")
+    if "controls" in problem:
+        out["controls"] = low.variables(problem["controls"], ("lower", "upper", "scale"), f"{field}.controls")
+    start = (problem.get("time") or {}).get("initial", 0.0)
+    start = float(start) if isinstance(start, int | float) and not isinstance(start, bool) else 0.0
+    out["definitions"] = low.definitions(problem.get("definitions", {}), f"{field}.definitions", start)
+    if "dynamics" in problem:
+        out["dynamics"] = low.dynamics(problem["dynamics"], f"{field}.dynamics")
+    if "objective" in problem:
+        objective = dict(problem["objective"])
+        for key, symbols in (("mayer", low.ends), ("lagrange", low.running)):
+            if key in objective:
+                objective[key] = low.scalar(objective[key], symbols, f"{field}.objective.{key}")
+        out["objective"] = objective
+    for key, symbols in (("path_constraints", low.running), ("boundary_constraints", low.ends)):
+        if key in problem:
+            out[key] = [
+                text
+                for i, c in enumerate(problem[key])
+                for text in low.relations(c, symbols, f"{field}.{key}.{i}")
+            ]
+    if "integral_constraints" in problem:
+        out["integral_constraints"] = [
+            {**c, "integrand": low.scalar(c.get("integrand"), low.running, f"{field}.integral_constraints.{i}.integrand")}
+            for i, c in enumerate(problem["integral_constraints"])
+        ]
+
+    def guess(raw: dict[str, Any], where: str) -> dict[str, Any]:
+        lowered = dict(raw)
+        for group in ("states", "controls"):
+            values = dict(raw.get(group, {}))
+            for name in [n for n in values if n in sizes]:
+                parts = low.components(values.pop(name), sizes[name], low.timed, f"{where}.{group}.{name}")
+                values |= {component(name, i): v for i, v in enumerate(parts)}
+            if group in raw:
+                lowered[group] = values
+        return lowered
+
+    return out, guess

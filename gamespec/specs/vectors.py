@@ -51,7 +51,9 @@ def _sizes(group: Mapping[str, Any], where: str) -> dict[str, int]:
         if isinstance(spec, Mapping) and spec.get("size") is not None:
             n = spec["size"]
             if type(n) is not int or not 1 <= n <= MAX_VECTOR_SIZE:
-                raise SpecError(f"size must be an integer from 1 to {MAX_VECTOR_SIZE}", field=f"{where}.{name}.size")
+                raise SpecError(
+                    f"size must be an integer from 1 to {MAX_VECTOR_SIZE}", field=f"{where}.{name}.size"
+                )
             sizes[name] = n
     return sizes
 
@@ -85,7 +87,9 @@ class _Lowering:
         self.timed = self.params | {"t": symbol("t"), "tau": symbol("tau")}
         self.inputs = set(problem.get("inputs", {}))
         self.scalar_variables = [
-            m for n in variables for m in ([n] if n not in sizes else [component(n, i) for i in range(sizes[n])])
+            m
+            for n in variables
+            for m in ([n] if n not in sizes else [component(n, i) for i in range(sizes[n])])
         ]
 
     def fail(self, err: ExpressionError, where: str) -> SpecError:
@@ -266,7 +270,12 @@ def lower_problem(
             ]
     if "integral_constraints" in problem:
         out["integral_constraints"] = [
-            {**c, "integrand": low.scalar(c.get("integrand"), low.running, f"{field}.integral_constraints.{i}.integrand")}
+            {
+                **c,
+                "integrand": low.scalar(
+                    c.get("integrand"), low.running, f"{field}.integral_constraints.{i}.integrand"
+                ),
+            }
             for i, c in enumerate(problem["integral_constraints"])
         ]
 

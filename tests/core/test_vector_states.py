@@ -27,7 +27,10 @@ def test_a_planar_double_integrator_meets_its_closed_form() -> None:
     d, T = np.array([1.0, -0.5]), 2.0
     result = _solved(
         {
-            "states": {"r": {"size": 2, "initial": 0, "final": list(d)}, "v": {"size": 2, "initial": 0, "final": 0}},
+            "states": {
+                "r": {"size": 2, "initial": 0, "final": list(d)},
+                "v": {"size": 2, "initial": 0, "final": 0},
+            },
             "controls": {"u": {"size": 2}},
             "dynamics": {"r": "v", "v": "u"},
             "objective": {"lagrange": "dot(u, u)"},
@@ -93,7 +96,9 @@ def test_a_vector_problem_equals_its_scalar_form() -> None:
 
 
 def test_a_vector_constraint_is_one_per_component() -> None:
-    spec = _spec({**VECTOR, "boundary_constraints": ["r_f == [0, 1, 0]"], "path_constraints": ["-1 <= u <= 1"]})
+    spec = _spec(
+        {**VECTOR, "boundary_constraints": ["r_f == [0, 1, 0]"], "path_constraints": ["-1 <= u <= 1"]}
+    )
     assert spec.problem.boundary_constraints == ["r__0_f == 0", "r__1_f - 1 == 0", "r__2_f == 0"]
     assert len(spec.problem.path_constraints) == 6
 
@@ -101,7 +106,11 @@ def test_a_vector_constraint_is_one_per_component() -> None:
 @pytest.mark.parametrize(
     ("change", "field", "reason"),
     [
-        ({"states": {**VECTOR["states"], "r": {"size": 3, "initial": [1, 0]}}}, "problem.states.r.initial", "2 values"),
+        (
+            {"states": {**VECTOR["states"], "r": {"size": 3, "initial": [1, 0]}}},
+            "problem.states.r.initial",
+            "2 values",
+        ),
         ({"dynamics": {**VECTOR["dynamics"], "v": "sin(v)"}}, "problem.dynamics.v", "takes scalars"),
         ({"dynamics": {**VECTOR["dynamics"], "v": "r*v"}}, "problem.dynamics.v", "dot\\(a, b\\)"),
         ({"dynamics": {**VECTOR["dynamics"], "omega": "[0, 0]"}}, "problem.dynamics.omega", "size 2, not 3"),

@@ -37,8 +37,8 @@ from pydantic import ValidationError
 
 from gamespec.errors import ExpressionError, SpecError
 from gamespec.specs.ocp import NORMALIZED_TIME, OptimalControlSpec, is_time_varying, parameter_values
-from gamespec.symbolic.language import TIME, Relation, parse, parse_relation, symbol
-from gamespec.symbolic.printer import to_text
+from gamespec.symbolic.language import TIME, parse, parse_relation, symbol
+from gamespec.symbolic.printer import relation_texts, to_text
 from gamespec.symbolic.translate import numeric
 
 if TYPE_CHECKING:
@@ -125,16 +125,13 @@ def _read(
         raise SpecError(f"{err}{where}", field=f"problem.{field}", source=source) from None
 
 
-def relation_texts(rel: Relation) -> list[str]:
-    """``rel`` as constraints of the file language: one equation, or one or two inequalities."""
-    if rel.is_equality:
-        return [to_text(sp.Eq(rel.expr - rel.lower, 0, evaluate=False))]
-    found = []
-    if math.isfinite(rel.lower):
-        found.append(to_text(sp.Ge(rel.expr, rel.lower, evaluate=False)))
-    if math.isfinite(rel.upper):
-        found.append(to_text(sp.Le(rel.expr, rel.upper, evaluate=False)))
-    return found
+def _phase_copies(pieces: list[Piece]) -> dict[str, tuple[str | None, str]]:
+    """Per state and control of a phase, its copy in the first piece (None for a control the first
+    piece lacks) and in the last: where the phase starts and ends."""
+    first, last = pieces[0], pieces[-1]
+    return {
+        n: (first.states.get(n, first.controls.get(n)), c) for n, c in (last.states | last.controls).items()
+    }
 
 
 def _merged(shared: Any, own: Any) -> dict[str, Any]:
@@ -192,6 +189,15 @@ class _Lowerer:
             if last is not None:
                 found[f"{name}_f"] = symbol(f"{last}_f")
         return found | {"t_0": t_first, "t_f": t_last}
+
+    def linked_ends(self, lowered: list[LoweredPhase]) -> dict[str, sp.Expr]:
+        """Every phase's end symbols by name (``phases.<phase>.x_f``, ``phases.<phase>.t_0``; the
+        module doc), for the problem's Mayer term and boundary constraints that link phases."""
+        found = {}
+        for k, phase in enumerate(lowered):
+            own = self.ends(_phase_copies(phase.pieces), self.starts[k], self.starts[k + 1])
+            found |= {f"phases.{phase.name}.{n}": v for n, v in own.items() if n not in self.constants}
+        return found
 
     def grid(self) -> tuple[int, list[int]]:
         """The common number of intervals and each phase's number of pieces: ``method.intervals``
@@ -258,11 +264,7 @@ class _Lowerer:
                     for x in p.states:
                         start, end = symbol(f"{piece.states[x]}_0"), symbol(f"{pieces[j - 1].states[x]}_f")
                         parts.boundary.append(to_text(sp.Eq(start - end, 0, evaluate=False)))
-            copies = {
-                n: (pieces[0].states.get(n, pieces[0].controls.get(n)), c)
-                for n, c in (pieces[-1].states | pieces[-1].controls).items()
-            }
-            ends = self.ends(copies, self.starts[k], self.starts[k + 1])
+            ends = self.ends(_phase_copies(pieces), self.starts[k], self.starts[k + 1])
             for i, text in enumerate(ph.boundary_constraints):
                 rel = _read(text, ends, f"phases.{k}.boundary_constraints.{i}", self.source, relation=True)
                 timed |= self.timed(rel.expr)
@@ -287,6 +289,7 @@ class _Lowerer:
         }
         ends = self.ends(names, self.starts[0], self.starts[-1])
         ends.pop("t_0")
+        ends |= self.linked_ends(lowered)
         mayer = _read(p.objective.mayer, ends, "objective.mayer", self.source)
         for i, text in enumerate(p.boundary_constraints):
             rel = _read(text, ends, f"boundary_constraints.{i}", self.source, relation=True)

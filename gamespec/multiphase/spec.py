@@ -9,8 +9,11 @@ replace or add to the shared dynamics and definitions, and give the start of its
 expressions of the previous phase's end (``jump``: ``{m: m_f - m_stage}``, a staged rocket's mass
 drop; a state not named there is continuous). The Mayer term and ``boundary_constraints`` use
 ``<state>_0`` (start of the first phase), ``<state>_f`` (end of the last), ``<control>_0``,
-``<control>_f`` and ``t_f``; a phase's own ``boundary_constraints`` use the same names at its own
-start and end, and ``t_0``, ``t_f`` for its start and end times.
+``<control>_f`` and ``t_f``, and link any two phases by name: ``phases.<phase>.<state>_0``,
+``phases.<phase>.<state>_f`` (and controls, ``phases.<phase>.t_0``, ``phases.<phase>.t_f``: that
+phase's start and end; ``phases.coast.h_f == phases.ascent.h_f + 10``); a phase's own
+``boundary_constraints`` use the same names at its own start and end, and ``t_0``, ``t_f`` for its
+start and end times. A definition may be given in some phases only (each phase's own).
 
 The kind is lowered to one ``optimal_control`` problem by the ``phases`` transform
 (:mod:`gamespec.multiphase.lowering` says how); loading a file lowers it once, so every
@@ -40,6 +43,7 @@ from gamespec.specs.ocp import (
     StateSpec,
 )
 from gamespec.specs.plot import PlotHint
+from gamespec.specs.vectors import lower_problem
 from gamespec.symbolic.language import RESERVED
 
 
@@ -138,11 +142,15 @@ class MultiPhaseProblem(StrictModel):
 
     @model_validator(mode="after")
     def _names(self) -> MultiPhaseProblem:
+        """Names are identifiers, without the phases' separator ``__`` (a vector's component
+        ``r__0``, :mod:`gamespec.specs.vectors`, has it before its index only), and not used twice."""
         names = [*self.parameters, *self.states, *self.controls, *self.design, *self.definitions]
-        names += [n for ph in self.phases for n in ph.definitions if n not in self.definitions]
+        names += sorted({n for ph in self.phases for n in ph.definitions if n not in self.definitions})
         phases = [ph.name for ph in self.phases]
         for name in names + phases:
-            if not name.isidentifier() or name in RESERVED or name == NORMALIZED_TIME or SEPARATOR in name:
+            base, _, index = name.rpartition(SEPARATOR)
+            plain = base if index.isdigit() and name not in phases else name
+            if not name.isidentifier() or name in RESERVED or name == NORMALIZED_TIME or SEPARATOR in plain:
                 raise ValueError(
                     f"{name!r} cannot be a name (reserved, not an identifier, or has {SEPARATOR})"
                 )
@@ -184,6 +192,15 @@ class MultiPhaseSpec(OcpFamily, SpecBase):
     problem: MultiPhaseProblem
     method: MethodSpec = Field(default_factory=MethodSpec)
     plot: PlotHint = Field(default_factory=PlotHint)
+
+    @model_validator(mode="before")
+    @classmethod
+    def _lower_vectors(cls, data: object) -> object:
+        """Vector states and controls as their components (:mod:`gamespec.specs.vectors`)."""
+        if not isinstance(data, dict) or not isinstance(data.get("problem"), dict):
+            return data
+        problem, _ = lower_problem(data["problem"], phases=True)
+        return data if problem is data["problem"] else {**data, "problem": problem}
 
     @model_validator(mode="after")
     def _lowers(self) -> MultiPhaseSpec:

@@ -23,7 +23,6 @@ from __future__ import annotations
 
 import ast
 import copy
-import math
 from collections.abc import Callable, Mapping
 from typing import Any
 
@@ -31,9 +30,9 @@ import sympy as sp
 
 from gamespec.errors import ExpressionError, SpecError
 from gamespec.limits import MAX_VECTOR_SIZE
-from gamespec.symbolic.grammar import Relation, syntax_tree
+from gamespec.symbolic.grammar import syntax_tree
 from gamespec.symbolic.language import symbol
-from gamespec.symbolic.printer import to_text
+from gamespec.symbolic.printer import relation_texts, to_text
 from gamespec.symbolic.vectors import Vector, is_vector, parse_vector, parse_vector_relation
 
 COMPONENT = "__"
@@ -133,7 +132,7 @@ class _Lowering:
             found = parse_vector_relation(text, symbols)
         except ExpressionError as err:
             raise self.fail(err, where) from None
-        return [t for r in found for t in _relation_texts(r)]
+        return [t for r in found for t in relation_texts(r)]
 
     def variables(self, group: dict[str, Any], keys: tuple[str, ...], where: str) -> dict[str, Any]:
         """``group`` (states or controls) with each vector replaced by its components."""
@@ -184,14 +183,100 @@ class _Lowering:
             mapping = {symbol(v): symbol(v + end) for v in self.scalar_variables} | {symbol("t"): time}
             self.ends[name + end] = value.xreplace(mapping)
 
-    def dynamics(self, raw: Mapping[str, Any], where: str) -> dict[str, Any]:
+    def link_phases(self, names: list[Any]) -> None:
+        """The end symbols of each phase by name (``phases.ascent.r_f``, a vector for a vector)."""
+        for phase in (n for n in names if isinstance(n, str)):
+            linked = {f"phases.{phase}.{n}": v for n, v in self.ends.items() if n not in self.params}
+            for name, value in list(linked.items()):
+                prefix = name.rsplit(".", 1)[0]
+                if is_vector(value):
+                    linked[name] = Vector([symbol(f"{prefix}.{c}") for c in value])
+                else:
+                    linked[name] = symbol(name)
+            self.ends |= linked | {f"phases.{phase}.t_0": symbol(f"phases.{phase}.t_0")}
+
+    def sections(self, raw: Mapping[str, Any], field: str, start: float) -> dict[str, Any]:
+        """The sections of a problem (or of a phase) that hold variables and expressions, lowered."""
+        out = dict(raw)
+        keys = ("initial", "final", "lower", "upper", "scale")
+        if isinstance(raw.get("states"), Mapping):
+            out["states"] = self.variables(raw["states"], keys, f"{field}.states")
+        if isinstance(raw.get("controls"), Mapping):
+            out["controls"] = self.variables(
+                raw["controls"], ("lower", "upper", "scale"), f"{field}.controls"
+            )
+        if "definitions" in raw:
+            out["definitions"] = self.definitions(raw["definitions"], f"{field}.definitions", start)
+        if "dynamics" in raw:
+            out["dynamics"] = self.dynamics(raw["dynamics"], f"{field}.dynamics")
+        if isinstance(raw.get("objective"), Mapping):
+            objective = dict(raw["objective"])
+            for key, symbols in (("mayer", self.ends), ("lagrange", self.running)):
+                if key in objective:
+                    objective[key] = self.scalar(objective[key], symbols, f"{field}.objective.{key}")
+            out["objective"] = objective
+        if "lagrange" in raw:
+            out["lagrange"] = self.scalar(raw["lagrange"], self.running, f"{field}.lagrange")
+        for key, symbols in (("path_constraints", self.running), ("boundary_constraints", self.ends)):
+            if isinstance(raw.get(key), list):
+                out[key] = [
+                    text
+                    for i, c in enumerate(raw[key])
+                    for text in self.relations(c, symbols, f"{field}.{key}.{i}")
+                ]
+        if isinstance(raw.get("integral_constraints"), list):
+            out["integral_constraints"] = [
+                {
+                    **c,
+                    "integrand": self.scalar(
+                        c.get("integrand"), self.running, f"{field}.integral_constraints.{i}.integrand"
+                    ),
+                }
+                for i, c in enumerate(raw["integral_constraints"])
+            ]
+        if isinstance(raw.get("jump"), Mapping):
+            out["jump"] = self.dynamics(raw["jump"], f"{field}.jump", self.ends)
+        if isinstance(raw.get("guess"), Mapping):
+            out["guess"] = self.guess(raw["guess"], f"{field}.guess")
+        return out
+
+    def phase(self, raw: Any, field: str) -> Any:
+        """One phase of a multi-phase problem, lowered with its own definitions."""
+        if not isinstance(raw, Mapping):
+            return raw
+        own = copy.copy(self)
+        own.running = dict(self.running)
+        own.ends = self.ends | {"t_0": symbol("t_0")}
+        return own.sections(raw, field, 0.0)
+
+    def guess(self, raw: dict[str, Any], where: str) -> dict[str, Any]:
+        """A guess's ``states`` and ``controls`` with each vector's value given per component."""
+        lowered = dict(raw)
+        for group in ("states", "controls"):
+            if not isinstance(raw.get(group), Mapping):
+                continue
+            values = dict(raw[group])
+            for name in [n for n in values if n in self.sizes]:
+                parts = self.components(
+                    values.pop(name), self.sizes[name], self.timed, f"{where}.{group}.{name}"
+                )
+                values |= {component(name, i): v for i, v in enumerate(parts)}
+            lowered[group] = values
+        return lowered
+
+    def dynamics(
+        self, raw: Mapping[str, Any], where: str, symbols: Mapping[str, Any] | None = None
+    ) -> dict[str, Any]:
+        """Per state, its equation over the running symbols (or ``symbols``: a jump over the
+        previous phase's end), a vector state's as one per component."""
+        symbols = self.running if symbols is None else symbols
         lowered: dict[str, Any] = {}
         for name, text in raw.items():
             n = self.sizes.get(name)
             if n is None:
-                lowered[name] = self.scalar(text, self.running, f"{where}.{name}")
+                lowered[name] = self.scalar(text, symbols, f"{where}.{name}")
                 continue
-            values = self.components(text, n, self.running, f"{where}.{name}")
+            values = self.components(text, n, symbols, f"{where}.{name}")
             lowered |= {component(name, i): v for i, v in enumerate(values)}
         return lowered
 
@@ -217,77 +302,28 @@ def _uses_end_definitions(problem: Mapping[str, Any]) -> bool:
     return False
 
 
-def _relation_texts(found: Relation) -> list[str]:
-    """``lower <= expr <= upper`` as the language's constraints (a chain as two one-sided ones)."""
-    expr, lo, hi = found.expr, found.lower, found.upper
-    if lo == hi:
-        return [to_text(sp.Eq(expr, sp.Float(lo) if lo != int(lo) else sp.Integer(int(lo)), evaluate=False))]
-    texts = []
-    if math.isfinite(lo):
-        texts.append(to_text(sp.Ge(expr, _number(lo), evaluate=False)))
-    if math.isfinite(hi):
-        texts.append(to_text(sp.Le(expr, _number(hi), evaluate=False)))
-    return texts
-
-
 def _number(value: float) -> sp.Expr:
     return sp.Integer(int(value)) if value == int(value) else sp.Float(value)
 
 
 def lower_problem(
-    problem: dict[str, Any], field: str = "problem"
+    problem: dict[str, Any], field: str = "problem", *, phases: bool = False
 ) -> tuple[dict[str, Any], Callable[[dict[str, Any], str], dict[str, Any]]]:
-    """``problem`` (an ``optimal_control`` problem mapping) with its vectors lowered (module doc),
-    and the lowering of a guess mapping (``states``/``controls`` values) of the same problem."""
+    """``problem`` (an ``optimal_control`` problem mapping, or a ``multiphase_optimal_control``
+    one when ``phases``) with its vectors lowered (module doc), and the lowering of a guess mapping
+    (``states``/``controls`` values) of the same problem. The definitions at the ends are for a
+    single phase (a phase may replace a definition, so that its end value would be ambiguous)."""
     sizes = _sizes(problem.get("states", {}), f"{field}.states") | _sizes(
         problem.get("controls", {}), f"{field}.controls"
     )
-    if not sizes and not _uses_end_definitions(problem):
+    if not sizes and (phases or not _uses_end_definitions(problem)):
         return problem, lambda guess, where: guess
     low = _Lowering(problem, sizes)
-    out = copy.copy(problem)
-    ends = ("initial", "final", "lower", "upper", "scale")
-    out["states"] = low.variables(problem["states"], ends, f"{field}.states")
-    if "controls" in problem:
-        out["controls"] = low.variables(problem["controls"], ("lower", "upper", "scale"), f"{field}.controls")
+    if phases:
+        low.link_phases([ph.get("name") for ph in problem.get("phases", []) if isinstance(ph, Mapping)])
     start = (problem.get("time") or {}).get("initial", 0.0)
     start = float(start) if isinstance(start, int | float) and not isinstance(start, bool) else 0.0
-    out["definitions"] = low.definitions(problem.get("definitions", {}), f"{field}.definitions", start)
-    if "dynamics" in problem:
-        out["dynamics"] = low.dynamics(problem["dynamics"], f"{field}.dynamics")
-    if "objective" in problem:
-        objective = dict(problem["objective"])
-        for key, symbols in (("mayer", low.ends), ("lagrange", low.running)):
-            if key in objective:
-                objective[key] = low.scalar(objective[key], symbols, f"{field}.objective.{key}")
-        out["objective"] = objective
-    for key, symbols in (("path_constraints", low.running), ("boundary_constraints", low.ends)):
-        if key in problem:
-            out[key] = [
-                text
-                for i, c in enumerate(problem[key])
-                for text in low.relations(c, symbols, f"{field}.{key}.{i}")
-            ]
-    if "integral_constraints" in problem:
-        out["integral_constraints"] = [
-            {
-                **c,
-                "integrand": low.scalar(
-                    c.get("integrand"), low.running, f"{field}.integral_constraints.{i}.integrand"
-                ),
-            }
-            for i, c in enumerate(problem["integral_constraints"])
-        ]
-
-    def guess(raw: dict[str, Any], where: str) -> dict[str, Any]:
-        lowered = dict(raw)
-        for group in ("states", "controls"):
-            values = dict(raw.get(group, {}))
-            for name in [n for n in values if n in sizes]:
-                parts = low.components(values.pop(name), sizes[name], low.timed, f"{where}.{group}.{name}")
-                values |= {component(name, i): v for i, v in enumerate(parts)}
-            if group in raw:
-                lowered[group] = values
-        return lowered
-
-    return out, guess
+    out = low.sections(problem, field, start)
+    if phases and isinstance(problem.get("phases"), list):
+        out["phases"] = [low.phase(ph, f"{field}.phases.{k}") for k, ph in enumerate(problem["phases"])]
+    return out, low.guess

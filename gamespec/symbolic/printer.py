@@ -25,6 +25,7 @@ from sympy.printing.precedence import PRECEDENCE
 from sympy.printing.str import StrPrinter
 
 from gamespec.errors import ExpressionError
+from gamespec.symbolic.grammar import Relation
 from gamespec.symbolic.language import CONSTANTS, FUNCTIONS
 
 _FUNCTION_NAMES: dict[type, str] = {
@@ -62,8 +63,14 @@ class LanguagePrinter(StrPrinter):
         return super()._print(expr, **kwargs)
 
     def _print_Symbol(self, expr: sp.Symbol) -> str:
+        """A name, or a dotted name (``phases.ascent.x_f``, a multi-phase link)."""
         name = expr.name
-        if not name.isidentifier() or keyword.iskeyword(name) or name in FUNCTIONS or name in CONSTANTS:
+        parts = name.split(".")
+        if (
+            not all(p.isidentifier() and not keyword.iskeyword(p) for p in parts)
+            or parts[0] in FUNCTIONS
+            or parts[0] in CONSTANTS
+        ):
             raise self.fail(f"symbol name {name!r} cannot be written in the language")
         return name
 
@@ -145,3 +152,15 @@ def to_text(expr: sp.Basic) -> str:
     if type(expr) in _RELATIONS:
         return f"{printer.doprint(expr.lhs)} {_RELATIONS[type(expr)]} {printer.doprint(expr.rhs)}"
     return printer.doprint(expr)
+
+
+def relation_texts(rel: Relation) -> list[str]:
+    """``rel`` as constraints of the file language: one equation, or one or two inequalities."""
+    if rel.is_equality:
+        return [to_text(sp.Eq(rel.expr - rel.lower, 0, evaluate=False))]
+    found = []
+    if math.isfinite(rel.lower):
+        found.append(to_text(sp.Ge(rel.expr, rel.lower, evaluate=False)))
+    if math.isfinite(rel.upper):
+        found.append(to_text(sp.Le(rel.expr, rel.upper, evaluate=False)))
+    return found

@@ -338,3 +338,52 @@ def test_phases_with_their_own_intervals_match_the_single_phase_mesh(backend: st
     assert abs(uniform.objective - one.objective) > 1e2 * abs(two.objective - one.objective)
     assert np.bincount(two.arrays["phase"]).tolist() == [2 * 3 + 1, 6 * 3 + 1]
     assert two.states["x"] == pytest.approx(np.interp(two.time, one.time, one.states["x"]), abs=1e-7)
+
+
+def _three_phases(**extra: object) -> dict:
+    data = _two_phases((1.0, 1.0), 4)
+    data["problem"]["phases"].insert(1, {"name": "middle", "duration": 1.0, "intervals": 2})
+    data["problem"]["phases"][0]["intervals"] = 4
+    data["problem"]["phases"][2]["intervals"] = 4
+    data["problem"].update(extra)
+    return data
+
+
+def test_phases_are_linked_by_name_as_by_their_own_constraints() -> None:
+    """``phases.<phase>.x_f`` in the problem's boundary constraints (issue 25, item 3): the
+    distance covered in the middle phase written over the first phase's end and the last one's
+    start equals the middle phase's own ``x_f - x_0 == 0.3``; the link holds in the solution."""
+    linked = _three_phases(boundary_constraints=["phases.last_one.x_0 - phases.first.x_f == 0.3"])
+    linked["problem"]["phases"][2]["name"] = "last_one"
+    own = _three_phases()
+    own["problem"]["phases"][1]["boundary_constraints"] = ["x_f - x_0 == 0.3"]
+    one, two = gamespec.solve(spec_from_dict(linked)), gamespec.solve(spec_from_dict(own))
+    assert one.ok and two.ok
+    assert one.objective == pytest.approx(two.objective, rel=1e-9)
+    phase = one.arrays["phase"]
+    x = one.states["x"]
+    assert x[phase == 2][0] - x[phase == 0][-1] == pytest.approx(0.3, abs=1e-8)
+    assert one.objective > 12.0 / 3.0**3 * (1 + 1e-3)
+
+
+def test_a_phase_link_names_a_declared_phase() -> None:
+    data = _three_phases(boundary_constraints=["phases.nowhere.x_f == 0"])
+    with pytest.raises(gamespec.SpecError, match="phases.nowhere.x_f"):
+        spec_from_dict(data)
+
+
+def test_a_definition_may_belong_to_some_phases_only() -> None:
+    """The same phase-only definition in two phases is each phase's own (it was refused as a
+    name used twice); it equals the shared definition."""
+    shared = _two_phases((1.0, 1.0), 4)
+    shared["problem"]["definitions"] = {"w": "u**2"}
+    shared["problem"]["objective"] = {"lagrange": "w"}
+    own = copy.deepcopy(shared)
+    del own["problem"]["definitions"]
+    own["problem"]["objective"] = {"lagrange": 0}
+    for phase in own["problem"]["phases"]:
+        phase["definitions"] = {"w": "u**2"}
+        phase["lagrange"] = "w"
+    one, two = gamespec.solve(spec_from_dict(shared)), gamespec.solve(spec_from_dict(own))
+    assert one.ok and two.ok
+    assert one.objective == pytest.approx(two.objective, rel=1e-10)

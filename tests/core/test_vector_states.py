@@ -160,3 +160,48 @@ def test_a_definition_at_the_ends_equals_it_written_out() -> None:
 def test_a_file_without_vectors_is_read_as_written() -> None:
     spec = _spec(SCALAR)
     assert spec.problem.definitions["speed"] == SCALAR["definitions"]["speed"]
+
+
+def _phases(problem: dict) -> gamespec.SpecBase:
+    return spec_from_dict(
+        {"kind": "multiphase_optimal_control", "problem": problem, "method": {"intervals": 6}}
+    )
+
+
+def test_vector_phases_equal_their_scalar_form() -> None:
+    """Two phases of a planar double integrator with a jump of the velocity, a phase's own vector
+    end constraint and a link by name, vector against scalar."""
+    vector = {
+        "states": {
+            "r": {"size": 2, "initial": 0, "final": [1, 0.5]},
+            "v": {"size": 2, "initial": 0, "final": 0},
+        },
+        "controls": {"u": {"size": 2}},
+        "dynamics": {"r": "v", "v": "u"},
+        "objective": {"lagrange": "dot(u, u)"},
+        "boundary_constraints": ["phases.second.r_0[1] >= 0.3"],
+        "phases": [
+            {"name": "first", "duration": 1.0, "boundary_constraints": ["dot(v_f, v_f) <= 0.64"]},
+            {"name": "second", "duration": 1.0, "jump": {"v": "v_f + [0.1, 0]"}},
+        ],
+    }
+    scalar = {
+        "states": {
+            "r0": {"initial": 0, "final": 1},
+            "r1": {"initial": 0, "final": 0.5},
+            "v0": {"initial": 0, "final": 0},
+            "v1": {"initial": 0, "final": 0},
+        },
+        "controls": {"u0": {}, "u1": {}},
+        "dynamics": {"r0": "v0", "r1": "v1", "v0": "u0", "v1": "u1"},
+        "objective": {"lagrange": "u0**2 + u1**2"},
+        "boundary_constraints": ["phases.second.r1_0 >= 0.3"],
+        "phases": [
+            {"name": "first", "duration": 1.0, "boundary_constraints": ["v0_f**2 + v1_f**2 <= 0.64"]},
+            {"name": "second", "duration": 1.0, "jump": {"v0": "v0_f + 0.1"}},
+        ],
+    }
+    one, two = gamespec.solve(_phases(vector)), gamespec.solve(_phases(scalar))
+    assert one.ok and two.ok
+    assert one.objective == pytest.approx(two.objective, rel=1e-10)
+    np.testing.assert_allclose(one.states["v__0"], two.states["v0"], atol=1e-8)

@@ -26,6 +26,7 @@ SLOW_PAIRS = {
     "cdoc_lqr_marginal",
     "rcs_constraint_form",
     "free_flying_robot",
+    "orbit_raising_vector",
 }
 """Files whose refined or long solves cost a second or more on each backend: compared with ``-m slow``
 (the other C-DOC, RCS and refined files keep the parity in the default suite)."""

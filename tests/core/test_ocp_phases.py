@@ -368,7 +368,7 @@ def test_phases_are_linked_by_name_as_by_their_own_constraints() -> None:
 
 def test_a_phase_link_names_a_declared_phase() -> None:
     data = _three_phases(boundary_constraints=["phases.nowhere.x_f == 0"])
-    with pytest.raises(gamespec.SpecError, match="phases.nowhere.x_f"):
+    with pytest.raises(gamespec.SpecError, match=r"phases\.nowhere\.x_f"):
         spec_from_dict(data)
 
 

@@ -54,7 +54,9 @@ def _axis_speed(along: float, across: float, speed: float) -> float:
 
 
 @njit(cache=True, error_model="numpy")
-def _one_sided(values: np.ndarray, state: np.ndarray, i: int, j: int, di: int, dj: int, order: int):
+def _one_sided(
+    values: np.ndarray, state: np.ndarray, i: int, j: int, di: int, dj: int, order: int
+) -> tuple[float, float, float]:
     """``(α, β, T₁)`` of the upwind difference ``(αT − β)/h`` towards node (i, j) from the
     neighbour (i − di, j − dj) of value ``T₁``: ``(1.5, 2T₁ − T₂/2)`` at second order where the
     node beyond has a value ``T₂``, ``(1, T₁)`` otherwise; zeros when the neighbour has none."""

@@ -25,9 +25,12 @@ class FlowGameOptions(StrictModel):
         "grid of the grid-error estimate, the cross-check), checked after every step: past it the run "
         "stops with the status time_limit (null: no limit).",
     )
-    engine: Literal["compiled", "numpy"] = Field(
-        "compiled",
+    engine: Literal["auto", "compiled", "numpy"] = Field(
+        "auto",
         description="The levelset backend's WENO5 step: compiled (one Numba loop over the nodes, "
-        "gamespec/flowfield/compiled.py; the fastest, benchmarks/test_bench_reach.py) or numpy (the "
-        "array operator of gamespec/flowfield/upwind.py). ENO2 and first order are always NumPy.",
+        "gamespec/flowfield/compiled.py; 3-4x less CPU a step, benchmarks/test_bench_reach.py, "
+        "after about 0.65 s to load Numba once per process), numpy (the array operator of "
+        "gamespec/flowfield/upwind.py) or auto (compiled from 150x150 nodes or once loaded, numpy "
+        "below: the faster for one solve, gamespec.flowfield.levelset.COMPILED_NODES). ENO2 and first "
+        "order are always NumPy.",
     )

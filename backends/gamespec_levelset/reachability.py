@@ -31,6 +31,7 @@ from gamespec.flowfield.hamiltonian import FlowHamiltonian
 from gamespec.flowfield.levelset import (
     LevelSetSolver,
     capture_by_level_sets,
+    choose_engine,
     coarser_grid,
     grid_error_estimate,
 )
@@ -68,31 +69,33 @@ def _level_set_reach(
     spec: FlowReachabilitySpec,
     data: FlowGameData,
     nominal: bool = True,
-    engine: str = "compiled",
+    engine: str = "auto",
     budget: Budget = UNLIMITED,
 ) -> Reachability:
     """Stage 1 by level sets; with ``nominal`` (not a cross-check) also the nominal paths and, for
-    the project's engines (``compiled``, ``numpy``; not ``jax``), the grid-error estimate from the
+    the project's engines (``auto``, ``compiled``, ``numpy``; not ``jax``), the grid-error estimate from the
     same levels on a coarser grid (:func:`~gamespec.flowfield.levelset.grid_error_estimate`, about
-    1/8 of the work). ``budget``: the time limit over both searches and the progress line."""
+    1/8 of the work), both grids by the engine :func:`~gamespec.flowfield.levelset.choose_engine`
+    picks for the fine one. ``budget``: the time limit over both searches and the progress line."""
     m = spec.method
     speeds = data.nominal_speeds
 
     def own_solver(grid: Grid) -> LevelSetSolver:
         hamiltonian = FlowHamiltonian(speeds, data.field.drift(grid.points))
-        return LevelSetSolver(grid, hamiltonian, m.scheme, m.cfl, engine)
+        return LevelSetSolver(grid, hamiltonian, m.scheme, m.cfl, choose_engine(engine, data.grid))
 
     if engine == "jax":
         from gamespec_levelset.hj_solver import HJSolver
 
         solver = HJSolver(data.grid, data.field, speeds, m.cfl)
+        name = "hj_reachability (jax)"
     else:
         solver = own_solver(data.grid)
+        name = "compiled" if solver.compiled else "numpy"
     reach = capture_by_level_sets(solver, data.origins, m.max_time, levels=m.read_levels, budget=budget)
-    kernel = "compiled" if engine == "compiled" and m.scheme == "weno5" else "numpy"
     metrics = {
         "method": "levelset",
-        "engine": "hj_reachability (jax)" if engine == "jax" else kernel,
+        "engine": name,
         "scheme": "weno5" if engine == "jax" else m.scheme,
         "nodes": list(data.grid.shape),
         "time_steps": reach.steps,

@@ -29,7 +29,7 @@ class _FlowGameBackend(Backend[FlowStageSpec, FlowGameOptions]):
 
     def _compile(self, spec: FlowStageSpec, options: FlowGameOptions) -> CompiledModel:
         if isinstance(spec, FlowReachabilitySpec):
-            return ReachabilityModel(spec, self.method, options.cross_check)
+            return ReachabilityModel(spec, self.method, options)
         return CovarianceGameModel(spec, options)
 
 

@@ -3,7 +3,7 @@ both of chapter 5's stages (``solver.options.<backend>`` in a file, or ``options
 
 from __future__ import annotations
 
-from typing import Any
+from typing import Any, Literal
 
 from pydantic import Field
 
@@ -12,9 +12,25 @@ from gamespec.specs.base import StrictModel
 
 class FlowGameOptions(StrictModel):
     """The conic solver of the players' steps and its keyword arguments (the covariance game);
-    ``cross_check`` also runs the other reachability method and reports the difference of ``T̂``
-    (the reachability stage)."""
+    ``cross_check`` also runs the other reachability method and reports the difference of ``T̂``,
+    ``max_wall_time`` and ``engine`` (the reachability stage)."""
 
     solver: str = "CLARABEL"
     solver_options: dict[str, Any] = Field(default_factory=dict)
     cross_check: bool = True
+    max_wall_time: float | None = Field(
+        300.0,
+        gt=0,
+        description="Seconds of wall time the reachability stage may take (level sets, the coarser "
+        "grid of the grid-error estimate, the cross-check), checked after every step: past it the run "
+        "stops with the status time_limit (null: no limit).",
+    )
+    engine: Literal["auto", "compiled", "numpy"] = Field(
+        "auto",
+        description="The levelset backend's WENO5 step: compiled (one Numba loop over the nodes, "
+        "gamespec/flowfield/compiled.py; 3-4x less CPU a step, benchmarks/test_bench_reach.py, "
+        "after about 0.65 s to load Numba once per process), numpy (the array operator of "
+        "gamespec/flowfield/upwind.py) or auto (compiled from 150x150 nodes or once loaded, numpy "
+        "below: the faster for one solve, gamespec.flowfield.levelset.COMPILED_NODES). ENO2 and first "
+        "order are always NumPy.",
+    )

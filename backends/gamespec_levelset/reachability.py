@@ -16,12 +16,14 @@ that enter only the game (α) recomputes nothing, the cross-check included.
 from __future__ import annotations
 
 import time
+from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
 
 from gamespec.compiling import CompiledModel, Inputs, refuse_inputs
+from gamespec.flowfield.budget import UNLIMITED, Budget
 from gamespec.flowfield.covariance_game import PLAYERS
 from gamespec.flowfield.extremals import capture_by_extremals
 from gamespec.flowfield.grid import Grid
@@ -29,6 +31,7 @@ from gamespec.flowfield.hamiltonian import FlowHamiltonian
 from gamespec.flowfield.levelset import (
     LevelSetSolver,
     capture_by_level_sets,
+    choose_engine,
     coarser_grid,
     grid_error_estimate,
 )
@@ -37,6 +40,8 @@ from gamespec.flowfield.problem import FlowGameData, evaluate
 from gamespec.flowfield.spec import FlowReachabilitySpec
 from gamespec.flowfield.stages import reachability_key
 from gamespec.result import Result, Status
+from gamespec.terminal import progress
+from gamespec_levelset.options import FlowGameOptions
 from gamespec_levelset.verdicts import verdicts
 
 GRID_ERROR_STEPS = 0.05
@@ -48,7 +53,7 @@ may move the game's time grid by at most 5 % of a step."""
 class Reachability:
     """Stage 1's outcome: ``T̂``, ``x_f`` and the nominal paths, or why there are none; the arrays
     and metrics it contributes to the Result; the grid-error estimate where one was made (None
-    inside: the coarser grid found no capture)."""
+    inside: the coarser grid found no capture); ``timed_out``: the time limit stopped it."""
 
     capture_time: float | None
     capture_point: np.ndarray | None
@@ -57,30 +62,40 @@ class Reachability:
     arrays: dict[str, np.ndarray]
     metrics: dict[str, Any]
     grid_error: dict[str, Any] | None = None
+    timed_out: bool = False
 
 
 def _level_set_reach(
-    spec: FlowReachabilitySpec, data: FlowGameData, nominal: bool = True, engine: str = "numpy"
+    spec: FlowReachabilitySpec,
+    data: FlowGameData,
+    nominal: bool = True,
+    engine: str = "auto",
+    budget: Budget = UNLIMITED,
 ) -> Reachability:
     """Stage 1 by level sets; with ``nominal`` (not a cross-check) also the nominal paths and, for
-    the NumPy engine, the grid-error estimate from the same levels on a coarser grid
-    (:func:`~gamespec.flowfield.levelset.grid_error_estimate`, about 1/8 of the work)."""
+    the project's engines (``auto``, ``compiled``, ``numpy``; not ``jax``), the grid-error estimate from the
+    same levels on a coarser grid (:func:`~gamespec.flowfield.levelset.grid_error_estimate`, about
+    1/8 of the work), both grids by the engine :func:`~gamespec.flowfield.levelset.choose_engine`
+    picks for the fine one. ``budget``: the time limit over both searches and the progress line."""
     m = spec.method
     speeds = data.nominal_speeds
 
-    def numpy_solver(grid: Grid) -> LevelSetSolver:
-        return LevelSetSolver(grid, FlowHamiltonian(speeds, data.field.drift(grid.points)), m.scheme, m.cfl)
+    def own_solver(grid: Grid) -> LevelSetSolver:
+        hamiltonian = FlowHamiltonian(speeds, data.field.drift(grid.points))
+        return LevelSetSolver(grid, hamiltonian, m.scheme, m.cfl, choose_engine(engine, data.grid))
 
     if engine == "jax":
         from gamespec_levelset.hj_solver import HJSolver
 
         solver = HJSolver(data.grid, data.field, speeds, m.cfl)
+        name = "hj_reachability (jax)"
     else:
-        solver = numpy_solver(data.grid)
-    reach = capture_by_level_sets(solver, data.origins, m.max_time, levels=m.read_levels)
+        solver = own_solver(data.grid)
+        name = "compiled" if solver.compiled else "numpy"
+    reach = capture_by_level_sets(solver, data.origins, m.max_time, levels=m.read_levels, budget=budget)
     metrics = {
         "method": "levelset",
-        "engine": "hj_reachability (jax)" if engine == "jax" else "numpy",
+        "engine": name,
         "scheme": "weno5" if engine == "jax" else m.scheme,
         "nodes": list(data.grid.shape),
         "time_steps": reach.steps,
@@ -88,12 +103,16 @@ def _level_set_reach(
     }
     arrays = {"reach_margin_time": reach.times, "reach_margin": reach.margins}
     if reach.capture_time is None:
-        return Reachability(None, None, None, reach.message, arrays, metrics)
+        return Reachability(None, None, None, reach.message, arrays, metrics, timed_out=reach.timed_out)
     paths = from_level_sets(reach, data.field, speeds, data.origins) if nominal else None
     grid_error = None
-    if nominal and engine == "numpy":
-        coarse_solver = numpy_solver(coarser_grid(data.grid))
-        coarse = capture_by_level_sets(coarse_solver, data.origins, m.max_time, levels=m.read_levels)
+    if nominal and engine != "jax":
+        coarse_solver = own_solver(coarser_grid(data.grid))
+        coarse = capture_by_level_sets(
+            coarse_solver, data.origins, m.max_time, levels=m.read_levels, budget=budget
+        )
+        if coarse.timed_out:
+            return Reachability(None, None, None, coarse.message, arrays, metrics, timed_out=True)
         grid_error = {"estimate": grid_error_estimate(reach, coarse)}
     metrics |= {
         "levels": reach.levels.tolist(),
@@ -108,13 +127,24 @@ def _level_set_reach(
     return Reachability(reach.capture_time, reach.capture_point, paths, "", arrays, metrics, grid_error)
 
 
-def _extremal_reach(spec: FlowReachabilitySpec, data: FlowGameData, nominal: bool = True) -> Reachability:
+def _extremal_reach(
+    spec: FlowReachabilitySpec, data: FlowGameData, nominal: bool = True, budget: Budget = UNLIMITED
+) -> Reachability:
     e = spec.method.extremals
     speeds = data.nominal_speeds
     reach = capture_by_extremals(
-        data.field, data.origins, speeds, spec.method.max_time, directions=e.directions, dt=e.step
+        data.field,
+        data.origins,
+        speeds,
+        spec.method.max_time,
+        directions=e.directions,
+        dt=e.step,
+        budget=budget,
     )
     metrics = {"method": "extremals", "directions": e.directions, "time_step": e.step}
+    if reach.timed_out:
+        message = budget.message(f"extremals at t = {reach.times[-1]:.4g}, no capture yet")
+        return Reachability(None, None, None, message, {}, metrics, timed_out=True)
     if reach.capture_time is None:
         return Reachability(
             None, None, None, f"no capture before t_max = {spec.method.max_time:g}", {}, metrics
@@ -128,37 +158,48 @@ def _extremal_reach(spec: FlowReachabilitySpec, data: FlowGameData, nominal: boo
     return Reachability(reach.capture_time, reach.capture_point, paths, "", arrays, metrics)
 
 
-REACHABILITY = {
-    "levelset": _level_set_reach,
-    "extremals": _extremal_reach,
-    "hj_reachability": lambda spec, data: _level_set_reach(spec, data, engine="jax"),
+def _differences(reach: Reachability, other: Reachability | None) -> dict[str, float | None]:
+    """The cross-check's values: the other method's ``T̂`` and both differences."""
+    if other is None:
+        return {}
+    if other.capture_time is None:
+        return {"capture_time_other_method": None}
+    return {
+        "capture_time_other_method": other.capture_time,
+        "capture_time_difference": abs(other.capture_time - reach.capture_time),
+        "capture_point_difference": float(np.linalg.norm(other.capture_point - reach.capture_point)),
+    }
+
+
+REACHABILITY: dict[str, Callable[[FlowReachabilitySpec, FlowGameData, str, Budget], Reachability]] = {
+    "levelset": lambda spec, data, engine, budget: _level_set_reach(spec, data, engine=engine, budget=budget),
+    "extremals": lambda spec, data, engine, budget: _extremal_reach(spec, data, budget=budget),
+    "hj_reachability": lambda spec, data, engine, budget: _level_set_reach(
+        spec, data, engine="jax", budget=budget
+    ),
 }
+"""Stage 1 by each backend's method, from the spec, its values, the levelset engine and the budget."""
 
 
 class ReachabilityModel(CompiledModel):
-    """Stage 1 for one ``flow_reachability`` spec by ``method`` (a key of :data:`REACHABILITY`);
-    ``cross_check`` also runs the other method and reports the difference of ``T̂``. The last
-    Result is kept for its :func:`~gamespec.flowfield.stages.reachability_key` and returned again
-    (with the new parameter values) while the key stays the same."""
+    """Stage 1 for one ``flow_reachability`` spec by ``method`` (a key of :data:`REACHABILITY`) with
+    the backend's ``options``: ``cross_check`` also runs the other method and reports the
+    difference of ``T̂``; ``max_wall_time`` bounds the whole stage (status ``time_limit``), which
+    shows its progress on stderr (:mod:`gamespec.terminal`); ``engine`` is the level sets' step.
+    The last Result is kept for its :func:`~gamespec.flowfield.stages.reachability_key` and
+    returned again (with the new parameter values) while the key stays the same."""
 
-    def __init__(self, spec: FlowReachabilitySpec, method: str, cross_check: bool) -> None:
-        self.spec, self.method, self.cross_check = spec, method, cross_check
+    def __init__(self, spec: FlowReachabilitySpec, method: str, options: FlowGameOptions) -> None:
+        self.spec, self.method, self.options = spec, method, options
         self._solved: tuple[tuple, Result] | None = None
 
-    def _cross_check(self, data: FlowGameData, reach: Reachability) -> dict[str, float | None]:
-        if not self.cross_check:
-            return {}
+    def _cross_check(self, data: FlowGameData, budget: Budget) -> Reachability | None:
+        """The other method's reachability (None without a cross-check)."""
+        if not self.options.cross_check:
+            return None
         if self.method != "extremals":
-            other = _extremal_reach(self.spec, data, nominal=False)
-        else:
-            other = _level_set_reach(self.spec, data, nominal=False)
-        if other.capture_time is None:
-            return {"capture_time_other_method": None}
-        return {
-            "capture_time_other_method": other.capture_time,
-            "capture_time_difference": abs(other.capture_time - reach.capture_time),
-            "capture_point_difference": float(np.linalg.norm(other.capture_point - reach.capture_point)),
-        }
+            return _extremal_reach(self.spec, data, nominal=False, budget=budget)
+        return _level_set_reach(self.spec, data, nominal=False, engine=self.options.engine, budget=budget)
 
     def solve(
         self, parameters: dict[str, float] | None = None, guess: Result | None = None, inputs: Inputs = None
@@ -175,12 +216,17 @@ class ReachabilityModel(CompiledModel):
         )
 
     def _reached(self, data: FlowGameData) -> Result:
-        """Stage 1's Result for ``data``: the reachability, the nominal paths and the checks."""
-        reach = REACHABILITY[self.method](self.spec, data)
-        if reach.capture_time is None:
+        """Stage 1's Result for ``data``: the reachability, the nominal paths and the checks; the
+        status ``time_limit`` when the limit stopped it (the search or the cross-check)."""
+        with progress(f"{self.spec.name} (reachability, {self.method})") as tracker:
+            budget = Budget(self.options.max_wall_time, tracker)
+            reach = REACHABILITY[self.method](self.spec, data, self.options.engine, budget)
+            other = None if reach.capture_time is None else self._cross_check(data, budget)
+        stopped = other if other is not None and other.timed_out else reach
+        if reach.capture_time is None or stopped.timed_out:
             return Result(
-                status=Status.INFEASIBLE,
-                message=reach.message,
+                status=Status.TIME_LIMIT if stopped.timed_out else Status.INFEASIBLE,
+                message=stopped.message,
                 arrays=reach.arrays,
                 metrics={"reachability": reach.metrics},
             )
@@ -195,7 +241,7 @@ class ReachabilityModel(CompiledModel):
             value = None if estimate is None else estimate["capture_time"]
             graded["capture_time_grid_error"] = (value, GRID_ERROR_STEPS * data.step)
             metrics["grid_error_estimate"] = estimate
-        checks = self._cross_check(data, reach)
+        checks = _differences(reach, other)
         checks |= {
             f"closure_error_{n}": float(e) for n, e in zip(PLAYERS, reach.paths.closure_error, strict=True)
         }

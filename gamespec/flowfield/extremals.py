@@ -17,6 +17,7 @@ from dataclasses import dataclass
 import numpy as np
 from matplotlib.path import Path
 
+from gamespec.flowfield.budget import UNLIMITED, Budget
 from gamespec.flowfield.capture import first_zero, refined_peak
 from gamespec.flowfield.field import FlowField
 
@@ -90,13 +91,15 @@ def front_margin(pursuer: np.ndarray, evader: np.ndarray) -> tuple[float, np.nda
 
 @dataclass(frozen=True)
 class ExtremalReach:
-    """Capture time and point by extremal shooting (None when no capture before ``t_max``) and the
-    fronts (S, 2, M, 2) at ``times``."""
+    """Capture time and point by extremal shooting (None when no capture before ``t_max``, or
+    ``timed_out``: the budget's time limit stopped the march) and the fronts (S, 2, M, 2) at
+    ``times``."""
 
     times: np.ndarray
     fronts: np.ndarray
     capture_time: float | None
     capture_point: np.ndarray | None
+    timed_out: bool = False
 
 
 def capture_by_extremals(
@@ -108,9 +111,11 @@ def capture_by_extremals(
     directions: int = 720,
     dt: float = 2e-3,
     check_every: int = 10,
+    budget: Budget = UNLIMITED,
 ) -> ExtremalReach:
     """March until every evader front point is inside the pursuer's front (checked every
-    ``check_every`` steps), then find the zero of the signed margin step by step in that bracket."""
+    ``check_every`` steps), then find the zero of the signed margin step by step in that bracket;
+    ``budget``: the time limit and the progress line, every ``check_every`` steps."""
     march = ExtremalMarch(field, origins, speeds, directions)
     fronts = [march.front]
     count = int(np.ceil(t_max / dt))
@@ -120,6 +125,9 @@ def capture_by_extremals(
         fronts.append(march.front)
         if k % check_every and k != count:
             continue
+        budget.advance(f"extremals, t = {k * h:.3g} of at most {t_max:g}")
+        if budget.expired():
+            return ExtremalReach(h * np.arange(len(fronts)), np.stack(fronts), None, None, timed_out=True)
         if Path(fronts[-1][0]).contains_points(fronts[-1][1]).all():
             break
     times = h * np.arange(len(fronts))

@@ -28,15 +28,15 @@ class FlowHamiltonian:
     drift: np.ndarray
 
     @cached_property
-    def _flow(self) -> np.ndarray:
+    def flow(self) -> np.ndarray:
         """``f`` as (2, nx, ny), C-contiguous per component."""
         return np.ascontiguousarray(np.moveaxis(np.asarray(self.drift, dtype=float), -1, 0))
 
     @cached_property
-    def _jump_weights(self) -> np.ndarray:
+    def jump_weights(self) -> np.ndarray:
         """``f⁺ + v̂/2`` per agent and component, (agents, 2, nx, ny)."""
         speeds = np.asarray(self.speeds, dtype=float).reshape(-1, 1, 1, 1)
-        return np.maximum(self._flow, 0.0)[None] + speeds / 2
+        return np.maximum(self.flow, 0.0)[None] + speeds / 2
 
     def numerical(
         self,
@@ -51,7 +51,7 @@ class FlowHamiltonian:
         same shape); ``minus`` and ``plus`` are overwritten."""
         (mx, my), (px, py), (h, work) = minus, plus, out
         speed = float(np.asarray(self.speeds, dtype=float)[agent])
-        f, weights = self._flow, self._jump_weights[agent]
+        f, weights = self.flow, self.jump_weights[agent]
         np.subtract(px, mx, out=mx)
         np.subtract(py, my, out=my)
         np.multiply(mx, -0.5, out=h)
@@ -72,5 +72,5 @@ class FlowHamiltonian:
 
     def max_step(self, spacing: np.ndarray, cfl: float) -> float:
         """The CFL-limited time step ``cfl / max(α_x/dx + α_y/dy)``."""
-        alpha = np.max(np.asarray(self.speeds, dtype=float)) + np.abs(self._flow)
+        alpha = np.max(np.asarray(self.speeds, dtype=float)) + np.abs(self.flow)
         return float(cfl / np.max(alpha[0] / spacing[0] + alpha[1] / spacing[1]))

@@ -94,10 +94,12 @@ def covariance_game_spec(spec: FlowGameSpec, reach: Result) -> FlowCovarianceGam
 
 def flow_game_result(game: Result, reach: Result) -> Result:
     """The game's Result with stage 1's metrics, arrays (but the directions), checks and verdicts;
-    without a capture, stage 1's message, arrays and reachability metrics."""
+    without a capture, stage 1's status (``infeasible``, or ``time_limit`` when its time limit
+    stopped it), message, arrays and reachability metrics."""
     if "capture_time" not in reach.metrics:
         return game.model_copy(
             update={
+                "status": reach.status,
                 "message": reach.message,
                 "arrays": reach.arrays,
                 "metrics": {"reachability": reach.metrics["reachability"], "game_converged": False},

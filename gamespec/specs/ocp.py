@@ -15,7 +15,7 @@ import itertools
 import math
 from collections.abc import Mapping
 from dataclasses import dataclass
-from typing import ClassVar, Literal
+from typing import Any, ClassVar, Literal
 
 from pydantic import Field, field_validator, model_validator
 
@@ -620,6 +620,12 @@ class OptimalControlSpec(OcpFamily, SpecBase):
     plot: PlotHint = Field(default_factory=PlotHint)
 
     guess_fields = ("guess", "problem.time.guess")
+
+    def analysis_values(self) -> dict[str, Any]:
+        """Each uncertain parameter's distribution (``problem.uncertain.<name>``): only the Monte
+        Carlo analyses read it (which parameters are uncertain stays structure: a rewrite builds
+        their sensitivities)."""
+        return {f"problem.uncertain.{n}": d for n, d in self.problem.uncertain.items()}
 
     @model_validator(mode="after")
     def _guess_names(self) -> OptimalControlSpec:

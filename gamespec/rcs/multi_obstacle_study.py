@@ -19,6 +19,7 @@ from pydantic import BaseModel, ConfigDict, model_validator
 from gamespec.analyses import for_study
 from gamespec.loader import spec_from_dict
 from gamespec.metrics import Finite
+from gamespec.rcs.report import Rows, point_line
 from gamespec.rcs.study_points import (
     HEADLINE,
     PARAMETERS,
@@ -35,6 +36,7 @@ from gamespec.result import Result, Status
 from gamespec.solving import Solver, compile_spec
 from gamespec.specs.ocp import GuessSpec, OptimalControlSpec
 from gamespec.studies.point_study import PointStudy, PointStudyModel
+from gamespec.studies.report import study_summary
 from gamespec.studies.runner import StudyRun
 from gamespec.studies.store import ResultStore
 
@@ -177,3 +179,13 @@ class RcsStudy(PointStudy):
     name: ClassVar[str] = "rcs_study"
     kinds: ClassVar[frozenset[str]] = frozenset({"rcs_multi_obstacle_study"})
     model: ClassVar[type[PointStudyModel]] = RcsStudyModel
+
+
+def rcs_study_summary(result: Result) -> Rows:
+    """:func:`~gamespec.studies.report.study_summary`, then one row per point of
+    ``metrics.table``: ``N = n, α = a, σ = s`` → P_c [interval], objective, t_f, status."""
+    rows: Rows = list(study_summary(result))
+    for entry in result.metrics.get("table", []):
+        key = f"N = {entry['obstacles']}, α = {entry['alpha']:g}, σ = {entry.get('sigma', float('nan')):g}"
+        rows.append((key, point_line(entry)))
+    return rows

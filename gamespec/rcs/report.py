@@ -4,15 +4,13 @@ summary of the §6.4.4 study, one row per point.
 Chapter 6's headline for the RCS regularizer (§6.4) is the probability that the uncertain
 obstacles hit the solved path, estimated by Monte Carlo over the uncertain parameters with its
 confidence interval, next to the regularizer's weight and power. The ``rcs``
-transform names it as its ``summary``; it reads the Result alone. The ``rcs_multi_obstacle_study``
-kind names :func:`rcs_study_summary`: the point study's rows, then per point (N, α, σ) its P_c with
-the interval, objective, final time and status (the Result's ``metrics.table``).
+transform names it as its ``summary``; it reads the Result alone. :func:`point_line` is one point
+of the §6.4.4 study in its summary (:func:`gamespec.rcs.multi_obstacle_study.rcs_study_summary`).
 """
 
 from __future__ import annotations
 
 from gamespec.result import Result
-from gamespec.studies.report import study_summary
 
 Rows = list[tuple[str, object]]
 
@@ -35,17 +33,7 @@ def rcs_summary(result: Result) -> Rows:
     return rows
 
 
-def rcs_study_summary(result: Result) -> Rows:
-    """:func:`~gamespec.studies.report.study_summary`, then one row per point of
-    ``metrics.table``: ``N = n, α = a, σ = s`` → P_c [interval], objective, t_f, status."""
-    rows: Rows = list(study_summary(result))
-    for entry in result.metrics.get("table", []):
-        key = f"N = {entry['obstacles']}, α = {entry['alpha']:g}, σ = {entry.get('sigma', float('nan')):g}"
-        rows.append((key, _point(entry)))
-    return rows
-
-
-def _point(entry: dict[str, object]) -> str:
+def point_line(entry: dict[str, object]) -> str:
     """P_c with its interval, the objective, the final time and the status of one table entry."""
     parts = []
     probability, interval = entry.get("collision_probability"), entry.get("collision_probability_ci")

@@ -403,7 +403,8 @@ def results(
         sys.stdout.write(json.dumps(rows, indent=2) + "\n")
     else:
         present = {name for row in rows for name in row}
-        shown = [c for c in [*study.parameters, *RESULT_COLUMNS] if c in present]
+        wanted = dict.fromkeys([*study.parameters, *study.headline, *RESULT_COLUMNS])
+        shown = [c for c in wanted if c in present]
         title = f"{study.type or 'study'} {study.problem}: {len(rows)} points".strip()
         _console().print(_rows_table(rows, shown or ["key"], title))
     for path in (write_csv(rows, csv) if csv else None, write_parquet(rows, parquet) if parquet else None):

@@ -31,7 +31,7 @@ from __future__ import annotations
 
 import datetime as _dt
 import time
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from functools import cache, cached_property
 from importlib.metadata import PackageNotFoundError, version
 from pathlib import Path
@@ -55,6 +55,7 @@ from gamespec.transforms.base import (
     Transform,
     lowering_path,
     requested_steps,
+    with_field_values,
     with_parameter_values,
 )
 
@@ -177,6 +178,24 @@ def _mapped(step: AnyStep, source: SpecBase) -> AnyStep:
     values, inverse = step.transform.parameter_map(source, step.inverse)
     target = with_parameter_values(step.target, values)
     return Step(step.transform, step.options, source, target, inverse, step.upstream)
+
+
+def _settable(path: str, parameters: set[str], fields: dict[str, Any]) -> bool:
+    """Whether a dotted ``path`` is a runtime parameter's or lies in an analysis field."""
+    return path in parameters or any(path == f or path.startswith(f"{f}.") for f in fields)
+
+
+def _new_analysis_values(old: SpecBase, new: SpecBase) -> dict[str, Any]:
+    """The :meth:`~SpecBase.analysis_values` of ``new`` that differ from ``old``'s."""
+    before = old.analysis_values()
+    return {path: value for path, value in new.analysis_values().items() if before.get(path) != value}
+
+
+def _with_analysis_values(step: AnyStep, source: SpecBase, fields: dict[str, Any]) -> AnyStep:
+    """``step`` from ``source`` (new analysis values only), its target given those of ``fields``
+    it has: no transform reads them, so nothing else changes."""
+    kept = {path: value for path, value in fields.items() if path in step.target.analysis_values()}
+    return replace(step, source=source, target=with_field_values(step.target, kept))
 
 
 def _unrequested(spec: SpecBase) -> SpecBase:
@@ -313,11 +332,13 @@ class Solver:
         current = _unrequested(spec)
         steps: list[AnyStep] = []
         if self._same_structure(spec, names):
+            fields = _new_analysis_values(self.spec, spec)
             for old in self.steps:
                 changed = _changed(old.source, current)
                 if old.upstream is not None or changed & old.transform.unmapped(current):
                     break
-                steps.append(_mapped(old, current) if changed else old)
+                step = _mapped(old, current) if changed else old
+                steps.append(_with_analysis_values(step, current, fields) if fields else step)
                 current = steps[-1].target
             else:
                 return steps
@@ -347,7 +368,8 @@ class Solver:
         ``names`` when they are given (each one a runtime parameter), else by its structure."""
         if names is not None:
             paths = {self.spec.parameter_path(n) for n in self.spec.runtime_parameters()}
-            return all(self.spec.parameter_path(n) in paths for n in names)
+            fields = self.spec.analysis_values()
+            return all(_settable(self.spec.parameter_path(n), paths, fields) for n in names)
         return spec.structure(with_guess=True) == self._source_structure
 
     @cached_property

@@ -7,12 +7,21 @@ polynomial of each mesh interval, :mod:`gamespec.ocp.control_signal`), and the r
 integrated as one more state. The dynamics are the file's SymPy
 expressions evaluated on arrays by :func:`gamespec.symbolic.calculus.numeric_function` (no code is
 generated, no Python call per sample).
+
+When every sample follows the same path (an open loop whose dynamics, running cost and initial
+state do not depend on the sampled parameters: chapter 6's obstacles of uncertain speed, eqs.
+6.38-6.39), the path is integrated once, all steps in one call of a CasADi function (the RK4 step
+of the same expressions, ``mapaccum``-ed over the steps), and only the path constraints are
+evaluated per sample, for every step at once: the same numbers to rounding, without a Python
+loop over the steps.
 """
 
 from __future__ import annotations
 
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass
+from functools import lru_cache
+from typing import Any
 
 import numpy as np
 import sympy as sp
@@ -22,6 +31,8 @@ from gamespec.ocp.symbolic import SymbolicOcp
 from gamespec.result import Result
 from gamespec.symbolic.calculus import numeric_function
 from gamespec.symbolic.language import TIME, symbol
+from gamespec.symbolic.library import casadi_library
+from gamespec.symbolic.translate import translate
 
 Values = Mapping[sp.Symbol, np.ndarray | float]
 Feedback = Callable[[int, np.ndarray], np.ndarray]
@@ -105,6 +116,8 @@ def rk4(
     stages = np.stack([t[:-1], t[:-1] + h / 2, t[1:]], axis=1)
     u_open = controls.on_steps(t).reshape(m, len(h), 3)
     w_open = inputs.on_steps(t) if inputs else np.empty((0, len(h), 3))
+    if feedback is None and _shared_path(ocp, x0, params):
+        return _one_path(ocp, x0, params, t, stages, u_open, w_open, keep)
     X = np.empty((len(t), n, keep))
     U = np.empty((len(t), m, keep))
     running, energy, violation = np.zeros(samples), np.zeros(samples), np.zeros(samples)
@@ -148,6 +161,129 @@ def rk4(
     correction = np.zeros((m, 1)) if feedback is None else feedback(len(h), x)
     record(len(h), last, 2, x, u_open[:, last, 2, None] + correction)
     return Trajectories(t, X, U, x, running, energy, violation)
+
+
+def _shared_path(ocp: SymbolicOcp, x0: np.ndarray, params: Values) -> bool:
+    """Whether every sample follows the same open-loop path: one initial state, and dynamics and
+    running cost free of the sampled parameters (those given one value per sample)."""
+    sampled = {p for p in ocp.p if np.size(params[p]) > 1}
+    flow = [*ocp.dynamics, ocp.lagrange]
+    depends = set().union(*(sp.sympify(e).free_symbols for e in flow)) & sampled
+    return not depends and bool(np.all(x0 == x0[:, :1]))
+
+
+def _one_path(
+    ocp: SymbolicOcp,
+    x0: np.ndarray,
+    params: Values,
+    t: np.ndarray,
+    stages: np.ndarray,
+    u_open: np.ndarray,
+    w_open: np.ndarray,
+    keep: int,
+) -> Trajectories:
+    """:func:`rk4` for samples that share one path (:func:`_shared_path`): the path integrated once
+    by :func:`_rk4_path`, the path constraints of every sample evaluated on it."""
+    samples, n, m = x0.shape[1], len(ocp.x), len(ocp.u)
+    h = np.diff(t)
+    nominal = [float(np.ravel(params[p])[0]) for p in ocp.p]
+    y0 = np.append(x0[:, 0], 0.0)
+    path = _rk4_path(*_flow_key(ocp), len(h))(
+        y0,
+        u_open.transpose(2, 0, 1).reshape(3 * m, len(h)),
+        w_open.transpose(2, 0, 1).reshape(3 * w_open.shape[0], len(h)),
+        stages.T,
+        h[None, :],
+        np.repeat(np.array(nominal, dtype=float)[:, None], len(h), axis=1),
+    )
+    y = np.hstack([y0[:, None], np.asarray(path, dtype=float)])  # (n + 1, steps + 1)
+    x_path = y[:n]
+    squares = np.sum(u_open**2, axis=0)  # (steps, 3)
+    energy = float(np.sum(h / 6 * (squares[:, 0] + 2 * squares[:, 1] + 2 * squares[:, 1] + squares[:, 2])))
+    u_path = np.concatenate([u_open[:, :, 0], u_open[:, -1:, 2]], axis=1)  # at each step's start
+    w_path = np.concatenate([w_open[:, :, 0], w_open[:, -1:, 2]], axis=1)
+    violation = _path_violation(ocp, x_path, u_path, w_path, t, params, samples)
+    X = np.repeat(x_path.T[:, :, None], keep, axis=2)
+    U = np.repeat(u_path.T[:, :, None], keep, axis=2)
+    final = np.repeat(x_path[:, -1:], samples, axis=1)
+    return Trajectories(t, X, U, final, np.full(samples, y[n, -1]), np.full(samples, energy), violation)
+
+
+CHUNK = 1 << 16
+"""Values (times × samples × constraints) of the path constraints evaluated in one NumPy call
+(small enough to stay in the cache: larger calls are slower)."""
+
+
+def _path_violation(
+    ocp: SymbolicOcp,
+    x: np.ndarray,
+    u: np.ndarray,
+    w: np.ndarray,
+    t: np.ndarray,
+    params: Values,
+    samples: int,
+) -> np.ndarray:
+    """Each sample's largest path-constraint violation over the times ``t`` of one shared path
+    ``x`` (n, len(t)) under ``u`` and ``w`` (the parameters per sample, broadcast along ``t``)."""
+    violation = np.zeros(samples)
+    if not ocp.path:
+        return violation
+    function = numeric_function([rel.expr for rel in ocp.path], [*ocp.p, *ocp.w, *ocp.x, *ocp.u, TIME])
+    lower = np.array([rel.lower for rel in ocp.path])[:, None, None]
+    upper = np.array([rel.upper for rel in ocp.path])[:, None, None]
+    fixed = [np.reshape(params[p], (1, -1)) if np.size(params[p]) > 1 else params[p] for p in ocp.p]
+    rows = max(1, CHUNK // (samples * len(ocp.path)))
+    for start in range(0, len(t), rows):
+        cut = slice(start, start + rows)
+        along = [v[cut, None] for v in (*w, *x, *u, t)]
+        g = np.broadcast_to(function(*fixed, *along), (len(ocp.path), len(t[cut]), samples))
+        excess = np.maximum(lower - g, 0.0) + np.maximum(g - upper, 0.0)
+        np.maximum(violation, excess.max(axis=(0, 1)), out=violation)
+    return violation
+
+
+Symbols = tuple[sp.Symbol, ...]
+
+
+def _flow_key(ocp: SymbolicOcp) -> tuple[Symbols, Symbols, Symbols, Symbols, tuple[sp.Expr, ...]]:
+    """The parameters, inputs, states, controls and flow (dynamics, signed running cost) of ``ocp``:
+    what :func:`_rk4_path` is built from, hashable."""
+    flow = tuple(sp.sympify(e) for e in [*ocp.dynamics, ocp.sign * ocp.lagrange])
+    return tuple(ocp.p), tuple(ocp.w), tuple(ocp.x), tuple(ocp.u), flow
+
+
+@lru_cache(maxsize=32)
+def _rk4_path(p: Symbols, w: Symbols, x: Symbols, u: Symbols, flow: tuple[sp.Expr, ...], steps: int) -> Any:
+    """:func:`_rk4_step` accumulated over ``steps`` steps (CasADi's ``mapaccum``): the state and
+    running cost after each step; kept for the re-solves of the same problem."""
+    return _rk4_step(p, w, x, u, flow).mapaccum(steps)
+
+
+def _rk4_step(p: Symbols, w: Symbols, x: Symbols, u: Symbols, flow: tuple[sp.Expr, ...]) -> Any:
+    """One RK4 step of the flow as a CasADi ``Function`` ``(y, u, w, t, h, p) → y⁺`` (``y`` the
+    state and the running cost; ``u``, ``w`` the controls and inputs at the step's start, middle and
+    end, stacked; ``t`` those three times), built from the same SymPy expressions as :func:`rk4`'s
+    NumPy ones."""
+    import casadi as ca
+
+    library = casadi_library(ca)
+    n, m, k = len(x), len(u), len(w)
+    y, U, W = ca.SX.sym("y", n + 1), ca.SX.sym("u", 3 * m), ca.SX.sym("w", 3 * k)
+    ts, h, P = ca.SX.sym("t", 3), ca.SX.sym("h"), ca.SX.sym("p", len(p))
+
+    def f(state: Any, stage: int) -> Any:
+        values = dict(zip(p, ca.vertsplit(P), strict=True))
+        values |= dict(zip(w, [W[stage * k + i] for i in range(k)], strict=True))
+        values |= dict(zip(x, ca.vertsplit(state[:n]), strict=True))
+        values |= dict(zip(u, [U[stage * m + j] for j in range(m)], strict=True))
+        values[TIME] = ts[stage]
+        return ca.vertcat(*(translate(e, values, library) for e in flow))
+
+    k1 = f(y, 0)
+    k2 = f(y + h / 2 * k1, 1)
+    k3 = f(y + h / 2 * k2, 1)
+    k4 = f(y + h * k3, 2)
+    return ca.Function("rk4_step", [y, U, W, ts, h, P], [y + h / 6 * (k1 + 2 * k2 + 2 * k3 + k4)])
 
 
 def end_values(

@@ -48,8 +48,14 @@ class StudyRow(BaseModel):
 
     obstacles: int = Field(description="N, the number of obstacles.")
     alpha: Finite = Field(description="The weight α.")
+    sigma: Finite | None = Field(None, description="σ of the Monte Carlo's speed draws.")
+    status: str | None = Field(None, description="Status of the kept solution (error: none solved).")
+    objective: float | None = Field(None, description="Objective (eq. 6.36) of the kept solution.")
     t_final: Finite | None = Field(None, description="Final time of the kept solution.")
     collision_probability: Finite | None = Field(None, description="Monte Carlo collision probability.")
+    collision_probability_ci: tuple[Finite, Finite] | None = Field(
+        None, description="Its Wilson interval (gamespec.montecarlo.proportion)."
+    )
 
 
 class RcsStudyMetrics(Metrics):

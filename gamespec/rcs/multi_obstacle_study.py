@@ -11,35 +11,70 @@ from __future__ import annotations
 
 import time
 from collections.abc import Callable
-from typing import Any, ClassVar
+from functools import lru_cache
+from typing import Any, ClassVar, cast
 
 from pydantic import BaseModel, ConfigDict, model_validator
 
 from gamespec.analyses import for_study
 from gamespec.loader import spec_from_dict
 from gamespec.metrics import Finite
-from gamespec.rcs.study_points import StudyPoint, arrays, layout, point_problem, study_points, summarize
+from gamespec.rcs.report import Rows, point_line
+from gamespec.rcs.study_points import (
+    HEADLINE,
+    PARAMETERS,
+    StudyPoint,
+    arrays,
+    layout,
+    point_problem,
+    study_points,
+    summarize,
+)
 from gamespec.rcs.study_spec import RcsStudySpec
+from gamespec.rcs.transform import starting_point
 from gamespec.result import Result, Status
-from gamespec.solving import solve
+from gamespec.solving import Solver, compile_spec
+from gamespec.specs.ocp import GuessSpec, OptimalControlSpec
 from gamespec.studies.point_study import PointStudy, PointStudyModel
+from gamespec.studies.report import study_summary
 from gamespec.studies.runner import StudyRun
+from gamespec.studies.store import ResultStore
 
 TABLE_ANALYSES = ("monte_carlo",)
 """What the table needs of each point's analyses: the collision probability."""
 
 
+@lru_cache(maxsize=4)
+def compiled_point(study: str, obstacles: int) -> tuple[Solver, tuple[Result, ...]]:
+    """The problem of ``obstacles`` obstacles compiled once for every α (a runtime parameter,
+    mapped through the rcs transform) and its starting points, one per guess of the study (JSON
+    ``study``): the points of one N re-solve this model (kept per process, so each worker of a
+    parallel executor compiles it once)."""
+    spec = RcsStudySpec.model_validate_json(study)
+    data = point_problem(spec, obstacles, spec.alphas[0], spec.guesses[0])
+    solver = compile_spec(
+        spec_from_dict(data), spec.ocp_backend, analyses=for_study(spec.analyses, TABLE_ANALYSES)
+    )
+    target = cast(OptimalControlSpec, solver.target_spec)
+    starts = tuple(
+        starting_point(target, GuessSpec.model_validate(point_problem(spec, obstacles, 0.0, a)["guess"]))
+        for a in spec.guesses
+    )
+    return solver, starts
+
+
 def evaluate(point: StudyPoint) -> dict[str, Any]:
-    """Solve one point from every guess; the best one's row (JSON-able) for the store."""
+    """Solve one point from every guess, each from its own starting point on the compiled model of
+    its N (:func:`compiled_point`: the same starting point as a file of its own, so a point's
+    answer does not depend on which points ran before it); the best one's row (JSON-able) for the
+    store."""
     spec = RcsStudySpec.model_validate_json(point.study)
     tic = time.perf_counter()
+    solver, starts = compiled_point(point.study, point.obstacles)
     best: tuple[float, Result] | None = None
     tried = []
-    for amplitude in spec.guesses:
-        data = point_problem(spec, point.obstacles, point.alpha, amplitude)
-        result = solve(
-            spec_from_dict(data), spec.ocp_backend, analyses=for_study(spec.analyses, TABLE_ANALYSES)
-        )
+    for amplitude, start in zip(spec.guesses, starts, strict=True):
+        result = solver.solve(parameters={"alpha": point.alpha}, guess=start)
         tried.append({"guess": amplitude, "status": result.status.value, "objective": result.objective})
         if result.ok and (best is None or result.objective < best[0]):
             best = (result.objective, result)
@@ -106,6 +141,12 @@ class RcsStudyModel(PointStudyModel):
     def point_function(self) -> Callable[[Any], dict[str, Any]]:
         return evaluate
 
+    def prepare(self, store: ResultStore) -> None:
+        """The store's ``study`` record: a sweep over N, α and σ whose headline is P_c (what
+        ``gamespec results`` shows)."""
+        meta = {"type": "sweep", "problem": self.spec.name, "parameters": list(PARAMETERS)}
+        store.set_meta("study", meta | {"headline": list(HEADLINE)})
+
     def result(self, rows: list[dict[str, Any]], run: StudyRun) -> Result:
         solved = sum(r["status"] != "error" for r in rows)
         if solved == len(rows):
@@ -138,3 +179,13 @@ class RcsStudy(PointStudy):
     name: ClassVar[str] = "rcs_study"
     kinds: ClassVar[frozenset[str]] = frozenset({"rcs_multi_obstacle_study"})
     model: ClassVar[type[PointStudyModel]] = RcsStudyModel
+
+
+def rcs_study_summary(result: Result) -> Rows:
+    """:func:`~gamespec.studies.report.study_summary`, then one row per point of
+    ``metrics.table``: ``N = n, α = a, σ = s`` → P_c [interval], objective, t_f, status."""
+    rows: Rows = list(study_summary(result))
+    for entry in result.metrics.get("table", []):
+        key = f"N = {entry['obstacles']}, α = {entry['alpha']:g}, σ = {entry.get('sigma', float('nan')):g}"
+        rows.append((key, point_line(entry)))
+    return rows

@@ -1,9 +1,11 @@
-"""The rows a risk-constrained (RCS) solve adds to its summary: the collision probability.
+"""The rows a risk-constrained (RCS) solve adds to its summary: the collision probability; and the
+summary of the §6.4.4 study, one row per point.
 
 Chapter 6's headline for the RCS regularizer (§6.4) is the probability that the uncertain
 obstacles hit the solved path, estimated by Monte Carlo over the uncertain parameters with its
 confidence interval, next to the regularizer's weight and power. The ``rcs``
-transform names it as its ``summary``; it reads the Result alone.
+transform names it as its ``summary``; it reads the Result alone. :func:`point_line` is one point
+of the §6.4.4 study in its summary (:func:`gamespec.rcs.multi_obstacle_study.rcs_study_summary`).
 """
 
 from __future__ import annotations
@@ -29,3 +31,19 @@ def rcs_summary(result: Result) -> Rows:
     if "obstacle_power" in m:
         rows.append(("obstacle power β", m["obstacle_power"]))
     return rows
+
+
+def point_line(entry: dict[str, object]) -> str:
+    """P_c with its interval, the objective, the final time and the status of one table entry."""
+    parts = []
+    probability, interval = entry.get("collision_probability"), entry.get("collision_probability_ci")
+    if isinstance(probability, float | int):
+        low, high = interval if isinstance(interval, list | tuple) and len(interval) == 2 else (None, None)
+        ci = f" [{low:.3g}, {high:.3g}]" if low is not None and high is not None else ""
+        parts.append(f"P_c = {probability:.4g}{ci}")
+    for name, label in (("objective", "objective"), ("t_final", "t_f")):
+        value = entry.get(name)
+        if isinstance(value, float | int):
+            parts.append(f"{label} = {value:.6g}")
+    parts.append(str(entry.get("status")))
+    return ", ".join(parts)

@@ -90,14 +90,22 @@ def point_problem(spec: RcsStudySpec, n: int, alpha: float, amplitude: float) ->
     }
 
 
+PARAMETERS = ("obstacles", "alpha", "sigma")
+"""What a point's row is a function of (N, α and the σ of the Monte Carlo): the columns its table
+and ``gamespec results`` lead with."""
+
+HEADLINE = ("collision_probability", "collision_probability_ci")
+"""The headline a point's row adds to the status, objective and final time: P_c and its interval."""
+
+
 def summarize(rows: list[dict[str, Any]]) -> list[dict[str, Any]]:
-    """Fig. 6.11's table: per (N, α) the travel time and collision probability, and their change
-    against α = 0 of the same N (``t_final_increase`` and ``collision_reduction`` in percent)."""
+    """Fig. 6.11's table: per (N, α, σ) the status, objective, travel time and collision
+    probability with its interval, and their change against α = 0 of the same N
+    (``t_final_increase`` and ``collision_reduction`` in percent)."""
     table = []
     for row in rows:
         base = next((r for r in rows if r["obstacles"] == row["obstacles"] and r["alpha"] == 0), None)
-        entry = {k: row.get(k) for k in ("obstacles", "alpha", "status", "t_final", "collision_probability")}
-        entry["collision_probability_ci"] = row.get("collision_probability_ci")
+        entry = {k: row.get(k) for k in (*PARAMETERS, "status", "objective", "t_final", *HEADLINE)}
         entry["t_final_increase"] = _percent(row.get("t_final"), base and base.get("t_final"), +1)
         entry["collision_reduction"] = _percent(
             row.get("collision_probability"), base and base.get("collision_probability"), -1

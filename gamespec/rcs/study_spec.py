@@ -84,7 +84,7 @@ KIND = Kind(
     RcsStudySpec,
     study="rcs_study",
     plot="gamespec.rcs.plotting:plot_study",
-    summary="gamespec.studies.report:study_summary",
+    summary="gamespec.rcs.multi_obstacle_study:rcs_study_summary",
     metrics="gamespec.rcs.metrics:RcsStudyMetrics",
 )
 """The ``RcsStudySpec`` kind as one plugin (:class:`~gamespec.registry.Kind`)."""

@@ -193,14 +193,21 @@ class SpecBase(StrictModel):
         """The dotted field a runtime parameter ``name`` stands for (the name itself by default)."""
         return name
 
+    def analysis_values(self) -> dict[str, Any]:
+        """The fields that only analyses read (a Monte Carlo's distributions), by dotted path: no
+        transform's ``apply`` and no backend reads them, so a compiled model re-solves for new
+        values of them (:meth:`gamespec.solving.Solver.mapped_steps`) and :meth:`structure` leaves
+        them out (none by default)."""
+        return {}
+
     def structure(self, with_guess: bool = False) -> dict[str, Any]:
-        """This spec without its runtime parameter values, name and description (and without its
-        starting point unless ``with_guess``): two specs with the same structure compile to the same
-        model."""
+        """This spec without its runtime parameter values, its :meth:`analysis_values`, name and
+        description (and without its starting point unless ``with_guess``): two specs with the
+        same structure compile to the same model."""
         data = self.model_dump(mode="json")
         data.pop("name")
         data.pop("description")
-        blanked = [self.parameter_path(n) for n in self.runtime_parameters()]
+        blanked = [self.parameter_path(n) for n in self.runtime_parameters()] + list(self.analysis_values())
         for path in blanked + ([] if with_guess else list(self.guess_fields)):
             *parents, last = path.split(".")
             node: Any = data

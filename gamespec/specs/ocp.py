@@ -15,7 +15,7 @@ import itertools
 import math
 from collections.abc import Mapping
 from dataclasses import dataclass
-from typing import ClassVar, Literal
+from typing import Any, ClassVar, Literal
 
 from pydantic import Field, field_validator, model_validator
 
@@ -638,6 +638,12 @@ class OptimalControlSpec(OcpFamily, SpecBase):
         if isinstance(data.get("guess"), dict):
             lowered["guess"] = guess(data["guess"], "guess")
         return lowered
+
+    def analysis_values(self) -> dict[str, Any]:
+        """Each uncertain parameter's distribution (``problem.uncertain.<name>``): only the Monte
+        Carlo analyses read it (which parameters are uncertain stays structure: a rewrite builds
+        their sensitivities)."""
+        return {f"problem.uncertain.{n}": d for n, d in self.problem.uncertain.items()}
 
     @model_validator(mode="after")
     def _guess_names(self) -> OptimalControlSpec:

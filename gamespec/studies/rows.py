@@ -32,6 +32,9 @@ class StudyMeta(BaseModel):
     type: Literal["sweep", "compare"] | None = Field(None, description="sweep or compare.")
     problem: str = Field("", description="The problem's name.")
     parameters: list[ParameterName] = Field(default_factory=list, description="A sweep's swept parameters.")
+    headline: list[ParameterName] = Field(
+        default_factory=list, description="Columns a study kind shows after its parameters (its headline)."
+    )
 
 
 class PointRow(BaseModel):

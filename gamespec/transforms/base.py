@@ -160,9 +160,15 @@ def with_parameter_values(spec: SpecT, values: Mapping[str, float]) -> SpecT:
     ``values``, copied without re-validation: for a parameter map's target, whose values the
     validated source determines (every other field, its source and file hash kept). Each model
     on the way is copied once, however many of its parameters change."""
+    return with_field_values(spec, {spec.parameter_path(n): v for n, v in values.items()})
+
+
+def with_field_values(spec: SpecT, values: Mapping[str, Any]) -> SpecT:
+    """``spec`` with the fields at the dotted paths of ``values`` set to them, copied without
+    re-validation (as :func:`with_parameter_values`)."""
     tree: dict[str, Any] = {}
-    for name, value in values.items():
-        *parents, last = spec.parameter_path(name).split(".")
+    for path, value in values.items():
+        *parents, last = path.split(".")
         node = tree
         for part in parents:
             node = node.setdefault(part, {})

@@ -52,6 +52,10 @@ def test_reduced_study_through_the_cli(cli, tmp_path):
     result = json.loads(out)
     table = result["metrics"]["table"]
     assert len(table) == 2 and all(set(row) >= ROW_FIELDS for row in table)
+    for row in table:
+        assert row["sigma"] == pytest.approx(0.1) and row["status"] in ("optimal", "feasible")
+        low, high = row["collision_probability_ci"]
+        assert low <= row["collision_probability"] <= high and row["objective"] >= row["t_final"]
     base, weighted = table
     assert base["t_final_increase"] == 0 and weighted["t_final_increase"] > 0
     assert weighted["collision_probability"] < base["collision_probability"]
@@ -64,6 +68,15 @@ def test_reduced_study_through_the_cli(cli, tmp_path):
     assert rows["store"] == str(tmp_path / "points")
     code, out, _ = cli("solve", str(path), "--set", "sigma=0.1")
     assert code == 0 and "computed in this run" in out
+    for entry in table:  # the summary: one line per point with its parameters and headline
+        line = next(x for x in out.splitlines() if f"N = 2, α = {entry['alpha']:g}, σ = 0.1" in x)
+        assert f"P_c = {entry['collision_probability']:.4g} [" in line and entry["status"] in line
+    code, out, _ = cli("results", str(tmp_path / "points"))
+    assert code == 0
+    header = next(x for x in out.splitlines() if "obstacles" in x)
+    named = [c for c in header.replace("┃", " ").replace("|", " ").split() if c]
+    assert named[:5] == ["obstacles", "alpha", "sigma", "collision_probability", "collision_probability_ci"]
+    assert {"status", "objective", "t_final"} <= set(named)
     code, _, _ = cli("plot", str(tmp_path / "res"), "--out", str(tmp_path / "fig"))
     assert code == 0
     assert {p.name for p in (tmp_path / "fig").iterdir()} >= {

@@ -201,6 +201,7 @@ class CasadiBackend(CollocationBackend[CasadiOptions]):
     name: ClassVar[str] = "casadi"
     options_model = CasadiOptions
     nlp_field: ClassVar[str] = "ipopt"
+    features: ClassVar[frozenset[str]] = CollocationBackend.features | {"tables"}
 
     @classmethod
     def available(cls) -> Availability:

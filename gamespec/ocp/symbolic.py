@@ -78,6 +78,11 @@ class SymbolicOcp:
         return list(self.spec.problem.inputs)
 
     @property
+    def functions(self) -> dict[str, Any]:
+        """The file's tables by name (:mod:`gamespec.symbolic.tables`), in every scope."""
+        return self.spec.problem.functions
+
+    @property
     def sign(self) -> float:
         return -1.0 if self.spec.problem.objective.sense == "maximize" else 1.0
 
@@ -118,7 +123,7 @@ class SymbolicOcp:
 
     def _scope(self, values: Mapping[str, Any], algebra: Algebra) -> dict[str, Any]:
         """``values`` (by name) and each definition built over them and the earlier ones."""
-        scope = dict(values)
+        scope = dict(values) | self.functions
         for name, raw in self.spec.problem.definitions.items():
             scope[name] = expression(raw, scope, algebra)
         return scope
@@ -142,10 +147,11 @@ class SymbolicOcp:
     def end_terms(self, values: Mapping[str, Any], algebra: Algebra) -> EndTerms:
         """The end-point terms over ``values`` (each of :attr:`end_names` by name)."""
         problem = self.spec.problem
-        mayer = expression(problem.objective.mayer, values, algebra)
+        scope = dict(values) | self.functions
+        mayer = expression(problem.objective.mayer, scope, algebra)
         return EndTerms(
             mayer=algebra.binary(ast.Mult, algebra.number(self.sign), mayer),
-            boundary=[relation(c, values, algebra) for c in problem.boundary_constraints],
+            boundary=[relation(c, scope, algebra) for c in problem.boundary_constraints],
         )
 
     @cached_property

@@ -24,6 +24,7 @@ from gamespec.limits import MAX_INTERVALS
 from gamespec.registry import Kind
 from gamespec.specs.base import Number, ProblemParameters, SpecBase, StrictModel, Value
 from gamespec.specs.plot import PlotHint
+from gamespec.specs.tables import TableSpec
 from gamespec.specs.uncertainty import UncertainParameter
 from gamespec.symbolic.canonical import check
 from gamespec.symbolic.grammar import (
@@ -35,6 +36,7 @@ from gamespec.symbolic.grammar import (
     relation,
     unknowns,
 )
+from gamespec.symbolic.tables import Table
 
 INF = math.inf
 NORMALIZED_TIME = "tau"
@@ -162,6 +164,10 @@ class OcpProblem(StrictModel):
         default_factory=dict,
         description="Named expressions used in dynamics, the Lagrange integrand and path constraints.",
     )
+    tables: dict[str, TableSpec] = Field(
+        default_factory=dict,
+        description="Gridded data, each a function of the expressions by its name (CL(mach, alpha)).",
+    )
     states: dict[str, StateSpec]
     controls: dict[str, ControlSpec] = Field(default_factory=dict)
     inputs: dict[str, InputSpec] = Field(default_factory=dict)
@@ -194,6 +200,7 @@ class OcpProblem(StrictModel):
             *self.inputs,
             *self.definitions,
             *self.design,
+            *self.tables,
         ]
         boundary = [f"{s}_{e}" for s in [*self.states, *self.controls] for e in "0f"] + ["t_f"]
         for name in names:
@@ -222,6 +229,11 @@ class OcpProblem(StrictModel):
         self._check_expressions()
         self.evaluate(self.parameter_values())
         return self
+
+    @property
+    def functions(self) -> dict[str, Table]:
+        """The tables as functions of the expressions, by name (each built once)."""
+        return {name: spec.named(name) for name, spec in self.tables.items()}
 
     def time_varying_bounds(self) -> list[tuple[str, str, str]]:
         """``(name, "lower" | "upper", expression)`` of each state or control bound that uses ``t``."""
@@ -373,9 +385,10 @@ class OcpProblem(StrictModel):
             (f"boundary_constraints.{i}", c, ends, True) for i, c in enumerate(self.boundary_constraints)
         ]
         numbers = self.parameter_values()
+        functions = self.functions
         for field, text, symbols, constraint in checks:
             try:
-                _check_at(text, symbols, numbers, constraint, self.definitions)
+                _check_at(text, symbols, numbers, constraint, self.definitions, functions)
             except ExpressionError as err:
                 used = _inputs_in(constraint, text, symbols, inputs)
                 reason = (
@@ -393,15 +406,17 @@ def _check_at(
     numbers: Mapping[str, float],
     constraint: bool,
     definitions: Mapping[str, str],
+    functions: Mapping[str, Table],
 ) -> None:
-    """:func:`~gamespec.symbolic.canonical.check` of ``text`` over ``names`` (those of
+    """:func:`~gamespec.symbolic.canonical.check` of ``text`` over ``names`` (and the file's tables,
+    ``functions``) (those of
     ``definitions`` standing for their expressions), the parameters among them at their ``numbers``
     (the file's values): what is undefined, not real or out of range at those values (``acos(xf)``
     with ``xf = 2``, ``sqrt(-w)``) is refused at load, not met by the solver."""
     defined = {n: definitions[n] for n in names if n in definitions}
     free = [n for n in names if n not in defined]
     values = {n: numbers[n] for n in free if n in numbers}
-    check(text, free, values, constraint=constraint, definitions=defined)
+    check(text, free, values, constraint=constraint, definitions=defined, functions=functions)
 
 
 def parameter_values(
@@ -649,6 +664,8 @@ class OptimalControlSpec(OcpFamily, SpecBase):
             needed.add("grid_inputs")
         if p.design:
             needed.add("design_parameters")
+        if p.tables:
+            needed.add("tables")
         return frozenset(needed)
 
 

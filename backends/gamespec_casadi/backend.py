@@ -201,7 +201,11 @@ class CasadiBackend(CollocationBackend[CasadiOptions]):
     name: ClassVar[str] = "casadi"
     options_model = CasadiOptions
     nlp_field: ClassVar[str] = "ipopt"
-    features: ClassVar[frozenset[str]] = CollocationBackend.features | {"tables"}
+    features: ClassVar[frozenset[str]] = CollocationBackend.features | {
+        "tables",
+        "interior_points",
+        "measurements",
+    }
 
     @classmethod
     def available(cls) -> Availability:

@@ -7,7 +7,8 @@
   (trapezoidal), so the check measures the discretization, not how a signal was tabulated.
 - ``max_defect_relative``: the same gap divided by the state's scale ``max(1, max |x|)`` (what
   ``method.refine.tolerance`` is compared with).
-- ``max_constraint_violation``: bounds, fixed end values, path, boundary and integral constraints,
+- ``max_constraint_violation``: bounds, fixed end values, path, boundary, interior-point (``at:``)
+  and integral constraints,
   the integrals re-integrated with the states (RK4, as the defects) rather than by the
   transcription's own quadrature, which cannot see an integrand between its points.
 - ``control_swings/<control>``: total variation of the control over the range it spans; ``chattering``
@@ -222,6 +223,8 @@ def max_constraint_violation(
     worst += [_relation_violation(r, t_eval.shape) for r in terms.path]
     ends = tr.ocp.end_terms(_end_values(tr, X, U, T, params), ARRAYS)
     worst += [_relation_violation(r, ()) for r in ends.boundary]
+    interior = tr.interior.terms(X, _arrays(params), ARRAYS)
+    worst += [_relation_violation(r, ()) for r in interior.constraints]
     q = tr.grid.triplets[2]
     if integrals is None:
         integrals = [

@@ -18,6 +18,7 @@ import numpy as np
 from gamespec.errors import ExpressionError, SpecError
 from gamespec.ocp.checks import Trajectory, check_tolerances, control_basis, solution_checks, verdicts
 from gamespec.ocp.collocation import Grid
+from gamespec.ocp.events import InteriorPoints
 from gamespec.ocp.inputs import InputGrid, InputValue, on_grid
 from gamespec.ocp.symbolic import SymbolicOcp
 from gamespec.result import Result, Status
@@ -63,6 +64,11 @@ class Transcription:
             m.scheme, m.intervals, m.degree if m.scheme == "radau" else 1, m.grading, mesh, degrees
         )
         self.t0 = spec.problem.time.initial
+
+    @cached_property
+    def interior(self) -> InteriorPoints:
+        """The ``at:`` constraints and ``measurements:`` (:mod:`gamespec.ocp.events`)."""
+        return InteriorPoints(self)
 
     @property
     def n_x(self) -> int:

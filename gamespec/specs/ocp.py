@@ -23,6 +23,7 @@ from gamespec.errors import ExpressionError, SpecError
 from gamespec.limits import MAX_INTERVALS
 from gamespec.registry import Kind
 from gamespec.specs.base import Number, ProblemParameters, SpecBase, StrictModel, Value
+from gamespec.specs.events import EventSpec, MeasurementsSpec
 from gamespec.specs.plot import PlotHint
 from gamespec.specs.tables import TableSpec
 from gamespec.specs.uncertainty import UncertainParameter
@@ -180,6 +181,13 @@ class OcpProblem(StrictModel):
     path_constraints: list[str] = Field(default_factory=list)
     boundary_constraints: list[str] = Field(default_factory=list)
     integral_constraints: list[IntegralConstraintSpec] = Field(default_factory=list)
+    at: list[EventSpec] = Field(
+        default_factory=list,
+        description="Interior-point constraints: [{time: ..., constraints: [...]}] over the states then.",
+    )
+    measurements: MeasurementsSpec | None = Field(
+        None, description="Measured data (times, values, weights): a least-squares term in the objective."
+    )
     uncertain: dict[str, UncertainParameter] = Field(
         default_factory=dict, description="Uncertain parameters (chapter 6) and their distributions."
     )
@@ -228,7 +236,51 @@ class OcpProblem(StrictModel):
             raise ValueError(f"uncertain names derived parameters (give a number instead): {sorted(derived)}")
         self._check_expressions()
         self.evaluate(self.parameter_values())
+        self._check_interior_points()
         return self
+
+    def interior_times(self, params: Mapping[str, float]) -> tuple[list[float], list[float]]:
+        """The times of the ``at:`` entries and of the measurements for these parameter values."""
+        values = {n: float(params[n]) for n in self.parameters if n in params}
+        events = [
+            _evaluated(e.time, values, f"problem.at.{i}.time") if isinstance(e.time, str) else float(e.time)
+            for i, e in enumerate(self.at)
+        ]
+        return events, [float(t) for t in (self.measurements.times if self.measurements else [])]
+
+    def _check_interior_points(self) -> None:
+        """Interior points need a fixed horizon that holds their times; their expressions parse
+        over the states (at that time), the parameters and the design variables."""
+        if not self.at and self.measurements is None:
+            return
+        field = "problem.at" if self.at else "problem.measurements"
+        if self.time.free:
+            raise SpecError("interior points (at, measurements) need a fixed final time", field=field)
+        if self.measurements is not None and self.objective.sense == "maximize":
+            reason = "a least-squares fit minimizes: measurements need objective.sense minimize"
+            raise SpecError(reason, field="problem.measurements")
+        numbers = self.parameter_values()
+        t_final = self.evaluate(numbers).t_final
+        events, measured = self.interior_times(numbers)
+        for where, times in (("at.{i}.time", events), ("measurements.times.{i}", measured)):
+            for i, t in enumerate(times):
+                if not self.time.initial <= t <= t_final:
+                    reason = f"time {t:g} lies outside the horizon [{self.time.initial:g}, {t_final:g}]"
+                    raise SpecError(reason, field="problem." + where.format(i=i))
+        names = dict.fromkeys([*self.parameters, *self.design, *self.states])
+        functions = self.functions
+        checks = [
+            (f"at.{i}.constraints.{j}", c, True)
+            for i, e in enumerate(self.at)
+            for j, c in enumerate(e.constraints)
+        ]
+        measured_keys = self.measurements.values if self.measurements else {}
+        checks += [(f"measurements.values.{key}", key, False) for key in measured_keys]
+        for field_name, text, constraint in checks:
+            try:
+                _check_at(text, names, numbers, constraint, {}, functions)
+            except ExpressionError as err:
+                raise SpecError(str(err), field=f"problem.{field_name}") from None
 
     @property
     def functions(self) -> dict[str, Table]:
@@ -666,6 +718,10 @@ class OptimalControlSpec(OcpFamily, SpecBase):
             needed.add("design_parameters")
         if p.tables:
             needed.add("tables")
+        if p.at:
+            needed.add("interior_points")
+        if p.measurements is not None:
+            needed.add("measurements")
         return frozenset(needed)
 
 

@@ -1,0 +1,109 @@
+"""Interior points of a transcription: the states at fixed times inside the horizon, as linear
+combinations of the state nodes (the collocation polynomial of the interval that holds the time),
+and the terms over them — the ``at:`` constraints and the least-squares misfit of ``measurements:``
+— in any algebra of :mod:`gamespec.symbolic.grammar` (the CasADi NLP adds them to its end-point
+rows and cost, the checks evaluate them over the Result's arrays).
+
+A time on a mesh break belongs to the interval that ends there (its polynomial reaches it; the
+states are continuous, so the next interval's start node has the same value).
+"""
+
+from __future__ import annotations
+
+import ast
+from collections.abc import Mapping
+from dataclasses import dataclass
+from functools import cached_property
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+
+from gamespec.ocp.collocation import Grid
+from gamespec.symbolic.grammar import Algebra, Relation, expression, relation
+
+if TYPE_CHECKING:
+    from gamespec.ocp.transcription import Transcription
+
+
+def node_weights(grid: Grid, tau: float) -> tuple[np.ndarray, np.ndarray]:
+    """The node indices and weights with ``x(tau) = sum_j weights[j] X[:, nodes[j]]``: the Lagrange
+    basis of the interval holding ``tau`` (in normalized time) at its local time."""
+    breaks = grid.breaks
+    k = int(np.clip(np.searchsorted(breaks, tau, side="left") - 1, 0, grid.intervals - 1))
+    degree = int(grid.interval_degrees[k])
+    local = grid.local_points(degree)
+    s = (tau - breaks[k]) / (breaks[k + 1] - breaks[k])
+    weights = np.ones(len(local))
+    for r, pr in enumerate(local):
+        for q, pq in enumerate(local):
+            if q != r:
+                weights[r] *= (s - pq) / (pr - pq)
+    start = int(grid.interval_start_index[k])
+    return start + np.arange(len(local)), weights
+
+
+def states_at(X: Any, nodes: np.ndarray, weights: np.ndarray, n_x: int) -> list[Any]:
+    """Each state's value ``sum_j weights[j] X[i, nodes[j]]`` (``X`` a NumPy array or a CasADi
+    matrix)."""
+    return [sum(float(w) * X[i, int(j)] for j, w in zip(nodes, weights, strict=True)) for i in range(n_x)]
+
+
+@dataclass(frozen=True)
+class InteriorTerms:
+    """The ``at:`` constraints (in the order of the file) and the measurements' weighted sum of
+    squared residuals (0 without measurements)."""
+
+    constraints: list[Relation]
+    misfit: Any
+
+
+@dataclass(frozen=True)
+class InteriorPoints:
+    """The interior points of a transcription, their node weights computed once (the horizon is
+    fixed: the times are fixed in normalized time too)."""
+
+    tr: Transcription
+
+    @cached_property
+    def _weights(self) -> tuple[list[tuple[np.ndarray, np.ndarray]], list[tuple[np.ndarray, np.ndarray]]]:
+        tr = self.tr
+        params = tr.ocp.parameter_values()
+        _, tf, _ = tr.ocp.final_time(params)
+        events, measured = tr.spec.problem.interior_times(params)
+        span = tf - tr.t0
+        return (
+            [node_weights(tr.grid, (t - tr.t0) / span) for t in events],
+            [node_weights(tr.grid, (t - tr.t0) / span) for t in measured],
+        )
+
+    @property
+    def empty(self) -> bool:
+        problem = self.tr.spec.problem
+        return not problem.at and problem.measurements is None
+
+    def terms(self, X: Any, others: Mapping[str, Any], algebra: Algebra) -> InteriorTerms:
+        """The terms over the state nodes ``X`` (unscaled) and the parameters and design variables
+        ``others`` (by name), built in ``algebra``."""
+        tr = self.tr
+        problem = tr.spec.problem
+        events, measured = self._weights
+        base = dict(others) | tr.ocp.functions
+        constraints = []
+        for event, (nodes, weights) in zip(problem.at, events, strict=True):
+            scope = base | dict(zip(tr.ocp.states, states_at(X, nodes, weights, tr.n_x), strict=True))
+            constraints += [relation(c, scope, algebra) for c in event.constraints]
+        misfit: Any = algebra.number(0.0)
+        data = problem.measurements
+        if data is not None:
+            rows = data.weight_rows()
+            for i, (nodes, weights) in enumerate(measured):
+                scope = base | dict(zip(tr.ocp.states, states_at(X, nodes, weights, tr.n_x), strict=True))
+                for key, values in data.values.items():
+                    residual = algebra.binary(
+                        ast.Sub, expression(key, scope, algebra), algebra.number(values[i])
+                    )
+                    square = algebra.binary(ast.Mult, residual, residual)
+                    misfit = algebra.binary(
+                        ast.Add, misfit, algebra.binary(ast.Mult, algebra.number(rows[key][i]), square)
+                    )
+        return InteriorTerms(constraints, misfit)

@@ -14,6 +14,7 @@ import gamespec
 from gamespec.errors import SpecError, UnsupportedFeature
 from gamespec.loader import spec_from_dict
 from gamespec.specs.tables import checked_table
+from tests.conftest import PROBLEMS
 
 LQ_T = 1.0
 
@@ -172,3 +173,15 @@ def test_a_table_in_sympy_prints_back_and_its_derivative_is_refused_by_the_print
     with pytest.raises(ExpressionError, match="derivative of table 'q'"):
         to_text(sp.diff(expr, symbol("x")))
     check("1/(q(x) + 1) + sqrt(q(x))", ["x"], functions={"q": q})
+
+
+def test_f4_minimum_time_to_climb_solves_with_its_published_tables() -> None:
+    """The F-4 climb (thrust table from a CSV grid, atmosphere from 1-D CSV tables): optimal, every
+    check passing, Mach 1 in level flight at 20 km (the published time is compared in the file's
+    header, not here)."""
+    result = gamespec.solve(PROBLEMS / "ocp" / "f4_min_time_climb.yaml")
+    assert result.status == gamespec.Status.OPTIMAL, result.message
+    assert all(result.metrics["checks_passed"].values())
+    spec = gamespec.load(PROBLEMS / "ocp" / "f4_min_time_climb.yaml")
+    sos = spec.problem.functions["sos"]
+    assert result.states["v"][-1] == pytest.approx(sos.floats(result.states["h"][-1]), rel=1e-8)

@@ -15,9 +15,9 @@ import itertools
 import math
 from collections.abc import Mapping
 from dataclasses import dataclass
-from typing import ClassVar, Literal
+from typing import Any, ClassVar, Literal
 
-from pydantic import Field, field_validator, model_validator
+from pydantic import Field, SerializerFunctionWrapHandler, field_validator, model_serializer, model_validator
 
 from gamespec.errors import ExpressionError, SpecError
 from gamespec.limits import MAX_INTERVALS
@@ -40,6 +40,8 @@ from gamespec.symbolic.grammar import (
 from gamespec.symbolic.tables import Table
 
 INF = math.inf
+OPTIONAL_SECTIONS = ("tables", "at", "measurements")
+"""The sections of ``problem`` left out of its data when empty (:meth:`OcpProblem.model_dump`)."""
 NORMALIZED_TIME = "tau"
 """The name of normalized time ``(t - t0) / (t_f - t0)`` in guess and input-default expressions."""
 
@@ -191,6 +193,13 @@ class OcpProblem(StrictModel):
     uncertain: dict[str, UncertainParameter] = Field(
         default_factory=dict, description="Uncertain parameters (chapter 6) and their distributions."
     )
+
+    @model_serializer(mode="wrap")
+    def _without_unused_sections(self, handler: SerializerFunctionWrapHandler) -> dict[str, Any]:
+        """The problem as data, leaving out the interior-point and table sections a file does not
+        use: a spec's content hash (its Results' provenance) is the same as before they existed."""
+        data: dict[str, Any] = handler(self)
+        return {k: v for k, v in data.items() if k not in OPTIONAL_SECTIONS or v}
 
     @field_validator("states")
     @classmethod

@@ -11,6 +11,7 @@ states are continuous, so the next interval's start node has the same value).
 from __future__ import annotations
 
 import ast
+import dataclasses
 from collections.abc import Mapping
 from dataclasses import dataclass
 from functools import cached_property
@@ -23,6 +24,33 @@ from gamespec.symbolic.grammar import Algebra, Relation, expression, relation
 
 if TYPE_CHECKING:
     from gamespec.ocp.transcription import Transcription
+    from gamespec.specs.ocp import OptimalControlSpec
+
+BREAK_GAP = 1e-9
+"""A mesh break this close to an event's normalized time is the event's break (none is added)."""
+
+
+def with_event_breaks(grid: Grid, spec: OptimalControlSpec) -> Grid:
+    """``grid`` with a mesh break at each ``at:`` time (normalized) that is not one already: an
+    interior-point constraint makes the costates jump there and the control kink or jump, which no
+    interval's polynomial holds inside it. The measurement times are not breaks (the states are
+    smooth through them). A grid given by its mesh or per-interval degrees is kept as given."""
+    problem = spec.problem
+    if not problem.at:
+        return grid
+    params = problem.parameter_values()
+    t_final = problem.evaluate(params).t_final
+    events, _ = problem.interior_times(params)
+    t0 = problem.time.initial
+    taus = [(t - t0) / (t_final - t0) for t in events]
+    breaks = list(grid.breaks)
+    for tau in taus:
+        if min(abs(tau - b) for b in breaks) > BREAK_GAP:
+            breaks.append(tau)
+    if len(breaks) == len(grid.breaks):
+        return grid
+    mesh = tuple(sorted(breaks))
+    return dataclasses.replace(grid, intervals=len(mesh) - 1, mesh=mesh)
 
 
 def node_weights(grid: Grid, tau: float) -> tuple[np.ndarray, np.ndarray]:

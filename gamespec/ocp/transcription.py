@@ -18,7 +18,7 @@ import numpy as np
 from gamespec.errors import ExpressionError, SpecError
 from gamespec.ocp.checks import Trajectory, check_tolerances, control_basis, solution_checks, verdicts
 from gamespec.ocp.collocation import Grid
-from gamespec.ocp.events import InteriorPoints
+from gamespec.ocp.events import InteriorPoints, with_event_breaks
 from gamespec.ocp.inputs import InputGrid, InputValue, on_grid
 from gamespec.ocp.symbolic import SymbolicOcp
 from gamespec.result import Result, Status
@@ -60,9 +60,8 @@ class Transcription:
         m = spec.method
         mesh = None if m.mesh is None else tuple(m.mesh)
         degrees = None if m.degrees is None else tuple(m.degrees)
-        self.grid = Grid(
-            m.scheme, m.intervals, m.degree if m.scheme == "radau" else 1, m.grading, mesh, degrees
-        )
+        grid = Grid(m.scheme, m.intervals, m.degree if m.scheme == "radau" else 1, m.grading, mesh, degrees)
+        self.grid = with_event_breaks(grid, spec) if mesh is None and degrees is None else grid
         self.t0 = spec.problem.time.initial
 
     @cached_property

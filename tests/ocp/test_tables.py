@@ -11,6 +11,7 @@ import numpy as np
 import pytest
 
 import gamespec
+import gamespec.reading
 from gamespec.errors import SpecError, UnsupportedFeature
 from gamespec.loader import spec_from_dict
 from gamespec.specs.tables import checked_table
@@ -185,3 +186,16 @@ def test_f4_minimum_time_to_climb_solves_with_its_published_tables() -> None:
     spec = gamespec.load(PROBLEMS / "ocp" / "f4_min_time_climb.yaml")
     sos = spec.problem.functions["sos"]
     assert result.states["v"][-1] == pytest.approx(sos.floats(result.states["h"][-1]), rel=1e-8)
+
+
+def test_tables_pass_through_the_multiphase_lowering() -> None:
+    """The two-phase minimum-time double integrator with its unit accelerations read from a table:
+    the closed form t_f = 2 sqrt(x0) holds as with the numbers written in."""
+    data = gamespec.reading.read_file(PROBLEMS / "ocp" / "double_integrator_two_phases.yaml")
+    data["problem"]["tables"] = {"gain": {"axes": [[-10.0, 0.0, 10.0]], "values": [1.0, 1.0, 1.0]}}
+    data["problem"]["phases"][0]["dynamics"] = {"v": "-gain(x)"}
+    data["problem"]["phases"][1]["dynamics"] = {"v": "gain(v)"}
+    result = gamespec.solve(spec_from_dict(data))
+    assert result.status == gamespec.Status.OPTIMAL, result.message
+    x0 = data["problem"]["parameters"]["x0"]
+    assert result.t_final == pytest.approx(2 * math.sqrt(x0), rel=1e-8)

@@ -205,6 +205,7 @@ class CasadiBackend(CollocationBackend[CasadiOptions]):
         "tables",
         "interior_points",
         "measurements",
+        "free_initial_time",
     }
 
     @classmethod

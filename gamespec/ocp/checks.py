@@ -38,6 +38,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from gamespec.ocp.compiled_checks import reintegrate
+from gamespec.specs.ocp import INITIAL_TIME
 from gamespec.symbolic.grammar import FLOATS, Relation, dependencies, unknowns
 from gamespec.symbolic.library import NUMPY, LibraryAlgebra
 
@@ -286,8 +287,12 @@ def mayer_slope(tr: Transcription, ends: Mapping[str, float], name: str) -> floa
 
 def hamiltonian_end_value(tr: Transcription, ends: Mapping[str, float]) -> float:
     """``-dPhi/dt_f`` at the solution's end values: the constant value of H on an autonomous,
-    free-final-time problem (transversality, e.g. eq. 2.23)."""
-    return -mayer_slope(tr, ends, "t_f")
+    free-final-time problem (transversality, e.g. eq. 2.23); with a fixed final time and a free
+    initial one, ``+dPhi/dt_0`` (the Mayer term sees ``t_f = t_0 + T``: its slope in ``t_0`` at
+    fixed ``t_f`` is the slope at fixed ``T`` less the slope in ``t_f``)."""
+    if tr.spec.problem.time.free:
+        return -mayer_slope(tr, ends, "t_f")
+    return mayer_slope(tr, ends, INITIAL_TIME) - mayer_slope(tr, ends, "t_f")
 
 
 def varying_hamiltonian(tr: Transcription, Win: np.ndarray) -> str | None:

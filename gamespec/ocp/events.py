@@ -41,7 +41,7 @@ def with_event_breaks(grid: Grid, spec: OptimalControlSpec) -> Grid:
     params = problem.parameter_values()
     t_final = problem.evaluate(params).t_final
     events, _ = problem.interior_times(params)
-    t0 = problem.time.initial
+    t0 = problem.time.origin
     taus = [(t - t0) / (t_final - t0) for t in events]
     breaks = list(grid.breaks)
     for tau in taus:

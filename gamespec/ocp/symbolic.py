@@ -19,10 +19,13 @@ from typing import Any
 import numpy as np
 
 from gamespec.errors import SpecError
-from gamespec.specs.ocp import EvaluatedValues, OptimalControlSpec
+from gamespec.specs.ocp import INITIAL_TIME, EvaluatedValues, OptimalControlSpec
 from gamespec.symbolic.grammar import FLOATS, Algebra, Relation, dependencies, expression, relation, unknowns
 from gamespec.symbolic.library import NUMPY, LibraryAlgebra
 from gamespec.symbolic.tape import vectorized
+
+HORIZON_FLOOR = 1e-6
+"""The shortest horizon a free initial time allows, relative to the longest: ``T`` stays positive."""
 
 
 @dataclass(frozen=True)
@@ -69,8 +72,16 @@ class SymbolicOcp:
 
     @property
     def design(self) -> list[str]:
-        """Names of the free static parameters (decision variables of the NLP)."""
-        return list(self.spec.problem.design)
+        """Names of the free static parameters (decision variables of the NLP), then ``t_0`` when
+        the initial time is free."""
+        free_initial = [INITIAL_TIME] if self.free_initial else []
+        return [*self.spec.problem.design, *free_initial]
+
+    @property
+    def free_initial(self) -> bool:
+        """Whether the initial time is free: the transcription's time ``t`` and final time ``t_f``
+        are then counted from 0, and every term sees them shifted by the variable ``t_0``."""
+        return self.spec.problem.time.free_initial
 
     @property
     def inputs(self) -> list[str]:
@@ -128,10 +139,16 @@ class SymbolicOcp:
             scope[name] = expression(raw, scope, algebra)
         return scope
 
+    def _shifted(self, values: Mapping[str, Any], name: str, algebra: Algebra) -> dict[str, Any]:
+        """``values`` with the time ``name`` shifted by a free initial time (unchanged when fixed)."""
+        if not self.free_initial:
+            return dict(values)
+        return {**values, name: algebra.binary(ast.Add, values[name], values[INITIAL_TIME])}
+
     def running_terms(self, values: Mapping[str, Any], algebra: Algebra) -> RunningTerms:
         """The running terms over ``values`` (each of :attr:`running_names` by name)."""
         problem = self.spec.problem
-        scope = self._scope(values, algebra)
+        scope = self._scope(self._shifted(values, "t", algebra), algebra)
         lagrange = expression(problem.objective.lagrange, scope, algebra)
         path = [relation(c, scope, algebra) for c in problem.path_constraints]
         for name, key, raw in problem.time_varying_bounds():
@@ -147,12 +164,13 @@ class SymbolicOcp:
     def end_terms(self, values: Mapping[str, Any], algebra: Algebra) -> EndTerms:
         """The end-point terms over ``values`` (each of :attr:`end_names` by name)."""
         problem = self.spec.problem
-        scope = dict(values) | self.functions
+        scope = self._shifted(values, "t_f", algebra) | self.functions
         mayer = expression(problem.objective.mayer, scope, algebra)
-        return EndTerms(
-            mayer=algebra.binary(ast.Mult, algebra.number(self.sign), mayer),
-            boundary=[relation(c, scope, algebra) for c in problem.boundary_constraints],
-        )
+        boundary = [relation(c, scope, algebra) for c in problem.boundary_constraints]
+        if self.free_initial:
+            lo, hi, _ = self.final_time(self.parameter_values())
+            boundary.append(Relation(scope["t_f"], lo, hi))
+        return EndTerms(mayer=algebra.binary(ast.Mult, algebra.number(self.sign), mayer), boundary=boundary)
 
     @cached_property
     def running_structure(self) -> RunningTerms:
@@ -295,8 +313,22 @@ class SymbolicOcp:
         return self._evaluated(params).controls
 
     def design_bounds(self, params: Mapping[str, float]) -> list[tuple[float, float, float]]:
-        """Per design variable: ``(lower, upper, guess)``."""
-        return self._evaluated(params).design
+        """Per design variable: ``(lower, upper, guess)`` (a free initial time's last)."""
+        evaluated = self._evaluated(params)
+        return evaluated.design + ([evaluated.t0_bounds] if evaluated.t0_bounds else [])
+
+    def horizon(self, params: Mapping[str, float]) -> tuple[float, float, float]:
+        """``(lower, upper, guess)`` of the horizon ``T = t_f - t_0``; with a free initial time
+        its bounds are the widest the two times' bounds allow (their sum is a boundary constraint of
+        :meth:`end_terms`), positive."""
+        lo, hi, guess = self.final_time(params)
+        t0 = self._evaluated(params).t0_bounds
+        if t0 is None:
+            origin = self.spec.problem.time.origin
+            return lo - origin, hi - origin, guess - origin
+        earliest, latest, start = t0
+        shortest = max(lo - latest, HORIZON_FLOOR * (hi - earliest))
+        return shortest, hi - earliest, max(guess - start, shortest)
 
     def _evaluated(self, params: Mapping[str, float]) -> EvaluatedValues:
         try:

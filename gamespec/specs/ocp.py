@@ -40,6 +40,8 @@ from gamespec.symbolic.grammar import (
 from gamespec.symbolic.tables import Table
 
 INF = math.inf
+INITIAL_TIME = "t_0"
+"""The name of a free initial time: a decision variable, usable in Mayer and boundary terms."""
 OPTIONAL_SECTIONS = ("tables", "at", "measurements")
 """The sections of ``problem`` left out of its data when empty (:meth:`OcpProblem.model_dump`)."""
 NORMALIZED_TIME = "tau"
@@ -141,11 +143,47 @@ class TimeSpec(FreeOrFixed):
     """Initial time, and the final time: a value, or ``free`` within ``bounds`` (numbers or
     expressions of the parameters) from ``guess``."""
 
-    initial: Number = 0.0
+    initial: Number | Literal["free"] = Field(
+        0.0,
+        description="The initial time, or free within initial_bounds (then t_0 in Mayer and boundary terms).",
+    )
+    initial_bounds: tuple[Value, Value] | None = Field(
+        None, description="Bounds of a free initial time (numbers or expressions of the parameters)."
+    )
+    initial_guess: Number | None = Field(None, description="Starting guess of a free initial time.")
     final: Value | Literal["free"] = 1.0
 
     fixed_field: ClassVar[str] = "final"
     what: ClassVar[str] = "final time"
+
+    @model_serializer(mode="wrap")
+    def _without_unused_initial(self, handler: SerializerFunctionWrapHandler) -> dict[str, Any]:
+        """The time as data, leaving out a fixed initial time's unused bounds and guess (content
+        hashes as before they existed)."""
+        data: dict[str, Any] = handler(self)
+        return {
+            k: v for k, v in data.items() if k not in ("initial_bounds", "initial_guess") or v is not None
+        }
+
+    @property
+    def free_initial(self) -> bool:
+        return self.initial == "free"
+
+    @property
+    def origin(self) -> float:
+        """The initial time when fixed; 0 when free (the transcription's time is then shifted by the
+        free initial time, :data:`INITIAL_TIME`)."""
+        return 0.0 if self.initial == "free" else float(self.initial)
+
+    @model_validator(mode="after")
+    def _free_initial_needs_bounds(self) -> TimeSpec:
+        if self.free_initial and self.initial_bounds is None:
+            raise ValueError("a free initial time needs initial_bounds: [lower, upper]")
+        if not self.free_initial and (self.initial_bounds is not None or self.initial_guess is not None):
+            raise ValueError(
+                "initial_bounds and initial_guess are only for a free initial time (initial: free)"
+            )
+        return self
 
 
 class OcpProblem(StrictModel):
@@ -219,7 +257,7 @@ class OcpProblem(StrictModel):
             *self.design,
             *self.tables,
         ]
-        boundary = [f"{s}_{e}" for s in [*self.states, *self.controls] for e in "0f"] + ["t_f"]
+        boundary = [f"{s}_{e}" for s in [*self.states, *self.controls] for e in "0f"] + ["t_f", INITIAL_TIME]
         for name in names:
             if name == NORMALIZED_TIME:
                 raise ValueError(
@@ -263,8 +301,10 @@ class OcpProblem(StrictModel):
         if not self.at and self.measurements is None:
             return
         field = "problem.at" if self.at else "problem.measurements"
-        if self.time.free:
-            raise SpecError("interior points (at, measurements) need a fixed final time", field=field)
+        if self.time.free or self.time.free_initial:
+            raise SpecError(
+                "interior points (at, measurements) need a fixed initial and final time", field=field
+            )
         if self.measurements is not None and self.objective.sense == "maximize":
             reason = "a least-squares fit minimizes: measurements need objective.sense minimize"
             raise SpecError(reason, field="problem.measurements")
@@ -273,8 +313,8 @@ class OcpProblem(StrictModel):
         events, measured = self.interior_times(numbers)
         for where, times in (("at.{i}.time", events), ("measurements.times.{i}", measured)):
             for i, t in enumerate(times):
-                if not self.time.initial <= t <= t_final:
-                    reason = f"time {t:g} lies outside the horizon [{self.time.initial:g}, {t_final:g}]"
+                if not self.time.origin <= t <= t_final:
+                    reason = f"time {t:g} lies outside the horizon [{self.time.origin:g}, {t_final:g}]"
                     raise SpecError(reason, field="problem." + where.format(i=i))
         names = dict.fromkeys([*self.parameters, *self.design, *self.states])
         functions = self.functions
@@ -370,17 +410,28 @@ class OcpProblem(StrictModel):
             hi = number(c.upper, INF, f"integral_constraints.{i}.upper")
             _ordered(lo, hi, f"integral_constraints.{i}")
             integrals.append((lo, hi))
-        t_final = t_bounds = None
+        t_final = t_bounds = t0_bounds = None
+        earliest = self.time.origin
+        if self.time.free_initial:
+            a, b = (
+                number(v, 0.0, f"time.initial_bounds.{i}") for i, v in enumerate(self.time.initial_bounds)
+            )
+            guess = self.time.initial_guess if self.time.initial_guess is not None else 0.5 * (a + b)
+            if not a <= guess <= b:
+                raise SpecError(
+                    "initial_bounds must hold the initial_guess", field="problem.time.initial_bounds"
+                )
+            t0_bounds, earliest = (a, b, guess), a
         if self.time.free:
             lo, hi = (number(b, 0.0, f"time.bounds.{i}") for i, b in enumerate(self.time.bounds))
-            if not self.time.initial <= lo < hi:
+            if not earliest <= lo < hi:
                 raise SpecError("bounds must satisfy initial <= lower < upper", field="problem.time.bounds")
             t_bounds = (lo, hi)
         else:
             t_final = number(self.time.final, 1.0, "time.final")
-            if t_final <= self.time.initial:
+            if t_final <= earliest:
                 raise SpecError("final time must be after the initial time", field="problem.time.final")
-        return EvaluatedValues(states, controls, t_final, t_bounds, design, integrals)
+        return EvaluatedValues(states, controls, t_final, t_bounds, design, integrals, t0_bounds)
 
     def _check_expressions(self) -> None:
         """Parse every expression over the symbols its field may use; an input where it may not
@@ -404,6 +455,7 @@ class OcpProblem(StrictModel):
             **design,
             **dict.fromkeys(f"{s}_{e}" for s in [*self.states, *self.controls] for e in "0f"),
             "t_f": None,
+            **({INITIAL_TIME: None} if self.time.free_initial else {}),
         }
         timed = params | {"t": None}
         for group, items in (("states", self.states), ("controls", self.controls), ("design", self.design)):
@@ -434,6 +486,9 @@ class OcpProblem(StrictModel):
         for i, bound in enumerate(self.time.bounds or ()):
             if isinstance(bound, str):
                 checks.append((f"time.bounds.{i}", bound, params, False))
+        for i, bound in enumerate(self.time.initial_bounds or ()):
+            if isinstance(bound, str):
+                checks.append((f"time.initial_bounds.{i}", bound, params, False))
         checks += [(f"path_constraints.{i}", c, running, True) for i, c in enumerate(self.path_constraints)]
         for i, c in enumerate(self.integral_constraints):
             checks.append((f"integral_constraints.{i}.integrand", c.integrand, running, False))
@@ -556,6 +611,7 @@ class EvaluatedValues:
     t_bounds: tuple[float, float] | None = None
     design: list[tuple[float, float, float]] = dataclasses.field(default_factory=list)
     integrals: list[tuple[float, float]] = dataclasses.field(default_factory=list)
+    t0_bounds: tuple[float, float, float] | None = None
 
 
 def bounds_midpoint(lo: float, hi: float) -> float:
@@ -715,6 +771,8 @@ class OptimalControlSpec(OcpFamily, SpecBase):
         needed = {"ode"}
         if p.time.free:
             needed.add("free_final_time")
+        if p.time.free_initial:
+            needed.add("free_initial_time")
         if p.path_constraints or p.time_varying_bounds():
             needed.add("path_constraints")
         if p.integral_constraints:

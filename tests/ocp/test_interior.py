@@ -153,7 +153,7 @@ def test_alpha_pinene_fit_is_a_least_squares_optimum_of_the_exact_ode() -> None:
         ({"at": [{"time": 1.0, "constraints": ["x == u"]}]}, "undefined symbol 'u'"),
         (
             {"time": {"final": "free", "bounds": [1, 3]}, "at": [{"time": 1.0, "constraints": ["x == 1"]}]},
-            "fixed final time",
+            "fixed initial and final time",
         ),
     ],
 )

@@ -165,7 +165,7 @@ def test_bad_interior_points_are_refused_at_load(change: dict, reason: str) -> N
 
 
 def test_bad_measurements_are_refused_at_load() -> None:
-    data = _decay([0.5, 1.0], {"x": [1.0]})
+    data = _decay([0.5, 1.0], {"x": [1.0], "x + y": [1.5, 1.0]})
     with pytest.raises(SpecError, match="1 entries for 2 times"):
         spec_from_dict(data)
 
@@ -173,3 +173,10 @@ def test_bad_measurements_are_refused_at_load() -> None:
 def test_pyomo_refuses_interior_points() -> None:
     with pytest.raises(UnsupportedFeature, match="interior_points"):
         gamespec.solve(spec_from_dict(_through(0.7, 2.0, 1.0, 10)), backend="pyomo")
+
+
+def test_measurements_refuse_a_maximized_objective() -> None:
+    data = _decay([0.5, 1.0], {"x": [0.7, 0.5], "x + y": [1.5, 1.0]})
+    data["problem"]["objective"] = {"sense": "maximize"}
+    with pytest.raises(SpecError, match=r"measurements need objective\.sense minimize"):
+        spec_from_dict(data)

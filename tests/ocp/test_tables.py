@@ -199,3 +199,24 @@ def test_tables_pass_through_the_multiphase_lowering() -> None:
     assert result.status == gamespec.Status.OPTIMAL, result.message
     x0 = data["problem"]["parameters"]["x0"]
     assert result.t_final == pytest.approx(2 * math.sqrt(x0), rel=1e-8)
+
+
+def test_three_axis_npz_table_is_read_and_evaluated_as_written(tmp_path: Path) -> None:
+    """A table of x + 2y + 3z on a 3-axis grid from an NPZ file: multilinear interpolation
+    reproduces the linear function everywhere (and beyond the grid, extended linearly)."""
+    import json
+
+    axes = [np.linspace(0, 1, 3), np.linspace(-1, 1, 4), np.array([0.0, 2.0])]
+    grid = np.meshgrid(*axes, indexing="ij")
+    np.savez(
+        tmp_path / "g.npz",
+        values=grid[0] + 2 * grid[1] + 3 * grid[2],
+        axis0=axes[0],
+        axis1=axes[1],
+        axis2=axes[2],
+    )
+    problem = tmp_path / "p.json"
+    problem.write_text(json.dumps(_lq("u**2 + g(x, u, 1)", {"g": {"file": "g.npz"}})))
+    g = gamespec.load(problem).problem.functions["g"]
+    for point in ([0.3, 0.2, 1.0], [1.5, -2.0, 3.0]):
+        assert g.floats(*point) == pytest.approx(point[0] + 2 * point[1] + 3 * point[2], abs=1e-12)

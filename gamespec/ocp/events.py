@@ -20,7 +20,10 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from gamespec.ocp.collocation import Grid
-from gamespec.symbolic.grammar import Algebra, Relation, expression, relation
+from gamespec.symbolic.grammar import Algebra, Relation, at_time_name, expression, relation
+
+Weights = tuple[np.ndarray, np.ndarray]
+"""Node indices and weights of a state's value at one time (:func:`node_weights`)."""
 
 if TYPE_CHECKING:
     from gamespec.ocp.transcription import Transcription
@@ -36,7 +39,7 @@ def with_event_breaks(grid: Grid, spec: OptimalControlSpec) -> Grid:
     interval's polynomial holds inside it. The measurement times are not breaks (the states are
     smooth through them). A grid given by its mesh or per-interval degrees is kept as given."""
     problem = spec.problem
-    if not problem.at:
+    if not problem.at and not problem.inline_points():
         return grid
     params = problem.parameter_values()
     t_final = problem.evaluate(params).t_final
@@ -78,8 +81,9 @@ def states_at(X: Any, nodes: np.ndarray, weights: np.ndarray, n_x: int) -> list[
 
 @dataclass(frozen=True)
 class InteriorTerms:
-    """The ``at:`` constraints (in the order of the file) and the measurements' weighted sum of
-    squared residuals (0 without measurements)."""
+    """The boundary constraints that name states at fixed times (``x(t=5)``), then the ``at:``
+    constraints (in the order of the file), and the measurements' weighted sum of squared residuals
+    (0 without measurements)."""
 
     constraints: list[Relation]
     misfit: Any
@@ -93,30 +97,47 @@ class InteriorPoints:
     tr: Transcription
 
     @cached_property
-    def _weights(self) -> tuple[list[tuple[np.ndarray, np.ndarray]], list[tuple[np.ndarray, np.ndarray]]]:
+    def _weights(self) -> tuple[list[Weights], list[Weights], dict[float, Weights]]:
+        """The node weights of the ``at:`` times, of the measurement times and of the times that
+        boundary constraints name (``x(t=5)``), by time."""
         tr = self.tr
         params = tr.ocp.parameter_values()
         _, tf, _ = tr.ocp.final_time(params)
         events, measured = tr.spec.problem.interior_times(params)
         span = tf - tr.t0
+        at = len(tr.spec.problem.at)
         return (
-            [node_weights(tr.grid, (t - tr.t0) / span) for t in events],
+            [node_weights(tr.grid, (t - tr.t0) / span) for t in events[:at]],
             [node_weights(tr.grid, (t - tr.t0) / span) for t in measured],
+            {t: node_weights(tr.grid, (t - tr.t0) / span) for t in events[at:]},
         )
 
-    @property
-    def empty(self) -> bool:
-        problem = self.tr.spec.problem
-        return not problem.at and problem.measurements is None
+    def _inline(self, X: Any, base: Mapping[str, Any], algebra: Algebra) -> list[Relation]:
+        """The boundary constraints that name states at fixed times, over those values, the states'
+        end values, the final time and ``base``."""
+        tr = self.tr
+        problem = tr.spec.problem
+        inline = problem.inline_points()
+        if not inline:
+            return []
+        scope = dict(base)
+        for time, (nodes, weights) in self._weights[2].items():
+            values = states_at(X, nodes, weights, tr.n_x)
+            scope |= {at_time_name(x, time): v for x, v in zip(tr.ocp.states, values, strict=True)}
+        last = tr.grid.n_nodes - 1
+        for i, x in enumerate(tr.ocp.states):
+            scope |= {f"{x}_0": X[i, 0], f"{x}_f": X[i, last]}
+        scope["t_f"] = tr.ocp.final_time(tr.ocp.parameter_values())[0]
+        return [relation(problem.boundary_constraints[i], scope, algebra) for i in sorted(inline)]
 
     def terms(self, X: Any, others: Mapping[str, Any], algebra: Algebra) -> InteriorTerms:
         """The terms over the state nodes ``X`` (unscaled) and the parameters and design variables
         ``others`` (by name), built in ``algebra``."""
         tr = self.tr
         problem = tr.spec.problem
-        events, measured = self._weights
+        events, measured, _ = self._weights
         base = dict(others) | tr.ocp.functions
-        constraints = []
+        constraints = self._inline(X, base, algebra)
         for event, (nodes, weights) in zip(problem.at, events, strict=True):
             scope = base | dict(zip(tr.ocp.states, states_at(X, nodes, weights, tr.n_x), strict=True))
             constraints += [relation(c, scope, algebra) for c in event.constraints]

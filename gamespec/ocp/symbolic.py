@@ -43,8 +43,9 @@ class RunningTerms:
 @dataclass(frozen=True)
 class EndTerms:
     """The end-point terms in one algebra: the Mayer term (``sign`` applied) and the boundary
-    constraints, over ``<state>_0``, ``<state>_f``, ``<control>_0``, ``<control>_f``, ``t_f``, the
-    parameters and the design variables."""
+    constraints (but those that name a state at a fixed time, ``x(t=5)``: interior points,
+    :mod:`gamespec.ocp.events`), over ``<state>_0``, ``<state>_f``, ``<control>_0``,
+    ``<control>_f``, ``t_f``, the parameters and the design variables."""
 
     mayer: Any
     boundary: list[Relation]
@@ -166,7 +167,10 @@ class SymbolicOcp:
         problem = self.spec.problem
         scope = self._shifted(values, "t_f", algebra) | self.functions
         mayer = expression(problem.objective.mayer, scope, algebra)
-        boundary = [relation(c, scope, algebra) for c in problem.boundary_constraints]
+        inline = problem.inline_points()
+        boundary = [
+            relation(c, scope, algebra) for i, c in enumerate(problem.boundary_constraints) if i not in inline
+        ]
         if self.free_initial:
             lo, hi, _ = self.final_time(self.parameter_values())
             boundary.append(Relation(scope["t_f"], lo, hi))

@@ -31,10 +31,13 @@ from gamespec.symbolic.canonical import check
 from gamespec.symbolic.grammar import (
     FLOATS,
     RESERVED,
+    at_time,
+    at_time_name,
     dependencies,
     expression,
     numeric_value,
     relation,
+    syntax_tree,
     unknowns,
 )
 from gamespec.symbolic.tables import Table
@@ -293,14 +296,45 @@ class OcpProblem(StrictModel):
             _evaluated(e.time, values, f"problem.at.{i}.time") if isinstance(e.time, str) else float(e.time)
             for i, e in enumerate(self.at)
         ]
-        return events, [float(t) for t in (self.measurements.times if self.measurements else [])]
+        inline = sorted({t for pairs in self.inline_points().values() for _, t in pairs})
+        measured = [float(t) for t in (self.measurements.times if self.measurements else [])]
+        return events + inline, measured
+
+    def inline_points(self) -> dict[int, list[tuple[str, float]]]:
+        """Per boundary constraint that names a state at a fixed time (``x(t=5) == 1``), by its
+        index, the (state, time) pairs it names (a time that is not a number is left to the check,
+        which refuses it)."""
+        found: dict[int, list[tuple[str, float]]] = {}
+        for i, text in enumerate(self.boundary_constraints):
+            try:
+                calls = at_time(syntax_tree(text))
+            except ExpressionError:
+                continue
+            pairs = []
+            for name, node in calls:
+                try:
+                    time = numeric_value(ast.unparse(node), {})
+                except ExpressionError:
+                    continue
+                if name in self.states:
+                    pairs.append((name, time))
+            if pairs:
+                found[i] = pairs
+        return found
 
     def _check_interior_points(self) -> None:
         """Interior points need a fixed horizon that holds their times; their expressions parse
         over the states (at that time), the parameters and the design variables."""
-        if not self.at and self.measurements is None:
+        inline = self.inline_points()
+        if not self.at and self.measurements is None and not inline:
             return
-        field = "problem.at" if self.at else "problem.measurements"
+        field = (
+            "problem.at"
+            if self.at
+            else "problem.measurements"
+            if self.measurements
+            else "problem.boundary_constraints"
+        )
         if self.time.free or self.time.free_initial:
             raise SpecError(
                 "interior points (at, measurements) need a fixed initial and final time", field=field
@@ -497,9 +531,14 @@ class OcpProblem(StrictModel):
                 for key, bound in (("lower", c.lower), ("upper", c.upper))
                 if isinstance(bound, str)
             ]
-        checks += [
-            (f"boundary_constraints.{i}", c, ends, True) for i, c in enumerate(self.boundary_constraints)
-        ]
+        inline = self.inline_points()
+        control_ends = {f"{c}_{e}" for c in self.controls for e in "0f"}
+        for i, c in enumerate(self.boundary_constraints):
+            names = ends
+            if i in inline:
+                at_times = dict.fromkeys(at_time_name(x, time) for x, time in inline[i])
+                names = {k: v for k, v in ends.items() if k not in control_ends} | at_times
+            checks.append((f"boundary_constraints.{i}", c, names, True))
         numbers = self.parameter_values()
         functions = self.functions
         for field, text, symbols, constraint in checks:
@@ -785,7 +824,7 @@ class OptimalControlSpec(OcpFamily, SpecBase):
             needed.add("design_parameters")
         if p.tables:
             needed.add("tables")
-        if p.at:
+        if p.at or p.inline_points():
             needed.add("interior_points")
         if p.measurements is not None:
             needed.add("measurements")

@@ -305,6 +305,8 @@ class _Walker:
         function = self.symbols.get(node.func.id)
         if isinstance(function, FileFunction):
             return self.tabulated(node, function)
+        if node.keywords and [k.arg for k in node.keywords] == ["t"] and not node.args:
+            return self.at_time(node)
         if node.func.id not in FUNCTION_ARITY:
             raise self.fail(node, f"unknown function {node.func.id!r}")
         if node.keywords:
@@ -314,6 +316,20 @@ class _Walker:
             raise self.fail(node, f"{node.func.id} takes {arity} argument(s), got {len(node.args)}")
         return self.apply(node, self.algebra.call, node.func.id, [self(a) for a in node.args])
 
+    def at_time(self, node: ast.Call) -> Any:
+        """``x(t=5)``: the value of the name :func:`at_time_name` gives, which the scope holds where
+        a value at a fixed time may appear (the states in a boundary constraint); the time must be
+        a number."""
+        assert isinstance(node.func, ast.Name)
+        time = self.apply(node, self.algebra.scalar, self(node.keywords[0].value))
+        if time is None:
+            raise self.fail(node, f"the time of {node.func.id}(t=...) must be a number")
+        name = at_time_name(node.func.id, time)
+        if name not in self.symbols:
+            reason = "is allowed only for a state in a boundary constraint, at a number (not a parameter)"
+            raise self.fail(node, f"{node.func.id}(t=...) {reason}")
+        return self.symbols[name]
+
     def tabulated(self, node: ast.Call, function: FileFunction) -> Any:
         """A call of one of the file's functions (a table), with its arity checked."""
         if node.keywords:
@@ -321,6 +337,24 @@ class _Walker:
         if len(node.args) != function.arity:
             raise self.fail(node, f"{function.name} takes {function.arity} argument(s), got {len(node.args)}")
         return self.apply(node, self.algebra.tabulated, function, [self(a) for a in node.args])
+
+
+def at_time(tree: ast.AST) -> list[tuple[str, ast.expr]]:
+    """The ``name(t=...)`` calls in a syntax tree: each name and its time's expression."""
+    return [
+        (node.func.id, node.keywords[0].value)
+        for node in ast.walk(tree)
+        if isinstance(node, ast.Call)
+        and isinstance(node.func, ast.Name)
+        and not node.args
+        and [k.arg for k in node.keywords] == ["t"]
+    ]
+
+
+def at_time_name(name: str, time: float) -> str:
+    """The symbol that stands for ``name`` at ``time`` (``x(t=5)`` → ``x(t=5.0)``), one spelling
+    for every way of writing the time."""
+    return f"{name}(t={float(time)!r})"
 
 
 def expression(text: str | float, symbols: Mapping[str, Any], algebra: Algebra) -> Any:

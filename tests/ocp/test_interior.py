@@ -180,3 +180,32 @@ def test_measurements_refuse_a_maximized_objective() -> None:
     data["problem"]["objective"] = {"sense": "maximize"}
     with pytest.raises(SpecError, match=r"measurements need objective\.sense minimize"):
         spec_from_dict(data)
+
+
+def test_a_state_at_a_fixed_time_in_a_boundary_constraint() -> None:
+    """``x(t=1) == a`` among the boundary constraints is the same interior point as ``at:``: the
+    closed form 192 a^2 / T^3 on 7 intervals (the time becomes a mesh break)."""
+    a, T = 0.7, 2.0
+    data = _through(a, T, T / 2, 7)
+    del data["problem"]["at"]
+    data["problem"]["boundary_constraints"] = ["x(t=1) == a", "v(t=2*0.5) <= x_f + 10"]
+    result = gamespec.solve(spec_from_dict(data))
+    assert result.status == gamespec.Status.OPTIMAL, result.message
+    assert result.objective == pytest.approx(192 * a**2 / T**3, rel=1e-9)
+    assert result.checks["max_constraint_violation"] < 1e-9
+
+
+@pytest.mark.parametrize(
+    ("constraint", "reason"),
+    [
+        ("x(t=a) == 1", "at a number"),
+        ("x(t=x_f) == 1", "must be a number"),
+        ("u(t=1) == 1", "only for a state in a boundary constraint"),
+        ("x(t=1) == u_f", "undefined symbol 'u_f'"),
+    ],
+)
+def test_states_at_fixed_times_are_checked_at_load(constraint: str, reason: str) -> None:
+    data = _through(0.7, 2.0, 1.0, 10)
+    data["problem"]["boundary_constraints"] = [constraint]
+    with pytest.raises(SpecError, match=reason):
+        spec_from_dict(data)

@@ -21,6 +21,7 @@ from gamespec import registry
 from gamespec.errors import SpecError
 from gamespec.reading import read_file, read_value
 from gamespec.specs.base import NLP_OPTIONS, SpecBase, SpecT
+from gamespec.specs.tables import FOLDER
 
 
 def override_path(key: str, source: str = "--set") -> list[str]:
@@ -185,13 +186,20 @@ def spec_from_dict(data: Mapping[str, Any], source: str = "<spec>") -> SpecBase:
     except SpecError as err:
         raise SpecError(err.reason, field="kind", source=source) from None
     try:
-        spec = cls.model_validate(dict(data))
+        spec = cls.model_validate(dict(data), context={FOLDER: _folder(source)})
     except ValidationError as err:
         raise format_validation_error(err, cls, source, data) from None
     except SpecError as err:
         raise SpecError(err.reason, field=err.field, source=source) from None
     check_backend_options(spec, source)
     return spec
+
+
+def _folder(source: str) -> str:
+    """The folder of the problem file ``source`` (where its table files lie); the working directory
+    for a spec that is no file."""
+    path = Path(source)
+    return str(path.parent) if source != "<spec>" and path.suffix else "."
 
 
 def check_backend_options(spec: SpecBase, source: str) -> None:

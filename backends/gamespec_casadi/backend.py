@@ -201,6 +201,12 @@ class CasadiBackend(CollocationBackend[CasadiOptions]):
     name: ClassVar[str] = "casadi"
     options_model = CasadiOptions
     nlp_field: ClassVar[str] = "ipopt"
+    features: ClassVar[frozenset[str]] = CollocationBackend.features | {
+        "tables",
+        "interior_points",
+        "measurements",
+        "free_initial_time",
+    }
 
     @classmethod
     def available(cls) -> Availability:

@@ -12,10 +12,12 @@ parameters) to
 
 and the NLP is linear in the outputs ``O = [o_1 ... o_k]`` (constant coefficients):
 
-    g = [vec(X D^T - O_f W^T); vec(O_path^T); boundary(ends); O_integrand q],
-    J = mayer(ends) + O_L q + rate penalty(U),
+    g = [vec(X D^T - O_f W^T); vec(O_path^T); boundary(ends, interior); O_integrand q],
+    J = mayer(ends) + O_L q + rate penalty(U) + misfit(interior),
 
-the defects ``D X - T W F`` and the Lagrange quadrature of :mod:`gamespec.ocp.collocation`, with the
+the defects ``D X - T W F`` and the Lagrange quadrature of :mod:`gamespec.ocp.collocation` (the
+interior points' constraints and least-squares misfit, :mod:`gamespec.ocp.events`, linear
+combinations of X, are end-point terms here), with the
 constant matrices built here once. That split is what :mod:`gamespec_casadi.assembly`
 differentiates; :meth:`CollocationNlp.closed` puts the mapped point function in place of ``O`` for
 the flat SX graph and the MX graph.
@@ -187,12 +189,14 @@ def collocation_nlp(
     x_first_last = (ca.vertsplit(x_ends[:, 0]), ca.vertsplit(x_ends[:, 1]))
     ends = ocp.end_values(x_first_last, tr.end_controls(U), tr.t0 + horizon, others)
     end_terms = ocp.end_terms(ends, LibraryAlgebra(lib))
-    boundary = ca.vertcat(*(r.expr for r in end_terms.boundary))
-    cost = end_terms.mayer + tr.rate_penalty(U)
+    interior = tr.interior.terms(ca.diag(ca.DM(sx)) @ X_scaled, others, LibraryAlgebra(lib))
+    rows = [*end_terms.boundary, *interior.constraints]
+    boundary = ca.vertcat(*(r.expr for r in rows))
+    cost = end_terms.mayer + tr.rate_penalty(U) + interior.misfit
 
     D = Coo.of(*grid.triplets[0])
     n_defects = D.shape[0] * nx
-    weights, cost_weights = _output_weights(tr, n_o, len(end_terms.boundary))
+    weights, cost_weights = _output_weights(tr, n_o, len(rows))
     scales = Coo.of(np.arange(nx), np.arange(nx), sx, (nx, nx))
     linear = D.kron(scales).resized((weights.shape[0], w.numel()))
     lower, upper = [np.zeros(n_defects)], [np.zeros(n_defects)]
@@ -200,7 +204,7 @@ def collocation_nlp(
         lower.append(np.full(k, r.lower))
         upper.append(np.full(k, r.upper))
     integrals = ocp.integral_bounds(ocp.parameter_values())
-    for group in (end_terms.boundary, [Relation(None, lo, hi) for lo, hi in integrals]):
+    for group in (rows, [Relation(None, lo, hi) for lo, hi in integrals]):
         lower.append(np.array([r.lower for r in group]))
         upper.append(np.array([r.upper for r in group]))
     first_boundary = n_defects + k * len(running.path)
@@ -220,7 +224,7 @@ def collocation_nlp(
         weights=weights,
         cost_weights=cost_weights,
         boundary=boundary,
-        boundary_rows=list(range(first_boundary, first_boundary + len(end_terms.boundary))),
+        boundary_rows=list(range(first_boundary, first_boundary + len(rows))),
         cost=cost,
         lbg=np.concatenate(lower),
         ubg=np.concatenate(upper),

@@ -51,6 +51,17 @@ class CollocationBackend(Backend[OptimalControlSpec, NlpOptionsT]):
         }
     )
 
+    def unsupported(self, spec: SpecBase) -> str | None:
+        """:meth:`Backend.unsupported`, naming the file's tables where this backend has no
+        interpolant for them."""
+        reason = super().unsupported(spec)
+        if reason is None or not isinstance(spec, OptimalControlSpec) or "tables" in self.features:
+            return reason
+        tables = ", ".join(spec.problem.tables)
+        return reason + (
+            f" (table(s) {tables}: no interpolant on {self.name}; casadi has one)" if tables else ""
+        )
+
     def shared_options(self, spec: SpecBase) -> dict[str, Any]:
         nlp = dict(spec.solver.options.get(NLP_OPTIONS, {}))
         own = spec.solver.options.get(self.name, {})

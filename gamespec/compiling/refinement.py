@@ -48,7 +48,8 @@ def trajectory_of(tr: Transcription, result: Result) -> tuple[Trajectory, dict[s
     Win = np.array([result.arrays[f"input/{n}"] for n in tr.ocp.inputs]).reshape(tr.n_w, k)
     values = dict(result.parameters) | result.metrics.get("design", {})
     assert result.t_final is not None, "a collocation Result has a final time"
-    return Trajectory(X, U, Win, result.t_final - tr.t0), values
+    start = tr.t0 if result.time is None else float(result.time[0])
+    return Trajectory(X, U, Win, result.t_final - start), values
 
 
 Interval = tuple[float, float]

@@ -154,7 +154,8 @@ class _Lowerer:
         self.durations = [symbol(duration_name(ph.name)) for ph in self.p.phases]
         t0 = sp.Float(self.p.time.initial)
         self.starts = [t0 + sum(self.durations[:k], sp.Integer(0)) for k in range(len(self.p.phases) + 1)]
-        self.constants = self.params | self.design
+        self.functions = {n: t.named(n) for n, t in self.p.tables.items()}
+        self.constants = self.params | self.design | self.functions
         self.values = parameter_values(self.p.parameters)
 
     def phase_controls(self, ph: PhaseSpec, k: int) -> dict[str, dict[str, Any]]:
@@ -302,6 +303,7 @@ class _Lowerer:
             "solver": spec.solver.model_dump(),
             "problem": {
                 "parameters": parameters,
+                "tables": {n: t.model_dump() for n, t in p.tables.items()},
                 "states": parts.states,
                 "controls": parts.controls,
                 "design": design,
@@ -459,6 +461,7 @@ class _Lowerer:
             "name": f"{self.spec.name}/{ph.name}",
             "problem": {
                 "parameters": dict(p.parameters),
+                "tables": {n: t.model_dump() for n, t in p.tables.items()},
                 "definitions": p.definitions | ph.definitions,
                 "states": states,
                 "controls": own,

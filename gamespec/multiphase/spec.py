@@ -22,9 +22,9 @@ expression is checked at load with the field that holds it.
 
 from __future__ import annotations
 
-from typing import ClassVar, Literal
+from typing import Any, ClassVar, Literal
 
-from pydantic import Field, field_validator, model_validator
+from pydantic import Field, SerializerFunctionWrapHandler, field_validator, model_serializer, model_validator
 
 from gamespec.errors import ExpressionError, SpecError
 from gamespec.limits import MAX_INTERVALS
@@ -43,6 +43,7 @@ from gamespec.specs.ocp import (
     StateSpec,
 )
 from gamespec.specs.plot import PlotHint
+from gamespec.specs.tables import TableSpec
 from gamespec.specs.vectors import lower_problem
 from gamespec.symbolic.language import RESERVED
 
@@ -123,6 +124,10 @@ class MultiPhaseProblem(StrictModel):
     definitions: dict[str, Value] = Field(
         default_factory=dict, description="Named expressions shared by every phase."
     )
+    tables: dict[str, TableSpec] = Field(
+        default_factory=dict,
+        description="Gridded data shared by every phase, each a function of the expressions by its name.",
+    )
     states: dict[str, StateSpec]
     controls: dict[str, ControlSpec] = Field(default_factory=dict)
     design: dict[str, DesignSpec] = Field(
@@ -140,11 +145,24 @@ class MultiPhaseProblem(StrictModel):
     )
     phases: list[PhaseSpec] = Field(min_length=1)
 
+    @model_serializer(mode="wrap")
+    def _without_unused_tables(self, handler: SerializerFunctionWrapHandler) -> dict[str, Any]:
+        """The problem as data, ``tables`` left out when empty (content hashes as before it existed)."""
+        data: dict[str, Any] = handler(self)
+        return {k: v for k, v in data.items() if k != "tables" or v}
+
     @model_validator(mode="after")
     def _names(self) -> MultiPhaseProblem:
         """Names are identifiers, without the phases' separator ``__`` (a vector's component
         ``r__0``, :mod:`gamespec.specs.vectors`, has it before its index only), and not used twice."""
-        names = [*self.parameters, *self.states, *self.controls, *self.design, *self.definitions]
+        names = [
+            *self.parameters,
+            *self.states,
+            *self.controls,
+            *self.design,
+            *self.definitions,
+            *self.tables,
+        ]
         names += sorted({n for ph in self.phases for n in ph.definitions if n not in self.definitions})
         phases = [ph.name for ph in self.phases]
         for name in names + phases:

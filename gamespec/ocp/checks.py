@@ -7,7 +7,8 @@
   (trapezoidal), so the check measures the discretization, not how a signal was tabulated.
 - ``max_defect_relative``: the same gap divided by the state's scale ``max(1, max |x|)`` (what
   ``method.refine.tolerance`` is compared with).
-- ``max_constraint_violation``: bounds, fixed end values, path, boundary and integral constraints,
+- ``max_constraint_violation``: bounds, fixed end values, path, boundary, interior-point (``at:``)
+  and integral constraints,
   the integrals re-integrated with the states (RK4, as the defects) rather than by the
   transcription's own quadrature, which cannot see an integrand between its points.
 - ``control_swings/<control>``: total variation of the control over the range it spans; ``chattering``
@@ -37,6 +38,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from gamespec.ocp.compiled_checks import reintegrate
+from gamespec.specs.ocp import INITIAL_TIME
 from gamespec.symbolic.grammar import FLOATS, Relation, dependencies, unknowns
 from gamespec.symbolic.library import NUMPY, LibraryAlgebra
 
@@ -222,6 +224,8 @@ def max_constraint_violation(
     worst += [_relation_violation(r, t_eval.shape) for r in terms.path]
     ends = tr.ocp.end_terms(_end_values(tr, X, U, T, params), ARRAYS)
     worst += [_relation_violation(r, ()) for r in ends.boundary]
+    interior = tr.interior.terms(X, _arrays(params), ARRAYS)
+    worst += [_relation_violation(r, ()) for r in interior.constraints]
     q = tr.grid.triplets[2]
     if integrals is None:
         integrals = [
@@ -283,8 +287,12 @@ def mayer_slope(tr: Transcription, ends: Mapping[str, float], name: str) -> floa
 
 def hamiltonian_end_value(tr: Transcription, ends: Mapping[str, float]) -> float:
     """``-dPhi/dt_f`` at the solution's end values: the constant value of H on an autonomous,
-    free-final-time problem (transversality, e.g. eq. 2.23)."""
-    return -mayer_slope(tr, ends, "t_f")
+    free-final-time problem (transversality, e.g. eq. 2.23); with a fixed final time and a free
+    initial one, ``+dPhi/dt_0`` (the Mayer term sees ``t_f = t_0 + T``: its slope in ``t_0`` at
+    fixed ``t_f`` is the slope at fixed ``T`` less the slope in ``t_f``)."""
+    if tr.spec.problem.time.free:
+        return -mayer_slope(tr, ends, "t_f")
+    return mayer_slope(tr, ends, INITIAL_TIME) - mayer_slope(tr, ends, "t_f")
 
 
 def varying_hamiltonian(tr: Transcription, Win: np.ndarray) -> str | None:

@@ -19,10 +19,13 @@ from typing import Any
 import numpy as np
 
 from gamespec.errors import SpecError
-from gamespec.specs.ocp import EvaluatedValues, OptimalControlSpec
+from gamespec.specs.ocp import INITIAL_TIME, EvaluatedValues, OptimalControlSpec
 from gamespec.symbolic.grammar import FLOATS, Algebra, Relation, dependencies, expression, relation, unknowns
 from gamespec.symbolic.library import NUMPY, LibraryAlgebra
 from gamespec.symbolic.tape import vectorized
+
+HORIZON_FLOOR = 1e-6
+"""The shortest horizon a free initial time allows, relative to the longest: ``T`` stays positive."""
 
 
 @dataclass(frozen=True)
@@ -40,8 +43,9 @@ class RunningTerms:
 @dataclass(frozen=True)
 class EndTerms:
     """The end-point terms in one algebra: the Mayer term (``sign`` applied) and the boundary
-    constraints, over ``<state>_0``, ``<state>_f``, ``<control>_0``, ``<control>_f``, ``t_f``, the
-    parameters and the design variables."""
+    constraints (but those that name a state at a fixed time, ``x(t=5)``: interior points,
+    :mod:`gamespec.ocp.events`), over ``<state>_0``, ``<state>_f``, ``<control>_0``,
+    ``<control>_f``, ``t_f``, the parameters and the design variables."""
 
     mayer: Any
     boundary: list[Relation]
@@ -69,13 +73,26 @@ class SymbolicOcp:
 
     @property
     def design(self) -> list[str]:
-        """Names of the free static parameters (decision variables of the NLP)."""
-        return list(self.spec.problem.design)
+        """Names of the free static parameters (decision variables of the NLP), then ``t_0`` when
+        the initial time is free."""
+        free_initial = [INITIAL_TIME] if self.free_initial else []
+        return [*self.spec.problem.design, *free_initial]
+
+    @property
+    def free_initial(self) -> bool:
+        """Whether the initial time is free: the transcription's time ``t`` and final time ``t_f``
+        are then counted from 0, and every term sees them shifted by the variable ``t_0``."""
+        return self.spec.problem.time.free_initial
 
     @property
     def inputs(self) -> list[str]:
         """Names of the grid inputs (signals tabulated at the evaluation points)."""
         return list(self.spec.problem.inputs)
+
+    @property
+    def functions(self) -> dict[str, Any]:
+        """The file's tables by name (:mod:`gamespec.symbolic.tables`), in every scope."""
+        return self.spec.problem.functions
 
     @property
     def sign(self) -> float:
@@ -118,15 +135,21 @@ class SymbolicOcp:
 
     def _scope(self, values: Mapping[str, Any], algebra: Algebra) -> dict[str, Any]:
         """``values`` (by name) and each definition built over them and the earlier ones."""
-        scope = dict(values)
+        scope = dict(values) | self.functions
         for name, raw in self.spec.problem.definitions.items():
             scope[name] = expression(raw, scope, algebra)
         return scope
 
+    def _shifted(self, values: Mapping[str, Any], name: str, algebra: Algebra) -> dict[str, Any]:
+        """``values`` with the time ``name`` shifted by a free initial time (unchanged when fixed)."""
+        if not self.free_initial:
+            return dict(values)
+        return {**values, name: algebra.binary(ast.Add, values[name], values[INITIAL_TIME])}
+
     def running_terms(self, values: Mapping[str, Any], algebra: Algebra) -> RunningTerms:
         """The running terms over ``values`` (each of :attr:`running_names` by name)."""
         problem = self.spec.problem
-        scope = self._scope(values, algebra)
+        scope = self._scope(self._shifted(values, "t", algebra), algebra)
         lagrange = expression(problem.objective.lagrange, scope, algebra)
         path = [relation(c, scope, algebra) for c in problem.path_constraints]
         for name, key, raw in problem.time_varying_bounds():
@@ -142,11 +165,16 @@ class SymbolicOcp:
     def end_terms(self, values: Mapping[str, Any], algebra: Algebra) -> EndTerms:
         """The end-point terms over ``values`` (each of :attr:`end_names` by name)."""
         problem = self.spec.problem
-        mayer = expression(problem.objective.mayer, values, algebra)
-        return EndTerms(
-            mayer=algebra.binary(ast.Mult, algebra.number(self.sign), mayer),
-            boundary=[relation(c, values, algebra) for c in problem.boundary_constraints],
-        )
+        scope = self._shifted(values, "t_f", algebra) | self.functions
+        mayer = expression(problem.objective.mayer, scope, algebra)
+        inline = problem.inline_points()
+        boundary = [
+            relation(c, scope, algebra) for i, c in enumerate(problem.boundary_constraints) if i not in inline
+        ]
+        if self.free_initial:
+            lo, hi, _ = self.final_time(self.parameter_values())
+            boundary.append(Relation(scope["t_f"], lo, hi))
+        return EndTerms(mayer=algebra.binary(ast.Mult, algebra.number(self.sign), mayer), boundary=boundary)
 
     @cached_property
     def running_structure(self) -> RunningTerms:
@@ -289,8 +317,22 @@ class SymbolicOcp:
         return self._evaluated(params).controls
 
     def design_bounds(self, params: Mapping[str, float]) -> list[tuple[float, float, float]]:
-        """Per design variable: ``(lower, upper, guess)``."""
-        return self._evaluated(params).design
+        """Per design variable: ``(lower, upper, guess)`` (a free initial time's last)."""
+        evaluated = self._evaluated(params)
+        return evaluated.design + ([evaluated.t0_bounds] if evaluated.t0_bounds else [])
+
+    def horizon(self, params: Mapping[str, float]) -> tuple[float, float, float]:
+        """``(lower, upper, guess)`` of the horizon ``T = t_f - t_0``; with a free initial time
+        its bounds are the widest the two times' bounds allow (their sum is a boundary constraint of
+        :meth:`end_terms`), positive."""
+        lo, hi, guess = self.final_time(params)
+        t0 = self._evaluated(params).t0_bounds
+        if t0 is None:
+            origin = self.spec.problem.time.origin
+            return lo - origin, hi - origin, guess - origin
+        earliest, latest, start = t0
+        shortest = max(lo - latest, HORIZON_FLOOR * (hi - earliest))
+        return shortest, hi - earliest, max(guess - start, shortest)
 
     def _evaluated(self, params: Mapping[str, float]) -> EvaluatedValues:
         try:

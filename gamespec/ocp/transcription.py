@@ -18,10 +18,11 @@ import numpy as np
 from gamespec.errors import ExpressionError, SpecError
 from gamespec.ocp.checks import Trajectory, check_tolerances, control_basis, solution_checks, verdicts
 from gamespec.ocp.collocation import Grid
+from gamespec.ocp.events import InteriorPoints, with_event_breaks
 from gamespec.ocp.inputs import InputGrid, InputValue, on_grid
 from gamespec.ocp.symbolic import SymbolicOcp
 from gamespec.result import Result, Status
-from gamespec.specs.ocp import NORMALIZED_TIME, OptimalControlSpec, bounds_midpoint
+from gamespec.specs.ocp import INITIAL_TIME, NORMALIZED_TIME, OptimalControlSpec, bounds_midpoint
 from gamespec.symbolic.grammar import FLOATS, dependencies, expression, relation, unknowns
 from gamespec.symbolic.library import NUMPY, LibraryAlgebra
 
@@ -59,10 +60,14 @@ class Transcription:
         m = spec.method
         mesh = None if m.mesh is None else tuple(m.mesh)
         degrees = None if m.degrees is None else tuple(m.degrees)
-        self.grid = Grid(
-            m.scheme, m.intervals, m.degree if m.scheme == "radau" else 1, m.grading, mesh, degrees
-        )
-        self.t0 = spec.problem.time.initial
+        grid = Grid(m.scheme, m.intervals, m.degree if m.scheme == "radau" else 1, m.grading, mesh, degrees)
+        self.grid = with_event_breaks(grid, spec) if mesh is None and degrees is None else grid
+        self.t0 = spec.problem.time.origin
+
+    @cached_property
+    def interior(self) -> InteriorPoints:
+        """The ``at:`` constraints and ``measurements:`` (:mod:`gamespec.ocp.events`)."""
+        return InteriorPoints(self)
 
     @property
     def n_x(self) -> int:
@@ -82,7 +87,9 @@ class Transcription:
 
     @property
     def free_time(self) -> bool:
-        return self.spec.problem.time.free
+        """Whether the horizon ``T`` is a decision variable (a free final or initial time)."""
+        time = self.spec.problem.time
+        return time.free or time.free_initial
 
     def input_grid(self, params: Mapping[str, float] | None = None) -> InputGrid:
         """Where grid inputs are tabulated: the evaluation points in normalized time and, for a fixed
@@ -136,9 +143,9 @@ class Transcription:
         k = len(self.grid.eval_index)
         ul = np.repeat(cb[:, :1], k, axis=1)
         uu = np.repeat(cb[:, 1:], k, axis=1)
-        tf_lo, tf_hi, _ = self.ocp.final_time(params)
+        t_lo, t_hi, _ = self.ocp.horizon(params)
         db = np.array(self.ocp.design_bounds(params)).reshape(self.n_d, 3)
-        return Bounds(xl, xu, ul, uu, tf_lo - self.t0, tf_hi - self.t0, db[:, 0], db[:, 1])
+        return Bounds(xl, xu, ul, uu, t_lo, t_hi, db[:, 0], db[:, 1])
 
     def guess(self, params: Mapping[str, float], previous: Result | None = None) -> Guess:
         """The starting point: from ``previous`` (or the spec's ``guess.result`` file), else from the
@@ -151,7 +158,7 @@ class Transcription:
                 raise SpecError(reason, field="guess.result", source=self.spec.source) from None
         if previous is not None and previous.time is not None and previous.states:
             return self._guess_from_result(previous)
-        *_, tf_guess = self.ocp.final_time(params)
+        *_, horizon = self.ocp.horizon(params)
         tau_nodes = self.grid.nodes
         X = np.empty((self.n_x, self.grid.n_nodes))
         for i, (name, (lo, hi, x0, xf)) in enumerate(
@@ -168,8 +175,8 @@ class Transcription:
                 raw, self.grid.eval_tau, params, f"guess.controls.{name}", None, None, lo, hi
             )
         d = np.array([g for *_, g in self.ocp.design_bounds(params)], dtype=float)
-        self._off_flat_boundary(X, U, tf_guess, params, d)
-        return Guess(X, U, tf_guess - self.t0, d)
+        self._off_flat_boundary(X, U, self.t0 + horizon, params, d)
+        return Guess(X, U, horizon, d)
 
     def _off_flat_boundary(
         self, X: np.ndarray, U: np.ndarray, tf: float, params: Mapping[str, float], d: np.ndarray
@@ -328,11 +335,12 @@ class Transcription:
             objective -= self.ocp.sign * float(self.rate_penalty(U))
         values = np.zeros(self.n_d) if design is None else np.asarray(design, dtype=float)
         optimized = {n: float(v) for n, v in zip(self.ocp.design, values, strict=True)}
-        t_nodes = self.t0 + T * self.grid.nodes
-        t_eval = self.t0 + T * self.grid.eval_tau
+        origin = self.t0 + optimized.get(INITIAL_TIME, 0.0)
+        t_nodes = origin + T * self.grid.nodes
+        t_eval = origin + T * self.grid.eval_tau
         costates: dict[str, np.ndarray] = {}
         arrays = {f"input/{n}": inputs[i] for i, n in enumerate(self.ocp.inputs)}
-        arrays["control_mesh"] = self.t0 + T * self.grid.breaks
+        arrays["control_mesh"] = origin + T * self.grid.breaks
         lam = None
         if defect_multipliers is not None and self.grid.scheme == "radau":
             lam = defect_multipliers * self.costate_rows[None, :]
@@ -348,7 +356,7 @@ class Transcription:
             status=status,
             message=message,
             objective=objective,
-            t_final=self.t0 + T,
+            t_final=origin + T,
             solve_time_s=solve_time_s,
             iterations=iterations,
             time=t_nodes,

@@ -17,27 +17,37 @@ from collections.abc import Mapping
 from dataclasses import dataclass
 from typing import Any, ClassVar, Literal
 
-from pydantic import Field, field_validator, model_validator
+from pydantic import Field, SerializerFunctionWrapHandler, field_validator, model_serializer, model_validator
 
 from gamespec.errors import ExpressionError, SpecError
 from gamespec.limits import MAX_INTERVALS
 from gamespec.registry import Kind
 from gamespec.specs.base import Number, ProblemParameters, SpecBase, StrictModel, Value
+from gamespec.specs.events import EventSpec, MeasurementsSpec
 from gamespec.specs.plot import PlotHint
+from gamespec.specs.tables import TableSpec
 from gamespec.specs.uncertainty import UncertainParameter
 from gamespec.specs.vectors import lower_problem
 from gamespec.symbolic.canonical import check
 from gamespec.symbolic.grammar import (
     FLOATS,
     RESERVED,
+    at_time,
+    at_time_name,
     dependencies,
     expression,
     numeric_value,
     relation,
+    syntax_tree,
     unknowns,
 )
+from gamespec.symbolic.tables import Table
 
 INF = math.inf
+INITIAL_TIME = "t_0"
+"""The name of a free initial time: a decision variable, usable in Mayer and boundary terms."""
+OPTIONAL_SECTIONS = ("tables", "at", "measurements")
+"""The sections of ``problem`` left out of its data when empty (:meth:`OcpProblem.model_dump`)."""
 NORMALIZED_TIME = "tau"
 """The name of normalized time ``(t - t0) / (t_f - t0)`` in guess and input-default expressions."""
 
@@ -140,11 +150,47 @@ class TimeSpec(FreeOrFixed):
     """Initial time, and the final time: a value, or ``free`` within ``bounds`` (numbers or
     expressions of the parameters) from ``guess``."""
 
-    initial: Number = 0.0
+    initial: Number | Literal["free"] = Field(
+        0.0,
+        description="The initial time, or free within initial_bounds (then t_0 in Mayer and boundary terms).",
+    )
+    initial_bounds: tuple[Value, Value] | None = Field(
+        None, description="Bounds of a free initial time (numbers or expressions of the parameters)."
+    )
+    initial_guess: Number | None = Field(None, description="Starting guess of a free initial time.")
     final: Value | Literal["free"] = 1.0
 
     fixed_field: ClassVar[str] = "final"
     what: ClassVar[str] = "final time"
+
+    @model_serializer(mode="wrap")
+    def _without_unused_initial(self, handler: SerializerFunctionWrapHandler) -> dict[str, Any]:
+        """The time as data, leaving out a fixed initial time's unused bounds and guess (content
+        hashes as before they existed)."""
+        data: dict[str, Any] = handler(self)
+        return {
+            k: v for k, v in data.items() if k not in ("initial_bounds", "initial_guess") or v is not None
+        }
+
+    @property
+    def free_initial(self) -> bool:
+        return self.initial == "free"
+
+    @property
+    def origin(self) -> float:
+        """The initial time when fixed; 0 when free (the transcription's time is then shifted by the
+        free initial time, :data:`INITIAL_TIME`)."""
+        return 0.0 if self.initial == "free" else float(self.initial)
+
+    @model_validator(mode="after")
+    def _free_initial_needs_bounds(self) -> TimeSpec:
+        if self.free_initial and self.initial_bounds is None:
+            raise ValueError("a free initial time needs initial_bounds: [lower, upper]")
+        if not self.free_initial and (self.initial_bounds is not None or self.initial_guess is not None):
+            raise ValueError(
+                "initial_bounds and initial_guess are only for a free initial time (initial: free)"
+            )
+        return self
 
 
 class OcpProblem(StrictModel):
@@ -166,6 +212,10 @@ class OcpProblem(StrictModel):
         default_factory=dict,
         description="Named expressions used in dynamics, the Lagrange integrand and path constraints.",
     )
+    tables: dict[str, TableSpec] = Field(
+        default_factory=dict,
+        description="Gridded data, each a function of the expressions by its name (CL(mach, alpha)).",
+    )
     states: dict[str, StateSpec]
     controls: dict[str, ControlSpec] = Field(default_factory=dict)
     inputs: dict[str, InputSpec] = Field(default_factory=dict)
@@ -178,9 +228,23 @@ class OcpProblem(StrictModel):
     path_constraints: list[str] = Field(default_factory=list)
     boundary_constraints: list[str] = Field(default_factory=list)
     integral_constraints: list[IntegralConstraintSpec] = Field(default_factory=list)
+    at: list[EventSpec] = Field(
+        default_factory=list,
+        description="Interior-point constraints: [{time: ..., constraints: [...]}] over the states then.",
+    )
+    measurements: MeasurementsSpec | None = Field(
+        None, description="Measured data (times, values, weights): a least-squares term in the objective."
+    )
     uncertain: dict[str, UncertainParameter] = Field(
         default_factory=dict, description="Uncertain parameters (chapter 6) and their distributions."
     )
+
+    @model_serializer(mode="wrap")
+    def _without_unused_sections(self, handler: SerializerFunctionWrapHandler) -> dict[str, Any]:
+        """The problem as data, leaving out the interior-point and table sections a file does not
+        use: a spec's content hash (its Results' provenance) is the same as before they existed."""
+        data: dict[str, Any] = handler(self)
+        return {k: v for k, v in data.items() if k not in OPTIONAL_SECTIONS or v}
 
     @field_validator("states")
     @classmethod
@@ -198,8 +262,9 @@ class OcpProblem(StrictModel):
             *self.inputs,
             *self.definitions,
             *self.design,
+            *self.tables,
         ]
-        boundary = [f"{s}_{e}" for s in [*self.states, *self.controls] for e in "0f"] + ["t_f"]
+        boundary = [f"{s}_{e}" for s in [*self.states, *self.controls] for e in "0f"] + ["t_f", INITIAL_TIME]
         for name in names:
             if name == NORMALIZED_TIME:
                 raise ValueError(
@@ -225,7 +290,89 @@ class OcpProblem(StrictModel):
             raise ValueError(f"uncertain names derived parameters (give a number instead): {sorted(derived)}")
         self._check_expressions()
         self.evaluate(self.parameter_values())
+        self._check_interior_points()
         return self
+
+    def interior_times(self, params: Mapping[str, float]) -> tuple[list[float], list[float]]:
+        """The times of the ``at:`` entries and of the measurements for these parameter values."""
+        values = {n: float(params[n]) for n in self.parameters if n in params}
+        events = [
+            _evaluated(e.time, values, f"problem.at.{i}.time") if isinstance(e.time, str) else float(e.time)
+            for i, e in enumerate(self.at)
+        ]
+        inline = sorted({t for pairs in self.inline_points().values() for _, t in pairs})
+        measured = [float(t) for t in (self.measurements.times if self.measurements else [])]
+        return events + inline, measured
+
+    def inline_points(self) -> dict[int, list[tuple[str, float]]]:
+        """Per boundary constraint that names a state at a fixed time (``x(t=5) == 1``), by its
+        index, the (state, time) pairs it names (a time that is not a number is left to the check,
+        which refuses it)."""
+        found: dict[int, list[tuple[str, float]]] = {}
+        for i, text in enumerate(self.boundary_constraints):
+            try:
+                calls = at_time(syntax_tree(text))
+            except ExpressionError:
+                continue
+            pairs = []
+            for name, node in calls:
+                try:
+                    time = numeric_value(ast.unparse(node), {})
+                except ExpressionError:
+                    continue
+                if name in self.states:
+                    pairs.append((name, time))
+            if pairs:
+                found[i] = pairs
+        return found
+
+    def _check_interior_points(self) -> None:
+        """Interior points need a fixed horizon that holds their times; their expressions parse
+        over the states (at that time), the parameters and the design variables."""
+        inline = self.inline_points()
+        if not self.at and self.measurements is None and not inline:
+            return
+        field = (
+            "problem.at"
+            if self.at
+            else "problem.measurements"
+            if self.measurements
+            else "problem.boundary_constraints"
+        )
+        if self.time.free or self.time.free_initial:
+            raise SpecError(
+                "interior points (at, measurements) need a fixed initial and final time", field=field
+            )
+        if self.measurements is not None and self.objective.sense == "maximize":
+            reason = "a least-squares fit minimizes: measurements need objective.sense minimize"
+            raise SpecError(reason, field="problem.measurements")
+        numbers = self.parameter_values()
+        t_final = self.evaluate(numbers).t_final
+        events, measured = self.interior_times(numbers)
+        for where, times in (("at.{i}.time", events), ("measurements.times.{i}", measured)):
+            for i, t in enumerate(times):
+                if not self.time.origin <= t <= t_final:
+                    reason = f"time {t:g} lies outside the horizon [{self.time.origin:g}, {t_final:g}]"
+                    raise SpecError(reason, field="problem." + where.format(i=i))
+        names = dict.fromkeys([*self.parameters, *self.design, *self.states])
+        functions = self.functions
+        checks = [
+            (f"at.{i}.constraints.{j}", c, True)
+            for i, e in enumerate(self.at)
+            for j, c in enumerate(e.constraints)
+        ]
+        measured_keys = self.measurements.values if self.measurements else {}
+        checks += [(f"measurements.values.{key}", key, False) for key in measured_keys]
+        for field_name, text, constraint in checks:
+            try:
+                _check_at(text, names, numbers, constraint, {}, functions)
+            except ExpressionError as err:
+                raise SpecError(str(err), field=f"problem.{field_name}") from None
+
+    @property
+    def functions(self) -> dict[str, Table]:
+        """The tables as functions of the expressions, by name (each built once)."""
+        return {name: spec.named(name) for name, spec in self.tables.items()}
 
     def time_varying_bounds(self) -> list[tuple[str, str, str]]:
         """``(name, "lower" | "upper", expression)`` of each state or control bound that uses ``t``."""
@@ -301,17 +448,28 @@ class OcpProblem(StrictModel):
             hi = number(c.upper, INF, f"integral_constraints.{i}.upper")
             _ordered(lo, hi, f"integral_constraints.{i}")
             integrals.append((lo, hi))
-        t_final = t_bounds = None
+        t_final = t_bounds = t0_bounds = None
+        earliest = self.time.origin
+        if self.time.free_initial:
+            a, b = (
+                number(v, 0.0, f"time.initial_bounds.{i}") for i, v in enumerate(self.time.initial_bounds)
+            )
+            guess = self.time.initial_guess if self.time.initial_guess is not None else 0.5 * (a + b)
+            if not a <= guess <= b:
+                raise SpecError(
+                    "initial_bounds must hold the initial_guess", field="problem.time.initial_bounds"
+                )
+            t0_bounds, earliest = (a, b, guess), a
         if self.time.free:
             lo, hi = (number(b, 0.0, f"time.bounds.{i}") for i, b in enumerate(self.time.bounds))
-            if not self.time.initial <= lo < hi:
+            if not earliest <= lo < hi:
                 raise SpecError("bounds must satisfy initial <= lower < upper", field="problem.time.bounds")
             t_bounds = (lo, hi)
         else:
             t_final = number(self.time.final, 1.0, "time.final")
-            if t_final <= self.time.initial:
+            if t_final <= earliest:
                 raise SpecError("final time must be after the initial time", field="problem.time.final")
-        return EvaluatedValues(states, controls, t_final, t_bounds, design, integrals)
+        return EvaluatedValues(states, controls, t_final, t_bounds, design, integrals, t0_bounds)
 
     def _check_expressions(self) -> None:
         """Parse every expression over the symbols its field may use; an input where it may not
@@ -335,6 +493,7 @@ class OcpProblem(StrictModel):
             **design,
             **dict.fromkeys(f"{s}_{e}" for s in [*self.states, *self.controls] for e in "0f"),
             "t_f": None,
+            **({INITIAL_TIME: None} if self.time.free_initial else {}),
         }
         timed = params | {"t": None}
         for group, items in (("states", self.states), ("controls", self.controls), ("design", self.design)):
@@ -365,6 +524,9 @@ class OcpProblem(StrictModel):
         for i, bound in enumerate(self.time.bounds or ()):
             if isinstance(bound, str):
                 checks.append((f"time.bounds.{i}", bound, params, False))
+        for i, bound in enumerate(self.time.initial_bounds or ()):
+            if isinstance(bound, str):
+                checks.append((f"time.initial_bounds.{i}", bound, params, False))
         checks += [(f"path_constraints.{i}", c, running, True) for i, c in enumerate(self.path_constraints)]
         for i, c in enumerate(self.integral_constraints):
             checks.append((f"integral_constraints.{i}.integrand", c.integrand, running, False))
@@ -373,13 +535,19 @@ class OcpProblem(StrictModel):
                 for key, bound in (("lower", c.lower), ("upper", c.upper))
                 if isinstance(bound, str)
             ]
-        checks += [
-            (f"boundary_constraints.{i}", c, ends, True) for i, c in enumerate(self.boundary_constraints)
-        ]
+        inline = self.inline_points()
+        control_ends = {f"{c}_{e}" for c in self.controls for e in "0f"}
+        for i, c in enumerate(self.boundary_constraints):
+            names = ends
+            if i in inline:
+                at_times = dict.fromkeys(at_time_name(x, time) for x, time in inline[i])
+                names = {k: v for k, v in ends.items() if k not in control_ends} | at_times
+            checks.append((f"boundary_constraints.{i}", c, names, True))
         numbers = self.parameter_values()
+        functions = self.functions
         for field, text, symbols, constraint in checks:
             try:
-                _check_at(text, symbols, numbers, constraint, self.definitions)
+                _check_at(text, symbols, numbers, constraint, self.definitions, functions)
             except ExpressionError as err:
                 used = _inputs_in(constraint, text, symbols, inputs)
                 reason = (
@@ -397,15 +565,17 @@ def _check_at(
     numbers: Mapping[str, float],
     constraint: bool,
     definitions: Mapping[str, str],
+    functions: Mapping[str, Table],
 ) -> None:
-    """:func:`~gamespec.symbolic.canonical.check` of ``text`` over ``names`` (those of
+    """:func:`~gamespec.symbolic.canonical.check` of ``text`` over ``names`` (and the file's tables,
+    ``functions``) (those of
     ``definitions`` standing for their expressions), the parameters among them at their ``numbers``
     (the file's values): what is undefined, not real or out of range at those values (``acos(xf)``
     with ``xf = 2``, ``sqrt(-w)``) is refused at load, not met by the solver."""
     defined = {n: definitions[n] for n in names if n in definitions}
     free = [n for n in names if n not in defined]
     values = {n: numbers[n] for n in free if n in numbers}
-    check(text, free, values, constraint=constraint, definitions=defined)
+    check(text, free, values, constraint=constraint, definitions=defined, functions=functions)
 
 
 def parameter_values(
@@ -484,6 +654,7 @@ class EvaluatedValues:
     t_bounds: tuple[float, float] | None = None
     design: list[tuple[float, float, float]] = dataclasses.field(default_factory=list)
     integrals: list[tuple[float, float]] = dataclasses.field(default_factory=list)
+    t0_bounds: tuple[float, float, float] | None = None
 
 
 def bounds_midpoint(lo: float, hi: float) -> float:
@@ -663,6 +834,8 @@ class OptimalControlSpec(OcpFamily, SpecBase):
         needed = {"ode"}
         if p.time.free:
             needed.add("free_final_time")
+        if p.time.free_initial:
+            needed.add("free_initial_time")
         if p.path_constraints or p.time_varying_bounds():
             needed.add("path_constraints")
         if p.integral_constraints:
@@ -673,6 +846,12 @@ class OptimalControlSpec(OcpFamily, SpecBase):
             needed.add("grid_inputs")
         if p.design:
             needed.add("design_parameters")
+        if p.tables:
+            needed.add("tables")
+        if p.at or p.inline_points():
+            needed.add("interior_points")
+        if p.measurements is not None:
+            needed.add("measurements")
         return frozenset(needed)
 
 

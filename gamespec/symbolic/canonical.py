@@ -35,7 +35,15 @@ from typing import Any
 
 from gamespec.errors import ExpressionError
 from gamespec.limits import MAX_MAGNITUDE
-from gamespec.symbolic.grammar import FLOATS, Refused, expression, relation, syntax_tree, unknown
+from gamespec.symbolic.grammar import (
+    FLOATS,
+    FileFunction,
+    Refused,
+    expression,
+    relation,
+    syntax_tree,
+    unknown,
+)
 
 SCREEN_LIMIT = MAX_MAGNITUDE * 2.0**-64
 """The largest bound the screen settles: far enough below the range of a double that its own
@@ -183,6 +191,19 @@ class Screen:
                 raise Undecided from None
         return self._bounded(largest, value, False, *args, real=name not in ATOM_FUNCTIONS)
 
+    def tabulated(self, function: FileFunction, args: list[Bounded]) -> Bounded:
+        """A table: defined, finite and real for every real argument, as its derivatives (an
+        interpolant of finite data, :mod:`gamespec.symbolic.tables`)."""
+        if all(a.value is not None and a.exact for a in args):
+            value = self._float(FLOATS.tabulated, function, [a.value for a in args])
+            return self._bounded(max(1.0, abs(value)), value, False, *args)
+        if not all(a.real for a in args):
+            raise Undecided
+        value = None
+        if all(a.value is not None for a in args):
+            value = self._float(FLOATS.tabulated, function, [a.value for a in args])
+        return self._bounded(max(math.pi, *(a.bound for a in args)), value, False, *args)
+
     def scalar(self, value: Bounded) -> float | None:
         """An outer term of a chained constraint: a number the same in floats and in SymPy."""
         if value.value is None or not value.exact:
@@ -202,22 +223,25 @@ def check(
     *,
     constraint: bool = False,
     definitions: Mapping[str, str | float] | None = None,
+    functions: Mapping[str, FileFunction] | None = None,
 ) -> None:
     """Refuse ``text`` (an ExpressionError) unless it is an expression (a constraint when
     ``constraint``) over ``names``, the parameters among them at their ``values`` and each of
     ``definitions`` (in order, over the names and the definitions before it) standing for its
     expression, whose solve path is defined: its parts made of numbers finite and real in floats, as
     a backend builds them, and its SymPy form (every name a real symbol) and that form's first
-    derivatives finite and real."""
+    derivatives finite and real. ``functions`` are the file's tables by name
+    (:mod:`gamespec.symbolic.tables`)."""
     values = dict(values or {})
+    tables = dict(functions or {})
     names = [*dict.fromkeys([*names, *values])]
     definitions = _used(text, dict(definitions or {}))
     floats = {n: values[n] if n in values else unknown(n) for n in names}
-    _walk(text, floats, FLOATS, constraint, definitions)
+    _walk(text, floats | tables, FLOATS, constraint, definitions)
     try:
-        _walk(text, dict.fromkeys(names, NAME), SCREEN, constraint, definitions)
+        _walk(text, dict.fromkeys(names, NAME) | tables, SCREEN, constraint, definitions)
     except Undecided:
-        _check_in_sympy(text, names, constraint, definitions)
+        _check_in_sympy(text, names, constraint, definitions, tables)
 
 
 def _used(text: str | float, definitions: dict[str, str | float]) -> dict[str, str | float]:
@@ -245,7 +269,11 @@ def _walk(
 
 
 def _check_in_sympy(
-    text: str | float, names: list[str], constraint: bool, definitions: Mapping[str, str | float]
+    text: str | float,
+    names: list[str],
+    constraint: bool,
+    definitions: Mapping[str, str | float],
+    tables: Mapping[str, FileFunction],
 ) -> None:
     """The SymPy form of ``text`` (refused there as :mod:`gamespec.symbolic.language` refuses), and
     its first derivatives in each of its names finite, real and in the language (SymPy's own
@@ -255,10 +283,12 @@ def _check_in_sympy(
     import sympy as sp
 
     from gamespec.symbolic.language import FUNCTIONS, SYMPY, symbol
+    from gamespec.symbolic.tables import TabulatedSympy
 
     functions = (f for _, f in FUNCTIONS.values() if isinstance(f, type))
     nodes = (sp.Symbol, sp.Number, sp.NumberSymbol, sp.Add, sp.Mul, sp.Pow, sp.DiracDelta, *functions)
-    expr = _walk(text, {n: symbol(n) for n in names}, SYMPY, constraint, definitions)
+    nodes = (*nodes, TabulatedSympy.base())
+    expr = _walk(text, {n: symbol(n) for n in names} | dict(tables), SYMPY, constraint, definitions)
     for name in sorted(expr.free_symbols, key=str):
         try:
             derivative = SYMPY.finite(sp.diff(expr, name))

@@ -20,6 +20,7 @@ from __future__ import annotations
 import ast
 import math
 import operator
+from abc import ABC, abstractmethod
 from collections.abc import Callable, Iterable, Mapping
 from dataclasses import dataclass
 from functools import lru_cache
@@ -59,6 +60,23 @@ BINARY: dict[type[ast.operator], Callable[[Any, Any], Any]] = {
 """The binary operators other than ``**``, by their syntax-tree node."""
 
 
+class FileFunction(ABC):
+    """A function a problem file defines (a ``tables:`` entry, :mod:`gamespec.symbolic.tables`): the
+    value of its name among the symbols of a walk, so that ``CL(mach, alpha)`` is a call the grammar
+    knows for that file only; the walk builds it with :meth:`Algebra.tabulated`."""
+
+    name: str
+
+    @property
+    @abstractmethod
+    def arity(self) -> int:
+        """How many arguments it takes."""
+
+    @abstractmethod
+    def floats(self, *args: float) -> float:
+        """Its value at numbers."""
+
+
 class Refused(ValueError):
     """Raised by an :class:`Algebra` for a value it will not build; the walker names the column."""
 
@@ -84,6 +102,9 @@ class Algebra(Protocol):
 
     def call(self, name: str, args: list[Any]) -> Any:
         """The whitelisted function ``name`` (:data:`FUNCTION_ARITY`) of ``args``."""
+
+    def tabulated(self, function: FileFunction, args: list[Any]) -> Any:
+        """The file's function ``function`` (a table) of ``args``."""
 
     def scalar(self, value: Any) -> float | None:
         """``value`` as a float when it is a number (no symbols), else None."""
@@ -211,6 +232,9 @@ class FloatAlgebra:
     def call(self, name: str, args: list[Value]) -> Value:
         return self._apply(FLOAT_FUNCTIONS[name], *args)
 
+    def tabulated(self, function: FileFunction, args: list[Value]) -> Value:
+        return self._apply(function.floats, *args)
+
     def scalar(self, value: Value) -> float | None:
         return None if isinstance(value, Dependent) else value
 
@@ -263,6 +287,8 @@ class _Walker:
                 raise self.fail(node, f"only numbers are allowed as literals, not {node.value!r}")
             return self.apply(node, algebra.number, node.value)
         if isinstance(node, ast.Name):
+            if isinstance(self.symbols.get(node.id), FileFunction):
+                raise self.fail(node, f"table {node.id!r} used without arguments")
             if node.id in self.symbols:
                 return self.symbols[node.id]
             if node.id in CONSTANT_NAMES:
@@ -325,6 +351,11 @@ class _Walker:
     def call(self, node: ast.Call) -> Any:
         if not isinstance(node.func, ast.Name):
             raise self.fail(node, "only calls of the whitelisted functions by name are allowed")
+        function = self.symbols.get(node.func.id)
+        if isinstance(function, FileFunction):
+            return self.tabulated(node, function)
+        if node.keywords and [k.arg for k in node.keywords] == ["t"] and not node.args:
+            return self.at_time(node)
         arities = {**FUNCTION_ARITY, **getattr(self.algebra, "functions", {})}
         if node.func.id not in arities:
             raise self.fail(node, f"unknown function {node.func.id!r}")
@@ -334,6 +365,46 @@ class _Walker:
         if len(node.args) != arity:
             raise self.fail(node, f"{node.func.id} takes {arity} argument(s), got {len(node.args)}")
         return self.apply(node, self.algebra.call, node.func.id, [self(a) for a in node.args])
+
+    def at_time(self, node: ast.Call) -> Any:
+        """``x(t=5)``: the value of the name :func:`at_time_name` gives, which the scope holds where
+        a value at a fixed time may appear (the states in a boundary constraint); the time must be
+        a number."""
+        assert isinstance(node.func, ast.Name)
+        time = self.apply(node, self.algebra.scalar, self(node.keywords[0].value))
+        if time is None:
+            raise self.fail(node, f"the time of {node.func.id}(t=...) must be a number")
+        name = at_time_name(node.func.id, time)
+        if name not in self.symbols:
+            reason = "is allowed only for a state in a boundary constraint, at a number (not a parameter)"
+            raise self.fail(node, f"{node.func.id}(t=...) {reason}")
+        return self.symbols[name]
+
+    def tabulated(self, node: ast.Call, function: FileFunction) -> Any:
+        """A call of one of the file's functions (a table), with its arity checked."""
+        if node.keywords:
+            raise self.fail(node, "keyword arguments are not allowed")
+        if len(node.args) != function.arity:
+            raise self.fail(node, f"{function.name} takes {function.arity} argument(s), got {len(node.args)}")
+        return self.apply(node, self.algebra.tabulated, function, [self(a) for a in node.args])
+
+
+def at_time(tree: ast.AST) -> list[tuple[str, ast.expr]]:
+    """The ``name(t=...)`` calls in a syntax tree: each name and its time's expression."""
+    return [
+        (node.func.id, node.keywords[0].value)
+        for node in ast.walk(tree)
+        if isinstance(node, ast.Call)
+        and isinstance(node.func, ast.Name)
+        and not node.args
+        and [k.arg for k in node.keywords] == ["t"]
+    ]
+
+
+def at_time_name(name: str, time: float) -> str:
+    """The symbol that stands for ``name`` at ``time`` (``x(t=5)`` → ``x(t=5.0)``), one spelling
+    for every way of writing the time."""
+    return f"{name}(t={float(time)!r})"
 
 
 def expression(text: str | float, symbols: Mapping[str, Any], algebra: Algebra) -> Any:

@@ -22,6 +22,7 @@ from gamespec.symbolic.grammar import (
     FLOAT_FUNCTIONS,
     FUNCTION_ARITY,
     RESERVED,
+    FileFunction,
     Refused,
     Relation,
     expression,
@@ -157,6 +158,16 @@ class SympyAlgebra:
             except (ValueError, TypeError, ZeroDivisionError, RecursionError):
                 pass
         return self.finite(_SYMPY_FUNCTIONS[name](*args))
+
+    def tabulated(self, function: FileFunction, args: list[sp.Expr]) -> sp.Expr:
+        """A table (:mod:`gamespec.symbolic.tables`) of numbers computed in floats, as a backend
+        computes it; of anything else its SymPy function."""
+        if all(a.is_number for a in args):
+            try:
+                return sp.Float(function.floats(*(float_value(a) for a in args)))
+            except (ValueError, TypeError, OverflowError):
+                raise Refused("is infinite, undefined or not real") from None
+        return function.sympy(*args)  # type: ignore[attr-defined, no-any-return]
 
     def scalar(self, value: sp.Expr) -> float | None:
         return float(value) if value.is_number else None

@@ -13,15 +13,20 @@ from dataclasses import dataclass
 from functools import cached_property
 from typing import Any
 
-from gamespec.symbolic.grammar import BINARY, FLOATS, FUNCTION_ARITY
+from gamespec.symbolic.grammar import BINARY, FLOATS, FUNCTION_ARITY, FileFunction, Refused
+
+TableBuilder = Callable[[FileFunction], Callable[..., Any]]
+"""How a target evaluates a file's table: the table → a function of the target's values."""
 
 
 @dataclass(frozen=True)
 class Library:
-    """A target's elementary functions, by the names of :data:`FUNCTION_ARITY`."""
+    """A target's elementary functions, by the names of :data:`FUNCTION_ARITY`, and how it evaluates
+    a file's tables (``tables``; None for a target that has no interpolant, which refuses them)."""
 
     functions: Mapping[str, Callable[..., Any]]
     power: Callable[[Any, Any], Any] = operator.pow
+    tables: TableBuilder | None = None
 
     @classmethod
     def from_namespace(
@@ -68,15 +73,25 @@ class _NumpyFunctions(Mapping[str, Callable[..., Any]]):
         return len(self._table)
 
 
-NUMPY = Library(_NumpyFunctions(), power=_numpy_power)
+def _numpy_table(table: FileFunction) -> Callable[..., Any]:
+    return table.numpy  # type: ignore[attr-defined, no-any-return]
+
+
+def _casadi_table(table: FileFunction) -> Callable[..., Any]:
+    return table.casadi  # type: ignore[attr-defined, no-any-return]
+
+
+NUMPY = Library(_NumpyFunctions(), power=_numpy_power, tables=_numpy_table)
 
 
 def casadi_library(ca: Any) -> Library:
     """CasADi's functions by gamespec's names; ``heaviside(x) = (1 + sign(x))/2``, which is 1/2 at 0
-    as SymPy's ``Heaviside`` (CasADi's ``sign(0) = 0``)."""
-    return Library.from_namespace(
+    as SymPy's ``Heaviside`` (CasADi's ``sign(0) = 0``); a table is a ``casadi.interpolant``
+    (:class:`gamespec.symbolic.tables.Table`)."""
+    library = Library.from_namespace(
         ca, abs=ca.fabs, min=ca.fmin, max=ca.fmax, heaviside=lambda x: 0.5 * (1 + ca.sign(x))
     )
+    return Library(library.functions, library.power, tables=_casadi_table)
 
 
 class LibraryAlgebra:
@@ -114,6 +129,13 @@ class LibraryAlgebra:
         if self._numbers(*args):
             return FLOATS.call(name, args)
         return self.library.functions[name](*args)
+
+    def tabulated(self, function: FileFunction, args: list[Any]) -> Any:
+        if self._numbers(*args):
+            return FLOATS.tabulated(function, args)
+        if self.library.tables is None:
+            raise Refused(f"table {function.name!r} has no interpolant on this backend")
+        return self.library.tables(function)(*args)
 
     def scalar(self, value: Any) -> float | None:
         return float(value) if self._numbers(value) else None

@@ -58,6 +58,11 @@ class LanguagePrinter(StrPrinter):
         return ExpressionError(StrPrinter().doprint(self.expr), reason)
 
     def _print(self, expr: Any, **kwargs: Any) -> str:
+        table = getattr(expr, "table", None) if isinstance(expr, sp.Function) else None
+        if table is not None:
+            if expr.derivative:
+                raise self.fail(f"a derivative of table {table.name!r} has no form in the language")
+            return f"{table.name}({', '.join(self._print(a) for a in expr.args)})"
         if isinstance(expr, sp.Basic) and not (type(expr) is sp.Symbol or isinstance(expr, _NODES)):
             raise self.fail(f"{type(expr).__name__} has no form in the gamespec expression language")
         return super()._print(expr, **kwargs)

@@ -86,7 +86,9 @@ def _recording(library: Library, tape: Tape) -> Library:
         return lambda *args: tape.push(func, *args)
 
     functions = {name: recorder(func) for name, func in library.functions.items()}
-    return Library(functions, power=recorder(library.power))
+    tables = library.tables
+    recorded = None if tables is None else (lambda table: recorder(tables(table)))
+    return Library(functions, power=recorder(library.power), tables=recorded)
 
 
 Build = Callable[[list[Slot], Library], Sequence[Any]]

@@ -64,6 +64,8 @@ def translate(expr: sp.Expr, values: Mapping[sp.Symbol, Any], library: Library) 
             if node.args[1] != sp.S.Half:
                 raise ExpressionError(str(expr), f"heaviside with value {node.args[1]} at 0 (only 1/2)")
             out = library.functions["heaviside"](walk(node.args[0]))
+        elif getattr(node, "table", None) is not None:
+            out = _table(expr, node, library)(*(walk(a) for a in node.args))
         elif type(node) in _SYMPY_NAMES:
             func = library.functions[_SYMPY_NAMES[type(node)]]
             args = [walk(a) for a in node.args]
@@ -74,6 +76,17 @@ def translate(expr: sp.Expr, values: Mapping[sp.Symbol, Any], library: Library) 
         return out
 
     return walk(sp.sympify(expr))
+
+
+def _table(expr: sp.Expr, node: sp.Basic, library: Library) -> Any:
+    """The target's function of a table's node (:mod:`gamespec.symbolic.tables`); a derivative of
+    a table, or a target without interpolants, is refused."""
+    table = node.table  # type: ignore[attr-defined]
+    if node.derivative:  # type: ignore[attr-defined]
+        raise ExpressionError(str(expr), f"a derivative of table {table.name!r} cannot be evaluated here")
+    if library.tables is None:
+        raise ExpressionError(str(expr), f"table {table.name!r} has no interpolant on this backend")
+    return library.tables(table)
 
 
 def numeric(expr: sp.Expr, values: Mapping[sp.Symbol, float]) -> float:

@@ -11,9 +11,10 @@ import yaml
 from gamespec.loader import read_file
 from tests.conftest import PROBLEMS
 
-CASADI_ONLY = {"car_vs_train"}
+CASADI_ONLY = {"car_vs_train", "f4_min_time_climb", "alpha_pinene"}
 """Files left out of the parity tests: §6.4.3's crossing constraint (a γ = 20 super-Gaussian)
-has several local optima and ripopt stops on it with numerical difficulties."""
+has several local optima and ripopt stops on it with numerical difficulties; the F-4 climb's tables
+and alpha-pinene's measurements have no Pyomo form (the backend refuses them, issue 25)."""
 
 OCP_FILES = sorted(
     p

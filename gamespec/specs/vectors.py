@@ -16,7 +16,8 @@ scalar form by construction:
   constraint per component (``r_f == [1, 0, 0]``, ``-1 <= u <= 1``); a chained one becomes two
   one-sided constraints.
 
-A file without ``size:`` is returned unchanged (its expressions are not re-printed).
+A file without ``size:`` is returned unchanged (its expressions are not re-printed). A file with
+vectors cannot have ``tables:`` yet (refused with the reason).
 """
 
 from __future__ import annotations
@@ -318,6 +319,12 @@ def lower_problem(
     )
     if not sizes and (phases or not _uses_end_definitions(problem)):
         return problem, lambda guess, where: guess
+    if sizes and problem.get("tables"):
+        raise SpecError(
+            "tables in a file with vector states or controls are not supported yet: write the "
+            "vectors' components as scalar states",
+            field=f"{field}.tables",
+        )
     low = _Lowering(problem, sizes)
     if phases:
         low.link_phases([ph.get("name") for ph in problem.get("phases", []) if isinstance(ph, Mapping)])

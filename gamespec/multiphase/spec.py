@@ -153,8 +153,9 @@ class MultiPhaseProblem(StrictModel):
 
     @model_validator(mode="after")
     def _names(self) -> MultiPhaseProblem:
-        """Names are identifiers, without the phases' separator ``__`` (a vector's component
-        ``r__0``, :mod:`gamespec.specs.vectors`, has it before its index only), and not used twice."""
+        """Names are identifiers, not used twice, without the phases' separator ``__`` but before
+        a vector component's index (``r__0``, :mod:`gamespec.specs.vectors`; the file's own names
+        never have it, :func:`_refuse_separator`)."""
         names = [
             *self.parameters,
             *self.states,
@@ -182,6 +183,23 @@ class MultiPhaseProblem(StrictModel):
         if not self.states:
             raise ValueError("at least one state is needed")
         return self
+
+
+def _refuse_separator(problem: dict[str, Any]) -> None:
+    """A name the file gives (a parameter, state, control, design variable, definition, table or
+    phase) with the phases' separator ``__`` is refused, naming it (the lowered copies use it)."""
+    groups = ["parameters", "states", "controls", "design", "definitions", "tables"]
+    found = [(f"problem.{g}.{n}", n) for g in groups if isinstance(problem.get(g), dict) for n in problem[g]]
+    phases = problem.get("phases") if isinstance(problem.get("phases"), list) else []
+    for k, phase in enumerate(p for p in phases if isinstance(p, dict)):
+        found.append((f"problem.phases.{k}.name", phase.get("name")))
+        if isinstance(phase.get("definitions"), dict):
+            found += [(f"problem.phases.{k}.definitions.{n}", n) for n in phase["definitions"]]
+    for field, name in found:
+        if isinstance(name, str) and SEPARATOR in name:
+            raise SpecError(
+                f"{name!r} cannot be a name (has {SEPARATOR}, which the phases' copies use)", field=field
+            )
 
 
 class MultiPhaseSpec(OcpFamily, SpecBase):
@@ -217,6 +235,7 @@ class MultiPhaseSpec(OcpFamily, SpecBase):
         """Vector states and controls as their components (:mod:`gamespec.specs.vectors`)."""
         if not isinstance(data, dict) or not isinstance(data.get("problem"), dict):
             return data
+        _refuse_separator(data["problem"])
         problem, _ = lower_problem(data["problem"], phases=True)
         return data if problem is data["problem"] else {**data, "problem": problem}
 

@@ -31,14 +31,17 @@ from __future__ import annotations
 
 from collections.abc import Mapping
 from dataclasses import dataclass, field
+from functools import cached_property
 from typing import TYPE_CHECKING
 
 import numpy as np
 
 from gamespec.best_response import BestResponseRun, Settings, VectorPlayer, iterate
 from gamespec.games.evaluation import payoff_at, states_at
+from gamespec.games.expressions import GameExpressions, game_expressions
 from gamespec.games.lq_structure import LQForm, lq_form
 from gamespec.games.problems import parameter_values, player_problem, views
+from gamespec.games.simulate import Dynamics
 from gamespec.loader import with_values
 from gamespec.result import Result, Status
 from gamespec.solving import Solver, compile_spec, get_backend
@@ -159,14 +162,19 @@ class GameModel:
     joint: dict = field(default_factory=dict)
     """Per game, the stacked KKT system of ``game.scheme: joint`` (:mod:`gamespec.games.joint`),
     built on first use."""
+    expressions: GameExpressions | None = None
+    """The game's expressions in SymPy (:mod:`gamespec.games.expressions`), parsed once here
+    unless given (a receding horizon's shrinking models share their game's)."""
 
     def __post_init__(self) -> None:
         self.parameters = dict(self.game.problem.parameters) | self.parameters
-        self.lq = lq_form(self.game)
+        parsed = self.expressions = self.expressions or game_expressions(self.game)
+        self.lq = lq_form(self.game, parsed)
         names = list(self.game.problem.players)
-        for view in views(self.game):
+        for view in views(self.game, parsed):
             for player in names:
-                spec = with_tied_tolerance(player_problem(self.game, player, view), self.game.game.tolerance)
+                problem = player_problem(self.game, player, view, parsed)
+                spec = with_tied_tolerance(problem, self.game.game.tolerance)
                 opponents = {o: list(self.game.problem.players[o].controls) for o in names if o != player}
                 self.responders[(view, player)] = BestResponder(
                     player, view, compile_spec(spec), list(spec.problem.controls), opponents, spec
@@ -175,6 +183,14 @@ class GameModel:
     @property
     def views(self) -> list[str]:
         return list(dict.fromkeys(view for view, _ in self.responders))
+
+    @cached_property
+    def dynamics(self) -> Dynamics:
+        """The game's dynamics compiled for the true system and the players' predictions
+        (:mod:`gamespec.games.simulate`), built on first use."""
+        assert self.expressions is not None, "a game model has its expressions"
+        controls = [c for p in self.game.problem.players.values() for c in p.controls]
+        return Dynamics(self.expressions, controls)
 
     @property
     def builds(self) -> int:

@@ -96,7 +96,7 @@ class BestResponder:
         (the code path of ``--set``) when a value other than the step's own changes; the step's own
         (the initial state, the start time and the predicted sensitivities, which the run computes
         from the validated game) are set on the validated spec, checked to be finite numbers."""
-        values = dict(values)
+        values = {n: float(v) for n, v in values.items()}
         steady = {n: v for n, v in values.items() if not n.startswith(STEP_VALUES)}
         if steady != self.validated:
             self.spec = with_values(self.solver.spec, values)

@@ -23,7 +23,7 @@ from gamespec.games.feedback import LQGame
 from gamespec.games.feedback_game import feedback_equilibrium
 from gamespec.games.lq_structure import LQForm, lq_form, lq_game
 from gamespec.games.problems import initial_state
-from gamespec.games.simulate import TrueSystem, control_signal, grid_of, true_parameters
+from gamespec.games.simulate import ControlPlan, TrueSystem, grid_of, true_parameters
 from gamespec.result import Result, Status
 from gamespec.specs.differential_game import DifferentialGameSpec
 
@@ -104,10 +104,10 @@ def _simulated(
     grid = grid_of(game.method)
     assert reference.time is not None, "a best response has its time grid"
     horizon = float(reference.time[-1] - reference.time[0])
-    signals = {c: control_signal(grid, v, t0, horizon) for c, v in controls.items()}
-    system = TrueSystem(game, true_parameters(model))
+    plan = ControlPlan.on_grid(grid, controls, t0, horizon)
+    system = TrueSystem(model.dynamics, true_parameters(model))
     times, rows = system.advance(
-        initial_state(game, model.parameters), signals, t0, horizon, t0 + horizon * grid.nodes
+        initial_state(game, model.parameters), plan, t0, horizon, t0 + horizon * grid.nodes
     )
     return times, dict(zip(system.states, rows.T, strict=True))
 

@@ -29,25 +29,34 @@ player the file lists, every player's being in ``metrics.payoffs``.
 
 from __future__ import annotations
 
+import math
 from collections.abc import Mapping
 from dataclasses import dataclass, field
+from functools import cached_property
 from typing import TYPE_CHECKING
 
 import numpy as np
 
 from gamespec.best_response import BestResponseRun, Settings, VectorPlayer, iterate
+from gamespec.errors import SpecError
 from gamespec.games.evaluation import payoff_at, states_at
+from gamespec.games.expressions import GameExpressions, game_expressions
 from gamespec.games.lq_structure import LQForm, lq_form
 from gamespec.games.problems import parameter_values, player_problem, views
+from gamespec.games.simulate import Dynamics
 from gamespec.loader import with_values
 from gamespec.result import Result, Status
 from gamespec.solving import Solver, compile_spec, get_backend
 from gamespec.specs.differential_game import INITIAL_PREFIX, NOMINAL_PREFIX, START_TIME, DifferentialGameSpec
 from gamespec.specs.ocp import OptimalControlSpec
+from gamespec.transforms.base import with_parameter_values
 
 if TYPE_CHECKING:
     from gamespec.games.joint import JointRun
 
+STEP_VALUES = (INITIAL_PREFIX, START_TIME)
+"""The prefixes of the runtime parameters each step of a run sets (the initial state, the
+predicted sensitivities ``initial_S_...``, the start time)."""
 TOLERANCE_RATIO = 1e-2
 """A player's NLP ``tol`` is at most this fraction of ``game.tolerance``: IPOPT's error in a response
 (its KKT residual over the problem's curvature) then stays well inside the residual the game tests."""
@@ -78,11 +87,25 @@ class BestResponder:
     spec: OptimalControlSpec
     solves: int = 0
     last: Result | None = None
+    validated: dict[str, float] | None = None
+    """The values other than the step's own (:data:`STEP_VALUES`) the spec was last validated with."""
 
     def set_values(self, values: Mapping[str, float]) -> None:
         """Runtime parameter values (the initial state, the start time, the game's parameters) for
-        the next responses: validated once, re-solved on the same compiled model."""
-        self.spec = with_values(self.solver.spec, dict(values))
+        the next responses, re-solved on the same compiled model. They are validated as at load
+        (the code path of ``--set``) when a value other than the step's own changes; the step's own
+        (the initial state, the start time and the predicted sensitivities, which the run computes
+        from the validated game) are set on the validated spec, checked to be finite numbers."""
+        values = {n: float(v) for n, v in values.items()}
+        steady = {n: v for n, v in values.items() if not n.startswith(STEP_VALUES)}
+        if steady != self.validated:
+            self.spec = with_values(self.solver.spec, values)
+            self.validated = steady
+            return
+        for name, value in values.items():
+            if not math.isfinite(value):
+                raise SpecError(f"{value} is not a finite number", field=name, source=self.spec.source)
+        self.spec = with_parameter_values(self.spec, values)
 
     def respond(self, others: Mapping[str, np.ndarray]) -> tuple[np.ndarray | None, Result]:
         inputs = {
@@ -159,14 +182,19 @@ class GameModel:
     joint: dict = field(default_factory=dict)
     """Per game, the stacked KKT system of ``game.scheme: joint`` (:mod:`gamespec.games.joint`),
     built on first use."""
+    expressions: GameExpressions | None = None
+    """The game's expressions in SymPy (:mod:`gamespec.games.expressions`), parsed once here
+    unless given (a receding horizon's shrinking models share their game's)."""
 
     def __post_init__(self) -> None:
         self.parameters = dict(self.game.problem.parameters) | self.parameters
-        self.lq = lq_form(self.game)
+        parsed = self.expressions = self.expressions or game_expressions(self.game)
+        self.lq = lq_form(self.game, parsed)
         names = list(self.game.problem.players)
-        for view in views(self.game):
+        for view in views(self.game, parsed):
             for player in names:
-                spec = with_tied_tolerance(player_problem(self.game, player, view), self.game.game.tolerance)
+                problem = player_problem(self.game, player, view, parsed)
+                spec = with_tied_tolerance(problem, self.game.game.tolerance)
                 opponents = {o: list(self.game.problem.players[o].controls) for o in names if o != player}
                 self.responders[(view, player)] = BestResponder(
                     player, view, compile_spec(spec), list(spec.problem.controls), opponents, spec
@@ -175,6 +203,14 @@ class GameModel:
     @property
     def views(self) -> list[str]:
         return list(dict.fromkeys(view for view, _ in self.responders))
+
+    @cached_property
+    def dynamics(self) -> Dynamics:
+        """The game's dynamics compiled for the true system and the players' predictions
+        (:mod:`gamespec.games.simulate`), built on first use."""
+        assert self.expressions is not None, "a game model has its expressions"
+        controls = [c for p in self.game.problem.players.values() for c in p.controls]
+        return Dynamics(self.expressions, controls)
 
     @property
     def builds(self) -> int:

@@ -22,10 +22,9 @@ from dataclasses import dataclass
 import numpy as np
 import sympy as sp
 
+from gamespec.games.expressions import GameExpressions, game_expressions
 from gamespec.games.feedback import LQGame, LQPlayer
-from gamespec.games.problems import symbols_of
 from gamespec.specs.differential_game import DifferentialGameSpec
-from gamespec.symbolic.language import parse
 
 
 def not_lq(game: DifferentialGameSpec) -> str:
@@ -88,26 +87,26 @@ class LQForm:
     t0: float
 
 
-def lq_form(game: DifferentialGameSpec) -> LQForm | str:
-    """The game's expressions, or the reason it cannot be LQ (:func:`not_lq`)."""
+def lq_form(game: DifferentialGameSpec, expressions: GameExpressions | None = None) -> LQForm | str:
+    """The game's expressions (its parsed ``expressions``, parsed here when not given), or the
+    reason it cannot be LQ (:func:`not_lq`)."""
     why = not_lq(game)
     if why:
         return why
     p = game.problem
-    sym = symbols_of(game)
+    parsed = expressions or game_expressions(game)
+    sym = parsed.symbols
     controls, slices, costs = [], [], []
-    for player in p.players.values():
+    for name, player in p.players.items():
         slices.append(slice(len(controls), len(controls) + len(player.controls)))
         controls += [sym.running[c] for c in player.controls]
-        payoff = player.payoff or p.payoff
+        payoff = parsed.payoffs.get(name, parsed.payoff)
         sign = 1 if player.objective == "minimize" else -1
-        lagrange = sp.sympify(parse(payoff.lagrange, sym.running))
-        mayer = sp.sympify(parse(payoff.mayer, sym.ends))
-        costs.append((sign * lagrange, sign * mayer))
+        costs.append((sign * payoff.lagrange, sign * payoff.mayer))
     return LQForm(
-        dynamics=[sp.sympify(parse(p.dynamics[name], sym.running)) for name in p.states],
+        dynamics=[parsed.dynamics[name] for name in p.states],
         costs=costs,
-        horizon=sp.sympify(parse(p.time.final, sym.running)),
+        horizon=parsed.final_time,
         z=[sym.running[n] for n in p.states] + controls,
         ends=[sym.ends[f"{s}_f"] for s in p.states],
         parameters={n: sym.running[n] for n in p.parameters},

@@ -14,57 +14,37 @@ optimal-control problem of its own controls with the other players' controls as 
 - ``j``'s requested ``transforms`` when ``j == i`` or ``i`` knows them (the evader does not know
   the pursuer's regularizer), so the solving chain applies them.
 
-Every expression is parsed from the file and printed back from SymPy by
-:func:`~gamespec.symbolic.printer.to_text`.
+Every expression is printed back by :func:`~gamespec.symbolic.printer.to_text` from its SymPy form
+parsed once when the game is compiled (:mod:`gamespec.games.expressions`).
 """
 
 from __future__ import annotations
 
 import math
 from collections.abc import Mapping
-from dataclasses import dataclass
 
 import sympy as sp
 
+from gamespec.games.expressions import GameExpressions, game_expressions
 from gamespec.specs.differential_game import (
     INITIAL_PREFIX,
     NOMINAL_PREFIX,
     START_TIME,
     DifferentialGameSpec,
-    PayoffSpec,
     sensitivity_name,
 )
 from gamespec.specs.ocp import OptimalControlSpec, StateSpec
-from gamespec.symbolic.language import parse, parse_relation, symbol
+from gamespec.symbolic.grammar import Relation
+from gamespec.symbolic.language import symbol
 from gamespec.symbolic.printer import to_text
 
 
-@dataclass(frozen=True)
-class Symbols:
-    """The symbol tables of a game's expressions."""
-
-    running: dict[str, sp.Symbol]
-    ends: dict[str, sp.Symbol]
-    shift: dict[sp.Symbol, sp.Expr]
+def _text(expr: sp.Expr, shift: dict) -> str:
+    return to_text(expr.subs(shift))
 
 
-def symbols_of(game: DifferentialGameSpec) -> Symbols:
-    p = game.problem
-    params = {n: symbol(n) for n in [*p.parameters, *p.uncertain]}
-    controls = {c: symbol(c) for pl in p.players.values() for c in pl.controls}
-    running = params | controls | {n: symbol(n) for n in [*p.states, "t"]}
-    ends = params | {f"{s}_f": symbol(f"{s}_f") for s in p.states} | {"t_f": symbol("t_f")}
-    start = symbol(START_TIME)
-    return Symbols(running, ends, {symbol("t"): symbol("t") + start, symbol("t_f"): symbol("t_f") + start})
-
-
-def _expression(text: float | str, table: dict[str, sp.Symbol], shift: dict) -> str:
-    return to_text(sp.sympify(parse(text, table)).subs(shift))
-
-
-def _relations(text: str, table: dict[str, sp.Symbol], shift: dict) -> list[str]:
+def _relations(rel: Relation, shift: dict) -> list[str]:
     """A constraint of the file printed back (a two-sided one as two one-sided ones)."""
-    rel = parse_relation(text, table)
     expr = sp.sympify(rel.expr).subs(shift)
     if rel.lower == rel.upper:
         return [to_text(sp.Eq(expr, sp.Float(rel.lower)))]
@@ -121,12 +101,15 @@ def _initial_value(name: str, predicted: bool, uncertain: list[str]) -> str:
     return to_text(value)
 
 
-def player_problem(game: DifferentialGameSpec, player: str, view: str) -> OptimalControlSpec:
-    """``player``'s best-response problem in the game ``view`` solves (see module doc)."""
+def player_problem(
+    game: DifferentialGameSpec, player: str, view: str, expressions: GameExpressions | None = None
+) -> OptimalControlSpec:
+    """``player``'s best-response problem in the game ``view`` solves (see module doc), printed
+    from the game's parsed ``expressions`` (parsed here when not given)."""
     p = game.problem
     me = p.players[player]
-    sym = symbols_of(game)
-    running, ends, shift = sym.running, sym.ends, sym.shift
+    parsed = expressions or game_expressions(game)
+    shift = parsed.symbols.shift
     x0 = initial_state(game)
     beliefs = parameter_values(game, player, view)
     predicted = predicted_states(game, view)
@@ -149,20 +132,20 @@ def player_problem(game: DifferentialGameSpec, player: str, view: str) -> Optima
     }
     others = {n: pl for n, pl in p.players.items() if n != player}
     inputs = {c: {"default": o.start.get(c, 0.0)} for o in others.values() for c in o.controls}
-    payoff: PayoffSpec = me.payoff or p.payoff
-    path = [r for c in me.path_constraints for r in _relations(c, running, shift)]
-    terminal = [r for c in p.terminal_constraints for r in _relations(c, ends, shift)]
-    horizon = sp.sympify(parse(p.time.final, running)) - p.time.initial
+    payoff = parsed.payoffs.get(player, parsed.payoff)
+    path = [r for c in parsed.path[player] for r in _relations(c, shift)]
+    terminal = [r for c in parsed.terminal for r in _relations(c, shift)]
+    horizon = parsed.final_time - p.time.initial
     problem = {
         "parameters": parameters,
         "states": {n: s.model_dump() for n, s in states.items()},
         "controls": {n: c.model_dump() for n, c in me.controls.items()},
         "inputs": inputs,
-        "dynamics": {n: _expression(e, running, shift) for n, e in p.dynamics.items()},
+        "dynamics": {n: _text(parsed.dynamics[n], shift) for n in p.dynamics},
         "objective": {
             "sense": me.objective,
-            "mayer": _expression(payoff.mayer, ends, shift),
-            "lagrange": _expression(payoff.lagrange, running, shift),
+            "mayer": _text(payoff.mayer, shift),
+            "lagrange": _text(payoff.lagrange, shift),
         },
         "time": {"initial": 0.0, "final": to_text(horizon)},
         "path_constraints": path,
@@ -181,9 +164,10 @@ def player_problem(game: DifferentialGameSpec, player: str, view: str) -> Optima
     )
 
 
-def views(game: DifferentialGameSpec) -> list[str]:
+def views(game: DifferentialGameSpec, expressions: GameExpressions | None = None) -> list[str]:
     """The games to solve: one per player (``G^i``), or one for all when every player's problems
     are the same in every player's game (no private beliefs or transforms)."""
     names = list(game.problem.players)
-    games = [[player_problem(game, j, i).model_dump(exclude={"name"}) for j in names] for i in names]
+    parsed = expressions or game_expressions(game)
+    games = [[player_problem(game, j, i, parsed).model_dump(exclude={"name"}) for j in names] for i in names]
     return names[:1] if all(g == games[0] for g in games) else names

@@ -30,16 +30,18 @@ from collections.abc import Mapping
 from dataclasses import dataclass, field
 
 import numpy as np
+import sympy as sp
 
 from gamespec import terminal
 from gamespec.errors import SpecError
 from gamespec.games.equilibrium import GameModel, GameSolution
 from gamespec.games.problems import initial_state, predicted_states
-from gamespec.games.simulate import TrueSystem, control_signal, grid_of, true_parameters
+from gamespec.games.simulate import ControlPlan, TrueSystem, grid_of, true_parameters
 from gamespec.result import Result, Status
 from gamespec.specs.differential_game import DifferentialGameSpec, intervals_per_step, sensitivity_name
 from gamespec.symbolic.calculus import numeric_function
-from gamespec.symbolic.language import parse, parse_relation, symbol
+from gamespec.symbolic.grammar import Relation
+from gamespec.symbolic.language import symbol
 
 SAMPLES_PER_STEP = 10
 """Points of the true trajectory per step at which capture and collisions are checked."""
@@ -54,22 +56,17 @@ def believed_parameters(model: GameModel, player: str) -> dict[str, float]:
 
 
 class StateFunction:
-    """An expression of the states and parameters, read from the file, evaluated along sampled
-    trajectories."""
+    """An expression of the states and parameters (parsed once, :mod:`gamespec.games.expressions`),
+    evaluated along sampled trajectories by vectorized NumPy; a relation's bounds in ``lower`` and
+    ``upper``."""
 
-    def __init__(
-        self, game: DifferentialGameSpec, text: str | float, field: str, relation: bool = False
-    ) -> None:
+    def __init__(self, game: DifferentialGameSpec, parsed: Relation | sp.Expr) -> None:
         p = game.problem
         self.names = [*p.parameters, *p.uncertain, *p.states]
-        table = {n: symbol(n) for n in self.names}
-        try:
-            parsed = parse_relation(text, table) if relation else parse(text, table)
-        except SpecError as err:
-            raise SpecError(err.reason, field=field, source=game.source) from None
+        relation = isinstance(parsed, Relation)
         self.lower, self.upper = (parsed.lower, parsed.upper) if relation else (-np.inf, np.inf)
         expr = parsed.expr if relation else parsed
-        self._f = numeric_function([expr], [table[n] for n in self.names])
+        self._f = numeric_function([expr], [symbol(n) for n in self.names])
 
     def __call__(self, states: Mapping[str, np.ndarray], params: Mapping[str, float]) -> np.ndarray:
         return self._f(*(states[n] if n in states else params[n] for n in self.names))[0]
@@ -85,14 +82,14 @@ class Predictor:
         self.player = player
         self.observes = game.problem.players[player].observes
         believed = believed_parameters(model, player)
-        self.system = TrueSystem(game, believed)
+        self.system = TrueSystem(model.dynamics, believed)
         self.state = dict(x0)
         self.predicted = predicted_states(game, player)
         self.perturbed: dict[str, list[tuple[TrueSystem, dict[str, float], float]]] = {}
         for u in game.problem.uncertain if self.predicted else ():
             h = DIFFERENCE_STEP * max(1.0, abs(believed[u]))
             self.perturbed[u] = [
-                (TrueSystem(game, believed | {u: believed[u] + sign * h}), dict(x0), sign * h)
+                (TrueSystem(model.dynamics, believed | {u: believed[u] + sign * h}), dict(x0), sign * h)
                 for sign in (1, -1)
             ]
 
@@ -112,15 +109,15 @@ class Predictor:
         return out
 
     def advance(
-        self, x: Mapping[str, float], signals: Mapping, t: float, step: float, times: np.ndarray
+        self, x: Mapping[str, float], plan: ControlPlan, t: float, step: float, times: np.ndarray
     ) -> np.ndarray:
         """Advance the predictions over the step; the nominal prediction's rows at ``times``."""
-        _, rows = self.system.advance(self.start(x), signals, t, step, times)
+        _, rows = self.system.advance(self.start(x), plan, t, step, times)
         self.state = dict(zip(self.system.states, rows[-1], strict=True))
         for u, runs in self.perturbed.items():
             updated = []
             for system, state, h in runs:
-                _, prow = system.advance(self._merged(x, state), signals, t, step, times)
+                _, prow = system.advance(self._merged(x, state), plan, t, step, times)
                 updated.append((system, dict(zip(system.states, prow[-1], strict=True)), h))
             self.perturbed[u] = updated
         return rows
@@ -154,7 +151,7 @@ class RecedingHorizon:
         self.game = game = model.game
         self.rh = rh = game.receding_horizon
         self.players = list(game.problem.players)
-        self.truth = TrueSystem(game, true_parameters(model))
+        self.truth = TrueSystem(model.dynamics, true_parameters(model))
         self.predicting = [n for n, pl in game.problem.players.items() if pl.observes is not None]
         self.horizon = game.problem.evaluate(model.parameters).horizon
         intervals = game.method.intervals
@@ -165,18 +162,12 @@ class RecedingHorizon:
             raise SpecError(err.reason, field=err.field, source=game.source) from None
         self.points_per_step = self.intervals_per_step * grid_of(game.method).points_per_interval
         self.models: dict[int, GameModel] = {intervals: model}
-        self.capture = (
-            StateFunction(game, rh.capture.when, "receding_horizon.capture.when", True)
-            if rh.capture
-            else None
-        )
-        ob = rh.obstacle
+        assert model.expressions is not None, "a game model has its expressions"
+        stop = model.expressions.stop
+        self.capture = StateFunction(game, stop.capture) if stop.capture is not None else None
         self.obstacle = (
-            {
-                k: StateFunction(game, getattr(ob, k), f"receding_horizon.obstacle.{k}")
-                for k in ("x", "y", "radius")
-            }
-            if ob
+            {k: StateFunction(game, e) for k, e in stop.obstacle.items()}
+            if stop.obstacle is not None
             else None
         )
 
@@ -187,7 +178,10 @@ class RecedingHorizon:
             data["method"]["intervals"] = intervals
             data["problem"]["time"] = {"initial": start, "final": self.game.problem.time.final}
             game = DifferentialGameSpec.model_validate(data)
-            self.models[intervals] = GameModel(game, parameters=dict(self.model.parameters))
+            parsed = self.model.expressions
+            self.models[intervals] = GameModel(
+                game, parameters=dict(self.model.parameters), expressions=parsed
+            )
         return self.models[intervals]
 
     def _observed(
@@ -230,18 +224,20 @@ class RecedingHorizon:
                 record.steps.append(self._step_record(t, solutions))
                 self._lookahead(record, solutions, t)
                 horizon = self.horizon if keep else intervals * self.interval
-                signals = {}
-                for player, strategy in applied.items():
-                    rows = list(game.problem.players[player].controls)
-                    for row, c in enumerate(rows):
-                        signals[c] = control_signal(grid_of(model.game.method), strategy[row], t, horizon)
-                        record.controls.setdefault(c, []).append(signals[c](t + 1e-9 * rh.step))
+                values = {
+                    c: strategy[row]
+                    for player, strategy in applied.items()
+                    for row, c in enumerate(game.problem.players[player].controls)
+                }
+                plan = ControlPlan.on_grid(grid_of(model.game.method), values, t, horizon)
+                for c, value in plan.at(t + 1e-9 * rh.step).items():
+                    record.controls.setdefault(c, []).append(value)
                 record.control_time.append(t)
                 times, rows = self.truth.advance(
-                    x, signals, t, rh.step, np.linspace(t, t + rh.step, SAMPLES_PER_STEP + 1)
+                    x, plan, t, rh.step, np.linspace(t, t + rh.step, SAMPLES_PER_STEP + 1)
                 )
                 for n, predictor in predictors.items():
-                    record.predicted[n].extend(predictor.advance(x, signals, t, rh.step, times)[1:])
+                    record.predicted[n].extend(predictor.advance(x, plan, t, rh.step, times)[1:])
                 record.times.extend(times[1:])
                 record.states.extend(rows[1:])
                 x = dict(zip(self.truth.states, rows[-1], strict=True))

@@ -37,7 +37,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from gamespec.ocp.compiled_checks import reintegrate
+from gamespec.ocp.compiled_checks import point_values, reintegrate
 from gamespec.specs.ocp import INITIAL_TIME
 from gamespec.symbolic.grammar import FLOATS, Relation, dependencies, unknowns
 from gamespec.symbolic.library import NUMPY, LibraryAlgebra
@@ -69,12 +69,14 @@ class Trajectory:
     T: float
 
 
-def _running(tr: Transcription, x, u, w, t: np.ndarray, params: Mapping[str, float]) -> np.ndarray:
-    """The dynamics (first ``n_x`` rows), the Lagrange integrand (row ``n_x``) and the integral
-    constraints' integrands (the rows after it) along ``t`` (``params`` holds the design variables'
-    values too)."""
-    p = [params[n] for n in [*tr.ocp.parameters, *tr.ocp.design]]
-    return tr.ocp.running_function(*x, *u, *w, *p, t)
+def _point_values(tr: Transcription, sol: Trajectory, params: Mapping[str, float]) -> np.ndarray:
+    """The running terms at the evaluation points (:func:`~gamespec.ocp.compiled_checks.point_values`:
+    the dynamics (first ``n_x`` rows), the Lagrange integrand (row ``n_x``), the integral
+    constraints' integrands, then the path constraints' expressions; ``params`` holds the design
+    variables' values too)."""
+    t_eval = tr.t0 + sol.T * tr.grid.eval_tau
+    p = np.array([params[n] for n in [*tr.ocp.parameters, *tr.ocp.design]], dtype=float)
+    return point_values(tr, sol.X[:, tr.grid.eval_index], sol.U, sol.Win, t_eval, p)
 
 
 def control_basis(tr: Transcription, s: np.ndarray, degree: int | None = None) -> np.ndarray:
@@ -218,19 +220,19 @@ def max_constraint_violation(
     worst = [_violation(X, b.x_lower, b.x_upper), _violation(U, b.u_lower, b.u_upper)]
     worst.append(_violation(np.array([T]), b.t_lower, b.t_upper))
     worst.append(_violation(np.array([params[n] for n in tr.ocp.design]), b.d_lower, b.d_upper))
-    t_eval = tr.t0 + T * tr.grid.eval_tau
-    running = tr.ocp.running_values(X[:, tr.grid.eval_index], U, sol.Win, t_eval, _arrays(params))
-    terms = tr.ocp.running_terms(running, ARRAYS)
-    worst += [_relation_violation(r, t_eval.shape) for r in terms.path]
+    values = _point_values(tr, sol, params)
+    structure = tr.ocp.running_structure
+    first_path = tr.n_x + 1 + len(structure.integrands)
+    worst += [
+        _violation(row, r.lower, r.upper) for row, r in zip(values[first_path:], structure.path, strict=True)
+    ]
     ends = tr.ocp.end_terms(_end_values(tr, X, U, T, params), ARRAYS)
     worst += [_relation_violation(r, ()) for r in ends.boundary]
     interior = tr.interior.terms(X, _arrays(params), ARRAYS)
     worst += [_relation_violation(r, ()) for r in interior.constraints]
     q = tr.grid.triplets[2]
     if integrals is None:
-        integrals = [
-            T * q @ np.broadcast_to(np.asarray(g, dtype=float), t_eval.shape) for g in terms.integrands
-        ]
+        integrals = [T * q @ row for row in values[tr.n_x + 1 : first_path]]
     for value, (lo, hi) in zip(integrals, tr.ocp.integral_bounds(params), strict=True):
         worst.append(_violation(np.array([value]), lo, hi))
     return float(np.max(worst))
@@ -258,13 +260,12 @@ def hamiltonian(
 ) -> np.ndarray:
     """``H = sign*L + lambda^T f + nu^T g`` at the collocation points (eq. 2.22 in general form,
     augmented by the integral constraints' integrands ``g`` and their multipliers ``nu``)."""
-    t_eval = tr.t0 + sol.T * tr.grid.eval_tau
-    xe = sol.X[:, tr.grid.eval_index]
-    values = _running(tr, xe, sol.U, sol.Win, t_eval, params)
+    values = _point_values(tr, sol, params)
     nx = tr.n_x
     H = values[nx] + np.sum(lam * values[:nx], axis=0)
     if integral_multipliers is not None and len(integral_multipliers):
-        H = H + np.asarray(integral_multipliers, dtype=float) @ values[nx + 1 :]
+        n_int = len(tr.ocp.running_structure.integrands)
+        H = H + np.asarray(integral_multipliers, dtype=float) @ values[nx + 1 : nx + 1 + n_int]
     return H
 
 

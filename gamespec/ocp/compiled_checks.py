@@ -26,9 +26,10 @@ if TYPE_CHECKING:
     from gamespec.ocp.transcription import Transcription
 
 
-_FUNCTIONS: weakref.WeakKeyDictionary[Transcription, dict[tuple[int, int], Any]] = weakref.WeakKeyDictionary()
-"""Each live transcription's compiled re-integrations by (degree, steps): a compiled model keeps
-one transcription, so one build serves every re-solve."""
+_FUNCTIONS: weakref.WeakKeyDictionary[Transcription, dict[tuple[int, ...], Any]] = weakref.WeakKeyDictionary()
+"""Each live transcription's compiled re-integrations by (degree, steps) and their maps by
+(degree, steps, intervals): a compiled model keeps one transcription, so one build serves every
+re-solve."""
 
 
 def rk4_function(tr: Transcription, degree: int, steps: int, bases: np.ndarray) -> Any:
@@ -82,7 +83,7 @@ def _build(tr: Transcription, degree: int, steps: int, bases: np.ndarray) -> Any
 def _split(v: Any, rows: int) -> list[Any]:
     import casadi as ca
 
-    return ca.vertsplit(v) if rows else []
+    return list(ca.vertsplit(v)) if rows else []
 
 
 def reintegrate(
@@ -100,7 +101,44 @@ def reintegrate(
     """The ends ``(n_y, k)`` of the ``k`` intervals' re-integrations from ``y0`` (n_y, k) under their
     control and input points ``U`` (n_u, k, d), ``W`` (n_w, k, d), lengths ``h`` and starts ``t0``."""
     k = y0.shape[1]
-    mapped = rk4_function(tr, degree, steps, bases).map(k)
+    functions = _FUNCTIONS.setdefault(tr, {})
+    if (degree, steps, k) not in functions:
+        functions[degree, steps, k] = rk4_function(tr, degree, steps, bases).map(k)
+    mapped = functions[degree, steps, k]
     d = bases.shape[1]
     out = mapped(y0, U.reshape(U.shape[0], k * d), W.reshape(W.shape[0], k * d), h[None, :], t0[None, :], p)
     return np.asarray(out, dtype=float).reshape(y0.shape[0], k)
+
+
+def point_values(
+    tr: Transcription, x: np.ndarray, u: np.ndarray, w: np.ndarray, t: np.ndarray, p: np.ndarray
+) -> np.ndarray:
+    """The running terms at ``k`` points (columns of the states ``x``, controls ``u``, grid inputs
+    ``w`` and times ``t``; ``p`` the parameter and design values): the dynamics (first ``n_x``
+    rows), the Lagrange integrand (``sign`` applied), the integral constraints' integrands and the
+    path constraints' expressions (:attr:`~gamespec.ocp.symbolic.SymbolicOcp.running_structure`'s
+    order, their bounds there), one CasADi SX function of one point built once per transcription
+    and mapped over the points."""
+    t = np.atleast_1d(np.asarray(t, dtype=float))
+    k = t.size
+    functions = _FUNCTIONS.setdefault(tr, {})
+    if (k,) not in functions:
+        if () not in functions:
+            functions[()] = _point_function(tr)
+        functions[k,] = functions[()].map(k)
+    out = functions[k,](x, u, w, p, t[None, :])
+    return np.asarray(out, dtype=float).reshape(-1, k)
+
+
+def _point_function(tr: Transcription) -> Any:
+    import casadi as ca
+
+    ocp = tr.ocp
+    algebra = LibraryAlgebra(casadi_library(ca))
+    n_p = len(ocp.parameters) + len(ocp.design)
+    x, u, w = ca.SX.sym("x", tr.n_x), ca.SX.sym("u", tr.n_u), ca.SX.sym("w", tr.n_w)
+    p, t = ca.SX.sym("p", n_p), ca.SX.sym("t")
+    slots = [*_split(x, tr.n_x), *_split(u, tr.n_u), *_split(w, tr.n_w), *_split(p, n_p), t]
+    terms = ocp.running_terms(dict(zip(ocp.running_names, slots, strict=True)), algebra)
+    rows = [*terms.dynamics, terms.lagrange, *terms.integrands, *(r.expr for r in terms.path)]
+    return ca.Function("point", [x, u, w, p, t], [ca.vertcat(*rows)])

@@ -106,7 +106,7 @@ def _linear(times: np.ndarray, table: np.ndarray) -> TranscribedSignal:
     return TranscribedSignal(times, np.stack([slopes, table[:, :-1]], axis=2))
 
 
-def _mesh_polynomials(mesh: np.ndarray, times: np.ndarray, table: np.ndarray) -> TranscribedSignal:
+def mesh_polynomials(mesh: np.ndarray, times: np.ndarray, table: np.ndarray) -> TranscribedSignal:
     """The polynomial through each mesh interval's own control points (see the module doc)."""
     eps = _rounding(mesh)
     closed = abs(times[0] - mesh[0]) <= eps
@@ -139,7 +139,7 @@ def transcribed_signal(result: Result, names: list[str]) -> TranscribedSignal:
     mesh = result.arrays.get("control_mesh")
     if mesh is None:
         return _linear(times, table)
-    return _mesh_polynomials(np.asarray(mesh, dtype=float), times, table)
+    return mesh_polynomials(np.asarray(mesh, dtype=float), times, table)
 
 
 def step_edges(mesh: np.ndarray | None, t0: float, tf: float, steps: int) -> np.ndarray:

@@ -26,6 +26,8 @@ from gamespec.symbolic.tape import vectorized
 
 HORIZON_FLOOR = 1e-6
 """The shortest horizon a free initial time allows, relative to the longest: ``T`` stays positive."""
+EVALUATIONS_KEPT = 8
+"""How many parameter values' bounds a :class:`SymbolicOcp` keeps."""
 
 
 @dataclass(frozen=True)
@@ -334,11 +336,25 @@ class SymbolicOcp:
         shortest = max(lo - latest, HORIZON_FLOOR * (hi - earliest))
         return shortest, hi - earliest, max(guess - start, shortest)
 
+    @cached_property
+    def _evaluations(self) -> dict[tuple[tuple[str, float], ...], EvaluatedValues]:
+        """The last :data:`EVALUATIONS_KEPT` values of :meth:`_evaluated` by parameter values: one
+        solve and its checks ask for the bounds at the same values several times."""
+        return {}
+
     def _evaluated(self, params: Mapping[str, float]) -> EvaluatedValues:
+        key = tuple((n, float(v)) for n, v in params.items())
+        found = self._evaluations.get(key)
+        if found is not None:
+            return found
         try:
-            return self.spec.problem.evaluate(params)
+            found = self.spec.problem.evaluate(params)
         except SpecError as err:
             raise SpecError(err.reason, field=err.field, source=self.spec.source) from None
+        if len(self._evaluations) >= EVALUATIONS_KEPT:
+            self._evaluations.pop(next(iter(self._evaluations)))
+        self._evaluations[key] = found
+        return found
 
     def final_time(self, params: Mapping[str, float]) -> tuple[float, float, float]:
         """``(lower, upper, guess)`` of the final time (lower == upper when it is fixed)."""

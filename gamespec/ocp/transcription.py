@@ -63,6 +63,7 @@ class Transcription:
         grid = Grid(m.scheme, m.intervals, m.degree if m.scheme == "radau" else 1, m.grading, mesh, degrees)
         self.grid = with_event_breaks(grid, spec) if mesh is None and degrees is None else grid
         self.t0 = spec.problem.time.origin
+        self._last_bounds: tuple[tuple[tuple[str, float], ...], Bounds] | None = None
 
     @cached_property
     def interior(self) -> InteriorPoints:
@@ -130,7 +131,17 @@ class Transcription:
         return np.array(rows, dtype=float).reshape(self.n_w, len(grid))
 
     def bounds(self, params: Mapping[str, float]) -> Bounds:
-        """Bounds on X, U and T; fixed initial/final states are bounds with lower == upper."""
+        """Bounds on X, U and T; fixed initial/final states are bounds with lower == upper (those of
+        the last parameter values kept: a solve, its checks and a game's evaluation of the point
+        ask for them several times)."""
+        key = tuple((n, float(v)) for n, v in params.items())
+        if self._last_bounds is not None and self._last_bounds[0] == key:
+            return self._last_bounds[1]
+        found = self._bounds(params)
+        self._last_bounds = (key, found)
+        return found
+
+    def _bounds(self, params: Mapping[str, float]) -> Bounds:
         n = self.grid.n_nodes
         xl = np.empty((self.n_x, n))
         xu = np.empty((self.n_x, n))

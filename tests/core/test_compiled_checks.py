@@ -96,3 +96,39 @@ def test_compiled_reintegration_equals_the_numpy_one(path) -> None:
             for ours, theirs in zip(compiled, reference, strict=True):
                 scale = max(1.0, float(np.nanmax(np.abs(theirs), initial=0.0)))
                 np.testing.assert_allclose(ours, theirs, rtol=1e-10, atol=1e-10 * scale, equal_nan=True)
+
+
+def _reference_point_values(tr, sol, params) -> np.ndarray:
+    """The running terms at the evaluation points as the checks evaluated them before: the recorded
+    NumPy running function (dynamics, Lagrange integrand, integrands) and the path constraints
+    walked from the text over NumPy arrays."""
+    from gamespec.ocp.checks import ARRAYS
+
+    t_eval = tr.t0 + sol.T * tr.grid.eval_tau
+    xe = sol.X[:, tr.grid.eval_index]
+    p = [params[n] for n in [*tr.ocp.parameters, *tr.ocp.design]]
+    running = tr.ocp.running_function(*xe, *sol.U, *sol.Win, *p, t_eval)
+    arrays = {n: np.float64(v) for n, v in params.items()}
+    terms = tr.ocp.running_terms(tr.ocp.running_values(xe, sol.U, sol.Win, t_eval, arrays), ARRAYS)
+    path = [np.broadcast_to(np.asarray(r.expr, dtype=float), t_eval.shape) for r in terms.path]
+    return np.vstack([np.broadcast_to(running, (running.shape[0], t_eval.size)), *path])
+
+
+@pytest.mark.parametrize("path", [*_ocp_targets(), "time_varying"], ids=lambda p: getattr(p, "stem", p))
+def test_compiled_point_values_equal_the_numpy_ones(path) -> None:
+    """What the path-constraint, integral and Hamiltonian checks read (the running terms at the
+    evaluation points), compiled once per transcription, equals the NumPy route to 1e-10 on every
+    shipped OCP."""
+    from gamespec.ocp.checks import _point_values
+
+    target = _time_varying() if path == "time_varying" else transformed(gamespec.load(path), "casadi")
+    tr = Transcription(target)
+    params = tr.ocp.parameter_values() | dict(zip(tr.ocp.design, np.zeros(tr.n_d), strict=True))
+    start = tr.guess(params)
+    rng = np.random.default_rng(1)
+    X = start.X * (1 + 0.01 * rng.standard_normal(start.X.shape)) + 0.01 * rng.standard_normal(start.X.shape)
+    U = start.U + 0.01 * rng.standard_normal(start.U.shape)
+    sol = Trajectory(X, U, tr.input_values(params), start.T)
+    with np.errstate(all="ignore"):
+        ours, theirs = _point_values(tr, sol, params), _reference_point_values(tr, sol, params)
+    np.testing.assert_allclose(ours, theirs, rtol=1e-10, atol=1e-300, equal_nan=True)

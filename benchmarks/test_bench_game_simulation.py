@@ -1,0 +1,153 @@
+"""Chapter 7's receding horizon at the solver's pace (issue 29 items 1, 2, 6): what a run costs
+beyond its NLP solves, and the compiled pieces against the interpreted routes they replaced
+(kept as the references of ``tests/games/test_compiled_simulation.py``), each as a ratio against
+a baseline measured in the same run; and the pursuit re-simulation against the OCP solve it checks.
+
+- ``test_chapter_7_run`` (slow): the whole ``asymmetric_obstacle.yaml`` run at Q = 1, CPU seconds,
+  and the CPU seconds inside IPOPT (every player's NLP call) of the same run: ``overhead`` is
+  total / NLP (1 would be the solver's pace).
+- ``test_true_system_step``: one step of the true system (CVODES chained in CasADi) against SciPy's
+  DOP853 with a Python right-hand side.
+- ``test_point_evaluation``: the collocation states and payoff of a point (Newton in CasADi) against
+  SciPy's ``hybr`` on the NumPy tape's defects.
+- ``test_pursuit_resimulation``: an engagement's OCP solve with its ``resimulation`` analysis
+  against the same solve without it (the re-simulation is still SciPy's ``solve_ivp`` with a Python
+  right-hand side: the ratio says what it costs).
+
+Run: ``python -m pytest benchmarks/test_bench_game_simulation.py --benchmark-enable -s`` (``-m slow``
+adds the whole run).
+"""
+
+from __future__ import annotations
+
+import time
+
+import numpy as np
+import pytest
+from gamespec_casadi import backend as casadi_backend
+
+import gamespec
+from gamespec.games import evaluation
+from gamespec.games.expressions import game_expressions
+from gamespec.games.problems import player_problem
+from gamespec.games.simulate import ControlPlan, Dynamics, grid_of
+from gamespec.loader import load
+from gamespec.ocp.transcription import Transcription
+from gamespec.solving import compile_spec
+from tests.conftest import PROBLEMS
+from tests.games.test_compiled_simulation import _interpreted_advance, _interpreted_states
+
+FILE = PROBLEMS / "ch7" / "asymmetric_obstacle.yaml"
+
+
+def _cpu(function, *args, repeat: int = 1) -> tuple[object, float]:
+    started = time.process_time()
+    for _ in range(repeat):
+        out = function(*args)
+    return out, (time.process_time() - started) / repeat
+
+
+@pytest.mark.slow
+def test_chapter_7_run(benchmark, monkeypatch) -> None:
+    nlp = [0.0]
+    real = casadi_backend.nlp_solver
+
+    def timed(*args, **kwargs):
+        solver = real(*args, **kwargs)
+
+        class Timed:
+            def __call__(self, **values):
+                started = time.process_time()
+                out = solver(**values)
+                nlp[0] += time.process_time() - started
+                return out
+
+            def stats(self):
+                return solver.stats()
+
+        return Timed()
+
+    monkeypatch.setattr(casadi_backend, "nlp_solver", timed)
+    spec = load(FILE, ["problem.parameters.Q=1"])
+
+    def run():
+        nlp[0] = 0.0
+        started = time.process_time()
+        result = compile_spec(spec).solve()
+        return result, time.process_time() - started
+
+    result, cpu = benchmark.pedantic(run, rounds=1, iterations=1)
+    m = result.metrics
+    benchmark.extra_info |= {
+        "cpu_s": cpu,
+        "nlp_cpu_s": nlp[0],
+        "overhead": cpu / nlp[0],
+        "solves": m["solves"],
+        "capture_time": m["capture_time"],
+    }
+    print(
+        f"\nchapter 7, Q = 1: {cpu:.2f} s CPU, {nlp[0]:.2f} s in IPOPT ({m['solves']} solves), "
+        f"total / NLP {cpu / nlp[0]:.2f}; capture time {m['capture_time']:.6f}"
+    )
+
+
+def _step_case():
+    spec = load(FILE)
+    p = spec.problem
+    controls = [c for pl in p.players.values() for c in pl.controls]
+    grid = grid_of(spec.method)
+    rng = np.random.default_rng(0)
+    values = {c: rng.uniform(-1.0, 1.0, grid.eval_tau.size) for c in controls}
+    params = dict(p.parameters) | {n: u.actual for n, u in p.uncertain.items()}
+    horizon = p.values.horizon
+    plan = ControlPlan.on_grid(grid, values, 0.0, horizon)
+    step = spec.receding_horizon.step
+    samples = np.linspace(0.0, step, 11)
+    return spec, controls, params, plan, step, samples
+
+
+def test_true_system_step(benchmark) -> None:
+    spec, controls, params, plan, step, samples = _step_case()
+    p = spec.problem
+    dynamics = Dynamics(game_expressions(spec), controls)
+    x0 = dict(p.values.initial)
+    x = np.array([x0[s] for s in p.states])
+    vector = np.array([params[n] for n in [*p.parameters, *p.uncertain]])
+    dynamics.advance(x, vector, plan, 0.0, step, samples)
+    signals = {c: (lambda t, c=c: plan.at(t)[c]) for c in controls}
+    _, baseline = _cpu(
+        _interpreted_advance, spec, params, x0, signals, 0.0, step, samples, plan.mesh, repeat=5
+    )
+    args = (x, vector, plan, 0.0, step, samples)
+    benchmark.pedantic(dynamics.advance, args=args, rounds=50, iterations=1)
+    compiled = _cpu(dynamics.advance, *args, repeat=50)[1]
+    benchmark.extra_info |= {"interpreted_s": baseline, "speedup": baseline / compiled}
+    print(f"\ntrue system, one step: {compiled * 1e3:.2f} ms compiled, {baseline * 1e3:.2f} ms interpreted")
+
+
+def test_point_evaluation(benchmark) -> None:
+    spec = load(FILE)
+    tr = Transcription(player_problem(spec, "evader", "evader"))
+    params = tr.ocp.parameter_values()
+    rng = np.random.default_rng(1)
+    k = tr.grid.eval_tau.size
+    U, Win = rng.standard_normal((tr.n_u, k)), rng.standard_normal((tr.n_w, k))
+    start = tr.guess(params).X
+    evaluation.states_at(tr, params, U, Win, start)
+    _, baseline = _cpu(_interpreted_states, tr, params, U, Win, start, repeat=5)
+    args = (tr, params, U, Win, start)
+    benchmark.pedantic(evaluation.states_at, args=args, rounds=50, iterations=1)
+    compiled = _cpu(evaluation.states_at, *args, repeat=50)[1]
+    benchmark.extra_info |= {"interpreted_s": baseline, "speedup": baseline / compiled}
+    print(f"\npoint states: {compiled * 1e3:.2f} ms compiled, {baseline * 1e3:.2f} ms interpreted")
+
+
+def test_pursuit_resimulation(benchmark) -> None:
+    path = PROBLEMS / "ch2" / "pure_pursuit_two_on_one.yaml"
+    plain = compile_spec(gamespec.load(path), "casadi", analyses="none")
+    _, baseline = _cpu(plain.solve, repeat=3)
+    checked = compile_spec(gamespec.load(path), "casadi", analyses=["resimulation"])
+    benchmark.pedantic(checked.solve, rounds=3, iterations=1)
+    with_check = _cpu(checked.solve, repeat=3)[1]
+    benchmark.extra_info |= {"solve_without_s": baseline, "ratio": with_check / baseline}
+    print(f"\npursuit solve: {with_check:.3f} s with the re-simulation, {baseline:.3f} s without")

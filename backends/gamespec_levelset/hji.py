@@ -77,6 +77,12 @@ class HJIOptions(StrictModel):
     control_samples: int = Field(
         33, ge=3, le=257, description="Samples of a control that does not enter the dynamics affinely."
     )
+    capture_time_tolerance: float = Field(
+        0.1,
+        gt=0,
+        description="time.final: free: how much the capture time from the initial state may change "
+        "between the grid and the half-resolution one, as a fraction of it.",
+    )
     refinement_tolerance: float = Field(
         1.0,
         gt=0,
@@ -190,19 +196,27 @@ def _number(
 
 
 def target(game: DifferentialGameSpec, grid: Grid, parameters: dict[str, float]) -> np.ndarray:
-    """``l / |∇l|`` at the nodes: negative inside the capture set, the signed distance to its edge to
-    first order there (module doc), so the level set's slope is about one at the front."""
+    """``l / |∇l|`` of ``problem.capture`` at the nodes (:func:`relation_level`)."""
+    assert game.problem.capture is not None, "checked by the backend"
+    return relation_level(game, game.problem.capture, "problem.capture", grid, parameters)
+
+
+def relation_level(
+    game: DifferentialGameSpec, relation: str, field: str, grid: Grid, parameters: dict[str, float]
+) -> np.ndarray:
+    """``l / |∇l|`` at the nodes for the set ``relation`` (``g ≤ c``: ``l = g − c``; ``g ≥ c``:
+    ``l = c − g``): negative inside the set, the signed distance to its edge to first order there
+    (module doc), so the level set's slope is about one at the front."""
     p = game.problem
-    assert p.capture is not None, "checked by the backend"
     table = {n: sp.Float(v) for n, v in parameters.items()} | {s: symbol(s) for s in p.states}
-    rel = parse_relation(p.capture, table)
+    rel = parse_relation(relation, table)
     expr, names = sp.sympify(rel.expr), [symbol(s) for s in p.states]
     if math.isfinite(rel.upper) and not math.isfinite(rel.lower):
         level = expr - rel.upper
     elif math.isfinite(rel.lower) and not math.isfinite(rel.upper):
         level = rel.lower - expr
     else:
-        raise SpecError("a capture set is one one-sided relation (g <= c or g >= c)", field="problem.capture")
+        raise SpecError("a set is one one-sided relation (g <= c or g >= c)", field=field)
     gradient = sp.sqrt(sum(sp.diff(level, n) ** 2 for n in names))
     f = numeric_function([level, gradient], names)
     values = np.broadcast_to(f(grid.points[..., 0], grid.points[..., 1]), (2, *grid.shape)).astype(float)
@@ -211,20 +225,47 @@ def target(game: DifferentialGameSpec, grid: Grid, parameters: dict[str, float])
     return distance
 
 
+@dataclass(frozen=True)
+class ReachRun:
+    """What :func:`reach_value` computes: ``value`` φ(·, T) and ``half`` φ(·, T/2); ``arrival`` the
+    first τ at which each node's φ reaches zero (the minimum time to capture, ``inf`` where it does
+    not within T; linear in τ between steps); ``probe_arrival`` the same for the bilinear
+    interpolation of φ at one point (the initial state), and the ``steps`` taken."""
+
+    value: np.ndarray
+    half: np.ndarray
+    arrival: np.ndarray
+    probe_arrival: float
+    steps: int
+
+
 def reach_value(
-    hamiltonian: SampledHamiltonian, grid: Grid, initial: np.ndarray, horizon: float, scheme: str, cfl: float
-) -> tuple[np.ndarray, int]:
-    """``φ(·, horizon)`` of ``∂φ/∂τ = min(0, H)`` from ``initial`` (module doc) and the steps taken."""
+    hamiltonian: SampledHamiltonian,
+    grid: Grid,
+    initial: np.ndarray,
+    horizon: float,
+    scheme: str,
+    cfl: float,
+    avoid: np.ndarray | None = None,
+    probe: tuple[float, float] | None = None,
+) -> ReachRun:
+    """φ of ``∂φ/∂τ = min(0, H)`` from ``initial`` up to ``horizon`` (module doc); with ``avoid``
+    (``g``, positive inside the avoid set) the reach–avoid value ``φ ← max(min(φ_step, φ), g)``
+    from ``max(initial, g)``."""
     g = GHOSTS
     nx, ny = grid.shape
     dx = grid.spacing
     rate_bound = float((hamiltonian.speed[0] / dx[0] + hamiltonian.speed[1] / dx[1]).max())
-    steps = max(1, math.ceil(horizon * rate_bound / cfl))
+    steps = 2 * max(1, math.ceil(horizon / 2 * rate_bound / cfl))
     dt = horizon / steps
     padded = [np.zeros((nx + 2 * g, ny + 2 * g)) for _ in range(3)]
     inner = [a[g:-g, g:-g] for a in padded]
-    inner[0][...] = initial
+    inner[0][...] = initial if avoid is None else np.maximum(initial, avoid)
     scratch = Scratch((nx + 2 * g) * (ny + 2 * g))
+    arrival = np.where(inner[0] <= 0, 0.0, np.inf)
+    weights = _bilinear(grid, probe)
+    probe_value = _at(inner[0], weights)
+    probe_arrival = 0.0 if probe_value <= 0 else math.inf
 
     def rate(k: int) -> np.ndarray:
         extrapolate_ghosts(padded[k])
@@ -235,11 +276,43 @@ def reach_value(
         total: np.ndarray = hamiltonian(central) + dissipation
         return total
 
-    for _ in range(steps):
+    half = inner[0].copy()
+    for step in range(steps):
         before = inner[0].copy()
         tvd_rk3_step(inner[0], inner[1], inner[2], dt, rate)
         np.minimum(inner[0], before, out=inner[0])
-    return inner[0].copy(), steps
+        if avoid is not None:
+            np.maximum(inner[0], avoid, out=inner[0])
+        reached = (inner[0] <= 0) & np.isinf(arrival)
+        arrival[reached] = (step + before[reached] / (before[reached] - inner[0][reached])) * dt
+        now = _at(inner[0], weights)
+        if math.isinf(probe_arrival) and now <= 0:
+            probe_arrival = (step + probe_value / (probe_value - now)) * dt
+        probe_value = now
+        if step + 1 == steps // 2:
+            half = inner[0].copy()
+    return ReachRun(inner[0].copy(), half, arrival, probe_arrival, steps)
+
+
+def _bilinear(grid: Grid, point: tuple[float, float] | None) -> list[tuple[int, int, float]]:
+    """The nodes and weights of the bilinear interpolation at ``point`` (none without a point)."""
+    if point is None:
+        return []
+    scaled = (np.asarray(point) - np.asarray(grid.lower)) / grid.spacing
+    base = np.clip(np.floor(scaled).astype(int), 0, np.asarray(grid.shape) - 2)
+    fx, fy = scaled - base
+    i, j = int(base[0]), int(base[1])
+    return [
+        (i, j, (1 - fx) * (1 - fy)),
+        (i + 1, j, fx * (1 - fy)),
+        (i, j + 1, (1 - fx) * fy),
+        (i + 1, j + 1, fx * fy),
+    ]
+
+
+def _at(values: np.ndarray, weights: list[tuple[int, int, float]]) -> float:
+    """``values`` interpolated with ``weights`` (:func:`_bilinear`; +inf without a point)."""
+    return float(sum(w * values[i, j] for i, j, w in weights)) if weights else math.inf
 
 
 class HJIModel(CompiledModel):
@@ -263,46 +336,66 @@ class HJIModel(CompiledModel):
         self.box = (corner("lower"), corner("upper"))
 
     def _region(
-        self, nodes: int, parameters: dict[str, float], horizon: float
-    ) -> tuple[Grid, np.ndarray, np.ndarray, int]:
-        """The grid, ``φ`` at the horizon and at half of it, and the steps taken."""
+        self, nodes: int, parameters: dict[str, float], horizon: float, probe: tuple[float, float] | None
+    ) -> tuple[Grid, ReachRun, bool]:
+        """The grid, the reach (–avoid) run on it and whether the min and max were taken separately
+        (Isaacs' condition holds for the sampled controls)."""
         grid = Grid(self.box[0], self.box[1], (nodes, nodes))
         ham = sampled_hamiltonian(self.game, grid, self.options.control_samples, parameters)
         start = target(self.game, grid, parameters)
-        half, first = reach_value(ham, grid, start, horizon / 2, self.options.scheme, self.options.cfl)
-        value, second = reach_value(ham, grid, half, horizon / 2, self.options.scheme, self.options.cfl)
-        return grid, value, half, first + second
+        avoid = self.game.problem.avoid
+        barrier = (
+            None if avoid is None else -relation_level(self.game, avoid, "problem.avoid", grid, parameters)
+        )
+        o = self.options
+        run = reach_value(ham, grid, start, horizon, o.scheme, o.cfl, barrier, probe)
+        return grid, run, ham.joint is None
 
     def solve(
         self, parameters: dict[str, float] | None = None, guess: Result | None = None, inputs: Inputs = None
     ) -> Result:
         refuse_inputs(inputs, self.game.kind)
         values = self.parameters | (parameters or {})
-        horizon = self.options.horizon or self.game.problem.evaluate(values).horizon
+        evaluated = self.game.problem.evaluate(values)
+        horizon = self.options.horizon or evaluated.horizon
+        probe = None
+        if self.game.problem.time.free:
+            x0, y0 = evaluated.initial.values()
+            probe = (x0, y0)
+            if not all(lo <= v <= hi for lo, v, hi in zip(self.box[0], probe, self.box[1], strict=True)):
+                raise SpecError(
+                    f"the initial state {probe} lies outside the grid {self.box}", field="solver.options.hji"
+                )
         n = self.options.nodes
-        grid, value, half, steps = self._region(n, values, horizon)
-        coarse = self._region((n + 1) // 2, values, horizon)[1]
-        captured = value <= 0
-        shift = boundary_shift(captured, coarse <= 0, grid)
+        grid, run, separable = self._region(n, values, horizon, probe)
+        coarse_grid, coarse, _ = self._region((n + 1) // 2, values, horizon, probe)
+        captured = run.value <= 0
+        shift = boundary_shift(captured, coarse.value <= 0, grid)
         cell = float(np.prod(grid.spacing))
         region: dict[str, Any] = {
             "area": float(captured.sum()) * cell,
             "fraction": float(captured.mean()),
-            "area_at_half_horizon": float((half <= 0).sum()) * cell,
+            "area_at_half_horizon": float((run.half <= 0).sum()) * cell,
             "horizon": horizon,
             "nodes": n,
             "lower": list(grid.lower),
             "upper": list(grid.upper),
             "states": list(self.game.problem.states),
+            "avoid": self.game.problem.avoid is not None,
         }
         tolerance = self.options.refinement_tolerance
-        return Result(
+        result = Result(
             status=Status.OPTIMAL,
             message=f"captured {region['fraction']:.1%} of the grid within T = {horizon:g} "
             f"({region['area_at_half_horizon'] / max(region['area'], cell):.0%} of it within T/2)",
-            iterations=steps,
+            iterations=run.steps,
             parameters=values,
-            arrays={"value": value, "grid_x": grid.axes[0], "grid_y": grid.axes[1]},
+            arrays={
+                "value": run.value,
+                "capture_time": run.arrival,
+                "grid_x": grid.axes[0],
+                "grid_y": grid.axes[1],
+            },
             checks={"capture_region_refinement": shift},
             metrics={
                 "capture_region": region,
@@ -312,6 +405,82 @@ class HJIModel(CompiledModel):
                 "check_tolerances": {"capture_region_refinement": tolerance},
             },
         )
+        if probe is None:
+            return result
+        outcomes = outcome(run, grid), outcome(coarse, coarse_grid)
+        return game_of_degree(self.game, result, run, outcomes, coarse, separable, self.options)
+
+
+def outcome(run: ReachRun, grid: Grid) -> Literal["capture", "escape", "undecided"]:
+    """What the value says from the initial state: ``capture`` when φ there reaches zero within the
+    time bound; ``escape`` when it does not and the captured set has converged — the same at the
+    bound as at half of it, and clear of the grid's two outer rings of nodes (where the
+    extrapolated ghost nodes guess what lies outside) — so the minimum time to capture is +∞ there;
+    otherwise ``undecided``."""
+    if math.isfinite(run.probe_arrival):
+        return "capture"
+    captured = run.value <= 0
+    ring = np.ones_like(captured)
+    ring[2:-2, 2:-2] = False
+    steady = bool(np.array_equal(captured, run.half <= 0))
+    return "escape" if steady and not np.any(captured & ring) else "undecided"
+
+
+def game_of_degree(
+    game: DifferentialGameSpec,
+    result: Result,
+    run: ReachRun,
+    outcomes: tuple[str, str],
+    coarse: ReachRun,
+    separable: bool,
+    options: HJIOptions,
+) -> Result:
+    """``result`` (the capture region) completed for a game of degree (``time.final: free``): the
+    minimum time to capture from the initial state (the payoff, +∞ on escape), the outcome, and the
+    check that the half-resolution grid decides the same with a capture time within
+    ``capture_time_tolerance`` of it, relatively (``checks.capture_time_refinement``)."""
+    decided, other = outcomes
+    bound = result.metrics["capture_region"]["horizon"]
+    if decided == "capture" and other == "capture":
+        change: float | None = abs(run.probe_arrival - coarse.probe_arrival) / max(run.probe_arrival, 1e-12)
+    else:
+        change = 0.0 if decided == other == "escape" else None
+    tolerance = options.capture_time_tolerance
+    time = run.probe_arrival
+    players = game.problem.players
+    metrics = result.metrics | {
+        "outcome": decided,
+        "captured": decided == "capture",
+        "capture_time": time if decided == "capture" else None,
+        "solution_concept": "saddle" if separable else "upper_value",
+        "value_function": "minimum time to capture (HJI, time-to-reach)",
+        "payoffs": {name: time if decided == "capture" else math.inf for name in players},
+        "checks_passed": result.metrics["checks_passed"]
+        | {"capture_time_refinement": change is not None and change <= tolerance},
+        "check_tolerances": result.metrics["check_tolerances"] | {"capture_time_refinement": tolerance},
+    }
+    checks = result.checks | {"capture_time_refinement": change}
+    if decided == "undecided":
+        return result.model_copy(
+            update={
+                "status": Status.ITERATION_LIMIT,
+                "message": f"undecided: not captured within t_f <= {bound:g}, and the captured set still "
+                "grows there or reaches the grid's edge (raise problem.time.bounds or widen "
+                "solver.options.hji.lower/upper)",
+                "metrics": metrics,
+                "checks": checks,
+            }
+        )
+    said = f"captured at t_f = {time:.4g}" if decided == "capture" else "escape (the capture time is +inf)"
+    return result.model_copy(
+        update={
+            "message": f"{said}; {result.message}",
+            "objective": time if decided == "capture" else math.inf,
+            "t_final": time if decided == "capture" else None,
+            "metrics": metrics,
+            "checks": checks,
+        }
+    )
 
 
 def boundary_shift(fine: np.ndarray, coarse: np.ndarray, grid: Grid) -> float:
@@ -348,6 +517,9 @@ class HJIBackend(Backend[DifferentialGameSpec, HJIOptions]):
             return "the hji backend solves autonomous games (dynamics free of t)"
         if spec.receding_horizon is not None:
             return "the hji backend computes a value function, not a receding-horizon run"
+        bounds = p.time.bounds
+        if bounds is not None and _number(bounds[0], dict(p.parameters)) != p.time.initial:
+            return "the hji backend computes the capture time from t_0: make the lower bound on t_f equal t_0"
         return None
 
     def _compile(self, spec: DifferentialGameSpec, options: HJIOptions) -> HJIModel:

@@ -382,6 +382,7 @@ class HJIModel(CompiledModel):
             "upper": list(grid.upper),
             "states": list(self.game.problem.states),
             "avoid": self.game.problem.avoid is not None,
+            "converged": converged(run),
         }
         tolerance = self.options.refinement_tolerance
         result = Result(
@@ -413,17 +414,22 @@ class HJIModel(CompiledModel):
 
 def outcome(run: ReachRun, grid: Grid) -> Literal["capture", "escape", "undecided"]:
     """What the value says from the initial state: ``capture`` when φ there reaches zero within the
-    time bound; ``escape`` when it does not and the captured set has converged — the same at the
-    bound as at half of it, and clear of the grid's two outer rings of nodes (where the
-    extrapolated ghost nodes guess what lies outside) — so the minimum time to capture is +∞ there;
-    otherwise ``undecided``."""
+    time bound; ``escape`` when it does not and the captured set has :func:`converged`, so the
+    minimum time to capture is +∞ there; otherwise ``undecided``."""
     if math.isfinite(run.probe_arrival):
         return "capture"
+    return "escape" if converged(run) else "undecided"
+
+
+def converged(run: ReachRun) -> bool:
+    """Whether the captured set has stopped growing: the same at the horizon as at half of it, and
+    clear of the grid's two outer rings of nodes (where the ghost nodes' extrapolation guesses what
+    lies outside). Below Isaacs' barrier threshold the barrier closes it off and the rest escapes;
+    above it the set keeps growing (``metrics.capture_region.converged``)."""
     captured = run.value <= 0
     ring = np.ones_like(captured)
     ring[2:-2, 2:-2] = False
-    steady = bool(np.array_equal(captured, run.half <= 0))
-    return "escape" if steady and not np.any(captured & ring) else "undecided"
+    return bool(np.array_equal(captured, run.half <= 0)) and not bool(np.any(captured & ring))
 
 
 def game_of_degree(

@@ -42,7 +42,7 @@ import sympy as sp
 from pydantic import Field, model_validator
 
 from gamespec.compiling import Backend, CompiledModel, Inputs, refuse_inputs
-from gamespec.errors import SpecError
+from gamespec.errors import SpecError, UnsupportedFeature
 from gamespec.flowfield.grid import Grid
 from gamespec.flowfield.scratch import Scratch
 from gamespec.flowfield.tvd_rk import tvd_rk3_step
@@ -73,6 +73,18 @@ class HJIOptions(StrictModel):
         None, gt=0, description="How long the pursuers have to capture (default: the game's horizon)."
     )
     scheme: Literal["first_order", "eno2", "weno5"] = Field("eno2", description="The upwind scheme.")
+    engine: Literal["gamespec", "hj_reachability"] = Field(
+        "gamespec",
+        description="gamespec: the project's level-set numerics; hj_reachability: the same value by "
+        "hj_reachability on JAX (the optional hj extra; gamespec_levelset.hji_jax).",
+    )
+    hj_outputs: int = Field(
+        100,
+        ge=2,
+        le=5000,
+        description="engine: hj_reachability: the stored times per half horizon (capture times are "
+        "linear between them).",
+    )
     cfl: float = Field(0.5, gt=0, le=1, description="The CFL number of the time step.")
     control_samples: int = Field(
         33, ge=3, le=257, description="Samples of a control that does not enter the dynamics affinely."
@@ -137,10 +149,22 @@ def _samples(
     return [dict(zip(names, combo, strict=True)) for combo in itertools.product(*per)]
 
 
-def sampled_hamiltonian(
-    game: DifferentialGameSpec, grid: Grid, samples: int, parameters: dict[str, float]
-) -> SampledHamiltonian:
-    """The dynamics of ``game`` sampled at ``grid``'s nodes over the players' control boxes (module doc)."""
+@dataclass(frozen=True)
+class ControlSamples:
+    """The game's dynamics as SymPy expressions over the states and controls (the parameters
+    substituted), and the samples of the minimizers' (``us``) and maximizers' (``ds``) controls
+    (module doc); ``separable`` when no component mixes a minimizer's and a maximizer's control."""
+
+    exprs: list[sp.Expr]
+    states: list[str]
+    controls: list[str]
+    us: list[dict[str, float]]
+    ds: list[dict[str, float]]
+    separable: bool
+
+
+def control_samples(game: DifferentialGameSpec, samples: int, parameters: dict[str, float]) -> ControlSamples:
+    """The dynamics and the samples of the players' control boxes (:class:`ControlSamples`)."""
     p = game.problem
     states = list(p.states)
     table = {n: sp.Float(v) for n, v in parameters.items()} | {
@@ -154,19 +178,27 @@ def sampled_hamiltonian(
         for pl in p.players.values()
         for c, ctl in pl.controls.items()
     }
-    controls = [*minimizers, *maximizers]
-    f = numeric_function(exprs, [symbol(s) for s in states] + [symbol(c) for c in controls])
+    us, ds = _samples(exprs, minimizers, bounds, samples), _samples(exprs, maximizers, bounds, samples)
+    separable = all(
+        sp.diff(e, symbol(u), symbol(d)) == 0 for e in exprs for u in minimizers for d in maximizers
+    )
+    return ControlSamples(exprs, states, [*minimizers, *maximizers], us, ds, separable)
+
+
+def sampled_hamiltonian(
+    game: DifferentialGameSpec, grid: Grid, samples: int, parameters: dict[str, float]
+) -> SampledHamiltonian:
+    """The dynamics of ``game`` sampled at ``grid``'s nodes over the players' control boxes (module doc)."""
+    sampled = control_samples(game, samples, parameters)
+    controls, us, ds, separable = sampled.controls, sampled.us, sampled.ds, sampled.separable
+    f = numeric_function(sampled.exprs, [symbol(s) for s in sampled.states] + [symbol(c) for c in controls])
     x, y = grid.points[..., 0], grid.points[..., 1]
 
     def at(u: dict[str, float]) -> np.ndarray:
         return np.broadcast_to(f(x, y, *(u[c] for c in controls)), (2, *x.shape)).astype(float)
 
-    us, ds = _samples(exprs, minimizers, bounds, samples), _samples(exprs, maximizers, bounds, samples)
     u0, d0 = us[0], ds[0]
     base = at(u0 | d0)
-    separable = all(
-        sp.diff(e, symbol(u), symbol(d)) == 0 for e in exprs for u in minimizers for d in maximizers
-    )
     if separable:
         pursuer = np.stack([at(u | d0) - base for u in us])
         evader = np.stack([at(u0 | d) - base for d in ds])
@@ -263,8 +295,8 @@ def reach_value(
     inner[0][...] = initial if avoid is None else np.maximum(initial, avoid)
     scratch = Scratch((nx + 2 * g) * (ny + 2 * g))
     arrival = np.where(inner[0] <= 0, 0.0, np.inf)
-    weights = _bilinear(grid, probe)
-    probe_value = _at(inner[0], weights)
+    weights = bilinear(grid, probe)
+    probe_value = at_point(inner[0], weights)
     probe_arrival = 0.0 if probe_value <= 0 else math.inf
 
     def rate(k: int) -> np.ndarray:
@@ -285,7 +317,7 @@ def reach_value(
             np.maximum(inner[0], avoid, out=inner[0])
         reached = (inner[0] <= 0) & np.isinf(arrival)
         arrival[reached] = (step + before[reached] / (before[reached] - inner[0][reached])) * dt
-        now = _at(inner[0], weights)
+        now = at_point(inner[0], weights)
         if math.isinf(probe_arrival) and now <= 0:
             probe_arrival = (step + probe_value / (probe_value - now)) * dt
         probe_value = now
@@ -294,7 +326,7 @@ def reach_value(
     return ReachRun(inner[0].copy(), half, arrival, probe_arrival, steps)
 
 
-def _bilinear(grid: Grid, point: tuple[float, float] | None) -> list[tuple[int, int, float]]:
+def bilinear(grid: Grid, point: tuple[float, float] | None) -> list[tuple[int, int, float]]:
     """The nodes and weights of the bilinear interpolation at ``point`` (none without a point)."""
     if point is None:
         return []
@@ -310,8 +342,8 @@ def _bilinear(grid: Grid, point: tuple[float, float] | None) -> list[tuple[int, 
     ]
 
 
-def _at(values: np.ndarray, weights: list[tuple[int, int, float]]) -> float:
-    """``values`` interpolated with ``weights`` (:func:`_bilinear`; +inf without a point)."""
+def at_point(values: np.ndarray, weights: list[tuple[int, int, float]]) -> float:
+    """``values`` interpolated with ``weights`` (:func:`bilinear`; +inf without a point)."""
     return float(sum(w * values[i, j] for i, j, w in weights)) if weights else math.inf
 
 
@@ -348,7 +380,12 @@ class HJIModel(CompiledModel):
             None if avoid is None else -relation_level(self.game, avoid, "problem.avoid", grid, parameters)
         )
         o = self.options
-        run = reach_value(ham, grid, start, horizon, o.scheme, o.cfl, barrier, probe)
+        if o.engine == "hj_reachability":
+            from gamespec_levelset.hji_jax import reach_value_hj
+
+            run = reach_value_hj(self.game, grid, start, horizon, o, parameters, barrier, probe)
+        else:
+            run = reach_value(ham, grid, start, horizon, o.scheme, o.cfl, barrier, probe)
         return grid, run, ham.joint is None
 
     def solve(
@@ -529,4 +566,10 @@ class HJIBackend(Backend[DifferentialGameSpec, HJIOptions]):
         return None
 
     def _compile(self, spec: DifferentialGameSpec, options: HJIOptions) -> HJIModel:
+        if options.engine == "hj_reachability":
+            from gamespec_levelset.hji_jax import available
+
+            missing = available()
+            if missing:
+                raise UnsupportedFeature(missing)
         return HJIModel(spec, options)

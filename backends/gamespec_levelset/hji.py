@@ -22,12 +22,34 @@ a maximizer's control (zero cross derivatives), the min and the max are taken se
 samples add); otherwise over every pair (the samples multiply). The payoff is not used: this is the
 game of kind.
 
+Reach–avoid (``problem.avoid``, a set the minimizing players must not enter, ``g`` its level
+negated, positive inside): ``φ ← max(min(φ_step, φ), g)`` from ``max(l, g)``, as hj_reachability's
+``static_obstacle`` value postprocessor (Fisac et al.'s reach–avoid value). The maximizing players
+are the disturbance.
+
+A game of degree (``time.final: free`` within ``bounds``; the payoff the capture time): the node's
+time to reach, ``T(x) = min{τ : φ(x, τ) ≤ 0}`` (linear in τ between steps), is the minimum time to
+capture (``arrays.capture_time``, +∞ where not reached within the upper bound), and the game from
+the initial state (φ interpolated bilinearly there) is decided: ``capture`` at ``T(x₀)``,
+``escape`` (the capture time +∞) when it is not reached and the captured set has converged (the
+same at the bound as at half of it, clear of the grid's edge: :func:`converged`), else
+``undecided`` (``iteration_limit``). The concept is ``saddle`` when the min and max separate
+(Isaacs' minimax condition, under which the upper and lower values of eqs. 4.9–4.10 agree), else
+``upper_value`` (eq. 4.9's order: the maximizer answers the minimizer's control); the information
+pattern is feedback. The value generalizes the reachability front of eq. 5.22 (the level of the
+target starts as eq. 5.21's signed distance to first order) to two players.
+
+``engine: hj_reachability`` computes the same value by hj_reachability (:mod:`gamespec_levelset.hji_jax`,
+the optional ``hj`` extra).
+
 Status: ``optimal`` when the grid-refinement check passes — the captured set's edge on the file's
 grid and on one with half the nodes per axis (the same box, every other node) are on average at most
 ``refinement_tolerance`` coarse cells apart (:func:`boundary_shift`,
 ``checks.capture_region_refinement``). ``metrics.capture_region`` holds the captured area, its share
 of the grid, and the area captured within half the horizon (equal when the region has stopped
-growing: every capture from it happens within T/2).
+growing: every capture from it happens within T/2) and whether it has :func:`converged`; a game of
+degree also checks that the half-resolution grid decides the same, with a capture time within
+``capture_time_tolerance`` of it (``checks.capture_time_refinement``).
 """
 
 from __future__ import annotations

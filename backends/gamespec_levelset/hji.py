@@ -369,6 +369,26 @@ def at_point(values: np.ndarray, weights: list[tuple[int, int, float]]) -> float
     return float(sum(w * values[i, j] for i, j, w in weights)) if weights else math.inf
 
 
+def stored_run(
+    values: np.ndarray, taus: np.ndarray, grid: Grid, probe: tuple[float, float] | None
+) -> ReachRun:
+    """The :class:`ReachRun` of the values ``values[k]`` stored at the times ``taus[k]`` (an even
+    number of intervals; first zero crossings linear between the stored times)."""
+    arrival = np.where(values[0] <= 0, 0.0, np.inf)
+    weights = bilinear(grid, probe)
+    along = [at_point(v, weights) for v in values]
+    probe_arrival = 0.0 if along[0] <= 0 else math.inf
+    for k in range(1, len(values)):
+        before, now = values[k - 1], values[k]
+        reached = (now <= 0) & np.isinf(arrival)
+        share = before[reached] / (before[reached] - now[reached])
+        arrival[reached] = taus[k - 1] + share * (taus[k] - taus[k - 1])
+        if math.isinf(probe_arrival) and along[k] <= 0:
+            probe_arrival = taus[k - 1] + along[k - 1] / (along[k - 1] - along[k]) * (taus[k] - taus[k - 1])
+    half = len(values) // 2
+    return ReachRun(values[-1].copy(), values[half].copy(), arrival, float(probe_arrival), len(values) - 1)
+
+
 class HJIModel(CompiledModel):
     """A compiled ``hji`` game: re-solved with new parameter values (the samples are recomputed)."""
 
@@ -403,12 +423,31 @@ class HJIModel(CompiledModel):
         )
         o = self.options
         if o.engine == "hj_reachability":
-            from gamespec_levelset.hji_jax import reach_value_hj
-
-            run = reach_value_hj(self.game, grid, start, horizon, o, parameters, barrier, probe)
+            run = self._hj_reachability(grid, start, horizon, parameters, barrier, probe)
         else:
             run = reach_value(ham, grid, start, horizon, o.scheme, o.cfl, barrier, probe)
         return grid, run, ham.joint is None
+
+    def _hj_reachability(
+        self,
+        grid: Grid,
+        start: np.ndarray,
+        horizon: float,
+        parameters: dict[str, float],
+        avoid: np.ndarray | None,
+        probe: tuple[float, float] | None,
+    ) -> ReachRun:
+        """:func:`reach_value`'s run by hj_reachability (:mod:`gamespec_levelset.hji_jax`)."""
+        from gamespec_levelset.hji_jax import reach_values_hj
+
+        sampled = control_samples(self.game, self.options.control_samples, parameters)
+        pairs = [[[(u | d)[c] for c in sampled.controls] for d in sampled.ds] for u in sampled.us]
+        taus = np.linspace(0.0, horizon, 2 * self.options.hj_outputs + 1)
+        box = (grid.lower, grid.upper, grid.shape)
+        o = self.options
+        names = [*sampled.states, *sampled.controls]
+        values = reach_values_hj(sampled.exprs, names, pairs, box, start, -taus, o.scheme, o.cfl, avoid)
+        return stored_run(values, taus, grid, probe)
 
     def solve(
         self, parameters: dict[str, float] | None = None, guess: Result | None = None, inputs: Inputs = None

@@ -9,22 +9,19 @@ postprocessor, linear extrapolation at the grid's edge as in the project's engin
 dissipation is global (one α per axis over the grid), the project's local. The dynamics are printed
 by SymPy's JAX printer (``lambdify(..., modules="jax")``) and the Hamiltonian's min and max are over
 the same control samples (:func:`gamespec_levelset.hji.control_samples`). Values are kept at
-``outputs`` equally spaced times, so the capture times are linear between those (not between the
-solver's own steps). JAX runs in 64-bit here (``jax_enable_x64``, set process-wide on first use).
+the times the caller asks for (``hj_outputs`` per half horizon), so the capture times are linear
+between those (not between the solver's own steps). It imports nothing of :mod:`gamespec_levelset.hji`
+(which calls it). JAX runs in 64-bit here (``jax_enable_x64``, set process-wide on first use).
 """
 
 from __future__ import annotations
 
-import math
 from typing import Any
 
 import numpy as np
 import sympy as sp
 
-from gamespec.flowfield.grid import Grid
-from gamespec.specs.differential_game import DifferentialGameSpec
 from gamespec.symbolic.language import symbol
-from gamespec_levelset.hji import HJIOptions, ReachRun, at_point, bilinear, control_samples
 
 SCHEMES = {"first_order": "first_order", "eno2": "ENO2", "weno5": "WENO5"}
 """The project's scheme names → hj_reachability's ``upwind_first`` functions."""
@@ -40,34 +37,35 @@ def available() -> str | None:
     return None
 
 
-def reach_value_hj(
-    game: DifferentialGameSpec,
-    grid: Grid,
+def reach_values_hj(
+    exprs: list[sp.Expr],
+    names: list[str],
+    pairs: list[list[list[float]]],
+    box: tuple[tuple[float, float], tuple[float, float], tuple[int, int]],
     initial: np.ndarray,
-    horizon: float,
-    options: HJIOptions,
-    parameters: dict[str, float],
+    times: np.ndarray,
+    scheme: str,
+    cfl: float,
     avoid: np.ndarray | None = None,
-    probe: tuple[float, float] | None = None,
-) -> ReachRun:
-    """:class:`~gamespec_levelset.hji.ReachRun` of the game on ``grid`` by hj_reachability (module doc)."""
+) -> np.ndarray:
+    """φ at each of the (decreasing, from 0) hj_reachability ``times`` (module doc) for the dynamics
+    ``exprs`` over ``names`` (the two states, then the controls) with the Hamiltonian's min–max
+    over ``pairs[k][m]`` (the controls of the minimizers' k-th and the maximizers' m-th sample), on
+    the grid ``box`` (lower corner, upper corner, nodes per axis)."""
     import jax
 
     jax.config.update("jax_enable_x64", True)  # type: ignore[no-untyped-call, unused-ignore]
     import hj_reachability as hj
     import jax.numpy as jnp
 
-    sampled = control_samples(game, options.control_samples, parameters)
-    names = sampled.controls
-    pairs = jnp.array([[[(u | d)[c] for c in names] for d in sampled.ds] for u in sampled.us])
-    args = [symbol(s) for s in sampled.states] + [symbol(c) for c in names]
-    printed = sp.lambdify(args, sampled.exprs, modules="jax")
+    samples = jnp.array(pairs)
+    printed = sp.lambdify([symbol(n) for n in names], exprs, modules="jax")
 
     def f(state: Any, control: Any) -> Any:
         return jnp.stack([jnp.asarray(v, dtype=float) for v in printed(state[0], state[1], *control)])
 
     def every(state: Any) -> Any:
-        return jax.vmap(jax.vmap(lambda c: f(state, c)))(pairs)
+        return jax.vmap(jax.vmap(lambda c: f(state, c)))(samples)
 
     class SampledDynamics(hj.Dynamics):  # type: ignore[misc]
         """The game's dynamics with the Hamiltonian's min–max over the control samples."""
@@ -79,7 +77,7 @@ def reach_value_hj(
             h = every(state) @ grad_value
             best_d = jnp.argmax(h, axis=1)
             k = jnp.argmin(jnp.take_along_axis(h, best_d[:, None], axis=1)[:, 0])
-            return pairs[k, best_d[k]], jnp.zeros(1)
+            return samples[k, best_d[k]], jnp.zeros(1)
 
         def partial_max_magnitudes(self, state: Any, time: Any, value: Any, grad_value_box: Any) -> Any:
             return jnp.abs(every(state)).max(axis=(0, 1))
@@ -87,37 +85,18 @@ def reach_value_hj(
     unused = hj.sets.Box(jnp.zeros(1), jnp.ones(1))
     dynamics = SampledDynamics("min", "max", unused, unused)
     edges = (hj.boundary_conditions.extrapolate, hj.boundary_conditions.extrapolate)
-    hj_grid = hj.Grid.from_lattice_parameters_and_boundary_conditions(
-        hj.sets.Box(jnp.array(grid.lower), jnp.array(grid.upper)), grid.shape, edges
+    lower, upper, shape = box
+    grid = hj.Grid.from_lattice_parameters_and_boundary_conditions(
+        hj.sets.Box(jnp.array(lower), jnp.array(upper)), shape, edges
     )
     start = initial if avoid is None else np.maximum(initial, avoid)
     settings = hj.SolverSettings(
-        upwind_scheme=getattr(hj.finite_differences.upwind_first, SCHEMES[options.scheme]),
+        upwind_scheme=getattr(hj.finite_differences.upwind_first, SCHEMES[scheme]),
         hamiltonian_postprocessor=hj.solver.backwards_reachable_tube,
         value_postprocessor=hj.solver.identity
         if avoid is None
         else hj.solver.static_obstacle(jnp.array(avoid)),
-        CFL_number=options.cfl,
+        CFL_number=cfl,
     )
-    outputs = 2 * options.hj_outputs
-    times = np.linspace(0.0, -horizon, outputs + 1)
-    values = np.asarray(hj.solve(settings, dynamics, hj_grid, times, jnp.array(start), progress_bar=False))
-    return _run(values, -times, grid, probe)
-
-
-def _run(values: np.ndarray, taus: np.ndarray, grid: Grid, probe: tuple[float, float] | None) -> ReachRun:
-    """The ReachRun of the values ``values[k]`` at the times ``taus[k]`` (first zero crossings,
-    linear between the stored times)."""
-    arrival = np.where(values[0] <= 0, 0.0, np.inf)
-    weights = bilinear(grid, probe)
-    along = [at_point(v, weights) for v in values]
-    probe_arrival = 0.0 if along[0] <= 0 else math.inf
-    for k in range(1, len(values)):
-        before, now = values[k - 1], values[k]
-        reached = (now <= 0) & np.isinf(arrival)
-        share = before[reached] / (before[reached] - now[reached])
-        arrival[reached] = taus[k - 1] + share * (taus[k] - taus[k - 1])
-        if math.isinf(probe_arrival) and along[k] <= 0:
-            probe_arrival = taus[k - 1] + along[k - 1] / (along[k - 1] - along[k]) * (taus[k] - taus[k - 1])
-    half = len(values) // 2
-    return ReachRun(values[-1].copy(), values[half].copy(), arrival, float(probe_arrival), len(values) - 1)
+    values = hj.solve(settings, dynamics, grid, jnp.array(times), jnp.array(start), progress_bar=False)
+    return np.asarray(values)

@@ -158,10 +158,14 @@ class BestResponseBackend(Backend[DifferentialGameSpec, NoOptions]):
         which a feedback pursuer always catches, and both players running straight is a stationary
         point of the open-loop game, so neither best responses nor the joint scheme can decide
         capture against escape (the homicidal chauffeur below Isaacs' barrier); its value function
-        can (the ``hji`` backend)."""
+        can (the ``hji`` backend). Refuses ``problem.avoid`` too, which only the ``hji`` backend reads."""
         reason = super().unsupported(spec)
-        if reason or not isinstance(spec, DifferentialGameSpec) or not spec.problem.time.free:
+        if reason or not isinstance(spec, DifferentialGameSpec):
             return reason
+        if spec.problem.avoid is not None:
+            return "problem.avoid (a reach-avoid game) is read by the hji backend only: use --backend hji"
+        if not spec.problem.time.free:
+            return None
         return (
             "time.final: free (a game of degree, the capture time as payoff) is decided by its value "
             "function: open-loop best responses and the joint scheme cannot tell capture from escape "

@@ -141,6 +141,15 @@ def test_open_loop_schemes_refuse_a_game_of_degree_with_the_reason(override):
         compile_spec(spec)
 
 
+def test_best_responses_refuse_an_avoid_set():
+    spec = load(
+        PROBLEMS / "ch7" / "homicidal_chauffeur_reduced.yaml",
+        ["solver.backend=best_response", "problem.avoid=x**2 + (y - 1)**2 <= 0.04"],
+    )
+    with pytest.raises(UnsupportedFeature, match=r"problem\.avoid"):
+        compile_spec(spec)
+
+
 @pytest.mark.parametrize(
     ("override", "field"),
     [

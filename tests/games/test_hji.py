@@ -10,14 +10,13 @@
   within a bounded time and the rest escapes), and above it the car captures from everywhere (the
   set keeps growing with the horizon). Checked at ℓ = 0.15 and 0.4 in the default suite, and the
   threshold bracketed by a study over ℓ (``metrics.capture_region.converged`` switches between
-  neighbouring ℓ): a few ℓ on a coarse grid by default, a fine one in a slow test. The bracket is
-  the grid's resolution wide: just above the threshold the set leaks through a gap 2(ℓ − ℓ*) wide
-  between the two barrier arcs (Isaacs' barrier traced below), which the scheme closes while it is
-  narrower than about a grid spacing, so the lower end of the bracket may lie up to one spacing
-  above ℓ*. What lies beyond the gap is captured only after the car loops round (about 2πR/w), so
-  the set shows its growth between T/2 and T only for T beyond about twice that: a shorter
-  horizon moves the switch up too (measured: 0.28–0.29 at T = 6 on 121 nodes over [−2, 2]²,
-  0.27–0.28 at T = 14 on 81 nodes over [−3, 3]²), within the one-spacing margin on the grids here.
+  neighbouring ℓ): a few ℓ on a coarse grid by default, a fine one in a slow test. The bracket's
+  lower end gets a margin of one grid spacing: the switch lies 0.02–0.03 above ℓ* on every grid
+  measured (0.28–0.29 at spacing 1/30, T = 6; 0.28 still converged at spacing 0.05, T = 14;
+  0.27–0.28 at spacing 0.075, T = 14). Just above the threshold the set leaks through a gap
+  2(ℓ − ℓ*) wide between the two barrier arcs (traced below), and what lies beyond it is reached
+  only after the car loops round (about 2πR/w); which of the two keeps the numerical switch high
+  is not pinned down.
 - Below the threshold the captured set is the region Isaacs' barrier closes off: the two
   semipermeable arcs traced back from the ends of the usable part of the capture circle (where
   the pedestrian's radial run is tangent to it, y = γℓ; the car turning fully, the pedestrian running

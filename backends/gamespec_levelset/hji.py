@@ -22,12 +22,34 @@ a maximizer's control (zero cross derivatives), the min and the max are taken se
 samples add); otherwise over every pair (the samples multiply). The payoff is not used: this is the
 game of kind.
 
+Reach–avoid (``problem.avoid``, a set the minimizing players must not enter, ``g`` its level
+negated, positive inside): ``φ ← max(min(φ_step, φ), g)`` from ``max(l, g)``, as hj_reachability's
+``static_obstacle`` value postprocessor (Fisac et al.'s reach–avoid value). The maximizing players
+are the disturbance.
+
+A game of degree (``time.final: free`` within ``bounds``; the payoff the capture time): the node's
+time to reach, ``T(x) = min{τ : φ(x, τ) ≤ 0}`` (linear in τ between steps), is the minimum time to
+capture (``arrays.capture_time``, +∞ where not reached within the upper bound), and the game from
+the initial state (φ interpolated bilinearly there) is decided: ``capture`` at ``T(x₀)``,
+``escape`` (the capture time +∞) when it is not reached and the captured set has converged (the
+same at the bound as at half of it, clear of the grid's edge: :func:`converged`), else
+``undecided`` (``iteration_limit``). The concept is ``saddle`` when the min and max separate
+(Isaacs' minimax condition, under which the upper and lower values of eqs. 4.9–4.10 agree), else
+``upper_value`` (eq. 4.9's order: the maximizer answers the minimizer's control); the information
+pattern is feedback. The value generalizes the reachability front of eq. 5.22 (the level of the
+target starts as eq. 5.21's signed distance to first order) to two players.
+
+``engine: hj_reachability`` computes the same value by hj_reachability (:mod:`gamespec_levelset.hji_jax`,
+the optional ``hj`` extra).
+
 Status: ``optimal`` when the grid-refinement check passes — the captured set's edge on the file's
 grid and on one with half the nodes per axis (the same box, every other node) are on average at most
 ``refinement_tolerance`` coarse cells apart (:func:`boundary_shift`,
 ``checks.capture_region_refinement``). ``metrics.capture_region`` holds the captured area, its share
 of the grid, and the area captured within half the horizon (equal when the region has stopped
-growing: every capture from it happens within T/2).
+growing: every capture from it happens within T/2) and whether it has :func:`converged`; a game of
+degree also checks that the half-resolution grid decides the same, with a capture time within
+``capture_time_tolerance`` of it (``checks.capture_time_refinement``).
 """
 
 from __future__ import annotations
@@ -42,7 +64,7 @@ import sympy as sp
 from pydantic import Field, model_validator
 
 from gamespec.compiling import Backend, CompiledModel, Inputs, refuse_inputs
-from gamespec.errors import SpecError
+from gamespec.errors import SpecError, UnsupportedFeature
 from gamespec.flowfield.grid import Grid
 from gamespec.flowfield.scratch import Scratch
 from gamespec.flowfield.tvd_rk import tvd_rk3_step
@@ -73,9 +95,27 @@ class HJIOptions(StrictModel):
         None, gt=0, description="How long the pursuers have to capture (default: the game's horizon)."
     )
     scheme: Literal["first_order", "eno2", "weno5"] = Field("eno2", description="The upwind scheme.")
+    engine: Literal["gamespec", "hj_reachability"] = Field(
+        "gamespec",
+        description="gamespec: the project's level-set numerics; hj_reachability: the same value by "
+        "hj_reachability on JAX (the optional hj extra; gamespec_levelset.hji_jax).",
+    )
+    hj_outputs: int = Field(
+        100,
+        ge=2,
+        le=5000,
+        description="engine: hj_reachability: the stored times per half horizon (capture times are "
+        "linear between them).",
+    )
     cfl: float = Field(0.5, gt=0, le=1, description="The CFL number of the time step.")
     control_samples: int = Field(
         33, ge=3, le=257, description="Samples of a control that does not enter the dynamics affinely."
+    )
+    capture_time_tolerance: float = Field(
+        0.1,
+        gt=0,
+        description="time.final: free: how much the capture time from the initial state may change "
+        "between the grid and the half-resolution one, as a fraction of it.",
     )
     refinement_tolerance: float = Field(
         1.0,
@@ -131,10 +171,22 @@ def _samples(
     return [dict(zip(names, combo, strict=True)) for combo in itertools.product(*per)]
 
 
-def sampled_hamiltonian(
-    game: DifferentialGameSpec, grid: Grid, samples: int, parameters: dict[str, float]
-) -> SampledHamiltonian:
-    """The dynamics of ``game`` sampled at ``grid``'s nodes over the players' control boxes (module doc)."""
+@dataclass(frozen=True)
+class ControlSamples:
+    """The game's dynamics as SymPy expressions over the states and controls (the parameters
+    substituted), and the samples of the minimizers' (``us``) and maximizers' (``ds``) controls
+    (module doc); ``separable`` when no component mixes a minimizer's and a maximizer's control."""
+
+    exprs: list[sp.Expr]
+    states: list[str]
+    controls: list[str]
+    us: list[dict[str, float]]
+    ds: list[dict[str, float]]
+    separable: bool
+
+
+def control_samples(game: DifferentialGameSpec, samples: int, parameters: dict[str, float]) -> ControlSamples:
+    """The dynamics and the samples of the players' control boxes (:class:`ControlSamples`)."""
     p = game.problem
     states = list(p.states)
     table = {n: sp.Float(v) for n, v in parameters.items()} | {
@@ -148,19 +200,27 @@ def sampled_hamiltonian(
         for pl in p.players.values()
         for c, ctl in pl.controls.items()
     }
-    controls = [*minimizers, *maximizers]
-    f = numeric_function(exprs, [symbol(s) for s in states] + [symbol(c) for c in controls])
+    us, ds = _samples(exprs, minimizers, bounds, samples), _samples(exprs, maximizers, bounds, samples)
+    separable = all(
+        sp.diff(e, symbol(u), symbol(d)) == 0 for e in exprs for u in minimizers for d in maximizers
+    )
+    return ControlSamples(exprs, states, [*minimizers, *maximizers], us, ds, separable)
+
+
+def sampled_hamiltonian(
+    game: DifferentialGameSpec, grid: Grid, samples: int, parameters: dict[str, float]
+) -> SampledHamiltonian:
+    """The dynamics of ``game`` sampled at ``grid``'s nodes over the players' control boxes (module doc)."""
+    sampled = control_samples(game, samples, parameters)
+    controls, us, ds, separable = sampled.controls, sampled.us, sampled.ds, sampled.separable
+    f = numeric_function(sampled.exprs, [symbol(s) for s in sampled.states] + [symbol(c) for c in controls])
     x, y = grid.points[..., 0], grid.points[..., 1]
 
     def at(u: dict[str, float]) -> np.ndarray:
         return np.broadcast_to(f(x, y, *(u[c] for c in controls)), (2, *x.shape)).astype(float)
 
-    us, ds = _samples(exprs, minimizers, bounds, samples), _samples(exprs, maximizers, bounds, samples)
     u0, d0 = us[0], ds[0]
     base = at(u0 | d0)
-    separable = all(
-        sp.diff(e, symbol(u), symbol(d)) == 0 for e in exprs for u in minimizers for d in maximizers
-    )
     if separable:
         pursuer = np.stack([at(u | d0) - base for u in us])
         evader = np.stack([at(u0 | d) - base for d in ds])
@@ -190,19 +250,27 @@ def _number(
 
 
 def target(game: DifferentialGameSpec, grid: Grid, parameters: dict[str, float]) -> np.ndarray:
-    """``l / |∇l|`` at the nodes: negative inside the capture set, the signed distance to its edge to
-    first order there (module doc), so the level set's slope is about one at the front."""
+    """``l / |∇l|`` of ``problem.capture`` at the nodes (:func:`relation_level`)."""
+    assert game.problem.capture is not None, "checked by the backend"
+    return relation_level(game, game.problem.capture, "problem.capture", grid, parameters)
+
+
+def relation_level(
+    game: DifferentialGameSpec, relation: str, field: str, grid: Grid, parameters: dict[str, float]
+) -> np.ndarray:
+    """``l / |∇l|`` at the nodes for the set ``relation`` (``g ≤ c``: ``l = g − c``; ``g ≥ c``:
+    ``l = c − g``): negative inside the set, the signed distance to its edge to first order there
+    (module doc), so the level set's slope is about one at the front."""
     p = game.problem
-    assert p.capture is not None, "checked by the backend"
     table = {n: sp.Float(v) for n, v in parameters.items()} | {s: symbol(s) for s in p.states}
-    rel = parse_relation(p.capture, table)
+    rel = parse_relation(relation, table)
     expr, names = sp.sympify(rel.expr), [symbol(s) for s in p.states]
     if math.isfinite(rel.upper) and not math.isfinite(rel.lower):
         level = expr - rel.upper
     elif math.isfinite(rel.lower) and not math.isfinite(rel.upper):
         level = rel.lower - expr
     else:
-        raise SpecError("a capture set is one one-sided relation (g <= c or g >= c)", field="problem.capture")
+        raise SpecError("a set is one one-sided relation (g <= c or g >= c)", field=field)
     gradient = sp.sqrt(sum(sp.diff(level, n) ** 2 for n in names))
     f = numeric_function([level, gradient], names)
     values = np.broadcast_to(f(grid.points[..., 0], grid.points[..., 1]), (2, *grid.shape)).astype(float)
@@ -211,20 +279,47 @@ def target(game: DifferentialGameSpec, grid: Grid, parameters: dict[str, float])
     return distance
 
 
+@dataclass(frozen=True)
+class ReachRun:
+    """What :func:`reach_value` computes: ``value`` φ(·, T) and ``half`` φ(·, T/2); ``arrival`` the
+    first τ at which each node's φ reaches zero (the minimum time to capture, ``inf`` where it does
+    not within T; linear in τ between steps); ``probe_arrival`` the same for the bilinear
+    interpolation of φ at one point (the initial state), and the ``steps`` taken."""
+
+    value: np.ndarray
+    half: np.ndarray
+    arrival: np.ndarray
+    probe_arrival: float
+    steps: int
+
+
 def reach_value(
-    hamiltonian: SampledHamiltonian, grid: Grid, initial: np.ndarray, horizon: float, scheme: str, cfl: float
-) -> tuple[np.ndarray, int]:
-    """``φ(·, horizon)`` of ``∂φ/∂τ = min(0, H)`` from ``initial`` (module doc) and the steps taken."""
+    hamiltonian: SampledHamiltonian,
+    grid: Grid,
+    initial: np.ndarray,
+    horizon: float,
+    scheme: str,
+    cfl: float,
+    avoid: np.ndarray | None = None,
+    probe: tuple[float, float] | None = None,
+) -> ReachRun:
+    """φ of ``∂φ/∂τ = min(0, H)`` from ``initial`` up to ``horizon`` (module doc); with ``avoid``
+    (``g``, positive inside the avoid set) the reach–avoid value ``φ ← max(min(φ_step, φ), g)``
+    from ``max(initial, g)``."""
     g = GHOSTS
     nx, ny = grid.shape
     dx = grid.spacing
     rate_bound = float((hamiltonian.speed[0] / dx[0] + hamiltonian.speed[1] / dx[1]).max())
-    steps = max(1, math.ceil(horizon * rate_bound / cfl))
+    steps = 2 * max(1, math.ceil(horizon / 2 * rate_bound / cfl))
     dt = horizon / steps
     padded = [np.zeros((nx + 2 * g, ny + 2 * g)) for _ in range(3)]
     inner = [a[g:-g, g:-g] for a in padded]
-    inner[0][...] = initial
+    inner[0][...] = initial if avoid is None else np.maximum(initial, avoid)
     scratch = Scratch((nx + 2 * g) * (ny + 2 * g))
+    arrival = np.where(inner[0] <= 0, 0.0, np.inf)
+    weights = bilinear(grid, probe)
+    probe_value = at_point(inner[0], weights)
+    probe_arrival = 0.0 if probe_value <= 0 else math.inf
 
     def rate(k: int) -> np.ndarray:
         extrapolate_ghosts(padded[k])
@@ -235,11 +330,63 @@ def reach_value(
         total: np.ndarray = hamiltonian(central) + dissipation
         return total
 
-    for _ in range(steps):
+    half = inner[0].copy()
+    for step in range(steps):
         before = inner[0].copy()
         tvd_rk3_step(inner[0], inner[1], inner[2], dt, rate)
         np.minimum(inner[0], before, out=inner[0])
-    return inner[0].copy(), steps
+        if avoid is not None:
+            np.maximum(inner[0], avoid, out=inner[0])
+        reached = (inner[0] <= 0) & np.isinf(arrival)
+        arrival[reached] = (step + before[reached] / (before[reached] - inner[0][reached])) * dt
+        now = at_point(inner[0], weights)
+        if math.isinf(probe_arrival) and now <= 0:
+            probe_arrival = (step + probe_value / (probe_value - now)) * dt
+        probe_value = now
+        if step + 1 == steps // 2:
+            half = inner[0].copy()
+    return ReachRun(inner[0].copy(), half, arrival, probe_arrival, steps)
+
+
+def bilinear(grid: Grid, point: tuple[float, float] | None) -> list[tuple[int, int, float]]:
+    """The nodes and weights of the bilinear interpolation at ``point`` (none without a point)."""
+    if point is None:
+        return []
+    scaled = (np.asarray(point) - np.asarray(grid.lower)) / grid.spacing
+    base = np.clip(np.floor(scaled).astype(int), 0, np.asarray(grid.shape) - 2)
+    fx, fy = scaled - base
+    i, j = int(base[0]), int(base[1])
+    return [
+        (i, j, (1 - fx) * (1 - fy)),
+        (i + 1, j, fx * (1 - fy)),
+        (i, j + 1, (1 - fx) * fy),
+        (i + 1, j + 1, fx * fy),
+    ]
+
+
+def at_point(values: np.ndarray, weights: list[tuple[int, int, float]]) -> float:
+    """``values`` interpolated with ``weights`` (:func:`bilinear`; +inf without a point)."""
+    return float(sum(w * values[i, j] for i, j, w in weights)) if weights else math.inf
+
+
+def stored_run(
+    values: np.ndarray, taus: np.ndarray, grid: Grid, probe: tuple[float, float] | None
+) -> ReachRun:
+    """The :class:`ReachRun` of the values ``values[k]`` stored at the times ``taus[k]`` (an even
+    number of intervals; first zero crossings linear between the stored times)."""
+    arrival = np.where(values[0] <= 0, 0.0, np.inf)
+    weights = bilinear(grid, probe)
+    along = [at_point(v, weights) for v in values]
+    probe_arrival = 0.0 if along[0] <= 0 else math.inf
+    for k in range(1, len(values)):
+        before, now = values[k - 1], values[k]
+        reached = (now <= 0) & np.isinf(arrival)
+        share = before[reached] / (before[reached] - now[reached])
+        arrival[reached] = taus[k - 1] + share * (taus[k] - taus[k - 1])
+        if math.isinf(probe_arrival) and along[k] <= 0:
+            probe_arrival = taus[k - 1] + along[k - 1] / (along[k - 1] - along[k]) * (taus[k] - taus[k - 1])
+    half = len(values) // 2
+    return ReachRun(values[-1].copy(), values[half].copy(), arrival, float(probe_arrival), len(values) - 1)
 
 
 class HJIModel(CompiledModel):
@@ -263,46 +410,91 @@ class HJIModel(CompiledModel):
         self.box = (corner("lower"), corner("upper"))
 
     def _region(
-        self, nodes: int, parameters: dict[str, float], horizon: float
-    ) -> tuple[Grid, np.ndarray, np.ndarray, int]:
-        """The grid, ``φ`` at the horizon and at half of it, and the steps taken."""
+        self, nodes: int, parameters: dict[str, float], horizon: float, probe: tuple[float, float] | None
+    ) -> tuple[Grid, ReachRun, bool]:
+        """The grid, the reach (–avoid) run on it and whether the min and max were taken separately
+        (Isaacs' condition holds for the sampled controls)."""
         grid = Grid(self.box[0], self.box[1], (nodes, nodes))
         ham = sampled_hamiltonian(self.game, grid, self.options.control_samples, parameters)
         start = target(self.game, grid, parameters)
-        half, first = reach_value(ham, grid, start, horizon / 2, self.options.scheme, self.options.cfl)
-        value, second = reach_value(ham, grid, half, horizon / 2, self.options.scheme, self.options.cfl)
-        return grid, value, half, first + second
+        avoid = self.game.problem.avoid
+        barrier = (
+            None if avoid is None else -relation_level(self.game, avoid, "problem.avoid", grid, parameters)
+        )
+        o = self.options
+        if o.engine == "hj_reachability":
+            run = self._hj_reachability(grid, start, horizon, parameters, barrier, probe)
+        else:
+            run = reach_value(ham, grid, start, horizon, o.scheme, o.cfl, barrier, probe)
+        return grid, run, ham.joint is None
+
+    def _hj_reachability(
+        self,
+        grid: Grid,
+        start: np.ndarray,
+        horizon: float,
+        parameters: dict[str, float],
+        avoid: np.ndarray | None,
+        probe: tuple[float, float] | None,
+    ) -> ReachRun:
+        """:func:`reach_value`'s run by hj_reachability (:mod:`gamespec_levelset.hji_jax`)."""
+        from gamespec_levelset.hji_jax import reach_values_hj
+
+        sampled = control_samples(self.game, self.options.control_samples, parameters)
+        pairs = [[[(u | d)[c] for c in sampled.controls] for d in sampled.ds] for u in sampled.us]
+        taus = np.linspace(0.0, horizon, 2 * self.options.hj_outputs + 1)
+        box = (grid.lower, grid.upper, grid.shape)
+        o = self.options
+        names = [*sampled.states, *sampled.controls]
+        values = reach_values_hj(sampled.exprs, names, pairs, box, start, -taus, o.scheme, o.cfl, avoid)
+        return stored_run(values, taus, grid, probe)
 
     def solve(
         self, parameters: dict[str, float] | None = None, guess: Result | None = None, inputs: Inputs = None
     ) -> Result:
         refuse_inputs(inputs, self.game.kind)
         values = self.parameters | (parameters or {})
-        horizon = self.options.horizon or self.game.problem.evaluate(values).horizon
+        evaluated = self.game.problem.evaluate(values)
+        horizon = self.options.horizon or evaluated.horizon
+        probe = None
+        if self.game.problem.time.free:
+            x0, y0 = evaluated.initial.values()
+            probe = (x0, y0)
+            if not all(lo <= v <= hi for lo, v, hi in zip(self.box[0], probe, self.box[1], strict=True)):
+                raise SpecError(
+                    f"the initial state {probe} lies outside the grid {self.box}", field="solver.options.hji"
+                )
         n = self.options.nodes
-        grid, value, half, steps = self._region(n, values, horizon)
-        coarse = self._region((n + 1) // 2, values, horizon)[1]
-        captured = value <= 0
-        shift = boundary_shift(captured, coarse <= 0, grid)
+        grid, run, separable = self._region(n, values, horizon, probe)
+        coarse_grid, coarse, _ = self._region((n + 1) // 2, values, horizon, probe)
+        captured = run.value <= 0
+        shift = boundary_shift(captured, coarse.value <= 0, grid)
         cell = float(np.prod(grid.spacing))
         region: dict[str, Any] = {
             "area": float(captured.sum()) * cell,
             "fraction": float(captured.mean()),
-            "area_at_half_horizon": float((half <= 0).sum()) * cell,
+            "area_at_half_horizon": float((run.half <= 0).sum()) * cell,
             "horizon": horizon,
             "nodes": n,
             "lower": list(grid.lower),
             "upper": list(grid.upper),
             "states": list(self.game.problem.states),
+            "avoid": self.game.problem.avoid is not None,
+            "converged": converged(run),
         }
         tolerance = self.options.refinement_tolerance
-        return Result(
+        result = Result(
             status=Status.OPTIMAL,
             message=f"captured {region['fraction']:.1%} of the grid within T = {horizon:g} "
             f"({region['area_at_half_horizon'] / max(region['area'], cell):.0%} of it within T/2)",
-            iterations=steps,
+            iterations=run.steps,
             parameters=values,
-            arrays={"value": value, "grid_x": grid.axes[0], "grid_y": grid.axes[1]},
+            arrays={
+                "value": run.value,
+                "capture_time": run.arrival,
+                "grid_x": grid.axes[0],
+                "grid_y": grid.axes[1],
+            },
             checks={"capture_region_refinement": shift},
             metrics={
                 "capture_region": region,
@@ -312,6 +504,87 @@ class HJIModel(CompiledModel):
                 "check_tolerances": {"capture_region_refinement": tolerance},
             },
         )
+        if probe is None:
+            return result
+        outcomes = outcome(run, grid), outcome(coarse, coarse_grid)
+        return game_of_degree(self.game, result, run, outcomes, coarse, separable, self.options)
+
+
+def outcome(run: ReachRun, grid: Grid) -> Literal["capture", "escape", "undecided"]:
+    """What the value says from the initial state: ``capture`` when φ there reaches zero within the
+    time bound; ``escape`` when it does not and the captured set has :func:`converged`, so the
+    minimum time to capture is +∞ there; otherwise ``undecided``."""
+    if math.isfinite(run.probe_arrival):
+        return "capture"
+    return "escape" if converged(run) else "undecided"
+
+
+def converged(run: ReachRun) -> bool:
+    """Whether the captured set has stopped growing: the same at the horizon as at half of it, and
+    clear of the grid's two outer rings of nodes (where the ghost nodes' extrapolation guesses what
+    lies outside). Below Isaacs' barrier threshold the barrier closes it off and the rest escapes;
+    above it the set keeps growing (``metrics.capture_region.converged``)."""
+    captured = run.value <= 0
+    ring = np.ones_like(captured)
+    ring[2:-2, 2:-2] = False
+    return bool(np.array_equal(captured, run.half <= 0)) and not bool(np.any(captured & ring))
+
+
+def game_of_degree(
+    game: DifferentialGameSpec,
+    result: Result,
+    run: ReachRun,
+    outcomes: tuple[str, str],
+    coarse: ReachRun,
+    separable: bool,
+    options: HJIOptions,
+) -> Result:
+    """``result`` (the capture region) completed for a game of degree (``time.final: free``): the
+    minimum time to capture from the initial state (the payoff, +∞ on escape), the outcome, and the
+    check that the half-resolution grid decides the same with a capture time within
+    ``capture_time_tolerance`` of it, relatively (``checks.capture_time_refinement``)."""
+    decided, other = outcomes
+    bound = result.metrics["capture_region"]["horizon"]
+    if decided == "capture" and other == "capture":
+        change: float | None = abs(run.probe_arrival - coarse.probe_arrival) / max(run.probe_arrival, 1e-12)
+    else:
+        change = 0.0 if decided == other == "escape" else None
+    tolerance = options.capture_time_tolerance
+    time = run.probe_arrival
+    players = game.problem.players
+    metrics = result.metrics | {
+        "outcome": decided,
+        "captured": decided == "capture",
+        "capture_time": time if decided == "capture" else None,
+        "solution_concept": "saddle" if separable else "upper_value",
+        "value_function": "minimum time to capture (HJI, time-to-reach)",
+        "payoffs": {name: time if decided == "capture" else math.inf for name in players},
+        "checks_passed": result.metrics["checks_passed"]
+        | {"capture_time_refinement": change is not None and change <= tolerance},
+        "check_tolerances": result.metrics["check_tolerances"] | {"capture_time_refinement": tolerance},
+    }
+    checks = result.checks | {"capture_time_refinement": change}
+    if decided == "undecided":
+        return result.model_copy(
+            update={
+                "status": Status.ITERATION_LIMIT,
+                "message": f"undecided: not captured within t_f <= {bound:g}, and the captured set still "
+                "grows there or reaches the grid's edge (raise problem.time.bounds or widen "
+                "solver.options.hji.lower/upper)",
+                "metrics": metrics,
+                "checks": checks,
+            }
+        )
+    said = f"captured at t_f = {time:.4g}" if decided == "capture" else "escape (the capture time is +inf)"
+    return result.model_copy(
+        update={
+            "message": f"{said}; {result.message}",
+            "objective": time if decided == "capture" else math.inf,
+            "t_final": time if decided == "capture" else None,
+            "metrics": metrics,
+            "checks": checks,
+        }
+    )
 
 
 def boundary_shift(fine: np.ndarray, coarse: np.ndarray, grid: Grid) -> float:
@@ -348,7 +621,16 @@ class HJIBackend(Backend[DifferentialGameSpec, HJIOptions]):
             return "the hji backend solves autonomous games (dynamics free of t)"
         if spec.receding_horizon is not None:
             return "the hji backend computes a value function, not a receding-horizon run"
+        bounds = p.time.bounds
+        if bounds is not None and _number(bounds[0], dict(p.parameters)) != p.time.initial:
+            return "the hji backend computes the capture time from t_0: make the lower bound on t_f equal t_0"
         return None
 
     def _compile(self, spec: DifferentialGameSpec, options: HJIOptions) -> HJIModel:
+        if options.engine == "hj_reachability":
+            from gamespec_levelset.hji_jax import available
+
+            missing = available()
+            if missing:
+                raise UnsupportedFeature(missing)
         return HJIModel(spec, options)

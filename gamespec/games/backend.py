@@ -25,6 +25,7 @@ from gamespec.games.lq_structure import LQForm, lq_form, lq_game
 from gamespec.games.problems import initial_state
 from gamespec.games.simulate import ControlPlan, TrueSystem, grid_of, true_parameters
 from gamespec.result import Result, Status
+from gamespec.specs.base import SpecBase
 from gamespec.specs.differential_game import DifferentialGameSpec
 
 
@@ -151,6 +152,25 @@ class BestResponseBackend(Backend[DifferentialGameSpec, NoOptions]):
 
     name: ClassVar[str] = "best_response"
     kinds: ClassVar[frozenset[str]] = frozenset({"differential_game"})
+
+    def unsupported(self, spec: SpecBase) -> str | None:
+        """Refuses a game of degree (``time.final: free``): an open-loop strategy is a committed path,
+        which a feedback pursuer always catches, and both players running straight is a stationary
+        point of the open-loop game, so neither best responses nor the joint scheme can decide
+        capture against escape (the homicidal chauffeur below Isaacs' barrier); its value function
+        can (the ``hji`` backend). Refuses ``problem.avoid`` too, which only the ``hji`` backend reads."""
+        reason = super().unsupported(spec)
+        if reason or not isinstance(spec, DifferentialGameSpec):
+            return reason
+        if spec.problem.avoid is not None:
+            return "problem.avoid (a reach-avoid game) is read by the hji backend only: use --backend hji"
+        if not spec.problem.time.free:
+            return None
+        return (
+            "time.final: free (a game of degree, the capture time as payoff) is decided by its value "
+            "function: open-loop best responses and the joint scheme cannot tell capture from escape "
+            "(a committed evader path is always caught); solve it with --backend hji"
+        )
 
     def _compile(self, spec: DifferentialGameSpec, options: NoOptions) -> GameCompiled:
         return GameCompiled(spec)

@@ -22,7 +22,7 @@ from __future__ import annotations
 import math
 from collections.abc import Mapping
 from dataclasses import dataclass
-from typing import Literal
+from typing import ClassVar, Literal
 
 from pydantic import Field, PrivateAttr, model_validator
 
@@ -30,7 +30,7 @@ from gamespec.errors import ExpressionError, SpecError
 from gamespec.limits import MAX_BEST_RESPONSES, MAX_GAME_STATE, MAX_RECEDING_STEPS
 from gamespec.registry import Kind
 from gamespec.specs.base import Number, ProblemParameters, RequestedTransforms, SpecBase, StrictModel, Value
-from gamespec.specs.ocp import ControlSpec, MethodSpec, StateSpec, _ordered, is_time_varying
+from gamespec.specs.ocp import ControlSpec, FreeOrFixed, MethodSpec, StateSpec, _ordered, is_time_varying
 from gamespec.specs.uncertainty import UncertainParameter
 from gamespec.symbolic.canonical import check
 from gamespec.symbolic.grammar import RESERVED, numeric_value
@@ -52,7 +52,7 @@ def sensitivity_name(state: str, parameter: str) -> str:
 @dataclass(frozen=True)
 class GameValues:
     """What :meth:`GameProblem.evaluate` gives: the initial state x_0 of eq. 7.2 (a free value at 0)
-    and the horizon ``t_f - t_0``."""
+    and the horizon ``t_f - t_0`` (with a free final time: its upper bound less ``t_0``)."""
 
     initial: dict[str, float]
     horizon: float
@@ -117,11 +117,21 @@ class PlayerSpec(StrictModel):
     start: dict[str, Number] = Field(default_factory=dict)
 
 
-class GameTime(StrictModel):
-    """The fixed horizon of the game: ``final`` is a number or an expression of the parameters."""
+class GameTime(FreeOrFixed):
+    """The horizon of the game: ``final`` is a number or an expression of the parameters (a fixed
+    horizon), or ``free`` within ``bounds`` (a game of degree, Isaacs: it ends at capture, the
+    ``problem.capture`` set reached, and its payoff is the capture time ``t_f``, minimized by the
+    pursuers and maximized by the evaders; the upper bound is the longest game considered)."""
 
     initial: Number = 0.0
-    final: Value = 1.0
+    final: Value | Literal["free"] = Field(
+        1.0,
+        description="The final time (a number or an expression of the parameters), or free: the game "
+        "ends at capture (problem.capture) and its payoff is the capture time t_f.",
+    )
+
+    fixed_field: ClassVar[str] = "final"
+    what: ClassVar[str] = "final time"
 
 
 class GameProblem(StrictModel):
@@ -139,7 +149,14 @@ class GameProblem(StrictModel):
         None,
         description="The target set of a game of kind (capture), a relation over the states and "
         "parameters such as 'x**2 + y**2 <= l**2': the minimizing players reach it, the maximizing "
-        "ones avoid it (read by the hji backend; the best-response schemes ignore it).",
+        "ones avoid it (read by the hji backend; the best-response schemes ignore it). With "
+        "time.final: free, the terminal condition that ends the game.",
+    )
+    avoid: str | None = Field(
+        None,
+        description="A set the minimizing players must not enter on their way to the capture set, a "
+        "relation over the states and parameters such as '(x - 1)**2 + y**2 <= 0.25' (reach-avoid, "
+        "as hj_reachability: a state that enters it is lost for them; read by the hji backend).",
     )
 
     _values: GameValues = PrivateAttr()
@@ -220,12 +237,37 @@ class GameProblem(StrictModel):
         checks += [
             (f"terminal_constraints.{i}", c, ends, True) for i, c in enumerate(self.terminal_constraints)
         ]
-        if self.capture is not None:
-            checks += [("capture", self.capture, list(self.states), True)]
+        for field in ("capture", "avoid"):
+            relation = getattr(self, field)
+            if relation is not None:
+                checks += [(field, relation, list(self.states), True)]
+        if self.time.free:
+            self._check_degree()
         for values in self.value_sets():
             for field, text, names, constraint in checks:
                 checked_expression(text, names, values, f"problem.{field}", constraint)
         self._values = self.evaluate()
+
+    def _check_degree(self) -> None:
+        """A game of degree (``time.final: free``) ends at ``capture`` and pays the capture time: it
+        needs ``problem.capture``, and its payoff is ``t_f`` (the default payoff, or ``mayer: t_f``
+        with no Lagrange term); a player's own payoff is refused."""
+        if self.capture is None:
+            raise SpecError(
+                "a free final time ends at capture: give problem.capture (e.g. x**2 + y**2 <= l**2)",
+                field="problem.time.final",
+            )
+        own = [n for n, p in self.players.items() if p.payoff is not None]
+        if own:
+            raise SpecError(
+                "a game of degree pays the capture time to every player (zero-sum)",
+                field=f"problem.players.{own[0]}.payoff",
+            )
+        if self.payoff.mayer not in (0.0, "t_f") or self.payoff.lagrange != 0.0:
+            raise SpecError(
+                "with time.final: free the payoff is the capture time: leave payoff out or write mayer: t_f",
+                field="problem.payoff",
+            )
 
     @property
     def values(self) -> GameValues:
@@ -272,6 +314,18 @@ class GameProblem(StrictModel):
                 lo = number(c.lower, -math.inf, f"players.{player}.controls.{name}.lower")
                 hi = number(c.upper, math.inf, f"players.{player}.controls.{name}.upper")
                 _ordered(lo, hi, f"players.{player}.controls.{name}")
+        if self.time.bounds is not None:
+            found = [
+                checked_expression(b, [], values, f"problem.time.bounds.{i}")
+                for i, b in enumerate(self.time.bounds)
+            ]
+            lower, upper = (math.nan if v is None else v for v in found)
+            if not self.time.initial <= lower < upper:
+                raise SpecError(
+                    "the bounds on a free final time are ordered and not before the initial time",
+                    field="problem.time.bounds",
+                )
+            return GameValues(initial, upper - self.time.initial)
         final = checked_expression(self.time.final, [], values, "problem.time.final")
         if not final > self.time.initial:
             raise SpecError("the final time must be after the initial time", field="problem.time.final")

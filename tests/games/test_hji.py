@@ -9,7 +9,23 @@
   ℓ/R < √(1−γ²) + γ·asin γ − 1, so below that the captured set stops growing (all of it is captured
   within a bounded time and the rest escapes), and above it the car captures from everywhere (the
   set keeps growing with the horizon). Checked at ℓ = 0.15 and 0.4 in the default suite, and the
-  threshold located by a sweep over ℓ in a slow test.
+  threshold bracketed by a study over ℓ (``metrics.capture_region.converged`` switches between
+  neighbouring ℓ): a few ℓ on a coarse grid by default, a fine one in a slow test. The bracket's
+  lower end gets a margin of one grid spacing: the switch lies 0.02–0.03 above ℓ* on every grid
+  measured (0.28–0.29 at spacing 1/30, T = 6; 0.28 still converged at spacing 0.05, T = 14;
+  0.27–0.28 at spacing 0.075, T = 14). Just above the threshold the set leaks through a gap
+  2(ℓ − ℓ*) wide between the two barrier arcs (traced below), and what lies beyond it is reached
+  only after the car loops round (about 2πR/w); which of the two keeps the numerical switch high
+  is not pinned down.
+- Below the threshold the captured set is the region Isaacs' barrier closes off: the two
+  semipermeable arcs traced back from the ends of the usable part of the capture circle (where
+  the pedestrian's radial run is tangent to it, y = γℓ; the car turning fully, the pedestrian running
+  along the arc's normal, which turns with the car; SciPy's DOP853 at 1e-11) until they meet on the
+  car's axis, and the circle's non-usable part. Every node farther than one grid spacing from that
+  curve is classified as the curve says.
+- Reach–avoid with a disturbance: the box game with ẏ = b/2 and a wall ``|x − 0.45| ≤ 0.05`` across
+  the grid that the pursuer must not enter: the set captured within T is the Minkowski sum
+  (``[−T/2, T/2]²``) on the near side of the wall only, though without the wall it reaches past it.
 """
 
 from __future__ import annotations
@@ -19,6 +35,9 @@ import textwrap
 
 import numpy as np
 import pytest
+from matplotlib.path import Path
+from scipy.integrate import solve_ivp
+from scipy.spatial import cKDTree
 
 from gamespec.loader import load
 from gamespec.result import Status
@@ -105,31 +124,124 @@ def test_capture_field_is_checked(tmp_path):
         load(file)
 
 
+def threshold_bracket(model, ells):
+    """The study over ℓ: ``metrics.capture_region.converged`` per ℓ, and the neighbouring ℓ between
+    which it switches from converged (a closed barrier) to growing (capture from everywhere)."""
+    converged = {ell: model.solve({"l": ell}).metrics["capture_region"]["converged"] for ell in ells}
+    stops = [ell for ell, done in converged.items() if done]
+    grows = [ell for ell, done in converged.items() if not done]
+    assert stops and grows and max(stops) < min(grows), converged
+    return max(stops), min(grows)
+
+
+def test_a_coarse_study_over_l_brackets_the_threshold():
+    """41 nodes on the file's box (spacing 0.075), ℓ from 0.18 in steps of 0.04."""
+    model = compile_spec(load(CHAUFFEUR, ["solver.options.hji.nodes=41"]))
+    spacing, step = 3.0 / 40, 0.04
+    below, above = threshold_bracket(model, [0.18 + step * k for k in range(4)])
+    assert below - spacing <= BARRIER <= above
+    assert above - below == pytest.approx(step)
+
+
 @pytest.mark.slow
-def test_the_switch_over_l_is_at_the_barrier_within_the_grid():
-    """On [−2, 2]² with 81 nodes (spacing 0.05) and T = 6: every ℓ whose captured set stops growing
-    lies below every ℓ whose set keeps growing, and Isaacs' threshold is within one spacing of the
-    switch."""
-    spacing = 0.05
-    model = compile_spec(
-        load(
-            CHAUFFEUR,
-            [
-                "problem.time.final=6.0",
-                "solver.options.hji.nodes=81",
-                "solver.options.hji.lower=[-2,-2]",
-                "solver.options.hji.upper=[2,2]",
-            ],
-        )
+def test_a_fine_study_over_l_brackets_the_threshold():
+    """On [−3, 3]² with 121 nodes (spacing 0.05) and T = 14 (more than twice the car's loop, 2πR/w,
+    after which the set beyond the gap is reached), ℓ from 0.24 in steps of 0.01."""
+    spacing, step = 6.0 / 120, 0.01
+    sets = ["problem.time.final=14.0", "solver.options.hji.nodes=121"]
+    sets += ["solver.options.hji.lower=[-3,-3]", "solver.options.hji.upper=[3,3]"]
+    model = compile_spec(load(CHAUFFEUR, sets))
+    below, above = threshold_bracket(model, [0.24 + step * k for k in range(7)])
+    assert below - spacing <= BARRIER <= above
+    assert above - below == pytest.approx(step)
+
+
+def isaacs_barrier(ell: float, gamma: float = GAMMA) -> np.ndarray:
+    """The closed curve that bounds the captured set below the threshold (w = R = 1): the capture
+    circle's non-usable part (y < γℓ) and the two barrier arcs from its ends to where they meet on
+    the y axis (module doc), as points in order."""
+    end = np.array([ell * math.sqrt(1 - gamma**2), gamma * ell])
+
+    def backward(t, z):
+        x, y, nx, ny = z
+        norm = math.hypot(nx, ny)
+        return [y - gamma * nx / norm, 1 - x - gamma * ny / norm, ny, -nx]
+
+    def on_axis(t, z):
+        return z[0]
+
+    on_axis.terminal, on_axis.direction = True, -1
+    arc = solve_ivp(
+        backward,
+        (0, 8),
+        [*end, *end / ell],
+        "DOP853",
+        rtol=1e-11,
+        atol=1e-12,
+        events=on_axis,
+        dense_output=True,
     )
-    growing = {}
-    for ell in np.arange(0.20, 0.345, 0.02):
-        region = model.solve({"l": float(ell)}).metrics["capture_region"]
-        growing[float(ell)] = region["area"] > region["area_at_half_horizon"]
-    stops = [ell for ell, grows in growing.items() if not grows]
-    grows = [ell for ell, grows in growing.items() if grows]
-    assert stops and grows and max(stops) < min(grows), growing
-    assert max(stops) - spacing <= BARRIER <= min(grows) + spacing, growing
+    assert arc.status == 1, "the arcs meet below the threshold"
+    right = arc.sol(np.linspace(0, arc.t[-1], 400))[:2].T
+    start = math.atan2(end[1], end[0])
+    angles = np.linspace(math.pi - start, 2 * math.pi + start, 200)
+    circle = np.column_stack([ell * np.cos(angles), ell * np.sin(angles)])
+    return np.vstack([circle, right, right[::-1] * [-1, 1]])
+
+
+@pytest.mark.parametrize(("ell", "nodes"), [(0.2, 41), (0.25, 61)])
+def test_below_the_threshold_the_captured_set_is_what_the_barrier_closes_off(ell, nodes):
+    sets = [f"solver.options.hji.nodes={nodes}", "problem.time.final=2.0"]
+    sets += ["solver.options.hji.lower=[-1,-1]", "solver.options.hji.upper=[1,1]"]
+    result = compile_spec(load(CHAUFFEUR, sets)).solve({"l": ell})
+    assert result.metrics["capture_region"]["converged"]
+    curve = isaacs_barrier(ell)
+    gx, gy = np.meshgrid(result.arrays["grid_x"], result.arrays["grid_y"], indexing="ij")
+    nodes_xy = np.column_stack([gx.ravel(), gy.ravel()])
+    inside = Path(curve).contains_points(nodes_xy).reshape(gx.shape)
+    dense = np.vstack([np.linspace(a, b, 5) for a, b in zip(curve, np.roll(curve, -1, axis=0), strict=True)])
+    distance = cKDTree(dense).query(nodes_xy)[0].reshape(gx.shape)
+    clear = distance > (gx[1, 0] - gx[0, 0]) * (1 + 1e-9)
+    assert np.array_equal((result.arrays["value"] <= 0)[clear], inside[clear])
+    assert inside.sum() > 40
+
+
+REACH_AVOID = """
+kind: differential_game
+name: box_reach_avoid
+problem:
+  parameters: {{r: 0.3}}
+  states:
+    x: {{lower: -1.0, upper: 1.0}}
+    y: {{lower: -1.0, upper: 1.0}}
+  dynamics: {{x: "{x}", y: b/2}}
+  players:
+    pursuer: {{objective: minimize, controls: {{a: {{lower: -1, upper: 1}}, b: {{lower: -1, upper: 1}}}}}}
+    evader: {{objective: maximize, controls: {{c: {{lower: {c_lower}, upper: 0.5}}}}}}
+  capture: x**2 + y**2 <= r**2
+  avoid: abs(x - 0.45) <= 0.05
+  time: {{final: 1.0}}
+solver: {{backend: hji, options: {{hji: {{nodes: 41}}}}}}
+"""
+
+
+@pytest.mark.parametrize(("x", "c_lower"), [("a + c", -0.5), ("a*(1 - c)", 0.0)], ids=["separable", "mixed"])
+def test_reach_avoid_with_a_disturbance_stops_at_the_wall(tmp_path, x, c_lower):
+    file = tmp_path / "wall.yaml"
+    file.write_text(textwrap.dedent(REACH_AVOID.format(x=x, c_lower=c_lower)))
+    spec = load(file)
+    result = compile_spec(spec).solve()
+    gx, gy = np.meshgrid(result.arrays["grid_x"], result.arrays["grid_y"], indexing="ij")
+    outside = np.hypot(np.maximum(abs(gx) - 0.5, 0), np.maximum(abs(gy) - 0.5, 0))
+    reached = outside <= 0.3
+    spacing = (gx[1, 0] - gx[0, 0]) * (1 + 1e-9)
+    clear = (abs(outside - 0.3) > spacing) & ((abs(gx - 0.4) > spacing) | ~reached)
+    captured = result.arrays["value"] <= 0
+    assert np.array_equal(captured[clear], (reached & (gx < 0.4))[clear])
+    assert result.metrics["capture_region"]["avoid"]
+    assert result.status is Status.OPTIMAL, result.message
+    free = compile_spec(load(file, ["problem.avoid=null"])).solve()
+    assert np.any((free.arrays["value"] <= 0) & (gx > 0.5 + spacing))
 
 
 def test_games_it_cannot_solve_are_refused_with_the_reason(tmp_path):

@@ -454,7 +454,10 @@ def plot(
         for line in store.damaged:
             print(line, file=sys.stderr)
     else:
-        paths = plot_result(Result.load(result), folder, animate=animate)
+        loaded = Result.load(result)
+        paths = plot_result(loaded, folder, animate=animate)
+        if animate and not any(p.suffix == ".gif" for p in paths):
+            print(f"no animation: a {loaded.kind} Result of this sort has none", file=sys.stderr)
     for path in paths:
         _console().print(f"wrote {path}")
 

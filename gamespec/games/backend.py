@@ -127,6 +127,13 @@ class GameCompiled(CompiledModel):
     def solve(
         self, parameters: dict[str, float] | None = None, guess: Result | None = None, inputs: Inputs = None
     ) -> Result:
+        """The game's Result, with the file's ``plot`` section in ``metrics["plot"]`` (what its
+        figures draw: :mod:`gamespec.games.plotting`)."""
+        result = self._solve(parameters, inputs)
+        plot = self.game.plot.as_metrics() | {"path_constraints": []}
+        return result.model_copy(update={"metrics": result.metrics | {"plot": plot}})
+
+    def _solve(self, parameters: dict[str, float] | None, inputs: Inputs) -> Result:
         refuse_inputs(inputs, self.game.kind)
         if self.iterative:
             self.parameters |= parameters or {}

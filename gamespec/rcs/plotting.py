@@ -75,10 +75,12 @@ def plot_sensitivity_map(path: Path, heading: str = "", **setting) -> Path:
         ax.set_aspect("equal")
         ax.set_xlabel("x")
         ax.set_ylabel("y")
-    if heading:
-        fig.suptitle(heading, fontsize="medium")
+    fig.suptitle(
+        f"{heading}\nsensitivity of the avoidance constraint to ρ about the agent's positions".lstrip(),
+        fontsize="medium",
+    )
     fig.tight_layout()
-    fig.savefig(path, dpi=120)
+    fig.savefig(path, dpi=120, bbox_inches="tight")
     plt.close(fig)
     return path
 
@@ -178,8 +180,12 @@ def plot_levels(
         else:
             _draw_path(ax, result, label=label, color=f"C{i}", snapshots=i == 0)
             ax.set_aspect("equal", adjustable="datalim")
-    ax.legend(loc="best")
-    fig.savefig(path, dpi=120)
+    ax.set_title(
+        "paths at each weight level" if control is None else f"{control} at each weight level",
+        fontsize="medium",
+    )
+    ax.legend(**LEGEND_RIGHT)
+    fig.savefig(path, dpi=120, bbox_inches="tight")
     plt.close(fig)
     return path
 
@@ -201,10 +207,13 @@ def plot_study(result: Result, output_dir: Path, *, animate: bool = False) -> li
             ax.annotate(f"α={r['alpha']:g}", (r["t_final"], r["collision_probability"]), fontsize=7)
     ax.set_xlabel("t_f")
     ax.set_ylabel("collision probability")
-    ax.legend(loc="best")
+    ax.set_title(
+        f"{headline(result)}\ntravel time against collision probability (Fig. 6.11)", fontsize="medium"
+    )
+    ax.legend(**LEGEND_RIGHT)
     ax.grid(alpha=0.3)
     paths = [output_dir / f"{result.problem}_tradeoff.png"]
-    fig.savefig(paths[0], dpi=120)
+    fig.savefig(paths[0], dpi=120, bbox_inches="tight")
     plt.close(fig)
     fig, axes = plt.subplots(len(counts), 1, figsize=(8, 2.6 * len(counts)), squeeze=False)
     radius = result.metrics.get("radius", 1.0)
@@ -222,9 +231,12 @@ def plot_study(result: Result, output_dir: Path, *, animate: bool = False) -> li
                 )
         ax.set_aspect("equal", adjustable="datalim")
         ax.set_title(f"N = {n} (obstacles drawn where they cross y = 0)", fontsize=9)
-        ax.legend(loc="best", fontsize=7)
+        ax.set_xlabel("x")
+        ax.set_ylabel("y")
+        ax.legend(**LEGEND_RIGHT)
+    fig.suptitle(headline(result), fontsize="medium")
     fig.tight_layout()
     paths.append(output_dir / f"{result.problem}_paths.png")
-    fig.savefig(paths[-1], dpi=120)
+    fig.savefig(paths[-1], dpi=120, bbox_inches="tight")
     plt.close(fig)
     return paths

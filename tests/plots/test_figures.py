@@ -33,6 +33,7 @@ def _check_common(result: gamespec.Result, saved) -> None:
     for figure in saved:
         text = titles(figure)
         assert result.problem in text and result.backend in text and result.status.value in text, figure.name
+        _check_cannot_mislead(figure)
         for ax, outside in zip(figure.axes, figure.legend_outside, strict=True):
             if outside is None:
                 continue
@@ -58,6 +59,32 @@ def test_shipped_problem_figures(path: Path, tmp_path: Path) -> None:
         "differential_game": _check_differential_game,
     }[result.kind]
     check(result, {s.name: s for s in saved})
+
+
+def _data_axes(figure):
+    """The axes that draw data (a colorbar's are the scale of another's)."""
+    return [ax for ax in figure.axes if not hasattr(ax, "_colorbar")]
+
+
+def _labelled(ax) -> list[str]:
+    """The labels of the artists an axes draws that ask for a legend entry."""
+    artists = [*ax.lines, *ax.patches, *ax.collections]
+    return [a.get_label() for a in artists if a.get_label() and not a.get_label().startswith("_")]
+
+
+def _check_cannot_mislead(figure) -> None:
+    """What every figure must show (issue 28 item 3): every data axes titled (or the figure), no
+    axis with an offset or a multiplier ("1e-7+1"), and a legend entry for every labelled series."""
+    axes = _data_axes(figure)
+    for ax in axes:
+        assert ax.get_title() or figure.title, (figure.name, "an untitled axes in an untitled figure")
+        for axis in (ax.xaxis, ax.yaxis):
+            assert not axis.get_offset_text().get_text(), (figure.name, axis.get_offset_text().get_text())
+    legends = [ax.get_legend() for ax in axes if ax.get_legend() is not None] + list(figure.figure.legends)
+    entries = {t.get_text() for legend in legends for t in legend.get_texts()}
+    labels = {label for ax in axes for label in _labelled(ax)}
+    if len(labels) >= 2 or legends:
+        assert labels <= entries, (figure.name, "not in a legend:", sorted(labels - entries))
 
 
 def _check_engagement(result, saved) -> None:
@@ -108,6 +135,8 @@ def _check_differential_game(result, saved) -> None:
     paths = saved.get(f"{result.problem}_paths.png")
     if paths is not None:
         assert legend_texts(paths.axes[0]), "each player is in the legend"
+    elif "value" not in result.arrays:
+        _check_ocp(result, saved)
 
 
 def _check_flow(result, saved) -> None:
@@ -118,7 +147,58 @@ def _check_flow(result, saved) -> None:
 def _check_ocp(result, saved) -> None:
     pairs = result.metrics["plot"]["planar"]
     assert (f"{result.problem}_path.png" in saved) == bool(pairs)
-    assert f"J = {result.objective:.6g}" in titles(saved[f"{result.problem}_time.png"])
+    figure = saved[f"{result.problem}_time.png"]
+    assert f"J = {result.objective:.6g}" in titles(figure)
+    angles = result.metrics["plot"].get("angles", [])
+    _check_spans(figure.axes[0], result.time, result.time, result.states, angles)
+    if result.controls:
+        times = result.control_time if result.control_time is not None else result.time
+        _check_spans(figure.axes[1], result.time, times, result.controls, angles)
+        _check_controls_per_interval(result, figure.axes[1])
+
+
+def _drawn(ax, name: str):
+    return next(line for line in ax.lines if line.get_label().split(" ")[0] == name)
+
+
+def _check_spans(ax, span, time, signals, angles) -> None:
+    """Each signal (values at ``time``) is drawn over the Result's whole ``span`` and keeps its
+    values (angles modulo 2π): one whose values vary by at most the solver's tolerance is drawn
+    flat and says "constant"; any other keeps its variation; the axes hold the whole line."""
+    for name, values in signals.items():
+        line = _drawn(ax, name)
+        x, y = np.asarray(line.get_xdata(), float), np.asarray(line.get_ydata(), float)
+        assert x.min() == pytest.approx(span[0]) and x.max() == pytest.approx(span[-1]), name
+        spread = np.ptp(np.unwrap(values) if name in angles else values)
+        if spread <= 1e-6 * max(1.0, np.abs(values).max()):
+            assert np.ptp(y) == 0 and "constant" in line.get_label(), name
+        else:
+            assert np.ptp(y) >= 0.5 * spread and "constant" not in line.get_label(), name
+        if name in angles:
+            assert np.all(np.abs(np.diff(y)) < np.pi), f"{name} is drawn with a 2π jump"
+            assert np.allclose(np.cos(np.interp(time, x, y)), np.cos(values), atol=1e-6), name
+        low, high = ax.get_ylim()
+        assert low <= y.min() and y.max() <= high, name
+
+
+def _check_controls_per_interval(result, ax) -> None:
+    """Controls drawn as the transcription holds them (:mod:`gamespec.ocp.control_signal`): the line
+    passes through every control point, and at each interior mesh point it is drawn twice (each side
+    of the jump from its own interval)."""
+    mesh = result.arrays.get("control_mesh")
+    for name, values in result.controls.items():
+        line = _drawn(ax, name)
+        x, y = np.asarray(line.get_xdata(), float), np.asarray(line.get_ydata(), float)
+        if "constant" in line.get_label():
+            continue
+        on_points = [y[np.isclose(x, t, rtol=0, atol=1e-9)] for t in result.control_time]
+        assert all(
+            np.any(np.isclose(ys, v, atol=1e-6 * max(1, abs(v))))
+            for ys, v in zip(on_points, values, strict=True)
+        ), name
+        if mesh is not None:
+            for t in mesh[1:-1]:
+                assert np.count_nonzero(np.isclose(x, t, rtol=0, atol=1e-9)) >= 2, (name, t)
 
 
 def _check_multiphase(result, saved) -> None:

@@ -309,3 +309,61 @@ def test_animations_show_time_legend_labels_and_growing_paths(name, tmp_path, mo
     assert all("t = " in title and legend and xlabel for title, legend, xlabel, _ in frames)
     lengths = [n for *_, n in frames]
     assert lengths == sorted(lengths) and lengths[0] < lengths[-1]
+
+
+def test_the_game_gif_ends_at_the_last_sample_without_warnings(tmp_path, monkeypatch, caplog) -> None:
+    """Chapter 7's GIF: a frame per receding-horizon step and one at the run's last sample (the
+    collision or capture), drawn without a library warning (fixed limits with a box aspect)."""
+    import warnings
+
+    import matplotlib
+    from matplotlib.animation import PillowWriter
+
+    result = fixtures.saved(PROBLEMS / "ch7/asymmetric_obstacle.yaml")
+    frames = []
+    original = PillowWriter.grab_frame
+
+    def grab(self, **kwargs):
+        frames.append(self.fig.axes[0].get_title())
+        return original(self, **kwargs)
+
+    monkeypatch.setattr(PillowWriter, "grab_frame", grab)
+    monkeypatch.setitem(matplotlib.rcParams, "savefig.dpi", 20)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        written = plot_result(result, tmp_path, animate=True)
+    assert [p.suffix for p in written].count(".gif") == 1
+    assert not [r for r in caplog.records if r.levelname == "WARNING"], caplog.text
+    assert frames[-1].endswith(f"t = {result.time[-1]:.2f}")
+    assert len(frames) == len(result.control_time) + (result.control_time[-1] < result.time[-1])
+
+
+def test_a_moving_obstacle_is_drawn_at_the_closest_approach(tmp_path) -> None:
+    """With the true obstacle nearest the pursuer at sample k (it sits on the pursuer's path
+    there), the paths figure draws it at t_k as well as at the end, with the players at t_k."""
+    result = fixtures.saved(PROBLEMS / "ch7/asymmetric_obstacle.yaml")
+    px, py = result.metrics["figure"]["positions"]["pursuer"]
+    k = len(result.time) // 2
+    x, y = result.states[px], result.states[py]
+    arrays = dict(result.arrays)
+    arrays["obstacle/true/x"] = np.full_like(x, x[k]) + 0.05 * (np.arange(len(x)) - k) ** 2
+    arrays["obstacle/true/y"] = np.full_like(y, y[k])
+    moved = result.model_copy(update={"arrays": arrays})
+    with recording() as saved:
+        plot_result(moved, tmp_path)
+    labels = legend_texts(saved[0].axes[0])
+    when = f"t = {result.time[k]:.2f}"
+    assert f"obstacle at pursuer's closest approach, {when} (true)" in labels
+    assert f"players at {when}" in labels
+    disks = [
+        p
+        for p in saved[0].axes[0].patches
+        if isinstance(p, Circle) and p.get_label().endswith(f"{when} (true)")
+    ]
+    assert [d.center for d in disks] == [pytest.approx((x[k], y[k]))]
+
+
+def test_animate_says_when_a_kind_has_no_animation(cli, tmp_path) -> None:
+    code, _, err = cli("plot", fixtures.FIXTURES / "linear_flow", "--out", tmp_path, "--animate")
+    assert code == 0 and "no animation" in err and "flow_field_game" in err
+    assert not list(tmp_path.glob("*.gif"))

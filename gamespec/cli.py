@@ -355,7 +355,8 @@ RESULT_COLUMNS = (
     "variation_percent",
     "solve_time_s",
 )
-"""Columns ``gamespec results`` shows after the swept parameters, where the rows have them."""
+"""Columns ``gamespec results`` shows after the swept parameters, where the rows have them; then
+the headline numbers of the points' kinds (:func:`~gamespec.studies.export.headline_columns`)."""
 
 
 def _result_trajectories(folder: Path, csv: Path | None, parquet: Path | None, json_: bool) -> None:
@@ -388,7 +389,7 @@ def results(
 ) -> None:
     """Print a study's table (sweep, compare, Table 2.1) and export it as CSV or Parquet; for one
     Result's folder, its summary, and its trajectories as the exported table."""
-    from gamespec.studies.export import find_store, study_rows, write_csv, write_parquet
+    from gamespec.studies.export import find_store, headline_columns, study_rows, write_csv, write_parquet
     from gamespec.studies.rows import study_meta
 
     if (folder / "result.json").is_file():
@@ -403,7 +404,7 @@ def results(
         sys.stdout.write(json.dumps(rows, indent=2) + "\n")
     else:
         present = {name for row in rows for name in row}
-        shown = [c for c in [*study.parameters, *RESULT_COLUMNS] if c in present]
+        shown = [c for c in [*study.parameters, *RESULT_COLUMNS] if c in present] + headline_columns(rows)
         title = f"{study.type or 'study'} {study.problem}: {len(rows)} points".strip()
         _console().print(_rows_table(rows, shown or ["key"], title))
     for path in (write_csv(rows, csv) if csv else None, write_parquet(rows, parquet) if parquet else None):

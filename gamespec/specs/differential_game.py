@@ -486,5 +486,11 @@ KIND = Kind(
     plot="gamespec.games.plotting:plot_game",
     summary="gamespec.games.report:game_summary",
     metrics="gamespec.games.metrics:GameMetrics",
+    columns=(
+        "metrics.solution_concept",
+        "metrics.saddle_gap",
+        "metrics.captured",
+        "metrics.capture_time",
+    ),
 )
 """The ``DifferentialGameSpec`` kind as one plugin (:class:`~gamespec.registry.Kind`)."""

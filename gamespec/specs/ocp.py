@@ -650,5 +650,12 @@ KIND = Kind(
     plot="gamespec.plotting:plot_trajectories",
     summary="gamespec.summaries:optimal_control_summary",
     metrics="gamespec.ocp.metrics:OcpMetrics",
+    columns=(
+        "metrics.nominal_objective",
+        "metrics.sensitivity_measure",
+        "metrics.monte_carlo.cost_mean",
+        "metrics.monte_carlo.cost_std",
+        "metrics.monte_carlo.collision_probability",
+    ),
 )
 """The ``OptimalControlSpec`` kind as one plugin (:class:`~gamespec.registry.Kind`)."""

@@ -17,13 +17,13 @@ import warnings
 from collections.abc import Iterator
 from contextlib import AbstractContextManager, contextmanager, nullcontext
 from pathlib import Path
-from typing import TYPE_CHECKING, Annotated
+from typing import TYPE_CHECKING, Annotated, Any
 
 import typer
 
 from gamespec import registry
 from gamespec.commands.options import AnalysesOpt, with_analyses
-from gamespec.errors import GamespecError
+from gamespec.errors import GamespecError, SpecError
 
 if TYPE_CHECKING:
     from rich.console import Console
@@ -144,7 +144,33 @@ def validate(file: FileArg, set_: SetOpt = None) -> None:
     from gamespec.loader import load
 
     spec = load(file, set_ or [])
+    if spec.transforms:
+        from gamespec.solving import check_requested
+
+        check_requested(spec)
+    for view, player, problem in _players(spec, with_transforms=True):
+        from gamespec.solving import check_requested
+
+        try:
+            check_requested(problem)
+        except SpecError as err:
+            field = f"problem.players.{player}.{err.field}" if err.field else f"problem.players.{player}"
+            raise SpecError(f"in {view}'s game: {err.reason}", field=field, source=str(file)) from None
     _console().print(f"[green]valid[/green] {file} (kind {spec.kind}, name {spec.name})")
+
+
+def _players(spec: Any, with_transforms: bool = False) -> list[tuple[str, str, Any]]:
+    """(game, player, best-response problem) of each player of a ``differential_game`` (none for
+    any other kind, or, ``with_transforms``, when no player requests a transform):
+    :func:`gamespec.games.problems.player_problems`. Nothing is imported for another kind (what
+    ``validate`` imports: ``tests/core/test_startup_imports.py``)."""
+    if spec.kind != "differential_game":
+        return []
+    if with_transforms and not any(p.transforms for p in spec.problem.players.values()):
+        return []
+    from gamespec.games.problems import player_problems
+
+    return [(v, p, problem) for v, players in player_problems(spec).items() for p, problem in players.items()]
 
 
 @app.command()
@@ -415,7 +441,13 @@ def results(
 @app.command()
 def show(
     file: FileArg,
-    transformed: Annotated[bool, typer.Option(help="Print the spec the backend actually solves.")] = False,
+    transformed: Annotated[
+        bool,
+        typer.Option(
+            help="Print the spec the backend actually solves (a differential game: each player's "
+            "best-response problem in each player's game, transformed)."
+        ),
+    ] = False,
     backend: Annotated[str | None, typer.Option(help="Backend whose input to show.")] = None,
     set_: SetOpt = None,
 ) -> None:
@@ -425,11 +457,20 @@ def show(
     from gamespec.loader import load
 
     spec = load(file, set_ or [])
-    if transformed:
+    players = _players(spec) if transformed else []
+    if players:
         from gamespec.solving import transformed as transformed_spec
 
-        spec = transformed_spec(spec, backend).as_solved()
-    data = spec.model_dump(mode="json", exclude_defaults=False)
+        data: dict[str, Any] = {}
+        for view, player, problem in players:
+            solved = transformed_spec(problem).as_solved()
+            data.setdefault(f"game of {view}", {})[player] = solved.model_dump(mode="json")
+    else:
+        if transformed:
+            from gamespec.solving import transformed as transformed_spec
+
+            spec = transformed_spec(spec, backend).as_solved()
+        data = spec.model_dump(mode="json", exclude_defaults=False)
     sys.stdout.write(yaml.safe_dump(data, sort_keys=False, allow_unicode=True))
 
 

@@ -69,7 +69,7 @@ def plot_desensitized(result: Result, output_dir: Path) -> list[Path]:
         ax.grid(alpha=0.3)
         ax.legend(**LEGEND_RIGHT)
         ax.set_title(
-            f"{headline(result)}\nMonte Carlo about the nominal{_collision(result)}", fontsize="medium"
+            f"{headline(result)}\nMonte Carlo about the nominal{collision_note(result)}", fontsize="medium"
         )
         paths.append(output_dir / f"{result.problem}_monte_carlo.png")
         fig.savefig(paths[-1], dpi=120, bbox_inches="tight")
@@ -98,13 +98,13 @@ def _coincide(ys, xs) -> bool:
     return all(all(is_flat(row) for row in np.asarray(b, dtype=float)) for b in bundles)
 
 
-def _collision(result: Result) -> str:
+def collision_note(result: Result) -> str:
     """``, P_c = p [low, high]`` (the open-loop Monte Carlo's collision probability and its
     interval) where the Result has one."""
     mc = result.metrics.get("monte_carlo", {})
     if "collision_probability" not in mc:
         return ""
-    low, high = mc["collision_probability_ci"]
+    low, high = (0.0 if abs(v) < 1e-12 else v for v in mc["collision_probability_ci"])
     return f", collision probability P_c = {mc['collision_probability']:.3g} [{low:.2g}, {high:.2g}]"
 
 

@@ -102,7 +102,7 @@ def plot(result: Result, output_dir: Path, *, animate: bool = False) -> list[Pat
     for name, draw in figures:
         fig, ax = plt.subplots(figsize=(7.5, 4.5))
         draw(ax, result)
-        fig.suptitle(headline(result), fontsize="medium")
+        ax.set_title(f"{headline(result)}\n{ax.get_title()}", fontsize="medium")
         ax.legend(**LEGEND_RIGHT)
         if name != "capture_probability.png":
             ax.set_aspect("equal")

@@ -12,6 +12,7 @@ from pathlib import Path
 import numpy as np
 import sympy as sp
 
+from gamespec.desensitize.plotting import collision_note
 from gamespec.plotting import LEGEND_RIGHT, headline
 from gamespec.rcs.obstacles import avoidance
 from gamespec.rcs.relevance import relevance
@@ -45,7 +46,9 @@ def sensitivity_map(
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
     """(X, Y, g, |S_g|, |S_r|) over agent positions, the obstacle at ``center`` at time ``t`` moving
     along y at speed ρ (Fig. 6.6's setting by default: (0, 1), r_o = 0.6, t = 1): S_g = ∂g/∂ρ
-    (eq. 6.40; eq. 6.42 for β ≠ 1), S_r = r(g) S_g."""
+    (eq. 6.40; eq. 6.42 for β ≠ 1), S_r = r(g) S_g. At the obstacle's centre (inside the infeasible
+    disc the figure leaves white) eq. 6.42 divides by zero: that value is not drawn, and no warning
+    is printed for it."""
     x, y, r = symbol("x"), symbol("y"), symbol("rho")
     names = {"rho": r}
     start = (center[0], center[1] - rho * t)
@@ -57,7 +60,8 @@ def sensitivity_map(
         np.linspace(center[0] - extent, center[0] + extent, points),
         np.linspace(center[1] - extent, center[1] + extent, points),
     )
-    G, Sg, Sr = (np.broadcast_to(v, X.shape) for v in f(X, Y, rho, t))
+    with np.errstate(divide="ignore", invalid="ignore"):
+        G, Sg, Sr = (np.broadcast_to(v, X.shape) for v in f(X, Y, rho, t))
     return X, Y, G, np.abs(Sg), np.abs(Sr)
 
 
@@ -120,7 +124,8 @@ def plot_rcs(result: Result, output_dir: Path) -> list[Path]:
         ax.set_xlabel("x")
         ax.set_ylabel("y")
         ax.set_title(
-            f"{headline(result)}\nobstacles at {OBSTACLE_SNAPSHOTS} times (same colour as the agent)",
+            f"{headline(result)}\nobstacles at {OBSTACLE_SNAPSHOTS} times (same colour as the agent)"
+            + collision_note(result).replace(", ", "\n", 1),
             fontsize="medium",
         )
         if ax.get_legend_handles_labels()[0]:

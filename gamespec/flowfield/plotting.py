@@ -52,6 +52,7 @@ def _sets(ax: Axes, result: Result) -> None:
             closed = np.vstack([front, front[:1]])
             ax.plot(closed[:, 0], closed[:, 1], color=color, lw=1)
     for path, color, name in zip(arrays["nominal_positions"], COLORS, ("pursuer", "evader"), strict=True):
+        ax.plot([], [], "-", color=color, lw=1, label=f"{name}'s reachable set")
         ax.plot(path[:, 0], path[:, 1], "--", color=color, label=f"{name} (nominal)")
         ax.plot(*path[0], "o", color=color)
     ax.plot(*result.metrics["capture_point"], "k*", ms=10, label="capture point")

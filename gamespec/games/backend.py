@@ -63,6 +63,8 @@ def open_loop(model: GameModel) -> Result:
     tc = first.control_time + t0
     controls = {c: own[p].controls_of(p)[c] for p, pl in game.problem.players.items() for c in pl.controls}
     arrays: dict[str, np.ndarray] = {}
+    if "control_mesh" in first.arrays:
+        arrays["control_mesh"] = first.arrays["control_mesh"] + t0
     if len(solutions) == 1:
         time, states = first.time + t0, dict(first.states)
     else:

@@ -119,7 +119,8 @@ def _controls_drawn(result: Result, angles: list[str]) -> tuple[dict[str, tuple]
     out = {}
     for row, name in enumerate(names):
         points, suffix = drawn[name]
-        out[name] = (times, stages[row].ravel(), suffix, points)
+        dense = np.full(times.shape, points[0]) if suffix else stages[row].ravel()
+        out[name] = (times, dense, suffix, points)
     return out, tc
 
 

@@ -373,3 +373,27 @@ def test_animate_says_when_a_kind_has_no_animation(cli, tmp_path) -> None:
     code, _, err = cli("plot", fixtures.FIXTURES / "linear_flow", "--out", tmp_path, "--animate")
     assert code == 0 and "no animation" in err and "flow_field_game" in err
     assert not list(tmp_path.glob("*.gif"))
+
+
+@pytest.mark.parametrize(
+    "name",
+    [
+        "ocp/brachistochrone.yaml",
+        "ch7/homicidal_chauffeur.yaml",
+        "ch7/unicycle_pursuit_evasion.yaml",
+        "ch7/lq_pursuit_evasion.yaml",
+    ],
+)
+def test_planar_problems_and_open_loop_games_get_their_path_figure(name, tmp_path) -> None:
+    """The planar OCP and the open-loop games with positions in a plane declare them (``plot.planar``)
+    and get the x–y figure: one path per pair, through the Result's states."""
+    result = fixtures.saved(PROBLEMS / name)
+    pairs = result.metrics["plot"]["planar"]
+    assert pairs
+    with recording() as saved:
+        plot_result(result, tmp_path)
+    (ax,) = next(s for s in saved if s.name == f"{result.problem}_path.png").axes
+    for xs, ys in pairs:
+        line = next(line for line in ax.lines if line.get_label() == f"({xs}, {ys})")
+        assert np.array_equal(line.get_xdata(), result.states[xs])
+        assert np.array_equal(line.get_ydata(), result.states[ys])

@@ -1,5 +1,6 @@
 """Figures of §6.4: |S_g| and |S_r| over a grid of agent positions (Fig. 6.6), the path with the
-obstacles drawn where they are (Figs. 6.7(a), 6.8), S_g and S_r along the solution (Fig. 6.7(b, c)),
+obstacles drawn where they are (Figs. 6.7(a), 6.8), S_g and S_r along the solution (Fig. 6.7(b, c))
+with the Monte Carlo's collision probability along the path,
 several weight levels overlaid (paths: Figs. 6.7(a), 6.8; controls: Fig. 6.9(b)), and the study's
 trade-off (Fig. 6.11). Plots read Results (and, for the map, the obstacle geometry) only.
 """
@@ -135,12 +136,15 @@ def plot_rcs(result: Result, output_dir: Path) -> list[Path]:
         plt.close(fig)
     keys = sorted(k for k in result.arrays if k.startswith(("S_g", "S_r")))
     if keys:
-        fig, axes = plt.subplots(2, 1, figsize=(7, 5.5), sharex=True)
+        along = "monte_carlo_violated" in result.arrays
+        fig, axes = plt.subplots(3 if along else 2, 1, figsize=(7, 7.5 if along else 5.5), sharex=True)
         for k in keys:
             axes[0 if k.startswith("S_r") else 1].plot(result.time, np.abs(result.arrays[k]), label=k)
         axes[0].set_ylabel("|S_r|")
         axes[1].set_ylabel("|S_g|")
-        axes[1].set_xlabel("t")
+        if along:
+            _collision_along(axes[2], result)
+        axes[-1].set_xlabel("t")
         for ax in axes:
             ax.legend(**LEGEND_RIGHT)
         fig.suptitle(headline(result), fontsize="medium")
@@ -167,6 +171,21 @@ def plot_rcs(result: Result, output_dir: Path) -> list[Path]:
             )
         )
     return paths
+
+
+def _collision_along(ax, result: Result) -> None:
+    """P_c along the path: the fraction of the open-loop Monte Carlo's samples that have collided
+    by each time (its last value is the collision probability)."""
+    mc = result.metrics["monte_carlo"]
+    ax.plot(
+        result.arrays["monte_carlo_time"],
+        result.arrays["monte_carlo_violated"],
+        color="tab:red",
+        label=f"collided by t ({mc['samples']} samples)",
+    )
+    ax.set_ylabel("P_c by t")
+    ax.set_ylim(-0.02, max(0.05, 1.1 * float(np.max(result.arrays["monte_carlo_violated"]))))
+    ax.set_title("collision probability along the path (open-loop Monte Carlo)", fontsize="medium")
 
 
 def plot_levels(

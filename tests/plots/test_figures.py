@@ -397,3 +397,22 @@ def test_planar_problems_and_open_loop_games_get_their_path_figure(name, tmp_pat
         line = next(line for line in ax.lines if line.get_label() == f"({xs}, {ys})")
         assert np.array_equal(line.get_xdata(), result.states[xs])
         assert np.array_equal(line.get_ydata(), result.states[ys])
+
+
+@pytest.mark.parametrize("name", ["ch6/car_vs_train.yaml", "ch6/rcs_single_obstacle.yaml"])
+def test_the_collision_probability_is_drawn_along_the_path(name, tmp_path) -> None:
+    """Uncertainty drawn where it is: the fraction of Monte Carlo samples that have collided by
+    each time never decreases and ends at the collision probability the analysis reports (counted
+    per sample over the whole run), and the RCS figure draws that curve against time."""
+    result = fixtures.saved(PROBLEMS / name)
+    along = result.arrays["monte_carlo_violated"]
+    assert np.all(np.diff(along) >= 0)
+    assert along[-1] == pytest.approx(result.metrics["monte_carlo"]["collision_probability"], abs=1e-12)
+    with recording() as saved:
+        plot_result(result, tmp_path)
+    figure = next(s for s in saved if s.name == f"{result.problem}_rcs.png")
+    line = next(
+        line for ax in figure.axes for line in ax.lines if line.get_label().startswith("collided by t")
+    )
+    assert np.array_equal(line.get_ydata(), along)
+    assert np.array_equal(line.get_xdata(), result.arrays["monte_carlo_time"])

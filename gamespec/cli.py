@@ -173,14 +173,15 @@ def _players(spec: Any, with_transforms: bool = False) -> list[tuple[str, str, A
     return [(v, p, problem) for v, players in player_problems(spec).items() for p, problem in players.items()]
 
 
-def _store_under(spec: Any, out: Path, assignments: list[str]) -> Any:
-    """A study kind's spec with its point store in ``out/points`` (where ``gamespec results OUT``
-    and ``gamespec plot OUT`` find it): ``--out`` decides where a run's output lands, over the
-    file's ``store`` (kept for runs without ``--out``) though not over a ``--set store=...``; any
-    other spec as it is."""
-    if "store" not in type(spec).model_fields or any(a.startswith("store=") for a in assignments):
+def _store_under(spec: Any, out: Path) -> Any:
+    """A study kind's spec with a relative point store (the shipped files' ``runs/.../points``)
+    moved under ``out``, keeping its last part (``OUT/points``, where ``gamespec results OUT`` and
+    ``gamespec plot OUT`` find it): ``--out`` decides where a run's output lands. An absolute store
+    is a place the user chose and is kept; any other spec is as it is."""
+    store = getattr(spec, "store", None)
+    if not isinstance(store, Path) or store.is_absolute():
         return spec
-    return spec.model_copy(update={"store": out / "points"})
+    return spec.model_copy(update={"store": out / store.name})
 
 
 @app.command()
@@ -204,7 +205,7 @@ def solve(
     spec = load(file, with_analyses(set_, analyses))
     if out is not None:
         writable_folder(out)
-        spec = _store_under(spec, out, set_ or [])
+        spec = _store_under(spec, out)
     options = _where_it_runs(spec, backend, scheduler, insecure_scheduler)
     with _spinner(f"solving {spec.name} ..."):
         result = run_solve(spec, backend, options=options)

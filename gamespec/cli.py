@@ -17,13 +17,13 @@ import warnings
 from collections.abc import Iterator
 from contextlib import AbstractContextManager, contextmanager, nullcontext
 from pathlib import Path
-from typing import TYPE_CHECKING, Annotated
+from typing import TYPE_CHECKING, Annotated, Any
 
 import typer
 
 from gamespec import registry
 from gamespec.commands.options import AnalysesOpt, with_analyses
-from gamespec.errors import GamespecError
+from gamespec.errors import GamespecError, SpecError
 
 if TYPE_CHECKING:
     from rich.console import Console
@@ -144,7 +144,44 @@ def validate(file: FileArg, set_: SetOpt = None) -> None:
     from gamespec.loader import load
 
     spec = load(file, set_ or [])
+    if spec.transforms:
+        from gamespec.solving import check_requested
+
+        check_requested(spec)
+    for view, player, problem in _players(spec, with_transforms=True):
+        from gamespec.solving import check_requested
+
+        try:
+            check_requested(problem)
+        except SpecError as err:
+            field = f"problem.players.{player}.{err.field}" if err.field else f"problem.players.{player}"
+            raise SpecError(f"in {view}'s game: {err.reason}", field=field, source=str(file)) from None
     _console().print(f"[green]valid[/green] {file} (kind {spec.kind}, name {spec.name})")
+
+
+def _players(spec: Any, with_transforms: bool = False) -> list[tuple[str, str, Any]]:
+    """(game, player, best-response problem) of each player of a ``differential_game`` (none for
+    any other kind, or, ``with_transforms``, when no player requests a transform):
+    :func:`gamespec.games.problems.player_problems`. Nothing is imported for another kind (what
+    ``validate`` imports: ``tests/core/test_startup_imports.py``)."""
+    if spec.kind != "differential_game":
+        return []
+    if with_transforms and not any(p.transforms for p in spec.problem.players.values()):
+        return []
+    from gamespec.games.problems import player_problems
+
+    return [(v, p, problem) for v, players in player_problems(spec).items() for p, problem in players.items()]
+
+
+def _store_under(spec: Any, out: Path) -> Any:
+    """A study kind's spec with a relative point store (the shipped files' ``runs/.../points``)
+    moved under ``out``, keeping its last part (``OUT/points``, where ``gamespec results OUT`` and
+    ``gamespec plot OUT`` find it): ``--out`` decides where a run's output lands. An absolute store
+    is a place the user chose and is kept; any other spec is as it is."""
+    store = getattr(spec, "store", None)
+    if not isinstance(store, Path) or store.is_absolute():
+        return spec
+    return spec.model_copy(update={"store": out / store.name})
 
 
 @app.command()
@@ -168,6 +205,7 @@ def solve(
     spec = load(file, with_analyses(set_, analyses))
     if out is not None:
         writable_folder(out)
+        spec = _store_under(spec, out)
     options = _where_it_runs(spec, backend, scheduler, insecure_scheduler)
     with _spinner(f"solving {spec.name} ..."):
         result = run_solve(spec, backend, options=options)
@@ -355,7 +393,8 @@ RESULT_COLUMNS = (
     "variation_percent",
     "solve_time_s",
 )
-"""Columns ``gamespec results`` shows after the swept parameters, where the rows have them."""
+"""Columns ``gamespec results`` shows after the swept parameters, where the rows have them; then
+the headline numbers of the points' kinds (:func:`~gamespec.studies.export.headline_columns`)."""
 
 
 def _result_trajectories(folder: Path, csv: Path | None, parquet: Path | None, json_: bool) -> None:
@@ -388,7 +427,7 @@ def results(
 ) -> None:
     """Print a study's table (sweep, compare, Table 2.1) and export it as CSV or Parquet; for one
     Result's folder, its summary, and its trajectories as the exported table."""
-    from gamespec.studies.export import find_store, study_rows, write_csv, write_parquet
+    from gamespec.studies.export import find_store, headline_columns, study_rows, write_csv, write_parquet
     from gamespec.studies.rows import study_meta
 
     if (folder / "result.json").is_file():
@@ -403,7 +442,7 @@ def results(
         sys.stdout.write(json.dumps(rows, indent=2) + "\n")
     else:
         present = {name for row in rows for name in row}
-        wanted = dict.fromkeys([*study.parameters, *study.headline, *RESULT_COLUMNS])
+        wanted = dict.fromkeys([*study.parameters, *study.headline, *headline_columns(rows), *RESULT_COLUMNS])
         shown = [c for c in wanted if c in present]
         title = f"{study.type or 'study'} {study.problem}: {len(rows)} points".strip()
         _console().print(_rows_table(rows, shown or ["key"], title))
@@ -415,7 +454,13 @@ def results(
 @app.command()
 def show(
     file: FileArg,
-    transformed: Annotated[bool, typer.Option(help="Print the spec the backend actually solves.")] = False,
+    transformed: Annotated[
+        bool,
+        typer.Option(
+            help="Print the spec the backend actually solves (a differential game: each player's "
+            "best-response problem in each player's game, transformed)."
+        ),
+    ] = False,
     backend: Annotated[str | None, typer.Option(help="Backend whose input to show.")] = None,
     set_: SetOpt = None,
 ) -> None:
@@ -425,11 +470,20 @@ def show(
     from gamespec.loader import load
 
     spec = load(file, set_ or [])
-    if transformed:
+    players = _players(spec) if transformed else []
+    if players:
         from gamespec.solving import transformed as transformed_spec
 
-        spec = transformed_spec(spec, backend).as_solved()
-    data = spec.model_dump(mode="json", exclude_defaults=False)
+        data: dict[str, Any] = {}
+        for view, player, problem in players:
+            solved = transformed_spec(problem).as_solved()
+            data.setdefault(f"game of {view}", {})[player] = solved.model_dump(mode="json")
+    else:
+        if transformed:
+            from gamespec.solving import transformed as transformed_spec
+
+            spec = transformed_spec(spec, backend).as_solved()
+        data = spec.model_dump(mode="json", exclude_defaults=False)
     sys.stdout.write(yaml.safe_dump(data, sort_keys=False, allow_unicode=True))
 
 
@@ -455,7 +509,10 @@ def plot(
         for line in store.damaged:
             print(line, file=sys.stderr)
     else:
-        paths = plot_result(Result.load(result), folder, animate=animate)
+        loaded = Result.load(result)
+        paths = plot_result(loaded, folder, animate=animate)
+        if animate and not any(p.suffix == ".gif" for p in paths):
+            print(f"no animation: a {loaded.kind} Result of this sort has none", file=sys.stderr)
     for path in paths:
         _console().print(f"wrote {path}")
 

@@ -60,8 +60,12 @@ class Kind:
     list[Path]``, ``summary`` its rows ``(result) -> list[(label, value)]`` that lead ``gamespec
     solve``'s table, ``metrics`` the :class:`~gamespec.metrics.Metrics` model of its Results'
     ``metrics`` (None: the common one), ``analyses`` the list of
-    :class:`~gamespec.analyses.Analysis` its Results get (:mod:`gamespec.analyses`; None: none).
-    The parts other than ``spec`` may be ``"module:attribute"`` texts, imported when first used.
+    :class:`~gamespec.analyses.Analysis` its Results get (:mod:`gamespec.analyses`; None: none),
+    ``columns`` its headline numbers as a study table's columns (the dotted names
+    :func:`gamespec.studies.export.study_rows` gives them, ``metrics.capture_time``), shown by
+    ``gamespec results`` after the swept parameters where the study's points have them.
+    The parts other than ``spec`` and ``columns`` may be ``"module:attribute"`` texts, imported
+    when first used.
     """
 
     spec: Ref
@@ -71,6 +75,7 @@ class Kind:
     summary: Ref | None = None
     metrics: Ref | None = None
     analyses: Ref | None = None
+    columns: tuple[str, ...] = ()
 
     def __post_init__(self) -> None:
         if (self.default_backend is None) == (self.study is None):

@@ -225,6 +225,18 @@ def build_steps(
     return steps
 
 
+def check_requested(spec: SpecBase) -> None:
+    """What ``gamespec validate`` checks beyond the schema: each requested transform of ``spec``
+    applied in order (its options against the problem: a sensitivity weight that names no
+    sensitivity, ``S_x1_v`` for ``S_x1_V``, is a SpecError naming the file and ``transforms.<i>``),
+    up to the first staged one, whose upstream stage is a solve (validate never solves)."""
+    current = _unrequested(spec)
+    for index, (transform, options) in enumerate(requested_steps(spec)):
+        if transform.stage(current, options) is not None:
+            return
+        current = _from_file(transform, options, current, spec.source, f"transforms.{index}").target
+
+
 def transformed(spec: SpecBase, backend: str | None = None) -> SpecBase:
     """The spec the backend receives: ``spec`` after its requested and lowering transforms."""
     steps = build_steps(spec, get_backend(backend_name(spec, backend)))

@@ -46,3 +46,6 @@ class MonteCarlo(BaseModel):
                 raise ValueError(f"arrays.{drawn[0]} and arrays.{drawn[1]} differ in shape")
         for name in pair or (names[0],):
             state(result, name)
+        if "monte_carlo_violated" in result.arrays:
+            time = array(result, "monte_carlo_time", 1)
+            array(result, "monte_carlo_violated", 1, rows=len(time))

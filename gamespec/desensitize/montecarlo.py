@@ -92,9 +92,22 @@ def monte_carlo(
 ) -> tuple[dict[str, Any], dict[str, np.ndarray]]:
     """``metrics.monte_carlo`` for the open-loop control of ``result``, and the trajectories of the
     first :data:`BUNDLE` samples (``monte_carlo_<state>``, (steps+1, samples) each, on
-    ``monte_carlo_time``) for plots."""
+    ``monte_carlo_time``) for plots; with path constraints, the fraction of all samples that have
+    violated one by each time (``monte_carlo_violated``, on ``monte_carlo_time``: its last value is
+    ``violation_probability``)."""
     d = draws(ocp, result, uncertain, options)
-    run = rk4(ocp, d.x0, d.controls, d.params, d.t0, d.tf, options.steps, keep=BUNDLE, inputs=d.inputs)
+    run = rk4(
+        ocp,
+        d.x0,
+        d.controls,
+        d.params,
+        d.t0,
+        d.tf,
+        options.steps,
+        keep=BUNDLE,
+        inputs=d.inputs,
+        tolerance=VIOLATION_TOL,
+    )
     spread = summarize(d.drawn)
     metrics = {
         "samples": options.samples,
@@ -105,7 +118,10 @@ def monte_carlo(
     }
     metrics.update(_outcome(ocp, d.x0, run, d.params))
     metrics["control_energy_mean"] = float(run.energy.mean())
-    return metrics, {"monte_carlo_time": run.t} | _bundle("monte_carlo", ocp, run)
+    arrays = {"monte_carlo_time": run.t} | _bundle("monte_carlo", ocp, run)
+    if ocp.path:
+        arrays["monte_carlo_violated"] = run.violated
+    return metrics, arrays
 
 
 def _bundle(prefix: str, ocp: SymbolicOcp, run: Trajectories) -> dict[str, np.ndarray]:

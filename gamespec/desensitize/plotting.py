@@ -10,8 +10,10 @@ from collections.abc import Iterable, Mapping
 from pathlib import Path
 from typing import Any
 
+import numpy as np
+
 from gamespec.errors import GamespecError
-from gamespec.plotting import LEGEND_RIGHT, headline
+from gamespec.plotting import LEGEND_RIGHT, headline, is_flat
 from gamespec.result import Result
 
 SENSITIVITY_PREFIXES = ("S_", "mu_", "Phi_")
@@ -53,16 +55,22 @@ def plot_desensitized(result: Result, output_dir: Path) -> list[Path]:
             )
             ys = result.arrays[f"{prefix}_{planar[1] if planar else states[0]}"]
             lines = ax.plot(xs if planar else xs.repeat(ys.shape[1], 1), ys, color=color, lw=0.6, alpha=0.5)
-            lines[0].set_label(
-                f"{label} ({result.metrics['monte_carlo']['samples']} samples, first {ys.shape[1]})"
-            )
+            note = f"{label} ({result.metrics['monte_carlo']['samples']} samples, first {ys.shape[1]})"
+            if _coincide(ys, xs if planar else None):
+                uncertain = (
+                    ", ".join(result.metrics["monte_carlo"].get("parameters", {})) or "the uncertainty"
+                )
+                note += f"\nall on one path: {uncertain} does not move these states"
+            lines[0].set_label(note)
         x_nominal = result.states[planar[0]] if planar else result.time
         ax.plot(x_nominal, result.states[planar[1] if planar else states[0]], "k-", lw=2, label="nominal")
         ax.set_xlabel(planar[0] if planar else "t")
         ax.set_ylabel(planar[1] if planar else states[0])
         ax.grid(alpha=0.3)
         ax.legend(**LEGEND_RIGHT)
-        ax.set_title(f"{headline(result)}\nMonte Carlo about the nominal", fontsize="medium")
+        ax.set_title(
+            f"{headline(result)}\nMonte Carlo about the nominal{collision_note(result)}", fontsize="medium"
+        )
         paths.append(output_dir / f"{result.problem}_monte_carlo.png")
         fig.savefig(paths[-1], dpi=120, bbox_inches="tight")
         plt.close(fig)
@@ -81,6 +89,23 @@ def plot_desensitized(result: Result, output_dir: Path) -> list[Path]:
         fig.savefig(paths[-1], dpi=120, bbox_inches="tight")
         plt.close(fig)
     return paths
+
+
+def _coincide(ys, xs) -> bool:
+    """Whether every sampled path is the same (to :data:`~gamespec.plotting.FLAT_TOLERANCE`) at
+    every time: an uncertainty that does not enter the drawn states."""
+    bundles = [ys] if xs is None else [ys, xs]
+    return all(all(is_flat(row) for row in np.asarray(b, dtype=float)) for b in bundles)
+
+
+def collision_note(result: Result) -> str:
+    """``, P_c = p [low, high]`` (the open-loop Monte Carlo's collision probability and its
+    interval) where the Result has one."""
+    mc = result.metrics.get("monte_carlo", {})
+    if "collision_probability" not in mc:
+        return ""
+    low, high = (0.0 if abs(v) < 1e-12 else v for v in mc["collision_probability_ci"])
+    return f", collision probability P_c = {mc['collision_probability']:.3g} [{low:.2g}, {high:.2g}]"
 
 
 def desensitized_rows(values: Iterable[Mapping[str, Any]]) -> list[Mapping[str, Any]]:

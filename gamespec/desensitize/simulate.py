@@ -44,7 +44,9 @@ class Trajectories:
     """The grid ``t``; states ``x`` and controls ``u`` (steps+1, n or m, kept samples) of the first
     ``keep`` samples; per sample the final state ``final`` (n, samples), the integrated running cost
     ``running`` (the file's Lagrange term, in its own sense), the control energy ∫Σu² ``energy``
-    and the largest path-constraint violation ``violation``."""
+    and the largest path-constraint violation ``violation``; at each time of ``t`` the fraction of
+    all samples whose violation so far exceeds the tolerance :func:`rk4` was given, ``violated``
+    (the probability of a violation by then: the collision probability along the path)."""
 
     t: np.ndarray
     x: np.ndarray
@@ -53,6 +55,7 @@ class Trajectories:
     running: np.ndarray
     energy: np.ndarray
     violation: np.ndarray
+    violated: np.ndarray
 
 
 def evaluate(exprs: list[sp.Expr], values: Values, shape: tuple[int, ...]) -> np.ndarray:
@@ -98,6 +101,7 @@ def rk4(
     keep: int | None = None,
     inputs: TranscribedSignal | None = None,
     feedback: Feedback | None = None,
+    tolerance: float = 0.0,
 ) -> Trajectories:
     """Integrate the file's dynamics from ``x0`` (n, samples) under the open-loop ``controls`` (plus
     ``feedback``, when given) and the grid ``inputs`` (when the problem has some); keep the
@@ -106,7 +110,8 @@ def rk4(
     The steps follow the controls' mesh (about ``steps`` of them, none across a mesh point); the
     open-loop signals are tabulated once at each step's RK4 stage times, from the step's own mesh
     interval; the feedback sees the state at the start of each step and is held over it (a
-    zero-order hold).
+    zero-order hold). ``tolerance`` is the violation above which a sample counts as violating
+    (``Trajectories.violated``).
     """
     samples = x0.shape[1]
     keep = samples if keep is None else min(keep, samples)
@@ -121,6 +126,7 @@ def rk4(
     X = np.empty((len(t), n, keep))
     U = np.empty((len(t), m, keep))
     running, energy, violation = np.zeros(samples), np.zeros(samples), np.zeros(samples)
+    violated = np.zeros(len(t))
     args = [*ocp.p, *ocp.w, *ocp.x, *ocp.u, TIME]
     flow = numeric_function([*ocp.dynamics, ocp.sign * ocp.lagrange], args)
     path = numeric_function([rel.expr for rel in ocp.path], args)
@@ -144,6 +150,7 @@ def rk4(
             g = at(path, len(ocp.path), k, stage, x, u)
             excess = np.maximum(lower - g, 0.0) + np.maximum(g - upper, 0.0)
             np.maximum(violation, excess.max(axis=0), out=violation)
+            violated[index] = np.count_nonzero(violation > tolerance) / samples
 
     x = x0
     for k, hk in enumerate(h):
@@ -160,7 +167,7 @@ def rk4(
     last = len(h) - 1
     correction = np.zeros((m, 1)) if feedback is None else feedback(len(h), x)
     record(len(h), last, 2, x, u_open[:, last, 2, None] + correction)
-    return Trajectories(t, X, U, x, running, energy, violation)
+    return Trajectories(t, X, U, x, running, energy, violation, violated)
 
 
 def _shared_path(ocp: SymbolicOcp, x0: np.ndarray, params: Values) -> bool:

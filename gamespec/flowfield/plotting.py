@@ -52,11 +52,16 @@ def _sets(ax: Axes, result: Result) -> None:
             closed = np.vstack([front, front[:1]])
             ax.plot(closed[:, 0], closed[:, 1], color=color, lw=1)
     for path, color, name in zip(arrays["nominal_positions"], COLORS, ("pursuer", "evader"), strict=True):
+        ax.plot([], [], "-", color=color, lw=1, label=f"{name}'s reachable set")
         ax.plot(path[:, 0], path[:, 1], "--", color=color, label=f"{name} (nominal)")
         ax.plot(*path[0], "o", color=color)
     ax.plot(*result.metrics["capture_point"], "k*", ms=10, label="capture point")
     ax.set(xlabel="x", ylabel="y")
-    ax.set_title(f"reachable sets at T̂ = {result.metrics['capture_time']:.3f} (level {_level(result)})")
+    title = f"reachable sets at T̂ = {result.metrics['capture_time']:.3f}"
+    if "phi_final" in arrays:
+        level = _level(result)
+        title += f"\nlevel φ = {level}: the sets reached from disks of radius {level} about the starts"
+    ax.set_title(title, fontsize="medium")
 
 
 def _dispersion(ax: Axes, result: Result) -> None:
@@ -66,8 +71,12 @@ def _dispersion(ax: Axes, result: Result) -> None:
             ax.plot(sample[:, 2 * i], sample[:, 2 * i + 1], color=color, lw=0.3, alpha=0.3)
     for path in result.arrays["nominal_positions"]:
         ax.plot(path[:, 0], path[:, 1], "k--", lw=0.8)
+    drawn = len(paths)
+    for color, name in zip(COLORS, ("pursuer", "evader"), strict=True):
+        ax.plot([], [], color=color, lw=1, label=f"{name}, closed loop ({drawn} sampled paths)")
+    ax.plot([], [], "k--", lw=0.8, label="nominal paths")
     ax.set(xlabel="x", ylabel="y")
-    ax.set_title("closed-loop trajectory dispersion")
+    ax.set_title("closed-loop trajectory dispersion (Monte Carlo)", fontsize="medium")
 
 
 def _probability(ax: Axes, result: Result) -> None:
@@ -78,6 +87,7 @@ def _probability(ax: Axes, result: Result) -> None:
             ax.plot(t, result.arrays[f"capture_probability_{loop}"], marker + "-", label=label)
     ax.set_xlabel("t")
     ax.set_ylabel("capture probability (eq. 5.39)")
+    ax.set_title("capture probability by time step", fontsize="medium")
 
 
 def plot(result: Result, output_dir: Path, *, animate: bool = False) -> list[Path]:
@@ -93,9 +103,8 @@ def plot(result: Result, output_dir: Path, *, animate: bool = False) -> list[Pat
     for name, draw in figures:
         fig, ax = plt.subplots(figsize=(7.5, 4.5))
         draw(ax, result)
-        fig.suptitle(headline(result), fontsize="medium")
-        if name != "dispersion.png":
-            ax.legend(**LEGEND_RIGHT)
+        ax.set_title(f"{headline(result)}\n{ax.get_title()}", fontsize="medium")
+        ax.legend(**LEGEND_RIGHT)
         if name != "capture_probability.png":
             ax.set_aspect("equal")
         fig.savefig(output_dir / name, dpi=120, bbox_inches="tight")
@@ -109,10 +118,12 @@ def capture_rows(values: Iterable[Mapping[str, Any]]) -> list[Mapping[str, Any]]
     return [v for v in values if "capture_probability_open_loop" in v.get("metrics", {})]
 
 
-def plot_capture_sweep(points: Sequence[tuple[float, Mapping[str, Any]]], parameter: str, path: Path) -> Path:
+def plot_capture_sweep(
+    points: Sequence[tuple[float, Mapping[str, Any]]], parameter: str, path: Path, problem: str = ""
+) -> Path:
     """Capture probability at ``T̂`` against ``parameter`` — ``points`` are (value, metrics) — in
     open loop and under each solution concept of :data:`LOOPS`, eq. 5.39 and the Monte Carlo with its
-    interval (Fig. 5.2)."""
+    interval (Fig. 5.2); ``problem`` heads the title."""
     points = sorted(points, key=lambda p: p[0])
     x = np.array([value for value, _ in points])
     fig, ax = plt.subplots(figsize=(6, 4))
@@ -127,8 +138,9 @@ def plot_capture_sweep(points: Sequence[tuple[float, Mapping[str, Any]]], parame
             ax.errorbar(x, est, yerr=err, fmt="x", color="gray", label=f"{loop} Monte Carlo")
     ax.set_xlabel(parameter)
     ax.set_ylabel("capture probability at T̂")
-    ax.legend(fontsize=8)
-    fig.tight_layout()
-    fig.savefig(path, dpi=120)
+    head = f"{problem}: " if problem else ""
+    ax.set_title(f"{head}capture probability at T̂ against {parameter} (eq. 5.39)", fontsize="medium")
+    ax.legend(**LEGEND_RIGHT)
+    fig.savefig(path, dpi=120, bbox_inches="tight")
     plt.close(fig)
     return Path(path)

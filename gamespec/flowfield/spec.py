@@ -532,6 +532,15 @@ KIND = Kind(
     plot="gamespec.flowfield.plotting:plot",
     summary="gamespec.flowfield.report:flow_game_summary",
     metrics="gamespec.flowfield.metrics:FlowGameMetrics",
+    columns=(
+        "metrics.capture_time",
+        "metrics.capture_probability_open_loop",
+        "metrics.capture_probability_closed_loop",
+        "metrics.monte_carlo_capture_probability.open_loop.estimate",
+        "metrics.monte_carlo_capture_probability.closed_loop.estimate",
+        "metrics.solution_concept",
+        "metrics.saddle_gap",
+    ),
 )
 """The ``FlowGameSpec`` kind as one plugin (:class:`~gamespec.registry.Kind`)."""
 

@@ -64,6 +64,8 @@ def open_loop(model: GameModel) -> Result:
     tc = first.control_time + t0
     controls = {c: own[p].controls_of(p)[c] for p, pl in game.problem.players.items() for c in pl.controls}
     arrays: dict[str, np.ndarray] = {}
+    if "control_mesh" in first.arrays:
+        arrays["control_mesh"] = first.arrays["control_mesh"] + t0
     if len(solutions) == 1:
         time, states = first.time + t0, dict(first.states)
     else:
@@ -128,6 +130,13 @@ class GameCompiled(CompiledModel):
     def solve(
         self, parameters: dict[str, float] | None = None, guess: Result | None = None, inputs: Inputs = None
     ) -> Result:
+        """The game's Result, with the file's ``plot`` section in ``metrics["plot"]`` (what its
+        figures draw: :mod:`gamespec.games.plotting`)."""
+        result = self._solve(parameters, inputs)
+        plot = self.game.plot.as_metrics() | {"path_constraints": []}
+        return result.model_copy(update={"metrics": result.metrics | {"plot": plot}})
+
+    def _solve(self, parameters: dict[str, float] | None, inputs: Inputs) -> Result:
         refuse_inputs(inputs, self.game.kind)
         if self.iterative:
             self.parameters |= parameters or {}

@@ -171,3 +171,10 @@ def views(game: DifferentialGameSpec, expressions: GameExpressions | None = None
     parsed = expressions or game_expressions(game)
     games = [[player_problem(game, j, i, parsed).model_dump(exclude={"name"}) for j in names] for i in names]
     return names[:1] if all(g == games[0] for g in games) else names
+
+
+def player_problems(game: DifferentialGameSpec) -> dict[str, dict[str, OptimalControlSpec]]:
+    """Every best-response problem the game's players solve: per game solved (:func:`views`),
+    each player's :func:`player_problem` (its requested ``transforms`` still to apply)."""
+    names = list(game.problem.players)
+    return {view: {player: player_problem(game, player, view) for player in names} for view in views(game)}

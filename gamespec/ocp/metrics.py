@@ -25,6 +25,7 @@ class Plot(BaseModel):
     planar: list[tuple[str, str]] = Field(default_factory=list, description="Pairs drawn as paths.")
     units: dict[str, str] = Field(default_factory=dict, description="Unit of each name.")
     path_constraints: list[str] = Field(default_factory=list, description="Constraints drawn as circles.")
+    angles: list[str] = Field(default_factory=list, description="Angles, drawn unwrapped.")
 
 
 class Phase(BaseModel):

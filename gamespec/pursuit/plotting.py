@@ -15,7 +15,7 @@ import numpy as np
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt
 
-from gamespec.plotting import LEGEND_RIGHT, headline
+from gamespec.plotting import LEGEND_RIGHT, as_drawn, headline, no_offsets
 from gamespec.pursuit import regions, relay
 from gamespec.result import Result
 from gamespec.specs.engagement import EngagementSpec
@@ -148,6 +148,7 @@ def plot_distances(result: Result, spec: EngagementSpec, path: Path) -> Path:
             bottom.plot(t, 0.5 * (r1**2 - r2**2), color="k", label="S")
             bottom.axhline(0.0, color="0.5", lw=0.6)
             bottom.set(ylabel="S = (r1² − r2²)/2")
+            bottom.set_title("relay switching function S (Fig. 2.14b)", fontsize="medium")
             arcs = result.metrics.get("arcs", {})
             for key in ("tau1", "tau2"):
                 if arcs.get(key) is not None:
@@ -155,10 +156,15 @@ def plot_distances(result: Result, spec: EngagementSpec, path: Path) -> Path:
         else:
             nearest = np.min(np.array(list(dist.values())), axis=0)
             for i, (name, d) in enumerate(dist.items()):
-                bottom.plot(t, d - nearest, color=PLAYER_COLOURS[i % len(PLAYER_COLOURS)], label=name)
+                shown, suffix = as_drawn(d - nearest, name, [])
+                bottom.plot(t, shown, color=PLAYER_COLOURS[i % len(PLAYER_COLOURS)], label=name + suffix)
             bottom.set(ylabel="r_i − min_j r_j")
+            bottom.set_title(
+                "distance above the nearest pursuer's (0 at t_c for the capturing set)", fontsize="medium"
+            )
         bottom.legend(**LEGEND_RIGHT)
     axes[-1, 0].set(xlabel="t")
+    no_offsets(fig)
     fig.savefig(path, dpi=120, bbox_inches="tight")
     plt.close(fig)
     return path

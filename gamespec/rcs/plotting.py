@@ -1,5 +1,6 @@
 """Figures of §6.4: |S_g| and |S_r| over a grid of agent positions (Fig. 6.6), the path with the
-obstacles drawn where they are (Figs. 6.7(a), 6.8), S_g and S_r along the solution (Fig. 6.7(b, c)),
+obstacles drawn where they are (Figs. 6.7(a), 6.8), S_g and S_r along the solution (Fig. 6.7(b, c))
+with the Monte Carlo's collision probability along the path,
 several weight levels overlaid (paths: Figs. 6.7(a), 6.8; controls: Fig. 6.9(b)), and the study's
 trade-off (Fig. 6.11). Plots read Results (and, for the map, the obstacle geometry) only.
 """
@@ -12,6 +13,7 @@ from pathlib import Path
 import numpy as np
 import sympy as sp
 
+from gamespec.desensitize.plotting import collision_note
 from gamespec.plotting import LEGEND_RIGHT, headline
 from gamespec.rcs.obstacles import avoidance
 from gamespec.rcs.relevance import relevance
@@ -45,7 +47,9 @@ def sensitivity_map(
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
     """(X, Y, g, |S_g|, |S_r|) over agent positions, the obstacle at ``center`` at time ``t`` moving
     along y at speed ρ (Fig. 6.6's setting by default: (0, 1), r_o = 0.6, t = 1): S_g = ∂g/∂ρ
-    (eq. 6.40; eq. 6.42 for β ≠ 1), S_r = r(g) S_g."""
+    (eq. 6.40; eq. 6.42 for β ≠ 1), S_r = r(g) S_g. At the obstacle's centre (inside the infeasible
+    disc the figure leaves white) eq. 6.42 divides by zero: that value is not drawn, and no warning
+    is printed for it."""
     x, y, r = symbol("x"), symbol("y"), symbol("rho")
     names = {"rho": r}
     start = (center[0], center[1] - rho * t)
@@ -57,7 +61,8 @@ def sensitivity_map(
         np.linspace(center[0] - extent, center[0] + extent, points),
         np.linspace(center[1] - extent, center[1] + extent, points),
     )
-    G, Sg, Sr = (np.broadcast_to(v, X.shape) for v in f(X, Y, rho, t))
+    with np.errstate(divide="ignore", invalid="ignore"):
+        G, Sg, Sr = (np.broadcast_to(v, X.shape) for v in f(X, Y, rho, t))
     return X, Y, G, np.abs(Sg), np.abs(Sr)
 
 
@@ -75,10 +80,12 @@ def plot_sensitivity_map(path: Path, heading: str = "", **setting) -> Path:
         ax.set_aspect("equal")
         ax.set_xlabel("x")
         ax.set_ylabel("y")
-    if heading:
-        fig.suptitle(heading, fontsize="medium")
+    fig.suptitle(
+        f"{heading}\nsensitivity of the avoidance constraint to ρ about the agent's positions".lstrip(),
+        fontsize="medium",
+    )
     fig.tight_layout()
-    fig.savefig(path, dpi=120)
+    fig.savefig(path, dpi=120, bbox_inches="tight")
     plt.close(fig)
     return path
 
@@ -118,7 +125,8 @@ def plot_rcs(result: Result, output_dir: Path) -> list[Path]:
         ax.set_xlabel("x")
         ax.set_ylabel("y")
         ax.set_title(
-            f"{headline(result)}\nobstacles at {OBSTACLE_SNAPSHOTS} times (same colour as the agent)",
+            f"{headline(result)}\nobstacles at {OBSTACLE_SNAPSHOTS} times (same colour as the agent)"
+            + collision_note(result).replace(", ", "\n", 1),
             fontsize="medium",
         )
         if ax.get_legend_handles_labels()[0]:
@@ -128,12 +136,15 @@ def plot_rcs(result: Result, output_dir: Path) -> list[Path]:
         plt.close(fig)
     keys = sorted(k for k in result.arrays if k.startswith(("S_g", "S_r")))
     if keys:
-        fig, axes = plt.subplots(2, 1, figsize=(7, 5.5), sharex=True)
+        along = "monte_carlo_violated" in result.arrays
+        fig, axes = plt.subplots(3 if along else 2, 1, figsize=(7, 7.5 if along else 5.5), sharex=True)
         for k in keys:
             axes[0 if k.startswith("S_r") else 1].plot(result.time, np.abs(result.arrays[k]), label=k)
         axes[0].set_ylabel("|S_r|")
         axes[1].set_ylabel("|S_g|")
-        axes[1].set_xlabel("t")
+        if along:
+            _collision_along(axes[2], result)
+        axes[-1].set_xlabel("t")
         for ax in axes:
             ax.legend(**LEGEND_RIGHT)
         fig.suptitle(headline(result), fontsize="medium")
@@ -162,6 +173,21 @@ def plot_rcs(result: Result, output_dir: Path) -> list[Path]:
     return paths
 
 
+def _collision_along(ax, result: Result) -> None:
+    """P_c along the path: the fraction of the open-loop Monte Carlo's samples that have collided
+    by each time (its last value is the collision probability)."""
+    mc = result.metrics["monte_carlo"]
+    ax.plot(
+        result.arrays["monte_carlo_time"],
+        result.arrays["monte_carlo_violated"],
+        color="tab:red",
+        label=f"collided by t ({mc['samples']} samples)",
+    )
+    ax.set_ylabel("P_c by t")
+    ax.set_ylim(-0.02, max(0.05, 1.1 * float(np.max(result.arrays["monte_carlo_violated"]))))
+    ax.set_title("collision probability along the path (open-loop Monte Carlo)", fontsize="medium")
+
+
 def plot_levels(
     results: Sequence[Result], labels: Sequence[str], path: Path, control: str | None = None
 ) -> Path:
@@ -178,8 +204,12 @@ def plot_levels(
         else:
             _draw_path(ax, result, label=label, color=f"C{i}", snapshots=i == 0)
             ax.set_aspect("equal", adjustable="datalim")
-    ax.legend(loc="best")
-    fig.savefig(path, dpi=120)
+    ax.set_title(
+        "paths at each weight level" if control is None else f"{control} at each weight level",
+        fontsize="medium",
+    )
+    ax.legend(**LEGEND_RIGHT)
+    fig.savefig(path, dpi=120, bbox_inches="tight")
     plt.close(fig)
     return path
 
@@ -201,10 +231,13 @@ def plot_study(result: Result, output_dir: Path, *, animate: bool = False) -> li
             ax.annotate(f"α={r['alpha']:g}", (r["t_final"], r["collision_probability"]), fontsize=7)
     ax.set_xlabel("t_f")
     ax.set_ylabel("collision probability")
-    ax.legend(loc="best")
+    ax.set_title(
+        f"{headline(result)}\ntravel time against collision probability (Fig. 6.11)", fontsize="medium"
+    )
+    ax.legend(**LEGEND_RIGHT)
     ax.grid(alpha=0.3)
     paths = [output_dir / f"{result.problem}_tradeoff.png"]
-    fig.savefig(paths[0], dpi=120)
+    fig.savefig(paths[0], dpi=120, bbox_inches="tight")
     plt.close(fig)
     fig, axes = plt.subplots(len(counts), 1, figsize=(8, 2.6 * len(counts)), squeeze=False)
     radius = result.metrics.get("radius", 1.0)
@@ -222,9 +255,12 @@ def plot_study(result: Result, output_dir: Path, *, animate: bool = False) -> li
                 )
         ax.set_aspect("equal", adjustable="datalim")
         ax.set_title(f"N = {n} (obstacles drawn where they cross y = 0)", fontsize=9)
-        ax.legend(loc="best", fontsize=7)
+        ax.set_xlabel("x")
+        ax.set_ylabel("y")
+        ax.legend(**LEGEND_RIGHT)
+    fig.suptitle(headline(result), fontsize="medium")
     fig.tight_layout()
     paths.append(output_dir / f"{result.problem}_paths.png")
-    fig.savefig(paths[-1], dpi=120)
+    fig.savefig(paths[-1], dpi=120, bbox_inches="tight")
     plt.close(fig)
     return paths

@@ -31,6 +31,7 @@ from gamespec.limits import MAX_BEST_RESPONSES, MAX_GAME_STATE, MAX_RECEDING_STE
 from gamespec.registry import Kind
 from gamespec.specs.base import Number, ProblemParameters, RequestedTransforms, SpecBase, StrictModel, Value
 from gamespec.specs.ocp import ControlSpec, FreeOrFixed, MethodSpec, StateSpec, _ordered, is_time_varying
+from gamespec.specs.plot import PlotHint
 from gamespec.specs.uncertainty import UncertainParameter
 from gamespec.symbolic.canonical import check
 from gamespec.symbolic.grammar import RESERVED, numeric_value
@@ -458,6 +459,13 @@ class DifferentialGameSpec(ProblemParameters, SpecBase):
     method: MethodSpec = Field(default_factory=MethodSpec)
     game: GameSettings = Field(default_factory=GameSettings)
     receding_horizon: RecedingHorizonSpec | None = None
+    plot: PlotHint = Field(default_factory=PlotHint)
+
+    @model_validator(mode="after")
+    def _plot_names(self) -> DifferentialGameSpec:
+        controls = [c for p in self.problem.players.values() for c in p.controls]
+        self.plot.check_names(list(self.problem.states), controls)
+        return self
 
     @model_validator(mode="after")
     def _receding_horizon(self) -> DifferentialGameSpec:
@@ -532,5 +540,11 @@ KIND = Kind(
     plot="gamespec.games.plotting:plot_game",
     summary="gamespec.games.report:game_summary",
     metrics="gamespec.games.metrics:GameMetrics",
+    columns=(
+        "metrics.solution_concept",
+        "metrics.saddle_gap",
+        "metrics.captured",
+        "metrics.capture_time",
+    ),
 )
 """The ``DifferentialGameSpec`` kind as one plugin (:class:`~gamespec.registry.Kind`)."""

@@ -140,5 +140,10 @@ KIND = Kind(
     plot="gamespec.pursuit.plotting:plot_engagement",
     summary="gamespec.pursuit.report:engagement_summary",
     metrics="gamespec.pursuit.metrics:EngagementMetrics",
+    columns=(
+        "metrics.capture_time",
+        "metrics.capturing_set",
+        "metrics.region",
+    ),
 )
 """The ``EngagementSpec`` kind as one plugin (:class:`~gamespec.registry.Kind`)."""

@@ -440,5 +440,11 @@ KIND = Kind(
     summary="gamespec.lqgame.report:lq_summary",
     metrics="gamespec.lqgame.metrics:LqGameMetrics",
     analyses="gamespec.lqgame.montecarlo:ANALYSES",
+    columns=(
+        "metrics.solution_concept",
+        "metrics.mean_payoff",
+        "metrics.covariance_payoff",
+        "metrics.saddle_gap",
+    ),
 )
 """The ``LQGameSpec`` kind as one plugin (:class:`~gamespec.registry.Kind`)."""

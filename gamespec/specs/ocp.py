@@ -763,17 +763,9 @@ class OcpFamily(ProblemParameters):
     runtime parameters, and a ``plot`` section that names their states and controls."""
 
     def check_plot_names(self) -> None:
-        """A SpecError naming the ``plot`` field that names no state (planar) or no state, control
-        or ``t`` (units)."""
-        states = set(self.problem.states)
-        for i, pair in enumerate(self.plot.planar):
-            unknown = [n for n in pair if n not in states]
-            if unknown:
-                raise SpecError(f"{', '.join(unknown)} is not a state", field=f"plot.planar.{i}")
-        named = {*self.problem.states, *self.problem.controls, "t"}
-        for name in self.plot.units:
-            if name not in named:
-                raise SpecError(f"{name!r} is not a state, a control or t", field=f"plot.units.{name}")
+        """A SpecError naming the ``plot`` field that names no state or control
+        (:meth:`~gamespec.specs.plot.PlotHint.check_names`)."""
+        self.plot.check_names(list(self.problem.states), list(self.problem.controls))
 
     @property
     def objective_sense(self) -> str:
@@ -861,5 +853,12 @@ KIND = Kind(
     plot="gamespec.plotting:plot_trajectories",
     summary="gamespec.summaries:optimal_control_summary",
     metrics="gamespec.ocp.metrics:OcpMetrics",
+    columns=(
+        "metrics.nominal_objective",
+        "metrics.sensitivity_measure",
+        "metrics.monte_carlo.cost_mean",
+        "metrics.monte_carlo.cost_std",
+        "metrics.monte_carlo.collision_probability",
+    ),
 )
 """The ``OptimalControlSpec`` kind as one plugin (:class:`~gamespec.registry.Kind`)."""

@@ -15,6 +15,7 @@ from collections.abc import Mapping
 from pathlib import Path
 from typing import Any
 
+from gamespec import registry
 from gamespec.errors import GamespecError
 from gamespec.studies.rows import study_meta, valid_points
 from gamespec.studies.store import ResultStore, is_store
@@ -55,6 +56,16 @@ def study_rows(store: ResultStore) -> list[dict[str, Any]]:
     return sorted(
         rows, key=lambda row: [(row.get(p) is None, str(type(row.get(p))), row.get(p)) for p in swept]
     )
+
+
+def headline_columns(rows: list[dict[str, Any]]) -> list[str]:
+    """The headline numbers of the kinds the rows are of (:attr:`gamespec.registry.Kind.columns`),
+    those that some row has, in the kinds' order: what a study table shows after its parameters."""
+    found: list[str] = []
+    for kind in dict.fromkeys(str(row.get("kind", "")) for row in rows):
+        if kind in registry.names("gamespec.kinds"):
+            found += [c for c in registry.kind(kind).columns if c not in found]
+    return [c for c in found if any(row.get(c) is not None for row in rows)]
 
 
 def columns(rows: list[dict[str, Any]]) -> list[str]:

@@ -106,7 +106,8 @@ def plot_study(store: ResultStore, output_dir: str | Path) -> list[Path]:
         games = capture_rows(values)
         for name in study.parameters if games else []:
             points = [(row[name], row["metrics"]) for row in games if _number(row.get(name)) is not None]
-            paths.append(plot_capture_sweep(points, name, folder / f"capture_probability_{name}.png"))
+            figure = folder / f"capture_probability_{name}.png"
+            paths.append(plot_capture_sweep(points, name, figure, study.problem))
         return paths
     damaged = [line for line in store.damaged if "meta:study" in line]
     why = f" ({damaged[0].split(': ', 1)[1]})" if damaged else ""

@@ -5,6 +5,8 @@ draw), not for their pixels."""
 
 from __future__ import annotations
 
+import logging
+import warnings
 from pathlib import Path
 
 import numpy as np
@@ -33,6 +35,7 @@ def _check_common(result: gamespec.Result, saved) -> None:
     for figure in saved:
         text = titles(figure)
         assert result.problem in text and result.backend in text and result.status.value in text, figure.name
+        _check_cannot_mislead(figure)
         for ax, outside in zip(figure.axes, figure.legend_outside, strict=True):
             if outside is None:
                 continue
@@ -42,10 +45,14 @@ def _check_common(result: gamespec.Result, saved) -> None:
 
 
 @pytest.mark.parametrize("path", fixtures.FILES, ids=lambda p: p.stem)
-def test_shipped_problem_figures(path: Path, tmp_path: Path) -> None:
+def test_shipped_problem_figures(path: Path, tmp_path: Path, caplog) -> None:
+    """Drawn without a library warning (a warning is an error here; matplotlib's logged ones are
+    read from the log), and showing what :func:`_check_common` and the kind's check say."""
     result = fixtures.saved(path)
-    with recording() as saved:
+    with recording() as saved, warnings.catch_warnings():
+        warnings.simplefilter("error")
         written = plot_result(result, tmp_path)
+    assert not [r.getMessage() for r in caplog.records if r.levelno >= logging.WARNING]
     assert [s.name for s in saved] == [p.name for p in written]
     _check_common(result, saved)
     check = {
@@ -58,6 +65,32 @@ def test_shipped_problem_figures(path: Path, tmp_path: Path) -> None:
         "differential_game": _check_differential_game,
     }[result.kind]
     check(result, {s.name: s for s in saved})
+
+
+def _data_axes(figure):
+    """The axes that draw data (a colorbar's are the scale of another's)."""
+    return [ax for ax in figure.axes if not hasattr(ax, "_colorbar")]
+
+
+def _labelled(ax) -> list[str]:
+    """The labels of the artists an axes draws that ask for a legend entry."""
+    artists = [*ax.lines, *ax.patches, *ax.collections]
+    return [a.get_label() for a in artists if a.get_label() and not a.get_label().startswith("_")]
+
+
+def _check_cannot_mislead(figure) -> None:
+    """What every figure must show (issue 28 item 3): every data axes titled (or the figure), no
+    axis with an offset or a multiplier ("1e-7+1"), and a legend entry for every labelled series."""
+    axes = _data_axes(figure)
+    for ax in axes:
+        assert ax.get_title() or figure.title, (figure.name, "an untitled axes in an untitled figure")
+        for axis in (ax.xaxis, ax.yaxis):
+            assert not axis.get_offset_text().get_text(), (figure.name, axis.get_offset_text().get_text())
+    legends = [ax.get_legend() for ax in axes if ax.get_legend() is not None] + list(figure.figure.legends)
+    entries = {t.get_text() for legend in legends for t in legend.get_texts()}
+    labels = {label for ax in axes for label in _labelled(ax)}
+    if len(labels) >= 2 or legends:
+        assert labels <= entries, (figure.name, "not in a legend:", sorted(labels - entries))
 
 
 def _check_engagement(result, saved) -> None:
@@ -108,6 +141,8 @@ def _check_differential_game(result, saved) -> None:
     paths = saved.get(f"{result.problem}_paths.png")
     if paths is not None:
         assert legend_texts(paths.axes[0]), "each player is in the legend"
+    elif "value" not in result.arrays:
+        _check_ocp(result, saved)
 
 
 def _check_flow(result, saved) -> None:
@@ -118,7 +153,58 @@ def _check_flow(result, saved) -> None:
 def _check_ocp(result, saved) -> None:
     pairs = result.metrics["plot"]["planar"]
     assert (f"{result.problem}_path.png" in saved) == bool(pairs)
-    assert f"J = {result.objective:.6g}" in titles(saved[f"{result.problem}_time.png"])
+    figure = saved[f"{result.problem}_time.png"]
+    assert f"J = {result.objective:.6g}" in titles(figure)
+    angles = result.metrics["plot"].get("angles", [])
+    _check_spans(figure.axes[0], result.time, result.time, result.states, angles)
+    if result.controls:
+        times = result.control_time if result.control_time is not None else result.time
+        _check_spans(figure.axes[1], result.time, times, result.controls, angles)
+        _check_controls_per_interval(result, figure.axes[1])
+
+
+def _drawn(ax, name: str):
+    return next(line for line in ax.lines if line.get_label().split(" ")[0] == name)
+
+
+def _check_spans(ax, span, time, signals, angles) -> None:
+    """Each signal (values at ``time``) is drawn over the Result's whole ``span`` and keeps its
+    values (angles modulo 2π): one whose values vary by at most the solver's tolerance is drawn
+    flat and says "constant"; any other keeps its variation; the axes hold the whole line."""
+    for name, values in signals.items():
+        line = _drawn(ax, name)
+        x, y = np.asarray(line.get_xdata(), float), np.asarray(line.get_ydata(), float)
+        assert x.min() == pytest.approx(span[0]) and x.max() == pytest.approx(span[-1]), name
+        spread = np.ptp(np.unwrap(values) if name in angles else values)
+        if spread <= 1e-6 * max(1.0, np.abs(values).max()):
+            assert np.ptp(y) == 0 and "constant" in line.get_label(), name
+        else:
+            assert np.ptp(y) >= 0.5 * spread and "constant" not in line.get_label(), name
+        if name in angles:
+            assert np.all(np.abs(np.diff(y)) < np.pi), f"{name} is drawn with a 2π jump"
+            assert np.allclose(np.cos(np.interp(time, x, y)), np.cos(values), atol=1e-6), name
+        low, high = ax.get_ylim()
+        assert low <= y.min() and y.max() <= high, name
+
+
+def _check_controls_per_interval(result, ax) -> None:
+    """Controls drawn as the transcription holds them (:mod:`gamespec.ocp.control_signal`): the line
+    passes through every control point, and at each interior mesh point it is drawn twice (each side
+    of the jump from its own interval)."""
+    mesh = result.arrays.get("control_mesh")
+    for name, values in result.controls.items():
+        line = _drawn(ax, name)
+        x, y = np.asarray(line.get_xdata(), float), np.asarray(line.get_ydata(), float)
+        if "constant" in line.get_label():
+            continue
+        on_points = [y[np.isclose(x, t, rtol=0, atol=1e-9)] for t in result.control_time]
+        assert all(
+            np.any(np.isclose(ys, v, atol=1e-6 * max(1, abs(v))))
+            for ys, v in zip(on_points, values, strict=True)
+        ), name
+        if mesh is not None:
+            for t in mesh[1:-1]:
+                assert np.count_nonzero(np.isclose(x, t, rtol=0, atol=1e-9)) >= 2, (name, t)
 
 
 def _check_multiphase(result, saved) -> None:
@@ -229,3 +315,104 @@ def test_animations_show_time_legend_labels_and_growing_paths(name, tmp_path, mo
     assert all("t = " in title and legend and xlabel for title, legend, xlabel, _ in frames)
     lengths = [n for *_, n in frames]
     assert lengths == sorted(lengths) and lengths[0] < lengths[-1]
+
+
+def test_the_game_gif_ends_at_the_last_sample_without_warnings(tmp_path, monkeypatch, caplog) -> None:
+    """Chapter 7's GIF: a frame per receding-horizon step and one at the run's last sample (the
+    collision or capture), drawn without a library warning (fixed limits with a box aspect)."""
+    import warnings
+
+    import matplotlib
+    from matplotlib.animation import PillowWriter
+
+    result = fixtures.saved(PROBLEMS / "ch7/asymmetric_obstacle.yaml")
+    frames = []
+    original = PillowWriter.grab_frame
+
+    def grab(self, **kwargs):
+        frames.append(self.fig.axes[0].get_title())
+        return original(self, **kwargs)
+
+    monkeypatch.setattr(PillowWriter, "grab_frame", grab)
+    monkeypatch.setitem(matplotlib.rcParams, "savefig.dpi", 20)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        written = plot_result(result, tmp_path, animate=True)
+    assert [p.suffix for p in written].count(".gif") == 1
+    assert not [r for r in caplog.records if r.levelname == "WARNING"], caplog.text
+    assert frames[-1].endswith(f"t = {result.time[-1]:.2f}")
+    assert len(frames) == len(result.control_time) + (result.control_time[-1] < result.time[-1])
+
+
+def test_a_moving_obstacle_is_drawn_at_the_closest_approach(tmp_path) -> None:
+    """With the true obstacle nearest the pursuer at sample k (it sits on the pursuer's path
+    there), the paths figure draws it at t_k as well as at the end, with the players at t_k."""
+    result = fixtures.saved(PROBLEMS / "ch7/asymmetric_obstacle.yaml")
+    px, py = result.metrics["figure"]["positions"]["pursuer"]
+    k = len(result.time) // 2
+    x, y = result.states[px], result.states[py]
+    arrays = dict(result.arrays)
+    arrays["obstacle/true/x"] = np.full_like(x, x[k]) + 0.05 * (np.arange(len(x)) - k) ** 2
+    arrays["obstacle/true/y"] = np.full_like(y, y[k])
+    moved = result.model_copy(update={"arrays": arrays})
+    with recording() as saved:
+        plot_result(moved, tmp_path)
+    labels = legend_texts(saved[0].axes[0])
+    when = f"t = {result.time[k]:.2f}"
+    assert f"obstacle at pursuer's closest approach, {when} (true)" in labels
+    assert f"players at {when}" in labels
+    disks = [
+        p
+        for p in saved[0].axes[0].patches
+        if isinstance(p, Circle) and p.get_label().endswith(f"{when} (true)")
+    ]
+    assert [d.center for d in disks] == [pytest.approx((x[k], y[k]))]
+
+
+def test_animate_says_when_a_kind_has_no_animation(cli, tmp_path) -> None:
+    code, _, err = cli("plot", fixtures.FIXTURES / "linear_flow", "--out", tmp_path, "--animate")
+    assert code == 0 and "no animation" in err and "flow_field_game" in err
+    assert not list(tmp_path.glob("*.gif"))
+
+
+@pytest.mark.parametrize(
+    "name",
+    [
+        "ocp/brachistochrone.yaml",
+        "ch7/homicidal_chauffeur.yaml",
+        "ch7/unicycle_pursuit_evasion.yaml",
+        "ch7/lq_pursuit_evasion.yaml",
+    ],
+)
+def test_planar_problems_and_open_loop_games_get_their_path_figure(name, tmp_path) -> None:
+    """The planar OCP and the open-loop games with positions in a plane declare them (``plot.planar``)
+    and get the x–y figure: one path per pair, through the Result's states."""
+    result = fixtures.saved(PROBLEMS / name)
+    pairs = result.metrics["plot"]["planar"]
+    assert pairs
+    with recording() as saved:
+        plot_result(result, tmp_path)
+    (ax,) = next(s for s in saved if s.name == f"{result.problem}_path.png").axes
+    for xs, ys in pairs:
+        line = next(line for line in ax.lines if line.get_label() == f"({xs}, {ys})")
+        assert np.array_equal(line.get_xdata(), result.states[xs])
+        assert np.array_equal(line.get_ydata(), result.states[ys])
+
+
+@pytest.mark.parametrize("name", ["ch6/car_vs_train.yaml", "ch6/rcs_single_obstacle.yaml"])
+def test_the_collision_probability_is_drawn_along_the_path(name, tmp_path) -> None:
+    """Uncertainty drawn where it is: the fraction of Monte Carlo samples that have collided by
+    each time never decreases and ends at the collision probability the analysis reports (counted
+    per sample over the whole run), and the RCS figure draws that curve against time."""
+    result = fixtures.saved(PROBLEMS / name)
+    along = result.arrays["monte_carlo_violated"]
+    assert np.all(np.diff(along) >= 0)
+    assert along[-1] == pytest.approx(result.metrics["monte_carlo"]["collision_probability"], abs=1e-12)
+    with recording() as saved:
+        plot_result(result, tmp_path)
+    figure = next(s for s in saved if s.name == f"{result.problem}_rcs.png")
+    line = next(
+        line for ax in figure.axes for line in ax.lines if line.get_label().startswith("collided by t")
+    )
+    assert np.array_equal(line.get_ydata(), along)
+    assert np.array_equal(line.get_xdata(), result.arrays["monte_carlo_time"])

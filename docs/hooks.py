@@ -3,7 +3,15 @@
 - ``kinds/<kind>.md``: one page per registered kind: the spec's docstring, a worked example (the
   smallest shipped problem file of that kind) and the file format rendered from its JSON Schema
   (``gamespec schema KIND``);
+- ``transforms/<name>.md``: one page per registered transform: its docstring, the kinds it maps
+  and its options, from its ``options_model``;
 - ``backends.md``: each backend's kinds, features and options, from its ``options_model``;
+- ``gallery/<stem>.md``: one page per shipped problem file with a saved Result under
+  ``tests/data/results/`` (:mod:`tests.plots.fixtures`): the command, the summary and the figures,
+  drawn from the saved Result by the kind's plotter (:meth:`gamespec.Result.plot`), so the build
+  solves nothing; ``gallery/index.md`` lists them by chapter;
+- the navigation's ``Problem kinds``, ``Transforms`` and ``Gallery`` sections list those pages
+  (:func:`on_config`), so a kind, transform or problem file added later is in the nav;
 - ``<!-- example: NAME -->`` in a page is replaced by ``docs/examples/NAME`` as a code block (the
   files that ``tests/docs/test_extension_examples.py`` runs).
 """
@@ -18,10 +26,16 @@ import yaml
 from mkdocs.structure.files import File
 
 from gamespec import registry
+from gamespec.result import Result
 from gamespec.specs.schema import json_schema
+from gamespec.summaries import outcome
 
 ROOT = Path(__file__).resolve().parents[1]
 EXAMPLE = re.compile(r"<!-- example: ([\w.]+) -->")
+RESULTS = ROOT / "tests" / "data" / "results"
+"""The saved Results the gallery is drawn from (written by ``python -m tests.plots.fixtures``)."""
+CHAPTERS = {"ocp": "Optimal-control classics"}
+"""Gallery headings of the ``problems/`` folders that are not a thesis chapter (``chN``)."""
 
 
 def _type(prop: dict[str, Any]) -> str:
@@ -146,11 +160,128 @@ def backends_page() -> str:
     return "\n".join(text)
 
 
+def transform_page(name: str) -> str:
+    """The page of one transform: what it is, the kinds it maps, when the chain applies it and its
+    options (the ``options_model``'s JSON Schema)."""
+    cls = registry.load("gamespec.transforms", name)
+    source, target = cls.source_kind, cls.target_kind
+    if cls.requested:
+        when = (
+            f"Requested: applied when a `{source}` file lists it under `transforms:` "
+            f"(`- {name}: {{...}}`), in the order given, before any lowering transform."
+        )
+    else:
+        when = (
+            f"Lowering: applied by the chain when the backend solves `{target}` and the file is `{source}`."
+        )
+    text = [
+        f"# Transform `{name}`\n",
+        (cls.__doc__ or "").strip() + "\n",
+        f"From [`{source}`](../kinds/{source}.md) to [`{target}`](../kinds/{target}.md). {when}\n",
+        "## Options\n",
+        f"Generated from `{cls.options_model.__name__}`.\n",
+        schema_markdown(cls.options_model.model_json_schema()),
+    ]
+    return "\n".join(text)
+
+
+def _value(value: object) -> str:
+    return f"{value:.6g}" if isinstance(value, float) else str(value)
+
+
+def _problem_files() -> dict[str, Path]:
+    """The shipped problem files that have a saved Result, by stem."""
+    saved = {p.name for p in RESULTS.iterdir() if (p / "result.json").is_file()}
+    return {p.stem: p for p in sorted((ROOT / "problems").rglob("*.yaml")) if p.stem in saved}
+
+
+def _chapter(path: Path) -> str:
+    folder = path.parent.name
+    return CHAPTERS.get(folder, f"Chapter {folder.removeprefix('ch')}")
+
+
+def gallery_page(path: Path, result: Result, figures: list[str]) -> str:
+    """A problem file's page: what it is, the command, the summary of its saved Result (the kind's
+    rows, then the scalars) and its figures."""
+    relative = path.relative_to(ROOT)
+    data = yaml.safe_load(path.read_text())
+    rows = outcome(result) + [
+        (k, v) for k, v in result.summary().items() if k not in ("problem", "message") and v not in (None, "")
+    ]
+    table = ["| | |", "|---|---|", *(f"| {_cell(k)} | {_cell(_value(v))} |" for k, v in rows)]
+    text = [
+        f"# `{path.stem}`\n",
+        _cell(data.get("description", "")) + "\n",
+        f"`{relative}`, kind [`{result.kind}`](../kinds/{result.kind}.md).\n",
+        "## Command\n",
+        f"```bash\ngamespec solve {relative} --out runs/{path.stem} --plot\n```\n",
+        "## Summary\n",
+        f"Of the saved Result `tests/data/results/{path.stem}/` (solved by `python -m tests.plots.fixtures "
+        f"{path.stem}`, with the settings that keep it short; the command above may print other digits).\n",
+        *([_cell(result.message) + "\n"] if result.message else []),
+        "\n".join(table) + "\n",
+        "## Figures\n",
+        *(f"![{name}]({path.stem}/{name})\n" for name in figures),
+    ]
+    return "\n".join(text)
+
+
+def gallery(config) -> list[File]:
+    """The gallery: a page per problem file with a saved Result, its figures (drawn into memory
+    from the Result, :meth:`gamespec.Result.plot`) and the index by chapter."""
+    generated, index = (
+        [],
+        [
+            "# Gallery\n",
+            "Every shipped problem file, solved once and saved; the figures are drawn from those Results.\n",
+        ],
+    )
+    chapter = None
+    for stem, path in sorted(_problem_files().items(), key=lambda item: (str(item[1].parent), item[0])):
+        result = Result.load(RESULTS / stem)
+        figures = result.plot().images
+        for name, data in figures:
+            generated.append(File.generated(config, f"gallery/{stem}/{name}", content=data))
+        page = gallery_page(path, result, [name for name, _ in figures])
+        generated.append(File.generated(config, f"gallery/{stem}.md", content=page))
+        if _chapter(path) != chapter:
+            chapter = _chapter(path)
+            index += [f"\n## {chapter}\n", "| problem | kind | status |", "|---|---|---|"]
+        index.append(f"| [`{stem}`]({stem}.md) | `{result.kind}` | {result.status.value} |")
+    generated.append(File.generated(config, "gallery/index.md", content="\n".join(index) + "\n"))
+    return generated
+
+
+def _gallery_nav() -> list[dict[str, object]]:
+    chapters: dict[str, list[dict[str, str]]] = {}
+    for stem, path in sorted(_problem_files().items(), key=lambda item: (str(item[1].parent), item[0])):
+        chapters.setdefault(_chapter(path), []).append({stem: f"gallery/{stem}.md"})
+    return [{"Overview": "gallery/index.md"}, *({c: pages} for c, pages in chapters.items())]
+
+
+def on_config(config):
+    """Fill the navigation's generated sections ``Problem kinds``, ``Transforms`` and ``Gallery``
+    (placeholders in ``mkdocs.yml``): every kind, every transform, every gallery page."""
+    sections = {
+        "Problem kinds": [{kind: f"kinds/{kind}.md"} for kind in registry.names("gamespec.kinds")],
+        "Transforms": [{name: f"transforms/{name}.md"} for name in registry.names("gamespec.transforms")],
+        "Gallery": _gallery_nav(),
+    }
+    for item in config["nav"]:
+        for title in set(item) & set(sections) if isinstance(item, dict) else ():
+            item[title] = sections[title]
+    return config
+
+
 def on_files(files, config):
     """Add the generated pages."""
     for kind in registry.names("gamespec.kinds"):
         files.append(File.generated(config, f"kinds/{kind}.md", content=kind_page(kind)))
+    for name in registry.names("gamespec.transforms"):
+        files.append(File.generated(config, f"transforms/{name}.md", content=transform_page(name)))
     files.append(File.generated(config, "backends.md", content=backends_page()))
+    for file in gallery(config):
+        files.append(file)
     return files
 
 

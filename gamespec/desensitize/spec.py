@@ -46,8 +46,22 @@ class MonteCarloOptions(StrictModel):
 class DesensitizeOptions(StrictModel):
     """What to desensitize, with which method, and the Monte Carlo check of the result."""
 
-    method: Literal["sensitivity", "seywald", "costate"] = "sensitivity"
-    trajectory: Weights | None = None
-    final: Weights | None = None
-    fixed: dict[str, Value] = Field(default_factory=dict)
-    monte_carlo: MonteCarloOptions = Field(default_factory=MonteCarloOptions)
+    method: Literal["sensitivity", "seywald", "costate"] = Field(
+        "sensitivity",
+        description="How: `sensitivity` (sensitivity equations, eq. 6.9), `seywald` or `costate`.",
+    )
+    trajectory: Weights | None = Field(
+        None,
+        description="Weights of the trajectory sensitivities ∫‖S‖² in the cost (eq. 6.13).",
+    )
+    final: Weights | None = Field(
+        None,
+        description="Weights of the final-state sensitivities S(t_f) in the cost (eq. 6.14).",
+    )
+    fixed: dict[str, Value] = Field(
+        default_factory=dict, description="Values the desensitized problem holds fixed, by name."
+    )
+    monte_carlo: MonteCarloOptions = Field(
+        default_factory=MonteCarloOptions,
+        description="The Monte Carlo check of the desensitized solution over the uncertain parameters.",
+    )

@@ -122,8 +122,13 @@ class SpecBase(StrictModel):
 
     kind: str
     name: str = Field("unnamed", description="A short name used in reports and output folders.")
-    description: str = ""
-    solver: SolverSection = Field(default_factory=SolverSection)
+    description: str = Field(
+        "", description="Free text: what the file is (shown in reports and the docs' gallery)."
+    )
+    solver: SolverSection = Field(
+        default_factory=SolverSection,
+        description="Which backend solves the file, and each backend's own options.",
+    )
     transforms: RequestedTransforms = Field(
         default_factory=list,
         description="Requested transforms, [{name: {options}}], applied in order before the solve.",

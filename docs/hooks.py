@@ -63,9 +63,17 @@ def _cell(text: object) -> str:
     return str(text).replace("|", "\\|").replace("\n", " ")
 
 
-def _table(model: dict[str, Any]) -> str:
-    """A Markdown table of one object schema's fields: name, type, default, description."""
-    props = model.get("properties", {})
+def _description(prop: dict[str, Any], defs: dict[str, Any]) -> str:
+    """A property's description, or that of the definition it refers to (pydantic leaves out a
+    field's description that equals its model's docstring)."""
+    referred = defs.get(prop.get("$ref", "").rsplit("/", 1)[-1], {})
+    return str(prop.get("description") or referred.get("description") or "")
+
+
+def _table(model: dict[str, Any], defs: dict[str, Any] | None = None) -> str:
+    """A Markdown table of one object schema's fields: name, type, default, description (``defs``:
+    the definitions its references name)."""
+    props, defs = model.get("properties", {}), defs or {}
     if not props:
         return "No fields.\n"
     required = set(model.get("required", []))
@@ -73,16 +81,21 @@ def _table(model: dict[str, Any]) -> str:
     for name, prop in props.items():
         default = "required" if name in required else f"`{prop['default']!r}`" if "default" in prop else ""
         lines.append(
-            f"| `{name}` | {_cell(_type(prop))} | {_cell(default)} | {_cell(prop.get('description', ''))} |"
+            f"| `{name}` | {_cell(_type(prop))} | {_cell(default)} | {_cell(_description(prop, defs))} |"
         )
     return "\n".join(lines) + "\n"
 
 
 def schema_markdown(schema: dict[str, Any]) -> str:
     """The top-level fields, then every definition the schema refers to, as tables."""
-    parts = ["### Top level\n", _table(schema)]
-    for name, definition in schema.get("$defs", {}).items():
-        parts += [f"\n### `{name}`\n", _cell(definition.get("description", "")) + "\n\n", _table(definition)]
+    defs = schema.get("$defs", {})
+    parts = ["### Top level\n", _table(schema, defs)]
+    for name, definition in defs.items():
+        parts += [
+            f"\n### `{name}`\n",
+            _cell(definition.get("description", "")) + "\n\n",
+            _table(definition, defs),
+        ]
     return "\n".join(parts)
 
 

@@ -18,7 +18,9 @@
 
 from __future__ import annotations
 
+import inspect
 import re
+import sys
 from pathlib import Path
 from typing import Any
 
@@ -125,12 +127,35 @@ def _written_example(kind: str) -> list[str]:
     return []
 
 
+def _related(kind: str) -> list[str]:
+    """Links from a kind's page: the requested transforms a file of the kind may list (their options
+    are on their pages), the lowering transforms from and to it, and its files in the gallery."""
+    links = []
+    for name in registry.names("gamespec.transforms"):
+        cls = registry.load("gamespec.transforms", name)
+        link = f"[`{name}`](../transforms/{name}.md)"
+        if cls.requested and cls.source_kind == kind:
+            links.append(f"- {link}: may be listed under `transforms:` (its options on its page).")
+        elif not cls.requested and kind in (cls.source_kind, cls.target_kind):
+            links.append(f"- {link}: lowers `{cls.source_kind}` to `{cls.target_kind}`.")
+    shipped = [stem for stem, path in _problem_files().items() if _kind_of(path) == kind]
+    if shipped:
+        links.append("- In the gallery: " + ", ".join(f"[`{s}`](../gallery/{s}.md)" for s in shipped) + ".")
+    return ["## Transforms and gallery\n", "\n".join(links) + "\n"] if links else []
+
+
+def _kind_of(path: Path) -> object:
+    data = yaml.safe_load(path.read_text())
+    return data.get("kind") if isinstance(data, dict) else None
+
+
 def kind_page(kind: str) -> str:
     """The page of one problem kind."""
     cls = registry.spec_class(kind)
-    text = [f"# Kind `{kind}`\n", (cls.__doc__ or "").strip() + "\n"]
-    if cls.default_backend:
-        text.append(f"Default backend: `{cls.default_backend}`.\n")
+    text = [f"# Kind `{kind}`\n", inspect.cleandoc(cls.__doc__ or "") + "\n"]
+    backend = registry.kind(kind).default_backend
+    if backend:
+        text.append(f"Default backend: [`{backend}`](../backends.md).\n")
     example = _example_file(kind)
     if example is not None:
         relative = example.relative_to(ROOT)
@@ -142,6 +167,7 @@ def kind_page(kind: str) -> str:
         ]
     else:
         text += _written_example(kind)
+    text += _related(kind)
     text += [
         "## File format\n",
         f"Generated from the JSON Schema (`gamespec schema {kind}`).\n",
@@ -180,7 +206,7 @@ def transform_page(name: str) -> str:
     source, target = cls.source_kind, cls.target_kind
     if cls.requested:
         when = (
-            f"Requested: applied when a `{source}` file lists it under `transforms:` "
+            f"Requested: applied when a file of kind `{source}` lists it under `transforms:` "
             f"(`- {name}: {{...}}`), in the order given, before any lowering transform."
         )
     else:
@@ -189,7 +215,7 @@ def transform_page(name: str) -> str:
         )
     text = [
         f"# Transform `{name}`\n",
-        (cls.__doc__ or "").strip() + "\n",
+        inspect.cleandoc(cls.__doc__ or "") + "\n",
         f"From [`{source}`](../kinds/{source}.md) to [`{target}`](../kinds/{target}.md). {when}\n",
         "## Options\n",
         f"Generated from `{cls.options_model.__name__}`.\n",
@@ -213,6 +239,20 @@ def _chapter(path: Path) -> str:
     return CHAPTERS.get(folder, f"Chapter {folder.removeprefix('ch')}")
 
 
+def _settings(path: Path) -> str:
+    """The ``--set`` assignments the saved Result of ``path`` was solved with, as text (the
+    fixtures' settings that keep a solve short, :func:`tests.plots.fixtures.overrides`)."""
+    if str(ROOT) not in sys.path:
+        sys.path.insert(0, str(ROOT))
+    from tests.plots.fixtures import overrides
+
+    chosen = overrides(path)
+    if not chosen:
+        return ": the file as shipped"
+    settings = " ".join(f"--set {o}" for o in chosen)
+    return f" with `{settings}` (to keep it short; the command above may print other digits)"
+
+
 def gallery_page(path: Path, result: Result, figures: list[str]) -> str:
     """A problem file's page: what it is, the command, the summary of its saved Result (the kind's
     rows, then the scalars) and its figures."""
@@ -229,8 +269,8 @@ def gallery_page(path: Path, result: Result, figures: list[str]) -> str:
         "## Command\n",
         f"```bash\ngamespec solve {relative} --out runs/{path.stem} --plot\n```\n",
         "## Summary\n",
-        f"Of the saved Result `tests/data/results/{path.stem}/` (solved by `python -m tests.plots.fixtures "
-        f"{path.stem}`, with the settings that keep it short; the command above may print other digits).\n",
+        f"Of the saved Result `tests/data/results/{path.stem}/`, written by `python -m tests.plots.fixtures "
+        f"{path.stem}`{_settings(path)}.\n",
         *([_cell(result.message) + "\n"] if result.message else []),
         "\n".join(table) + "\n",
         "## Figures\n",

@@ -122,9 +122,7 @@ class SpecBase(StrictModel):
 
     kind: str
     name: str = Field("unnamed", description="A short name used in reports and output folders.")
-    description: str = Field(
-        "", description="Free text: what the file is (shown in reports and the docs' gallery)."
-    )
+    description: str = Field("", description="Free text: what the file is (the docs' gallery shows it).")
     solver: SolverSection = Field(
         default_factory=SolverSection,
         description="Which backend solves the file, and each backend's own options.",

@@ -6,10 +6,10 @@
 - ``transforms/<name>.md``: one page per registered transform: its docstring, the kinds it maps
   and its options, from its ``options_model``;
 - ``backends.md``: each backend's kinds, features and options, from its ``options_model``;
-- ``gallery/<stem>.md``: one page per shipped problem file with a saved Result under
-  ``tests/data/results/`` (:mod:`tests.plots.fixtures`): the command, the summary and the figures,
-  drawn from the saved Result by the kind's plotter (:meth:`gamespec.Result.plot`), so the build
-  solves nothing; ``gallery/index.md`` lists them by chapter;
+- ``gallery/<stem>.md``: one page per shipped problem file: the command, and the summary and the
+  figures of its saved Result under ``tests/data/results/`` (:mod:`tests.plots.fixtures`; a study
+  has none), drawn by the kind's plotter (:meth:`gamespec.Result.plot`), so the build solves
+  nothing; ``gallery/index.md`` lists them by chapter;
 - the navigation's ``Problem kinds``, ``Transforms`` and ``Gallery`` sections list those pages
   (:func:`on_config`), so a kind, transform or problem file added later is in the nav;
 - ``<!-- example: NAME -->`` in a page is replaced by ``docs/examples/NAME`` as a code block (the
@@ -229,9 +229,14 @@ def _value(value: object) -> str:
 
 
 def _problem_files() -> dict[str, Path]:
-    """The shipped problem files that have a saved Result, by stem."""
-    saved = {p.name for p in RESULTS.iterdir() if (p / "result.json").is_file()}
-    return {p.stem: p for p in sorted((ROOT / "problems").rglob("*.yaml")) if p.stem in saved}
+    """The shipped problem files, by stem."""
+    return {p.stem: p for p in sorted((ROOT / "problems").rglob("*.yaml"))}
+
+
+def _saved(stem: str) -> Result | None:
+    """The saved Result of the problem file ``stem`` (None for a study, which has none)."""
+    folder = RESULTS / stem
+    return Result.load(folder) if (folder / "result.json").is_file() else None
 
 
 def _chapter(path: Path) -> str:
@@ -253,46 +258,62 @@ def _settings(path: Path) -> str:
     return f" with `{settings}` (to keep it short; the command above may print other digits)"
 
 
-def gallery_page(path: Path, result: Result, figures: list[str]) -> str:
-    """A problem file's page: what it is, the command, the summary of its saved Result (the kind's
-    rows, then the scalars) and its figures."""
-    relative = path.relative_to(ROOT)
-    data = yaml.safe_load(path.read_text())
+def _summary(path: Path, result: Result | None) -> list[str]:
+    """The summary section of a gallery page: the saved Result's rows (the kind's, then the
+    scalars), or why there is none."""
+    if result is None:
+        return [
+            "## Summary\n",
+            "No saved Result: a study runs many solves, too long for the documentation build; the command "
+            "above runs it, and its figures are drawn from its store.\n",
+        ]
     rows = outcome(result) + [
         (k, v) for k, v in result.summary().items() if k not in ("problem", "message") and v not in (None, "")
     ]
     table = ["| | |", "|---|---|", *(f"| {_cell(k)} | {_cell(_value(v))} |" for k, v in rows)]
-    text = [
-        f"# `{path.stem}`\n",
-        _cell(data.get("description", "")) + "\n",
-        f"`{relative}`, kind [`{result.kind}`](../kinds/{result.kind}.md).\n",
-        "## Command\n",
-        f"```bash\ngamespec solve {relative} --out runs/{path.stem} --plot\n```\n",
+    return [
         "## Summary\n",
         f"Of the saved Result `tests/data/results/{path.stem}/`, written by `python -m tests.plots.fixtures "
         f"{path.stem}`{_settings(path)}.\n",
         *([_cell(result.message) + "\n"] if result.message else []),
         "\n".join(table) + "\n",
-        "## Figures\n",
+    ]
+
+
+def gallery_page(path: Path, result: Result | None, figures: list[str]) -> str:
+    """A problem file's page: what it is, the command, the summary of its saved Result and its
+    figures."""
+    relative = path.relative_to(ROOT)
+    data = yaml.safe_load(path.read_text())
+    kind = data.get("kind", "")
+    plot = " --plot" if result is not None else ""
+    text = [
+        f"# `{path.stem}`\n",
+        _cell(data.get("description", "")) + "\n",
+        f"`{relative}`, kind [`{kind}`](../kinds/{kind}.md).\n",
+        "## Command\n",
+        f"```bash\ngamespec solve {relative} --out runs/{path.stem}{plot}\n```\n",
+        *_summary(path, result),
+        *(["## Figures\n"] if figures else []),
         *(f"![{name}]({path.stem}/{name})\n" for name in figures),
     ]
     return "\n".join(text)
 
 
 def gallery(config) -> list[File]:
-    """The gallery: a page per problem file with a saved Result, its figures (drawn into memory
-    from the Result, :meth:`gamespec.Result.plot`) and the index by chapter."""
+    """The gallery: a page per shipped problem file with its saved Result's figures (drawn into
+    memory from the Result, :meth:`gamespec.Result.plot`), and the index by chapter."""
     generated, index = (
         [],
         [
             "# Gallery\n",
-            "Every shipped problem file, solved once and saved; the figures are drawn from those Results.\n",
+            "Every shipped problem file; the figures are drawn from its saved Result (the studies aside).\n",
         ],
     )
     chapter = None
     for stem, path in sorted(_problem_files().items(), key=lambda item: (str(item[1].parent), item[0])):
-        result = Result.load(RESULTS / stem)
-        figures = result.plot().images
+        result = _saved(stem)
+        figures = result.plot().images if result is not None else []
         for name, data in figures:
             generated.append(File.generated(config, f"gallery/{stem}/{name}", content=data))
         page = gallery_page(path, result, [name for name, _ in figures])
@@ -300,7 +321,8 @@ def gallery(config) -> list[File]:
         if _chapter(path) != chapter:
             chapter = _chapter(path)
             index += [f"\n## {chapter}\n", "| problem | kind | status |", "|---|---|---|"]
-        index.append(f"| [`{stem}`]({stem}.md) | `{result.kind}` | {result.status.value} |")
+        status = result.status.value if result is not None else "(a study: not saved)"
+        index.append(f"| [`{stem}`]({stem}.md) | `{_kind_of(path)}` | {status} |")
     generated.append(File.generated(config, "gallery/index.md", content="\n".join(index) + "\n"))
     return generated
 

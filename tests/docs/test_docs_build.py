@@ -76,13 +76,14 @@ def test_every_kind_transform_and_problem_is_in_the_nav(site: Site) -> None:
     home = (site.folder / "index.html").read_text()
     pages = [f"kinds/{kind}/" for kind in registry.names("gamespec.kinds")]
     pages += [f"transforms/{name}/" for name in registry.names("gamespec.transforms")]
-    pages += [f"gallery/{path.stem}/" for path in fixtures.FILES]
+    pages += [f"gallery/{path.stem}/" for path in sorted(fixtures.PROBLEMS.rglob("*.yaml"))]
     assert not [page for page in pages if f'href="{page}"' not in home]
 
 
 def test_gallery_page_of_each_shipped_problem(site: Site) -> None:
     """Each shipped problem file's page names its file, kind and status, gives the command and
-    shows every figure its saved Result draws, each written beside the page."""
+    shows every figure its saved Result draws, each written beside the page (a study's page, with
+    no saved Result, gives the command)."""
     for path in fixtures.FILES:
         page = site.folder / "gallery" / path.stem / "index.html"
         result = Result.load(fixtures.FIXTURES / path.stem)
@@ -92,6 +93,9 @@ def test_gallery_page_of_each_shipped_problem(site: Site) -> None:
         images = re.findall(r'<img alt="[^"]*" src="([^"]+)"', page.read_text())
         assert images, path.stem
         assert all((page.parent / image).read_bytes().startswith(b"\x89PNG") for image in images)
+    for path in sorted(set(fixtures.PROBLEMS.rglob("*.yaml")) - set(fixtures.FILES)):
+        text = _text(site.folder / "gallery" / path.stem / "index.html")
+        assert f"gamespec solve {path.relative_to(ROOT)}" in text and "No saved Result" in text
 
 
 def test_notebook_page_is_executed(site: Site) -> None:

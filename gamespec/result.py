@@ -103,11 +103,16 @@ def _missing(value: Any) -> bool:
 
 @dataclass(frozen=True)
 class Figures:
-    """The figures :meth:`Result.plot` drew: the files it wrote (none when it drew them in a
-    temporary folder) and each figure's name and bytes, shown inline by a notebook."""
+    """The figures :meth:`Result.plot` drew: the files it wrote, or, when it drew them in a
+    temporary folder, each figure's name and bytes (``drawn``); shown inline by a notebook."""
 
     paths: list[Path]
-    images: list[tuple[str, bytes]]
+    drawn: tuple[tuple[str, bytes], ...] = ()
+
+    @property
+    def images(self) -> list[tuple[str, bytes]]:
+        """Each figure's file name and bytes (read from :attr:`paths` when they were written)."""
+        return list(self.drawn) or [(path.name, path.read_bytes()) for path in self.paths]
 
     def _repr_html_(self) -> str:
         """Each figure as an ``<img>`` with its bytes inline (PNG or GIF), captioned by its name."""
@@ -280,7 +285,7 @@ class Result(BaseModel):
         no plotter."""
         if directory is None:
             with tempfile.TemporaryDirectory() as folder:
-                return Figures([], self.plot(folder, animate=animate).images)
+                return Figures([], tuple(self.plot(folder, animate=animate).images))
         plotter = registry.kind(self.kind).part("plot")
         if plotter is None:
             raise BackendError(f"kind {self.kind!r} has no plotter")
@@ -291,7 +296,7 @@ class Result(BaseModel):
         paths = list(plotter(typed, out, animate=animate))
         for plot in registry.transform_parts(self.provenance.transforms, "plot"):
             paths += plot(typed, out)
-        return Figures(paths, [(p.name, p.read_bytes()) for p in paths])
+        return Figures(paths)
 
     def to_json(self, *, arrays: bool = True, indent: int | None = 2) -> str:
         """JSON text of the Result; with ``arrays=False`` only scalars, checks and metrics."""

@@ -48,18 +48,19 @@ class DesensitizeOptions(StrictModel):
 
     method: Literal["sensitivity", "seywald", "costate"] = Field(
         "sensitivity",
-        description="How: `sensitivity` (sensitivity equations, eq. 6.9), `seywald` or `costate`.",
+        description="`sensitivity` (eqs. 6.11–6.18), `seywald` (6.4–6.7) or `costate` (C-DOC, 6.46–6.64).",
     )
     trajectory: Weights | None = Field(
         None,
-        description="Weights of the trajectory sensitivities ∫‖S‖² in the cost (eq. 6.13).",
+        description="Weight(s) of the integral sensitivity term (eq. 6.16; 6.7 Seywald, 6.62 C-DOC).",
     )
     final: Weights | None = Field(
         None,
-        description="Weights of the final-state sensitivities S(t_f) in the cost (eq. 6.14).",
+        description="Weight(s) of the final-time sensitivity term (eq. 6.17).",
     )
     fixed: dict[str, Value] = Field(
-        default_factory=dict, description="Values the desensitized problem holds fixed, by name."
+        default_factory=dict,
+        description="Final-time sensitivities held at given values, by entry name (eq. 6.18).",
     )
     monte_carlo: MonteCarloOptions = Field(
         default_factory=MonteCarloOptions,

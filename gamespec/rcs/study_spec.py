@@ -41,7 +41,7 @@ class RcsStudySpec(SpecBase):
     alphas: list[Number] = Field(
         default_factory=lambda: [0.0, 0.1, 0.33, 1.0],
         min_length=1,
-        description="The RCS weights α the study solves for (one point per weight and obstacle count).",
+        description="The RCS weights α (Q = α I_N, eq. 6.36): every N of `obstacles` is solved with every α.",
     )
     sigma: Number = Field(0.1, gt=0, description="σ (sigma_is: std) or σ² (sigma_is: variance) of Δρ.")
     sigma_is: Literal["std", "variance"] = Field(

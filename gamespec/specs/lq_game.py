@@ -119,7 +119,7 @@ class TerminalTarget(StrictModel):
         None, description="The target mean (None entries are free); omitted: none."
     )
     covariance: MatrixValue | None = Field(
-        None, description="The target covariance (an upper bound); omitted: none."
+        None, description="The target covariance (the relaxed constraint of eqs. 4.61–4.62); omitted: none."
     )
 
 

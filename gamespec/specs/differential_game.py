@@ -442,7 +442,7 @@ class RecedingHorizonSpec(StrictModel):
     )
     positions: dict[str, tuple[str, str]] = Field(
         default_factory=dict,
-        description="Per player, the pair of its position states (figures and the capture distance).",
+        description="Per player, the pair of its position states (the figures draw its path).",
     )
     """Each player's position states, for the figures."""
     sensitivity_time: Literal["absolute", "relative"] = Field(

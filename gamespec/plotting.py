@@ -24,9 +24,6 @@ from pathlib import Path
 
 import numpy as np
 
-from gamespec import registry
-from gamespec.errors import BackendError
-from gamespec.metrics import validated
 from gamespec.ocp.control_signal import step_edges, transcribed_signal
 from gamespec.rcs.circles import circles
 from gamespec.result import Result
@@ -221,15 +218,6 @@ def plot_plane(result: Result, pairs: list[tuple[str, str]], path: Path) -> Path
 
 
 def plot_result(result: Result, output_dir: Path, *, animate: bool = False) -> list[Path]:
-    """The figures of the Result's kind, then those of each transform its chain applied
-    (:func:`~gamespec.registry.transform_parts`), with the Result's metrics validated by the kind's
-    schema (:func:`gamespec.metrics.validated`): a plotter reads only metrics and arrays of the
-    types and shapes that schema promises."""
-    plotter = registry.kind(result.kind).part("plot")
-    if plotter is None:
-        raise BackendError(f"kind {result.kind!r} has no plotter")
-    typed = validated(result, result.problem or "<result>")
-    paths = plotter(typed, output_dir, animate=animate)
-    for plot in registry.transform_parts(result.provenance.transforms, "plot"):
-        paths += plot(typed, output_dir)
-    return paths
+    """The figures of the Result's kind, then those of each transform its chain applied, written
+    into ``output_dir`` (:meth:`gamespec.result.Result.plot`, which notebooks call too)."""
+    return result.plot(output_dir, animate=animate).paths

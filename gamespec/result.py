@@ -3,14 +3,21 @@
 A :class:`Result` holds the status, the objective, trajectories on a time grid, backend-independent
 checks, solver statistics, timings and provenance. It is saved as ``result.json`` plus
 ``arrays.npz`` and read back without any solver installed. Plots and reports read Results only.
+
+In a notebook a Result shows itself (:meth:`Result._repr_html_`: status, the kind's summary rows, the
+scalars and the failed checks) and draws its figures (:meth:`Result.plot`) through the plotters its
+kind and transforms register, the ones ``gamespec plot`` uses.
 """
 
 from __future__ import annotations
 
+import base64
+import html
 import json
 import math
 import os
 import stat
+import tempfile
 from dataclasses import dataclass
 from enum import StrEnum
 from pathlib import Path
@@ -19,8 +26,8 @@ from typing import Any, BinaryIO
 import numpy as np
 from pydantic import BaseModel, ConfigDict, Field, field_serializer, field_validator
 
-from gamespec import limits
-from gamespec.errors import GamespecError, SpecError
+from gamespec import limits, registry
+from gamespec.errors import BackendError, GamespecError, SpecError
 
 ArrayDict = dict[str, np.ndarray]
 
@@ -92,6 +99,37 @@ class FailedCheck:
 
 def _missing(value: Any) -> bool:
     return value is None or (isinstance(value, float) and not math.isfinite(value))
+
+
+@dataclass(frozen=True)
+class Figures:
+    """The figures :meth:`Result.plot` drew: the files it wrote, or, when it drew them in a
+    temporary folder, each figure's name and bytes (``drawn``); shown inline by a notebook."""
+
+    paths: list[Path]
+    drawn: tuple[tuple[str, bytes], ...] = ()
+
+    @property
+    def images(self) -> list[tuple[str, bytes]]:
+        """Each figure's file name and bytes (read from :attr:`paths` when they were written)."""
+        return list(self.drawn) or [(path.name, path.read_bytes()) for path in self.paths]
+
+    def _repr_html_(self) -> str:
+        """Each figure as an ``<img>`` with its bytes inline (PNG or GIF), captioned by its name."""
+        parts = []
+        for name, data in self.images:
+            mime = "image/gif" if name.endswith(".gif") else "image/png"
+            source = f"data:{mime};base64,{base64.b64encode(data).decode()}"
+            caption = html.escape(name)
+            parts.append(
+                f'<figure><img src="{source}" alt="{caption}"><figcaption>{caption}</figcaption></figure>'
+            )
+        return "\n".join(parts)
+
+
+def _html_value(value: Any) -> str:
+    text = f"{value:.6g}" if isinstance(value, float) else str(value)
+    return html.escape(text)
 
 
 class Provenance(BaseModel):
@@ -203,6 +241,62 @@ class Result(BaseModel):
             "iterations": self.iterations,
             **{k: v for k, v in self.checks.items()},
         }
+
+    def summary_rows(self) -> list[tuple[str, object]]:
+        """The rows of the kind's summary (its :class:`~gamespec.registry.Kind`'s ``summary``; none
+        when the kind names none or is not installed), then those of each transform the chain applied
+        that names one (:func:`~gamespec.registry.transform_parts`)."""
+        own = registry.kind_part(self.kind, "summary")
+        summaries = [own, *registry.transform_parts(self.provenance.transforms, "summary")]
+        return [row for summary in summaries if summary is not None for row in summary(self)]
+
+    def _repr_html_(self) -> str:
+        """The Result in a notebook: problem, kind, backend and status over its message, a table of
+        the kind's summary rows (:meth:`summary_rows`), the scalars of :meth:`summary` and the other
+        scalar metrics, then one row per failed check (:meth:`failed_checks`)."""
+        shown = {"problem", "kind", "backend", "status", "message"}
+        scalars = {k: v for k, v in self.summary().items() if k not in shown and v not in (None, "")}
+        scalars |= {
+            k: v for k, v in self.metrics.items() if isinstance(v, int | float | str) and k not in scalars
+        }
+        rows = [
+            *self.summary_rows(),
+            *scalars.items(),
+            *(("failed check", str(f)) for f in self.failed_checks()),
+        ]
+        cells = "".join(
+            f'<tr><th style="text-align:left">{html.escape(str(k))}</th><td>{_html_value(v)}</td></tr>'
+            for k, v in rows
+        )
+        head = (
+            f"<strong>{html.escape(self.problem)}</strong> ({html.escape(self.kind)}) on "
+            f"{html.escape(self.backend)}: <strong>{html.escape(self.status.value)}</strong>"
+        )
+        message = f"<p>{html.escape(self.message)}</p>" if self.message else ""
+        return f'<div class="gamespec-result"><p>{head}</p>{message}<table>{cells}</table></div>'
+
+    def plot(self, directory: str | Path | None = None, *, animate: bool = False) -> Figures:
+        """Draw the Result's figures into ``directory`` (a temporary folder, removed once the
+        figures are read, when None): those of its kind's plotter (the kind's ``plot``), then those of
+        each transform its chain applied (:func:`~gamespec.registry.transform_parts`), with the
+        metrics validated by the kind's schema (:func:`gamespec.metrics.validated`), so a plotter
+        reads only metrics of the types and shapes that schema promises. ``gamespec plot`` draws
+        with this method (:func:`gamespec.plotting.plot_result`). A BackendError when the kind has
+        no plotter."""
+        if directory is None:
+            with tempfile.TemporaryDirectory() as folder:
+                return Figures([], tuple(self.plot(folder, animate=animate).images))
+        plotter = registry.kind(self.kind).part("plot")
+        if plotter is None:
+            raise BackendError(f"kind {self.kind!r} has no plotter")
+        from gamespec.metrics import validated
+
+        typed = validated(self, self.problem or "<result>")
+        out = Path(directory)
+        paths = list(plotter(typed, out, animate=animate))
+        for plot in registry.transform_parts(self.provenance.transforms, "plot"):
+            paths += plot(typed, out)
+        return Figures(paths)
 
     def to_json(self, *, arrays: bool = True, indent: int | None = 2) -> str:
         """JSON text of the Result; with ``arrays=False`` only scalars, checks and metrics."""

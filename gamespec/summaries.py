@@ -12,7 +12,6 @@ that does not apply, with the reason (``metrics["checks_skipped"]``).
 
 from __future__ import annotations
 
-from gamespec import registry
 from gamespec.result import Result
 
 Rows = list[tuple[str, object]]
@@ -23,10 +22,7 @@ def outcome(result: Result) -> Rows:
     installed), the rows of each transform the chain applied that names one (the desensitization's
     sensitivities and Monte Carlo, the RCS collision probability), then the failed and the left-out
     checks."""
-    own = registry.kind_part(result.kind, "summary")
-    summaries = [own, *registry.transform_parts(result.provenance.transforms, "summary")]
-    rows = [row for summary in summaries if summary is not None for row in summary(result)]
-    return rows + check_rows(result)
+    return result.summary_rows() + check_rows(result)
 
 
 def headline(result: Result) -> str:

@@ -49,7 +49,7 @@ class CasadiOptions(StrictModel):
 
     solver: str = Field("ipopt", description="NLP solver plugin of CasADi's nlpsol.")
     tol: float = Field(1e-8, gt=0, description="IPOPT's tol.")
-    max_iter: int = Field(3000, ge=1)
+    max_iter: int = Field(3000, ge=1, description="IPOPT's iteration limit.")
     max_wall_time: float = Field(300.0, gt=0, description="IPOPT's wall-time limit in seconds.")
     ipopt: dict[str, Any] = Field(default_factory=dict, description="Further IPOPT options.")
     warm_start: bool = Field(True, description="Re-solves start from the previous solution.")

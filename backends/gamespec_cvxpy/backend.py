@@ -55,7 +55,7 @@ class CvxpyOptions(LQSolverOptions):
     """Options of the ``cvxpy`` backend: the conic solver's name and its keyword arguments, how to
     retry a step it fails on numerically, and an optional second solver for such a step."""
 
-    solver: str = "CLARABEL"
+    solver: str = Field("CLARABEL", description="The CVXPY solver's name (`CLARABEL`, `SCS`, ...).")
     retry_solver_options: dict[str, Any] | None = Field(
         None,
         description="solver_options added for a second attempt at a step the solver fails on "

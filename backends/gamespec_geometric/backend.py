@@ -23,7 +23,10 @@ from gamespec_geometric.spec import PursuitScenarioSpec
 class GeometricOptions(StrictModel):
     """Options of the geometric backend."""
 
-    active_check: Literal["fast", "reference"] = "fast"
+    active_check: Literal["fast", "reference"] = Field(
+        "fast",
+        description="The active-pursuer check: `fast` or `reference` (AAPC for CB, edge clipping for PP).",
+    )
     pp_samples: int = Field(64, ge=8, description="Vertices of each refined Apollonius polygon (PP).")
 
 

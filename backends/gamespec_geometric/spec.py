@@ -56,7 +56,7 @@ Heading = Annotated[
 class FixedHeading(StrictModel):
     """A non-maneuvering evader: one heading for the whole game."""
 
-    type: Literal["fixed"] = "fixed"
+    type: Literal["fixed"] = Field("fixed", description="`fixed`: one heading for the whole game.")
     heading: Heading
 
     @field_validator("heading", mode="before")
@@ -68,16 +68,18 @@ class FixedHeading(StrictModel):
 class PureEvasion(StrictModel):
     """Run straight away from the nearest pursuer, re-aimed at every time step."""
 
-    type: Literal["pure_evasion"] = "pure_evasion"
+    type: Literal["pure_evasion"] = Field(
+        "pure_evasion", description="`pure_evasion`: run straight away from the nearest pursuer."
+    )
 
 
 class BlindEvasion(StrictModel):
     """Blind evasion with switching headings (§3.3.2): every ``switch_period`` a heading drawn from
     ``headings`` with a seeded random generator."""
 
-    type: Literal["blind"] = "blind"
-    headings: list[Heading] = Field(min_length=1)
-    switch_period: PositiveFloat = 1.0
+    type: Literal["blind"] = Field("blind", description="`blind`: switch headings at random.")
+    headings: list[Heading] = Field(min_length=1, description="The headings drawn from, in radians.")
+    switch_period: PositiveFloat = Field(1.0, description="Time between heading switches.")
     seed: int = Field(0, ge=0, description="Seed of the random generator (a non-negative integer).")
 
     @field_validator("headings", mode="before")
@@ -93,7 +95,7 @@ class Team(StrictModel):
     """Positions and speeds (one for all or one each) of one team; ``role`` names it in errors."""
 
     role: ClassVar[str]
-    positions: list[Position]
+    positions: list[Position] = Field(description="Initial positions [x, y], one per agent.")
     speed: PositiveSpeed | list[PositiveSpeed]
 
     @field_validator("positions")
@@ -125,8 +127,13 @@ class PursuerTeam(Team):
     :class:`gamespec_geometric.active.CaptureRegions`)."""
 
     role: ClassVar[str] = "pursuer"
-    speed: PositiveSpeed | list[PositiveSpeed] = 1.0
-    strategy: Literal["cb", "pp"] | list[Literal["cb", "pp"]] = "cb"
+    speed: PositiveSpeed | list[PositiveSpeed] = Field(
+        1.0, description="The pursuers' speed: one for all, or a list with one per pursuer."
+    )
+    strategy: Literal["cb", "pp"] | list[Literal["cb", "pp"]] = Field(
+        "cb",
+        description="Pursuit law, `cb` (constant bearing) or `pp` (pure pursuit): one, or one per pursuer.",
+    )
 
     def strategies(self) -> np.ndarray:
         """Strategy of each pursuer, ``(len(positions),)``."""
@@ -143,8 +150,13 @@ class EvaderTeam(Team):
     """Evader positions, speeds and strategies (one for all or one each)."""
 
     role: ClassVar[str] = "evader"
-    speed: PositiveSpeed | list[PositiveSpeed] = 0.6
-    strategy: EvaderStrategy | list[EvaderStrategy] = Field(default_factory=PureEvasion)
+    speed: PositiveSpeed | list[PositiveSpeed] = Field(
+        0.6, description="The evaders' speed: one for all, or a list with one per evader."
+    )
+    strategy: EvaderStrategy | list[EvaderStrategy] = Field(
+        default_factory=PureEvasion,
+        description="The evaders' strategy (fixed, pure evasion or blind): one, or one per evader.",
+    )
 
     def strategies(self) -> list[FixedHeading | PureEvasion | BlindEvasion]:
         """Strategy of each evader."""
@@ -160,13 +172,20 @@ class PursuitScenarioSpec(SpecBase):
     tie-break) or ``auto`` (``avaa`` for homogeneous teams, ``a2`` otherwise).
     """
 
-    kind: Literal["pursuit_scenario"] = "pursuit_scenario"
-    pursuers: PursuerTeam
-    evaders: EvaderTeam
-    capture_radius: PositiveFloat = 0.1
-    time_step: PositiveFloat = 0.01
-    horizon: PositiveFloat = 50.0
-    allocation: Literal["auto", "avaa", "a2"] = "auto"
+    kind: Literal["pursuit_scenario"] = Field(
+        "pursuit_scenario", description="The problem kind; selects the schema of the rest of the file."
+    )
+    pursuers: PursuerTeam = Field(description="The pursuer team.")
+    evaders: EvaderTeam = Field(description="The evader team.")
+    capture_radius: PositiveFloat = Field(0.1, description="Distance at which a pursuer captures an evader.")
+    time_step: PositiveFloat = Field(0.01, description="The simulation's time step.")
+    horizon: PositiveFloat = Field(
+        50.0, description="The simulated time after which the run stops (escapes are reported)."
+    )
+    allocation: Literal["auto", "avaa", "a2"] = Field(
+        "auto",
+        description="Task allocation: `avaa` (§3.4), `a2` (§3.5) or `auto` (avaa when homogeneous, else a2).",
+    )
 
     def runtime_parameters(self) -> dict[str, float]:
         """The simulation's capture radius, time step and horizon (what a compiled scenario re-runs

@@ -15,9 +15,13 @@ class FlowGameOptions(StrictModel):
     ``cross_check`` also runs the other reachability method and reports the difference of ``T̂``,
     ``max_wall_time`` and ``engine`` (the reachability stage)."""
 
-    solver: str = "CLARABEL"
-    solver_options: dict[str, Any] = Field(default_factory=dict)
-    cross_check: bool = True
+    solver: str = Field("CLARABEL", description="The CVXPY conic solver of the players' steps.")
+    solver_options: dict[str, Any] = Field(
+        default_factory=dict, description="Keyword arguments passed to that solver."
+    )
+    cross_check: bool = Field(
+        True, description="Also run the other reachability method and report the difference of T̂."
+    )
     max_wall_time: float | None = Field(
         300.0,
         gt=0,

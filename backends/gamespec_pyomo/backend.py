@@ -49,7 +49,7 @@ class PyomoOptions(StrictModel):
         "auto", description="NLP executable: auto takes ipopt on PATH, else the bundled ripopt."
     )
     tol: float = Field(1e-8, gt=0, description="The solver's tol.")
-    max_iter: int = Field(3000, ge=1)
+    max_iter: int = Field(3000, ge=1, description="The NLP solver's iteration limit.")
     max_wall_time: float = Field(300.0, gt=0, description="The solver's wall-time limit in seconds.")
     options: dict[str, Any] = Field(
         default_factory=dict, description="Further solver options (key=value on its command line)."

@@ -19,6 +19,7 @@ import time
 from typing import TYPE_CHECKING, ClassVar
 
 import numpy as np
+from pydantic import Field
 from scipy.sparse import csc_matrix
 
 from gamespec.compiling.lq import LQBackend, LQCompiledModel, LQSolverOptions
@@ -96,7 +97,7 @@ def residuals(solution: qpsolvers.Solution, scale: float) -> dict[str, float | N
 class QpOptions(LQSolverOptions):
     """Options of the ``qp`` backend: the qpsolvers solver's name and its keyword arguments."""
 
-    solver: str = "proxqp"
+    solver: str = Field("proxqp", description="The qpsolvers solver's name (`proxqp`, `osqp`, ...).")
 
 
 class QpModel(LQCompiledModel):

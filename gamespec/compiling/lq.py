@@ -36,8 +36,10 @@ from gamespec.specs.lq_game import LQGameSpec
 class LQSolverOptions(StrictModel):
     """An LQ backend's options block: the solver's name and its keyword arguments."""
 
-    solver: str
-    solver_options: dict[str, Any] = Field(default_factory=dict)
+    solver: str = Field(description="The solver's name.")
+    solver_options: dict[str, Any] = Field(
+        default_factory=dict, description="Keyword arguments passed to the solver."
+    )
 
     def rejected(self, err: Exception) -> BackendError:
         """The solver's complaint about ``solver_options`` as a one-line error."""

@@ -46,8 +46,23 @@ class MonteCarloOptions(StrictModel):
 class DesensitizeOptions(StrictModel):
     """What to desensitize, with which method, and the Monte Carlo check of the result."""
 
-    method: Literal["sensitivity", "seywald", "costate"] = "sensitivity"
-    trajectory: Weights | None = None
-    final: Weights | None = None
-    fixed: dict[str, Value] = Field(default_factory=dict)
-    monte_carlo: MonteCarloOptions = Field(default_factory=MonteCarloOptions)
+    method: Literal["sensitivity", "seywald", "costate"] = Field(
+        "sensitivity",
+        description="`sensitivity` (eqs. 6.11–6.18), `seywald` (6.4–6.7) or `costate` (C-DOC, 6.46–6.64).",
+    )
+    trajectory: Weights | None = Field(
+        None,
+        description="Weight(s) of the integral sensitivity term (eq. 6.16; 6.7 Seywald, 6.62 C-DOC).",
+    )
+    final: Weights | None = Field(
+        None,
+        description="Weight(s) of the final-time sensitivity term (eq. 6.17).",
+    )
+    fixed: dict[str, Value] = Field(
+        default_factory=dict,
+        description="Final-time sensitivities held at given values, by entry name (eq. 6.18).",
+    )
+    monte_carlo: MonteCarloOptions = Field(
+        default_factory=MonteCarloOptions,
+        description="The Monte Carlo check of the desensitized solution over the uncertain parameters.",
+    )

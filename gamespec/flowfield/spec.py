@@ -49,21 +49,26 @@ LEVEL_FRACTIONS = (0.06, 0.12)
 class Identity(StrictModel):
     """``scale · I₂``."""
 
-    identity: Value = 1.0
+    identity: Value = Field(1.0, description="The scale of the identity matrix (a number or an expression).")
 
 
 class FlowSpec(StrictModel):
     """Drift ``f(x)`` (two expressions) and diffusion ``g(x)`` (2 × 2) of eq. 5.3."""
 
-    drift: tuple[Value, Value]
-    diffusion: tuple[tuple[Value, Value], tuple[Value, Value]] | Identity = Identity(identity=0.0)
+    drift: tuple[Value, Value] = Field(
+        description="The drift f(x): two expressions of the position and the parameters."
+    )
+    diffusion: tuple[tuple[Value, Value], tuple[Value, Value]] | Identity = Field(
+        Identity(identity=0.0),
+        description="The diffusion g(x): a 2 × 2 matrix of expressions, or `{identity: scale}`.",
+    )
 
 
 class PlayerSpec(StrictModel):
     """One agent: start ``x₀ⁱ``, speed limit ``vⁱ_max`` (eq. 5.2) and the bounds of eqs. 5.35–5.36."""
 
-    initial: tuple[Value, Value]
-    max_speed: Value
+    initial: tuple[Value, Value] = Field(description="The start x₀ (two numbers or expressions).")
+    max_speed: Value = Field(description="The speed limit v_max (eq. 5.2).")
     delta_x: Value = Field(0.1, description="δ_x: distance of the mean from the nominal path (eq. 5.35a).")
     delta_u: Value = Field(
         description="δ_u: distance of the feedforward from the nominal control (eq. 5.35b)."
@@ -74,15 +79,23 @@ class PlayerSpec(StrictModel):
 class FlowGameProblem(StrictModel):
     """The mathematics of the game."""
 
-    parameters: dict[str, FiniteFloat] = Field(default_factory=dict)
-    position: tuple[str, str] = ("x1", "x2")
-    flow: FlowSpec
-    pursuer: PlayerSpec
-    evader: PlayerSpec
+    parameters: dict[str, FiniteFloat] = Field(
+        default_factory=dict,
+        description="Named numbers the expressions may use (runtime parameters: `--set`, `sweep --param`).",
+    )
+    position: tuple[str, str] = Field(
+        ("x1", "x2"), description="The names of the two position coordinates the expressions use."
+    )
+    flow: FlowSpec = Field(description="The flow field: drift and diffusion (eq. 5.3).")
+    pursuer: PlayerSpec = Field(description="The pursuer: start, speed limit and covariance bounds.")
+    evader: PlayerSpec = Field(description="The evader: start, speed limit and covariance bounds.")
     nominal_speed_fraction: Value = Field(0.8, description="v̂/v_max of eq. 5.24, 5.26.")
     capture_radius: Value = Field(description="ε of eq. 5.4.")
     step: Value = Field(description="T̂/N of eq. 5.7; N = round(T̂/step).")
-    payoff: Literal["trace", "frobenius"] = "trace"
+    payoff: Literal["trace", "frobenius"] = Field(
+        "trace",
+        description="The payoff: `trace` of eq. 5.34, or `frobenius` (squared Frobenius norm, eq. 5.17).",
+    )
     feedforward: Literal["nominal", "free"] = Field(
         "free",
         description="free: each player's V moves within eq. 5.35; nominal: V = Û, the means stay on the "
@@ -103,9 +116,9 @@ class FlowGameProblem(StrictModel):
 class GridSpec(StrictModel):
     """The reachability grid: the box and the number of nodes per axis."""
 
-    lower: tuple[FiniteFloat, FiniteFloat]
-    upper: tuple[FiniteFloat, FiniteFloat]
-    nodes: tuple[int, int] = Field((101, 101))
+    lower: tuple[FiniteFloat, FiniteFloat] = Field(description="The box's lower corner.")
+    upper: tuple[FiniteFloat, FiniteFloat] = Field(description="The box's upper corner.")
+    nodes: tuple[int, int] = Field((101, 101), description="Grid nodes per axis.")
 
     @model_validator(mode="after")
     def _box(self) -> GridSpec:
@@ -139,38 +152,53 @@ class GameMethod(StrictModel):
         "min_p J by at most gap; a saddle gap v₊ − v₋ ≤ gap·v₊ is a pure saddle point.",
     )
     tolerance: float = Field(5e-3, gt=0, description="ε_v = ε_k of the iteration's stopping rule.")
-    max_iterations: int = Field(30, ge=1, le=1000)
+    max_iterations: int = Field(30, ge=1, le=1000, description="Iteration limit of the best responses.")
 
 
 class ConvexConcaveMethod(StrictModel):
     """The evader's convex–concave procedure: stop when ``J`` rises by less than ``tolerance · J``."""
 
-    tolerance: float = Field(1e-6, gt=0)
-    max_iterations: int = Field(500, ge=1, le=10_000)
+    tolerance: float = Field(
+        1e-6, gt=0, description="Stop when the payoff J rises by less than tolerance · J."
+    )
+    max_iterations: int = Field(
+        500, ge=1, le=10_000, description="Iteration limit of the evader's convex–concave procedure."
+    )
 
 
 class MonteCarloMethod(StrictModel):
     """Euler–Maruyama samples of the nonlinear SDE (0 to skip), ``substeps`` per control step."""
 
-    samples: int = Field(20_000, ge=0, le=1_000_000)
+    samples: int = Field(
+        20_000, ge=0, le=1_000_000, description="Number of sample paths (0 skips the Monte Carlo)."
+    )
     seed: int = Field(0, ge=0, description="Seed of the random generator (a non-negative integer).")
-    substeps: int = Field(5, ge=1, le=100)
+    substeps: int = Field(5, ge=1, le=100, description="Euler–Maruyama steps per control step.")
 
 
 class ExtremalMethod(StrictModel):
     """Extremal shooting: initial directions and the RK4 step."""
 
-    directions: int = Field(720, ge=16, le=20_000)
-    step: float = Field(2e-3, gt=0)
+    directions: int = Field(
+        720, ge=16, le=20_000, description="Number of initial directions the extremals are shot from."
+    )
+    step: float = Field(2e-3, gt=0, description="The RK4 step of the extremals.")
 
 
 class FlowGameMethod(StrictModel):
     """Reachability (grid, scheme, CFL, levels), the game's iterations and the Monte Carlo."""
 
-    grid: GridSpec
-    scheme: Literal["weno5", "eno2", "first_order"] = "weno5"
-    cfl: float = Field(0.5, gt=0, le=1)
-    max_time: float = Field(20.0, gt=0)
+    grid: GridSpec = Field(description="The reachability grid.")
+    scheme: Literal["weno5", "eno2", "first_order"] = Field(
+        "weno5",
+        description="The spatial scheme of the level-set equation 5.22: `weno5`, `eno2` or `first_order`.",
+    )
+    cfl: float = Field(0.5, gt=0, le=1, description="The CFL number of the level-set time steps.")
+    max_time: float = Field(
+        20.0,
+        gt=0,
+        description="The longest time the reachable sets are grown to before giving up on capture.",
+    )
     levels: tuple[PositiveFloat, PositiveFloat] | None = Field(
         None,
         description="The two levels c₁ < c₂ the capture search reads, as lengths (the sets reached from "
@@ -179,10 +207,21 @@ class FlowGameMethod(StrictModel):
         "0.2 the level 4 cells out was 5e-4 off in T̂, 6 cells out 5e-5). Default: 6 % and 12 % of the "
         "box's longer side (6 and 12 cells of a 101-node axis).",
     )
-    extremals: ExtremalMethod = Field(default_factory=ExtremalMethod)
-    game: GameMethod = Field(default_factory=GameMethod)
-    convex_concave: ConvexConcaveMethod = Field(default_factory=ConvexConcaveMethod)
-    monte_carlo: MonteCarloMethod = Field(default_factory=MonteCarloMethod)
+    extremals: ExtremalMethod = Field(
+        default_factory=ExtremalMethod,
+        description="The extremal shooting (the grid-free cross-check of the capture time).",
+    )
+    game: GameMethod = Field(
+        default_factory=GameMethod,
+        description="The solution concept and the best-response iteration of the covariance game.",
+    )
+    convex_concave: ConvexConcaveMethod = Field(
+        default_factory=ConvexConcaveMethod, description="The evader's convex–concave procedure."
+    )
+    monte_carlo: MonteCarloMethod = Field(
+        default_factory=MonteCarloMethod,
+        description="The Monte Carlo of the nonlinear SDE with the feedback applied.",
+    )
 
     @model_validator(mode="after")
     def _levels(self) -> FlowGameMethod:
@@ -240,9 +279,13 @@ class FlowGameSpec(ProblemParameters, SpecBase):
     """Two agents in a stochastic flow field: reachability, nominal paths, covariance game (ch. 5);
     its runtime parameters are ``problem.parameters`` (``gamespec sweep --param alpha=…``)."""
 
-    kind: Literal["flow_field_game"] = "flow_field_game"
-    problem: FlowGameProblem
-    method: FlowGameMethod
+    kind: Literal["flow_field_game"] = Field(
+        "flow_field_game", description="The problem kind; selects the schema of the rest of the file."
+    )
+    problem: FlowGameProblem = Field(description="The flow field, the players and the payoff.")
+    method: FlowGameMethod = Field(
+        description="Reachability grid and scheme, the game's iteration and the Monte Carlo."
+    )
 
     @property
     def objective_sense(self) -> str:
@@ -284,18 +327,24 @@ class NominalPath(StrictModel):
     """One agent's nominal path (eqs. 5.23–5.26) at the nodes ``nominal.times``: the positions
     ``x̂`` and the unit directions ``n`` of the nominal control ``û = v̂ n``."""
 
-    positions: list[tuple[FiniteFloat, FiniteFloat]] = Field(min_length=2)
-    directions: list[tuple[FiniteFloat, FiniteFloat]] = Field(min_length=2)
+    positions: list[tuple[FiniteFloat, FiniteFloat]] = Field(
+        min_length=2, description="The nominal positions x̂, one per node."
+    )
+    directions: list[tuple[FiniteFloat, FiniteFloat]] = Field(
+        min_length=2, description="The unit directions n of the nominal control û = v̂ n, one per node."
+    )
 
 
 class NominalSpec(StrictModel):
     """Both agents' nominal paths from the reachability stage, ``0 = t_0 < … < t_M = T̂``, and their
     nominal speeds ``v̂`` (eq. 5.24, 5.26)."""
 
-    times: list[FiniteFloat] = Field(min_length=2)
-    speeds: tuple[PositiveFloat, PositiveFloat]
-    pursuer: NominalPath
-    evader: NominalPath
+    times: list[FiniteFloat] = Field(min_length=2, description="The nodes 0 = t_0 < … < t_M = T̂.")
+    speeds: tuple[PositiveFloat, PositiveFloat] = Field(
+        description="The nominal speeds v̂ of pursuer and evader."
+    )
+    pursuer: NominalPath = Field(description="The pursuer's nominal path.")
+    evader: NominalPath = Field(description="The evader's nominal path.")
 
     @model_validator(mode="after")
     def _nodes(self) -> NominalSpec:
@@ -313,14 +362,24 @@ class CovarianceGameProblem(StrictModel):
     ``flow_field_game`` it came from, the number of steps ``N`` and the nominal paths (both None
     when the reachability stage found no capture: there is no game to play)."""
 
-    parameters: dict[str, FiniteFloat] = Field(default_factory=dict)
-    position: tuple[str, str] = ("x1", "x2")
-    flow: FlowSpec
-    pursuer: PlayerSpec
-    evader: PlayerSpec
+    parameters: dict[str, FiniteFloat] = Field(
+        default_factory=dict, description="Named numbers the expressions may use (runtime parameters)."
+    )
+    position: tuple[str, str] = Field(
+        ("x1", "x2"), description="The names of the two position coordinates the expressions use."
+    )
+    flow: FlowSpec = Field(description="The flow field: drift and diffusion (eq. 5.3).")
+    pursuer: PlayerSpec = Field(description="The pursuer: start, speed limit and covariance bounds.")
+    evader: PlayerSpec = Field(description="The evader: start, speed limit and covariance bounds.")
     capture_radius: Value = Field(description="ε of eq. 5.4.")
-    payoff: Literal["trace", "frobenius"] = "trace"
-    feedforward: Literal["nominal", "free"] = "free"
+    payoff: Literal["trace", "frobenius"] = Field(
+        "trace",
+        description="The payoff: `trace` of eq. 5.34, or `frobenius` (squared Frobenius norm, eq. 5.17).",
+    )
+    feedforward: Literal["nominal", "free"] = Field(
+        "free",
+        description="The feedforward: `nominal` (the nominal path's) or `free` (a decision of the game).",
+    )
     steps: int | None = Field(description="N of eq. 5.7, round(T̂ / step) of the flow_field_game.", ge=1)
     nominal: NominalSpec | None = Field(description="The paths of eq. 5.5's linearization.")
 
@@ -335,9 +394,16 @@ class CovarianceGameMethod(StrictModel):
     """The game's solution concept and iteration, the evader's procedure and the Monte Carlo (as in
     ``flow_field_game``'s ``method``)."""
 
-    game: GameMethod = Field(default_factory=GameMethod)
-    convex_concave: ConvexConcaveMethod = Field(default_factory=ConvexConcaveMethod)
-    monte_carlo: MonteCarloMethod = Field(default_factory=MonteCarloMethod)
+    game: GameMethod = Field(
+        default_factory=GameMethod, description="The solution concept and the best-response iteration."
+    )
+    convex_concave: ConvexConcaveMethod = Field(
+        default_factory=ConvexConcaveMethod, description="The evader's convex–concave procedure."
+    )
+    monte_carlo: MonteCarloMethod = Field(
+        default_factory=MonteCarloMethod,
+        description="The Monte Carlo of the nonlinear SDE with the feedback applied.",
+    )
 
 
 class FlowCovarianceGameSpec(ProblemParameters, SpecBase):
@@ -346,9 +412,14 @@ class FlowCovarianceGameSpec(ProblemParameters, SpecBase):
     and solves the game; what :mod:`gamespec.flowfield.transform` makes of a ``flow_field_game``
     once its reachability stage is solved. Its runtime parameters are the flow game's."""
 
-    kind: Literal["flow_covariance_game"] = "flow_covariance_game"
-    problem: CovarianceGameProblem
-    method: CovarianceGameMethod = Field(default_factory=CovarianceGameMethod)
+    kind: Literal["flow_covariance_game"] = Field(
+        "flow_covariance_game", description="The problem kind; selects the schema of the rest of the file."
+    )
+    problem: CovarianceGameProblem = Field(description="The covariance game about the nominal paths.")
+    method: CovarianceGameMethod = Field(
+        default_factory=CovarianceGameMethod,
+        description="The game's solution concept, iteration and Monte Carlo.",
+    )
 
     @property
     def objective_sense(self) -> str:

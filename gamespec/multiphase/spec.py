@@ -53,7 +53,10 @@ class DurationSpec(FreeOrFixed):
     within ``bounds`` (numbers or expressions of the parameters) from ``guess`` (the middle of the
     bounds when omitted). A phase may give a number or an expression instead of the mapping."""
 
-    value: Value | Literal["free"] = "free"
+    value: Value | Literal["free"] = Field(
+        "free",
+        description="The duration: a number, an expression of the parameters, or `free` (within `bounds`).",
+    )
 
     fixed_field: ClassVar[str] = "value"
     what: ClassVar[str] = "duration"
@@ -63,15 +66,21 @@ class PhaseGuessSpec(StrictModel):
     """A phase's starting point: per state or control a number or an expression of the phase's
     normalized time ``tau`` (0 at its start, 1 at its end) and the parameters."""
 
-    states: dict[str, Value] = Field(default_factory=dict)
-    controls: dict[str, Value] = Field(default_factory=dict)
+    states: dict[str, Value] = Field(
+        default_factory=dict,
+        description="Per state, a number or an expression of the phase's tau and the parameters.",
+    )
+    controls: dict[str, Value] = Field(
+        default_factory=dict,
+        description="Per control, a number or an expression of the phase's tau and the parameters.",
+    )
 
 
 class PhaseSpec(StrictModel):
     """One phase (see the module doc)."""
 
-    name: str
-    duration: DurationSpec
+    name: str = Field(description="The phase's name (figures, summaries, `<phase>.<state>_f`).")
+    duration: DurationSpec = Field(description="The phase's duration: fixed, or free within bounds.")
     dynamics: dict[str, Value] = Field(
         default_factory=dict, description="Per state; replaces problem.dynamics for the states it names."
     )
@@ -86,7 +95,9 @@ class PhaseSpec(StrictModel):
         None, description="The controls of this phase (all shared ones when omitted), bounds narrowed."
     )
     lagrange: Value | None = Field(None, description="The running cost here (problem.objective.lagrange).")
-    path_constraints: list[str] = Field(default_factory=list)
+    path_constraints: list[str] = Field(
+        default_factory=list, description="Relations that hold along the phase."
+    )
     boundary_constraints: list[str] = Field(
         default_factory=list, description="Over this phase's <state>_0, <state>_f, t_0, t_f."
     )
@@ -95,7 +106,7 @@ class PhaseSpec(StrictModel):
         description="Per state, its value at this phase's start over the previous phase's end "
         "(<state>_f, <control>_f, t_f); states not named are continuous.",
     )
-    guess: PhaseGuessSpec = Field(default_factory=PhaseGuessSpec)
+    guess: PhaseGuessSpec = Field(default_factory=PhaseGuessSpec, description="The phase's starting point.")
     intervals: int | None = Field(
         None, ge=1, le=MAX_INTERVALS, description="Collocation intervals of this phase (method.intervals)."
     )
@@ -111,7 +122,7 @@ class PhaseSpec(StrictModel):
 class StartSpec(StrictModel):
     """When the first phase starts."""
 
-    initial: Number = 0.0
+    initial: Number = Field(0.0, description="The initial time.")
 
 
 class MultiPhaseProblem(StrictModel):
@@ -128,22 +139,32 @@ class MultiPhaseProblem(StrictModel):
         default_factory=dict,
         description="Gridded data shared by every phase, each a function of the expressions by its name.",
     )
-    states: dict[str, StateSpec]
-    controls: dict[str, ControlSpec] = Field(default_factory=dict)
+    states: dict[str, StateSpec] = Field(
+        description="The states, with their bounds and initial and final values."
+    )
+    controls: dict[str, ControlSpec] = Field(
+        default_factory=dict, description="The controls of any phase, with their bounds."
+    )
     design: dict[str, DesignSpec] = Field(
         default_factory=dict, description="Free static parameters optimized with the trajectory."
     )
     dynamics: dict[str, Value] = Field(
         default_factory=dict, description="Shared dynamics, per state; a phase replaces them by name."
     )
-    objective: ObjectiveSpec = Field(default_factory=ObjectiveSpec)
-    time: StartSpec = Field(default_factory=StartSpec)
+    objective: ObjectiveSpec = Field(
+        default_factory=ObjectiveSpec,
+        description="The objective: Mayer term plus Lagrange integrand over all phases.",
+    )
+    time: StartSpec = Field(default_factory=StartSpec, description="When the first phase starts.")
     path_constraints: list[str] = Field(default_factory=list, description="Imposed in every phase.")
-    boundary_constraints: list[str] = Field(default_factory=list)
+    boundary_constraints: list[str] = Field(
+        default_factory=list,
+        description="Relations over the phases' end values (`<state>_0`, `<phase>.<state>_f` ...).",
+    )
     integral_constraints: list[IntegralConstraintSpec] = Field(
         default_factory=list, description="Over the whole horizon: the integrand summed over the phases."
     )
-    phases: list[PhaseSpec] = Field(min_length=1)
+    phases: list[PhaseSpec] = Field(min_length=1, description="The phases, in order.")
 
     @model_serializer(mode="wrap")
     def _without_unused_tables(self, handler: SerializerFunctionWrapHandler) -> dict[str, Any]:
@@ -224,10 +245,18 @@ class MultiPhaseSpec(OcpFamily, SpecBase):
     of free duration, ``hamiltonian_end_error/<phase>`` = ``max |H + dPhi/dt_f|``, the switching
     time's transversality condition). Its runtime parameters are ``problem.parameters``."""
 
-    kind: Literal["multiphase_optimal_control"] = "multiphase_optimal_control"
-    problem: MultiPhaseProblem
-    method: MethodSpec = Field(default_factory=MethodSpec)
-    plot: PlotHint = Field(default_factory=PlotHint)
+    kind: Literal["multiphase_optimal_control"] = Field(
+        "multiphase_optimal_control",
+        description="The problem kind; selects the schema of the rest of the file.",
+    )
+    problem: MultiPhaseProblem = Field(description="The mathematics: states, controls, objective and phases.")
+    method: MethodSpec = Field(
+        default_factory=MethodSpec,
+        description="The transcription of each phase (on its own normalized time).",
+    )
+    plot: PlotHint = Field(
+        default_factory=PlotHint, description="What the figures draw: planar pairs, units."
+    )
 
     @model_validator(mode="before")
     @classmethod

@@ -68,7 +68,10 @@ class RcsOptions(StrictModel):
         "quadrature error and method.refine refines where the risk is under-resolved (a steep "
         "integrand: car_vs_train); false: a Lagrange term, seen at the collocation points only.",
     )
-    monte_carlo: MonteCarloOptions = Field(default_factory=MonteCarloOptions)
+    monte_carlo: MonteCarloOptions = Field(
+        default_factory=MonteCarloOptions,
+        description="The Monte Carlo estimate of the collision probability over the uncertain parameters.",
+    )
     restarts: list[GuessSpec] = Field(
         default_factory=list,
         description="Other starting points (each a guess section of the problem) re-solved from when "
@@ -85,8 +88,8 @@ class Track(StrictModel):
     """The rail track of eq. 6.43: the obstacle runs along it; the super-Gaussian of eq. 6.44 (even
     ``gamma``) switches the constraint on while the agent is within ``half_width`` (w_o) of it."""
 
-    half_width: Value
-    gamma: int = Field(20, ge=2, le=200)
+    half_width: Value = Field(description="The half width w_o within which the constraint is on.")
+    gamma: int = Field(20, ge=2, le=200, description="The even exponent of the super-Gaussian of eq. 6.44.")
 
     @field_validator("gamma")
     @classmethod
@@ -99,18 +102,22 @@ class Track(StrictModel):
 class Obstacle(StrictModel):
     """A circular obstacle at ``center + velocity·(t - t0)`` with safe distance ``radius`` (r_o)."""
 
-    center: tuple[Value, Value]
-    velocity: tuple[Value, Value] = (0.0, 0.0)
-    radius: Value
+    center: tuple[Value, Value] = Field(
+        description="The centre at t0: two numbers or expressions of the parameters."
+    )
+    velocity: tuple[Value, Value] = Field((0.0, 0.0), description="The constant velocity of the centre.")
+    radius: Value = Field(description="The safe distance r_o.")
     track: Track | None = Field(None, description="Car-vs-train form (eq. 6.43), moving along y.")
 
 
 class MovingObstaclesOptions(StrictModel):
     """Obstacles whose closed-form positions enter avoidance path constraints g <= 0."""
 
-    agent: tuple[Value, Value] = ("x", "y")
+    agent: tuple[Value, Value] = Field(
+        ("x", "y"), description="The agent's position: two state names or expressions."
+    )
     power: Value = Field(1.0, description="β of eq. 6.41 (β = 1 is eq. 6.39); a number or parameter.")
-    obstacles: dict[str, Obstacle] = Field(min_length=1)
+    obstacles: dict[str, Obstacle] = Field(min_length=1, description="The obstacles, by name.")
 
     def check_against(self, parameters: Mapping[str, float], running: Iterable[str], field: str) -> None:
         """The agent's position over the ``running`` names, and β, the centres, velocities, radii and

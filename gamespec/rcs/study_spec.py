@@ -31,27 +31,41 @@ from gamespec.specs.ocp import MethodSpec
 class RcsStudySpec(SpecBase):
     """Fig. 6.11: travel time against collision probability per number of obstacles and weight."""
 
-    kind: Literal["rcs_multi_obstacle_study"] = "rcs_multi_obstacle_study"
+    kind: Literal["rcs_multi_obstacle_study"] = Field(
+        "rcs_multi_obstacle_study",
+        description="The problem kind; selects the schema of the rest of the file.",
+    )
     obstacles: list[Annotated[int, Field(ge=1, le=MAX_RCS_OBSTACLES)]] = Field(
         default_factory=lambda: [2, 3, 5, 10], min_length=1, description="Numbers of obstacles N."
     )
-    alphas: list[Number] = Field(default_factory=lambda: [0.0, 0.1, 0.33, 1.0], min_length=1)
+    alphas: list[Number] = Field(
+        default_factory=lambda: [0.0, 0.1, 0.33, 1.0],
+        min_length=1,
+        description="The RCS weights α (Q = α I_N, eq. 6.36): every N of `obstacles` is solved with every α.",
+    )
     sigma: Number = Field(0.1, gt=0, description="σ (sigma_is: std) or σ² (sigma_is: variance) of Δρ.")
-    sigma_is: Literal["std", "variance"] = "std"
+    sigma_is: Literal["std", "variance"] = Field(
+        "std", description="Whether the thesis' σ is a standard deviation (`std`) or a variance (`variance`)."
+    )
     rho: Number = Field(0.25, gt=0, description="Nominal obstacle speed ρ̂.")
     radius: Number = Field(1.0, gt=0, description="Safe distance r_o of every obstacle.")
     goal: Number = Field(30.0, gt=0, description="The target (goal, 0).")
-    v_max: Number = Field(1.0, gt=0)
+    v_max: Number = Field(1.0, gt=0, description="The agent's maximum speed.")
     guesses: list[Number] = Field(
         default_factory=lambda: [4.0, -4.0, 0.0],
         min_length=1,
         description="Initial guesses y = a·sin(πτ) (homotopy classes); the best solution is kept.",
     )
-    samples: int = Field(1000, ge=2, le=100_000)
-    seed: int = Field(0, ge=0)
+    samples: int = Field(
+        1000, ge=2, le=100_000, description="Monte Carlo samples of each point's collision probability."
+    )
+    seed: int = Field(0, ge=0, description="The seed of the obstacles' samples.")
     steps: int = Field(1000, ge=10, le=100_000, description="RK4 steps of the Monte Carlo re-simulation.")
-    method: MethodSpec = Field(default_factory=lambda: MethodSpec(intervals=40, degree=3))
-    ocp_backend: BackendName = "casadi"
+    method: MethodSpec = Field(
+        default_factory=lambda: MethodSpec(intervals=40, degree=3),
+        description="The transcription of each point's optimal-control problem.",
+    )
+    ocp_backend: BackendName = Field("casadi", description="The backend that solves each point.")
     store: Path = Field(Path("runs/rcs_multi_obstacle/points"), description="Folder of per-point records.")
 
     @model_validator(mode="after")

@@ -122,8 +122,11 @@ class SpecBase(StrictModel):
 
     kind: str
     name: str = Field("unnamed", description="A short name used in reports and output folders.")
-    description: str = ""
-    solver: SolverSection = Field(default_factory=SolverSection)
+    description: str = Field("", description="Free text: what the file is (the docs' gallery shows it).")
+    solver: SolverSection = Field(
+        default_factory=SolverSection,
+        description="Which backend solves the file, and each backend's own options.",
+    )
     transforms: RequestedTransforms = Field(
         default_factory=list,
         description="Requested transforms, [{name: {options}}], applied in order before the solve.",

@@ -77,8 +77,10 @@ class PayoffSpec(StrictModel):
     """Eq. 7.1: ``mayer`` over ``<state>_f``, ``t_f`` and the parameters, plus the ``lagrange``
     integrand over states, every player's controls, ``t`` and the parameters."""
 
-    mayer: Value = 0.0
-    lagrange: Value = 0.0
+    mayer: Value = Field(0.0, description="The terminal payoff over `<state>_f`, `t_f` and the parameters.")
+    lagrange: Value = Field(
+        0.0, description="The running payoff over states, every player's controls, t and the parameters."
+    )
 
 
 class BelievedParameter(StrictModel):
@@ -87,9 +89,15 @@ class BelievedParameter(StrictModel):
     ``distribution`` about a player's belief (as chapter 6's ``problem.uncertain``) is passed to
     every player's problem, where the sensitivity transforms (``desensitize``, ``rcs``) read it."""
 
-    actual: Number
-    beliefs: dict[str, Number] = Field(default_factory=dict)
-    distribution: UncertainParameter | None = None
+    actual: Number = Field(description="The true value: what moves the true system.")
+    beliefs: dict[str, Number] = Field(
+        default_factory=dict,
+        description="Each player's belief, by player; a player not listed knows the true value.",
+    )
+    distribution: UncertainParameter | None = Field(
+        None,
+        description="A distribution about a belief, read by the sensitivity transforms (desensitize, rcs).",
+    )
 
     def belief(self, player: str) -> float:
         return self.beliefs.get(player, self.actual)
@@ -107,15 +115,34 @@ class PlayerSpec(StrictModel):
     (a number per control, held along the horizon).
     """
 
-    objective: Literal["minimize", "maximize"]
-    controls: dict[str, ControlSpec]
-    path_constraints: list[str] = Field(default_factory=list)
-    payoff: PayoffSpec | None = None
-    transforms: RequestedTransforms = Field(default_factory=list)
-    observes: list[str] | None = None
-    knows_beliefs: bool = False
-    knows_transforms: bool = False
-    start: dict[str, Number] = Field(default_factory=dict)
+    objective: Literal["minimize", "maximize"] = Field(
+        description="Whether the player minimizes or maximizes the payoff."
+    )
+    controls: dict[str, ControlSpec] = Field(description="The player's controls, with their bounds.")
+    path_constraints: list[str] = Field(
+        default_factory=list, description="The player's own path constraints (eqs. 7.3–7.4)."
+    )
+    payoff: PayoffSpec | None = Field(
+        None, description="The player's own payoff (a non-zero-sum game); omitted: the game's."
+    )
+    transforms: RequestedTransforms = Field(
+        default_factory=list,
+        description="Requested transforms of the player's own problem, [{name: {options}}] (rcs: eq. 7.20)",
+    )
+    observes: list[str] | None = Field(
+        None,
+        description="The states the player observes (omitted: all); the others it predicts with its beliefs.",
+    )
+    knows_beliefs: bool = Field(
+        False, description="Whether the player knows the others' beliefs (else it models them with its own)."
+    )
+    knows_transforms: bool = Field(
+        False, description="Whether the player knows the others' requested transforms (their regularizers)."
+    )
+    start: dict[str, Number] = Field(
+        default_factory=dict,
+        description="The starting strategy: a number per control, held along the horizon.",
+    )
 
 
 class GameTime(FreeOrFixed):
@@ -124,7 +151,7 @@ class GameTime(FreeOrFixed):
     ``problem.capture`` set reached, and its payoff is the capture time ``t_f``, minimized by the
     pursuers and maximized by the evaders; the upper bound is the longest game considered)."""
 
-    initial: Number = 0.0
+    initial: Number = Field(0.0, description="The initial time.")
     final: Value | Literal["free"] = Field(
         1.0,
         description="The final time (a number or an expression of the parameters), or free: the game "
@@ -138,14 +165,25 @@ class GameTime(FreeOrFixed):
 class GameProblem(StrictModel):
     """The mathematics of a differential game (section 7.1.1)."""
 
-    parameters: dict[str, Number] = Field(default_factory=dict)
-    uncertain: dict[str, BelievedParameter] = Field(default_factory=dict)
-    states: dict[str, StateSpec]
-    dynamics: dict[str, Value]
-    players: dict[str, PlayerSpec]
-    payoff: PayoffSpec = Field(default_factory=PayoffSpec)
-    terminal_constraints: list[str] = Field(default_factory=list)
-    time: GameTime = Field(default_factory=GameTime)
+    parameters: dict[str, Number] = Field(
+        default_factory=dict, description="Named numbers the expressions may use (runtime parameters)."
+    )
+    uncertain: dict[str, BelievedParameter] = Field(
+        default_factory=dict,
+        description="Parameters some players do not know, with each player's belief (eq. 7.2).",
+    )
+    states: dict[str, StateSpec] = Field(
+        description="The shared states, with bounds and initial and final values."
+    )
+    dynamics: dict[str, Value] = Field(
+        description="Each state's ODE right-hand side: states, every player's controls, t, parameters."
+    )
+    players: dict[str, PlayerSpec] = Field(description="The players, by name.")
+    payoff: PayoffSpec = Field(default_factory=PayoffSpec, description="The zero-sum payoff (eq. 7.1).")
+    terminal_constraints: list[str] = Field(
+        default_factory=list, description="Relations over the final state (eq. 7.5)."
+    )
+    time: GameTime = Field(default_factory=GameTime, description="The horizon.")
     capture: str | None = Field(
         None,
         description="The target set of a game of kind (capture), a relation over the states and "
@@ -384,10 +422,14 @@ class GameSettings(StrictModel):
         "dynamics' Hessian to its LQ game (needed where a control enters its owner's cost only through "
         "the dynamics); gauss_newton is iLQGames' own linearization.",
     )
-    tolerance: float = Field(1e-6, gt=0)
-    max_iterations: int = Field(100, ge=1)
-    damping: float = Field(1.0, gt=0, le=1)
-    backend: Literal["casadi", "pyomo"] = "casadi"
+    tolerance: float = Field(
+        1e-6, gt=0, description="Stop when every player's change between iterations is below this."
+    )
+    max_iterations: int = Field(100, ge=1, description="Iteration limit of the best responses.")
+    damping: float = Field(1.0, gt=0, le=1, description="Damping of the best-response update (1: none).")
+    backend: Literal["casadi", "pyomo"] = Field(
+        "casadi", description="The OCP backend that solves each best response."
+    )
     """The OCP backend each player's best response is compiled on."""
 
     @model_validator(mode="after")
@@ -400,7 +442,7 @@ class GameSettings(StrictModel):
 class StopRule(StrictModel):
     """A condition on the true state that ends a receding-horizon run (``<=``/``>=`` relation)."""
 
-    when: str
+    when: str = Field(description="A relation (`<=`/`>=`) over the true state and the parameters.")
 
 
 class ObstacleSpec(StrictModel):
@@ -408,10 +450,13 @@ class ObstacleSpec(StrictModel):
     radius; ``avoided_by`` maps a player to the pair of its position states, so the run reports that
     player's smallest distance to the obstacle's edge and whether it collided."""
 
-    x: Value
-    y: Value
-    radius: Value
-    avoided_by: dict[str, tuple[str, str]] = Field(default_factory=dict)
+    x: Value = Field(description="The centre's x: an expression of states and parameters.")
+    y: Value = Field(description="The centre's y: an expression of states and parameters.")
+    radius: Value = Field(description="The obstacle's radius.")
+    avoided_by: dict[str, tuple[str, str]] = Field(
+        default_factory=dict,
+        description="Per player, the pair of its position states (its distance to the obstacle, collision).",
+    )
 
 
 class RecedingHorizonSpec(StrictModel):
@@ -427,22 +472,38 @@ class RecedingHorizonSpec(StrictModel):
     next control of the plan of the step before, from the last game that converged).
     """
 
-    step: float = Field(gt=0)
-    time_limit: float = Field(gt=0)
+    step: float = Field(
+        gt=0, description="Time between re-solves: the first controls are applied for this long."
+    )
+    time_limit: float = Field(gt=0, description="The run's last time (the game's time, not wall-clock).")
     max_wall_time: Number | None = Field(
         None,
         gt=0,
         description="Seconds of wall time after which the run stops at the end of a step, with the "
         "status time_limit and what it has so far (none: no limit).",
     )
-    capture: StopRule | None = None
-    obstacle: ObstacleSpec | None = None
-    stop_at_collision: bool = True
-    horizon: Literal["receding", "shrinking"] = "receding"
-    on_not_converged: Literal["last_iterate", "previous_plan"] = "last_iterate"
-    positions: dict[str, tuple[str, str]] = Field(default_factory=dict)
+    capture: StopRule | None = Field(None, description="The capture condition that ends the run.")
+    obstacle: ObstacleSpec | None = Field(
+        None, description="The obstacle reported on and drawn (distances, collisions)."
+    )
+    stop_at_collision: bool = Field(True, description="Whether a collision with the obstacle ends the run.")
+    horizon: Literal["receding", "shrinking"] = Field(
+        "receding",
+        description="`receding` (N Δt ahead at every step) or `shrinking` (to the game's final time).",
+    )
+    on_not_converged: Literal["last_iterate", "previous_plan"] = Field(
+        "last_iterate",
+        description="What a player applies when its game fails: `last_iterate` or `previous_plan`.",
+    )
+    positions: dict[str, tuple[str, str]] = Field(
+        default_factory=dict,
+        description="Per player, the pair of its position states (the figures draw its path).",
+    )
     """Each player's position states, for the figures."""
-    sensitivity_time: Literal["absolute", "relative"] = "absolute"
+    sensitivity_time: Literal["absolute", "relative"] = Field(
+        "absolute",
+        description="The t of eq. 7.26: `absolute` (from the run's start) or `relative` (the step's).",
+    )
     """The sensitivity to the uncertain parameters a player's problem starts with, for a state the
     player predicts (does not observe): ``absolute`` — the sensitivity its prediction has
     accumulated since the start of the run (eq. 7.26 with t the absolute time; the prediction's
@@ -454,12 +515,24 @@ class DifferentialGameSpec(ProblemParameters, SpecBase):
     """A differential game (kind ``differential_game``); its runtime parameters are
     ``problem.parameters``."""
 
-    kind: Literal["differential_game"] = "differential_game"
-    problem: GameProblem
-    method: MethodSpec = Field(default_factory=MethodSpec)
-    game: GameSettings = Field(default_factory=GameSettings)
-    receding_horizon: RecedingHorizonSpec | None = None
-    plot: PlotHint = Field(default_factory=PlotHint)
+    kind: Literal["differential_game"] = Field(
+        "differential_game", description="The problem kind; selects the schema of the rest of the file."
+    )
+    problem: GameProblem = Field(description="The mathematics: states, dynamics, players, payoff, horizon.")
+    method: MethodSpec = Field(
+        default_factory=MethodSpec,
+        description="The collocation of each player's problem (Radau degree 1 is eqs. 7.27–7.29).",
+    )
+    game: GameSettings = Field(
+        default_factory=GameSettings, description="The best-response iteration (or the feedback equilibrium)."
+    )
+    receding_horizon: RecedingHorizonSpec | None = Field(
+        None,
+        description="Run Algorithm 4 (receding horizon on the true system); omitted: one open-loop game.",
+    )
+    plot: PlotHint = Field(
+        default_factory=PlotHint, description="Figure hints: planar position pairs, angles, units."
+    )
 
     @model_validator(mode="after")
     def _plot_names(self) -> DifferentialGameSpec:

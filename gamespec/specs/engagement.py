@@ -31,7 +31,7 @@ class PursuerSpec(StrictModel):
     """
 
     name: str = Field(description="Label used in reports and plots (P1, P2, ...).")
-    position: tuple[Coordinate, Coordinate]
+    position: tuple[Coordinate, Coordinate] = Field(description="The initial position [x, y].")
     speed: Speed = Field(1.0, description="Speed u_i; unused while the pursuer is stationary.")
     strategy: Strategy = Field(description="cb (constant bearing), pp (pure pursuit) or stationary.")
 
@@ -39,8 +39,8 @@ class PursuerSpec(StrictModel):
 class EvaderSpec(StrictModel):
     """The evader: its initial position and speed v."""
 
-    position: tuple[Coordinate, Coordinate]
-    speed: Speed = Field(gt=0)
+    position: tuple[Coordinate, Coordinate] = Field(description="The initial position [x, y].")
+    speed: Speed = Field(gt=0, description="The evader's speed v.")
 
 
 class EngagementSpec(SpecBase):
@@ -52,12 +52,18 @@ class EngagementSpec(SpecBase):
     ``line_of_sight`` for two pursuers led by a pure-pursuit one, ``fixed`` otherwise.
     """
 
-    kind: Literal["engagement"] = "engagement"
-    pursuers: list[PursuerSpec] = Field(min_length=1)
-    evader: EvaderSpec
+    kind: Literal["engagement"] = Field(
+        "engagement", description="The problem kind; selects the schema of the rest of the file."
+    )
+    pursuers: list[PursuerSpec] = Field(min_length=1, description="The pursuers.")
+    evader: EvaderSpec = Field(description="The evader.")
     capture_radius: Number = Field(0.001, gt=0, description="Capture radius ε.")
-    frame: Literal["auto", "fixed", "line_of_sight"] = "auto"
-    method: MethodSpec = Field(default_factory=MethodSpec)
+    frame: Literal["auto", "fixed", "line_of_sight"] = Field(
+        "auto", description="The reduced state's frame: `fixed`, `line_of_sight` or `auto`."
+    )
+    method: MethodSpec = Field(
+        default_factory=MethodSpec, description="The transcription of the lowered optimal-control problem."
+    )
     guess_heading: Number | None = Field(
         None,
         description="Constant inertial-frame evader heading simulated to capture as the OCP's initial "

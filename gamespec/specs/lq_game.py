@@ -33,13 +33,13 @@ from gamespec.symbolic.grammar import RESERVED, numeric_value
 class Diagonal(StrictModel):
     """A diagonal matrix."""
 
-    diag: list[Value] = Field(min_length=1)
+    diag: list[Value] = Field(min_length=1, description="The diagonal entries.")
 
 
 class Identity(StrictModel):
     """``scale · I`` of the size the slot needs."""
 
-    identity: Value = 1.0
+    identity: Value = Field(1.0, description="The scale of the identity matrix.")
 
 
 _KEYS = {"diag": "matrix-diag", "identity": "matrix-identity", "per_step": "matrix-per-step"}
@@ -70,7 +70,7 @@ MatrixValue = Annotated[_Rows | _Diagonal | _Identity, _MATRIX_FORM]
 class PerStep(StrictModel):
     """One matrix per step k = 0 … N−1."""
 
-    per_step: list[MatrixValue] = Field(min_length=1)
+    per_step: list[MatrixValue] = Field(min_length=1, description="One matrix per step k = 0 … N−1.")
 
 
 _PerStep = Annotated[PerStep, Tag("matrix-per-step")]
@@ -81,55 +81,67 @@ StepMatrix = Annotated[_Rows | _Diagonal | _Identity | _PerStep, _MATRIX_FORM]
 class DiscreteModel(StrictModel):
     """``x_{k+1} = A_k x_k + B_k u_k + C_k v_k + D_k w_k`` (eq. 4.1)."""
 
-    A: StepMatrix
-    B: StepMatrix
-    C: StepMatrix
-    D: StepMatrix
+    A: StepMatrix = Field(description="The state matrices A_k.")
+    B: StepMatrix = Field(description="The controller's input matrices B_k.")
+    C: StepMatrix = Field(description="The stopper's input matrices C_k.")
+    D: StepMatrix = Field(description="The noise matrices D_k.")
 
 
 class ContinuousModel(StrictModel):
     """``ẋ = A x + B u + C v + noise · w`` held constant over each ``step`` (eq. 4.68–4.70)."""
 
-    A: MatrixValue
-    B: MatrixValue
-    C: MatrixValue
-    noise: MatrixValue
-    step: Value
+    A: MatrixValue = Field(description="The state matrix A.")
+    B: MatrixValue = Field(description="The controller's input matrix B.")
+    C: MatrixValue = Field(description="The stopper's input matrix C.")
+    noise: MatrixValue = Field(description="The noise matrix.")
+    step: Value = Field(description="The sampling step the model is held constant over.")
 
 
 class CostWeights(StrictModel):
     """Weights of the payoff eq. 4.4: state ``Q``, controller ``R`` and stopper ``S``."""
 
-    Q: StepMatrix
-    R: StepMatrix
-    S: StepMatrix
+    Q: StepMatrix = Field(description="The state weight Q.")
+    R: StepMatrix = Field(description="The controller's weight R.")
+    S: StepMatrix = Field(description="The stopper's weight S.")
 
 
 class InitialDistribution(StrictModel):
     """``x_0 ~ N(mean, covariance)``."""
 
-    mean: list[Value] = Field(min_length=1)
-    covariance: MatrixValue
+    mean: list[Value] = Field(min_length=1, description="The initial mean.")
+    covariance: MatrixValue = Field(description="The initial covariance.")
 
 
 class TerminalTarget(StrictModel):
     """The controller's terminal target ``x_N ~ N(mean, covariance)`` (eq. 4.11); each part optional."""
 
-    mean: list[Value | None] | None = None
-    covariance: MatrixValue | None = None
+    mean: list[Value | None] | None = Field(
+        None, description="The target mean (None entries are free); omitted: none."
+    )
+    covariance: MatrixValue | None = Field(
+        None, description="The target covariance (the relaxed constraint of eqs. 4.61–4.62); omitted: none."
+    )
 
 
 class LQGameProblem(StrictModel):
     """The mathematics of the game."""
 
-    parameters: dict[str, Number] = Field(default_factory=dict)
+    parameters: dict[str, Number] = Field(
+        default_factory=dict, description="Named numbers the expressions may use (runtime parameters)."
+    )
     horizon: int = Field(ge=1, le=MAX_INTERVALS, description="Number of steps N.")
     states: list[str] | None = Field(None, description="State names (default x1, x2, ...).")
-    discrete: DiscreteModel | None = None
-    continuous: ContinuousModel | None = None
-    cost: CostWeights
-    initial: InitialDistribution
-    terminal: TerminalTarget = Field(default_factory=TerminalTarget)
+    discrete: DiscreteModel | None = Field(
+        None, description="A discrete-time model (eq. 4.1; give this or `continuous`)."
+    )
+    continuous: ContinuousModel | None = Field(
+        None, description="A continuous-time model, sampled (give this or `discrete`)."
+    )
+    cost: CostWeights = Field(description="The payoff's weights (eq. 4.4).")
+    initial: InitialDistribution = Field(description="The initial distribution.")
+    terminal: TerminalTarget = Field(
+        default_factory=TerminalTarget, description="The controller's terminal target (eq. 4.11)."
+    )
 
     @field_validator("states")
     @classmethod
@@ -158,7 +170,9 @@ class LQGameProblem(StrictModel):
 class MonteCarloSpec(StrictModel):
     """Closed-loop samples drawn after the solve (0 to skip)."""
 
-    samples: int = Field(100, ge=0, le=MAX_SAMPLES)
+    samples: int = Field(
+        100, ge=0, le=MAX_SAMPLES, description="Number of closed-loop samples (0 skips the check)."
+    )
     seed: int = Field(0, ge=0, description="Seed of the random generator (a non-negative integer).")
 
 
@@ -167,7 +181,7 @@ class LQMethodSpec(StrictModel):
     damping, acceleration; :mod:`gamespec.best_response`) and the Monte Carlo check."""
 
     tolerance: Number = Field(1e-5, gt=0, description="Bound on ε_k and ε_ℓ (section 4.5).")
-    max_iterations: int = Field(100, ge=1)
+    max_iterations: int = Field(100, ge=1, description="Iteration limit of the best responses.")
     scheme: Literal["jacobi", "gauss_seidel"] = Field(
         "jacobi", description="jacobi (Algorithm 2) or gauss_seidel (the controller answers L_{i+1})."
     )
@@ -180,7 +194,9 @@ class LQMethodSpec(StrictModel):
         "(same best responses, same stopping rule; converges where the plain scheme spirals outwards).",
     )
     memory: int = Field(5, ge=1, description="Sweeps Anderson's extrapolation uses.")
-    monte_carlo: MonteCarloSpec = Field(default_factory=MonteCarloSpec)
+    monte_carlo: MonteCarloSpec = Field(
+        default_factory=MonteCarloSpec, description="The closed-loop Monte Carlo check."
+    )
 
     def settings(self) -> Settings:
         """The best-response engine's settings of this method."""
@@ -197,9 +213,15 @@ class LQMethodSpec(StrictModel):
 class LQGameSpec(ProblemParameters, SpecBase):
     """An LQ stochastic game with one-sided terminal mean/covariance constraints (chapter 4)."""
 
-    kind: Literal["lq_stochastic_game"] = "lq_stochastic_game"
-    problem: LQGameProblem
-    method: LQMethodSpec = Field(default_factory=LQMethodSpec)
+    kind: Literal["lq_stochastic_game"] = Field(
+        "lq_stochastic_game", description="The problem kind; selects the schema of the rest of the file."
+    )
+    problem: LQGameProblem = Field(
+        description="The model, the payoff, the initial distribution and the target."
+    )
+    method: LQMethodSpec = Field(
+        default_factory=LQMethodSpec, description="The best-response iteration and the Monte Carlo check."
+    )
 
     @model_validator(mode="after")
     def _evaluates(self) -> LQGameSpec:

@@ -57,10 +57,14 @@ class StateSpec(StrictModel):
     (``size: N``, values as lists of N or one value for all) is lowered at load to its components
     ``NAME__0 ...`` (:mod:`gamespec.specs.vectors`)."""
 
-    initial: Value | None = None
-    final: Value | None = None
-    lower: Value | None = None
-    upper: Value | None = None
+    initial: Value | None = Field(
+        None, description="The initial value (a number or an expression of the parameters); omitted: free."
+    )
+    final: Value | None = Field(
+        None, description="The final value (a number or an expression of the parameters); omitted: free."
+    )
+    lower: Value | None = Field(None, description="Lower bound; omitted: none.")
+    upper: Value | None = Field(None, description="Upper bound; omitted: none.")
     scale: Number | Literal["auto"] | None = Field(
         None, description="The NLP sees this variable divided by scale; auto: from the bounds or the guess."
     )
@@ -70,8 +74,12 @@ class ControlSpec(StrictModel):
     """One control: its bounds. A vector control (``size: N``, bounds as lists of N or one value for
     all) is lowered at load to its components ``NAME__0 ...`` (:mod:`gamespec.specs.vectors`)."""
 
-    lower: Value | None = None
-    upper: Value | None = None
+    lower: Value | None = Field(
+        None, description="Lower bound (a number or an expression of the parameters); omitted: none."
+    )
+    upper: Value | None = Field(
+        None, description="Upper bound (a number or an expression of the parameters); omitted: none."
+    )
     scale: Number | Literal["auto"] | None = Field(
         None, description="The NLP sees this variable divided by scale; auto: from the bounds or the guess."
     )
@@ -83,7 +91,10 @@ class InputSpec(StrictModel):
     parameter that varies along the horizon. ``default`` is a number or an expression of normalized
     time ``tau`` (in [0, 1]) and the parameters; ``CompiledModel.solve(inputs=...)`` replaces it."""
 
-    default: Value = 0.0
+    default: Value = Field(
+        0.0,
+        description="The signal when none is given: a number or an expression of tau and the parameters.",
+    )
 
 
 class DesignSpec(StrictModel):
@@ -91,9 +102,11 @@ class DesignSpec(StrictModel):
     wherever a parameter may be used in dynamics, costs and constraints; bounds are numbers or
     expressions of the parameters, the guess defaults to the middle of finite bounds."""
 
-    lower: Value | None = None
-    upper: Value | None = None
-    guess: Number | None = None
+    lower: Value | None = Field(None, description="Lower bound; omitted: none.")
+    upper: Value | None = Field(None, description="Upper bound; omitted: none.")
+    guess: Number | None = Field(
+        None, description="The starting value; omitted: the middle of finite bounds."
+    )
 
 
 class IntegralConstraintSpec(StrictModel):
@@ -102,9 +115,9 @@ class IntegralConstraintSpec(StrictModel):
     re-evaluated when a compiled model is solved with new parameter values; an omitted bound is
     infinite)."""
 
-    integrand: Value
-    lower: Value | None = None
-    upper: Value | None = None
+    integrand: Value = Field(description="The running expression integrated over the horizon.")
+    lower: Value | None = Field(None, description="Lower bound of the integral; omitted: none.")
+    upper: Value | None = Field(None, description="Upper bound of the integral; omitted: none.")
 
     @model_validator(mode="after")
     def _some_bound(self) -> IntegralConstraintSpec:
@@ -117,9 +130,11 @@ class ObjectiveSpec(StrictModel):
     """Mayer term (over ``<state>_0``, ``<state>_f``, ``<control>_0``, ``<control>_f``, ``t_f``,
     parameters and design variables) plus Lagrange integrand."""
 
-    sense: Literal["minimize", "maximize"] = "minimize"
-    mayer: Value = 0.0
-    lagrange: Value = 0.0
+    sense: Literal["minimize", "maximize"] = Field("minimize", description="`minimize` or `maximize`.")
+    mayer: Value = Field(
+        0.0, description="The terminal cost over end values, t_f, parameters and design variables."
+    )
+    lagrange: Value = Field(0.0, description="The running cost integrated over the horizon.")
 
 
 class FreeOrFixed(StrictModel):
@@ -127,8 +142,10 @@ class FreeOrFixed(StrictModel):
     parameters) from ``guess``: a final time, a phase's duration. A subclass names the field of the
     value (``fixed_field``, free when it reads ``free``) and what it is (``what``)."""
 
-    bounds: tuple[Value, Value] | None = None
-    guess: Number | None = None
+    bounds: tuple[Value, Value] | None = Field(
+        None, description="[lower, upper] when free (numbers or expressions of the parameters)."
+    )
+    guess: Number | None = Field(None, description="The starting value when free.")
 
     fixed_field: ClassVar[str] = ""
     what: ClassVar[str] = ""
@@ -158,7 +175,9 @@ class TimeSpec(FreeOrFixed):
         None, description="Bounds of a free initial time (numbers or expressions of the parameters)."
     )
     initial_guess: Number | None = Field(None, description="Starting guess of a free initial time.")
-    final: Value | Literal["free"] = 1.0
+    final: Value | Literal["free"] = Field(
+        1.0, description="The final time: a number, an expression of the parameters, or `free`."
+    )
 
     fixed_field: ClassVar[str] = "final"
     what: ClassVar[str] = "final time"
@@ -216,18 +235,33 @@ class OcpProblem(StrictModel):
         default_factory=dict,
         description="Gridded data, each a function of the expressions by its name (CL(mach, alpha)).",
     )
-    states: dict[str, StateSpec]
-    controls: dict[str, ControlSpec] = Field(default_factory=dict)
-    inputs: dict[str, InputSpec] = Field(default_factory=dict)
+    states: dict[str, StateSpec] = Field(
+        description="The states, with their bounds and initial and final values."
+    )
+    controls: dict[str, ControlSpec] = Field(
+        default_factory=dict, description="The controls, with their bounds."
+    )
+    inputs: dict[str, InputSpec] = Field(
+        default_factory=dict, description="Grid inputs: signals along the horizon, by name."
+    )
     design: dict[str, DesignSpec] = Field(
         default_factory=dict, description="Free static parameters optimized with the trajectory."
     )
-    dynamics: dict[str, Value]
-    objective: ObjectiveSpec = Field(default_factory=ObjectiveSpec)
-    time: TimeSpec = Field(default_factory=TimeSpec)
-    path_constraints: list[str] = Field(default_factory=list)
-    boundary_constraints: list[str] = Field(default_factory=list)
-    integral_constraints: list[IntegralConstraintSpec] = Field(default_factory=list)
+    dynamics: dict[str, Value] = Field(description="The right-hand side of each state's ODE.")
+    objective: ObjectiveSpec = Field(
+        default_factory=ObjectiveSpec, description="The objective: Mayer term plus Lagrange integrand."
+    )
+    time: TimeSpec = Field(default_factory=TimeSpec, description="The initial and final times.")
+    path_constraints: list[str] = Field(
+        default_factory=list, description="Relations that hold along the horizon."
+    )
+    boundary_constraints: list[str] = Field(
+        default_factory=list,
+        description="Relations over the end values (`<state>_0`, `<state>_f`, t_f, parameters).",
+    )
+    integral_constraints: list[IntegralConstraintSpec] = Field(
+        default_factory=list, description="Isoperimetric constraints on integrals over the horizon."
+    )
     at: list[EventSpec] = Field(
         default_factory=list,
         description="Interior-point constraints: [{time: ..., constraints: [...]}] over the states then.",
@@ -680,9 +714,13 @@ class RefineSpec(StrictModel):
     ``hp`` raises its Radau degree instead where the defect predicts that a degree up to
     ``max_degree`` meets the tolerance (a smooth solution), and splits it otherwise."""
 
-    tolerance: Number = Field(1e-6, gt=0)
-    max_iterations: int = Field(8, ge=1, le=30)
-    strategy: Literal["h", "hp"] = "h"
+    tolerance: Number = Field(
+        1e-6, gt=0, description="Refine every interval whose relative defect exceeds this."
+    )
+    max_iterations: int = Field(8, ge=1, le=30, description="The most refinements made.")
+    strategy: Literal["h", "hp"] = Field(
+        "h", description="`h` (split intervals) or `hp` (raise the degree where the solution is smooth)."
+    )
     max_degree: int = Field(
         8,
         ge=2,
@@ -699,10 +737,17 @@ class MethodSpec(StrictModel):
     first and the last interval's length).
     """
 
-    scheme: Literal["radau", "trapezoidal"] = "radau"
-    intervals: int = Field(40, ge=1, le=MAX_INTERVALS)
-    degree: int = Field(3, ge=1, le=12)
-    grading: Number = Field(1.0, gt=0, le=1e4)
+    scheme: Literal["radau", "trapezoidal"] = Field(
+        "radau", description="The transcription: `radau` collocation or `trapezoidal`."
+    )
+    intervals: int = Field(40, ge=1, le=MAX_INTERVALS, description="Number of collocation intervals.")
+    degree: int = Field(3, ge=1, le=12, description="The Radau collocation degree.")
+    grading: Number = Field(
+        1.0,
+        gt=0,
+        le=1e4,
+        description="Ratio of the first to the last interval's length (> 1 shrinks them toward t_f).",
+    )
     mesh: list[Number] | None = Field(
         None, description="Interval boundaries in normalized time, 0 to 1 increasing (sets intervals)."
     )
@@ -752,10 +797,17 @@ class GuessSpec(StrictModel):
     parameters, or ``linear`` between a state's initial and final values), a final-time guess, or a
     previous Result file (``result``) interpolated onto the new grid."""
 
-    states: dict[str, Value] = Field(default_factory=dict)
-    controls: dict[str, Value] = Field(default_factory=dict)
-    t_final: Number | None = None
-    result: str | None = None
+    states: dict[str, Value] = Field(
+        default_factory=dict,
+        description="Per state, a number, an expression of tau and the parameters, or `linear`.",
+    )
+    controls: dict[str, Value] = Field(
+        default_factory=dict, description="Per control, a number or an expression of tau and the parameters."
+    )
+    t_final: Number | None = Field(None, description="The final time's starting value.")
+    result: str | None = Field(
+        None, description="A saved Result (folder or result.json) interpolated onto the new grid."
+    )
 
 
 class OcpFamily(ProblemParameters):
@@ -780,11 +832,20 @@ class OptimalControlSpec(OcpFamily, SpecBase):
     """An optimal-control problem (kind ``optimal_control``); its runtime parameters are
     ``problem.parameters``, its starting point ``guess`` and ``problem.time.guess``."""
 
-    kind: Literal["optimal_control"] = "optimal_control"
-    problem: OcpProblem
-    method: MethodSpec = Field(default_factory=MethodSpec)
-    guess: GuessSpec = Field(default_factory=GuessSpec)
-    plot: PlotHint = Field(default_factory=PlotHint)
+    kind: Literal["optimal_control"] = Field(
+        "optimal_control", description="The problem kind; selects the schema of the rest of the file."
+    )
+    problem: OcpProblem = Field(
+        description="The mathematics: states, controls, dynamics, objective, constraints."
+    )
+    method: MethodSpec = Field(
+        default_factory=MethodSpec,
+        description="The transcription: scheme, intervals, degree, mesh refinement.",
+    )
+    guess: GuessSpec = Field(default_factory=GuessSpec, description="The starting point of the solve.")
+    plot: PlotHint = Field(
+        default_factory=PlotHint, description="What the figures draw: planar pairs, units."
+    )
 
     guess_fields = ("guess", "problem.time.guess")
 

@@ -16,9 +16,11 @@ from gamespec.specs.base import StrictModel
 class UniformSpec(StrictModel):
     """Uniform on ``[low, high]``, or on ``nominal · (1 ± percent/100)``."""
 
-    percent: FiniteFloat | None = Field(None, gt=0, le=1000)
-    low: FiniteFloat | None = None
-    high: FiniteFloat | None = None
+    percent: FiniteFloat | None = Field(
+        None, gt=0, le=1000, description="The interval's half width in percent of the nominal value."
+    )
+    low: FiniteFloat | None = Field(None, description="The interval's lower end.")
+    high: FiniteFloat | None = Field(None, description="The interval's upper end.")
 
     @model_validator(mode="after")
     def _one_form(self) -> UniformSpec:
@@ -35,14 +37,14 @@ class UniformSpec(StrictModel):
 class NormalSpec(StrictModel):
     """Normal about the nominal value with standard deviation ``std``."""
 
-    std: FiniteFloat = Field(gt=0)
+    std: FiniteFloat = Field(gt=0, description="The standard deviation.")
 
 
 class UncertainParameter(StrictModel):
     """The distribution of one uncertain parameter: exactly one of ``uniform`` and ``normal``."""
 
-    uniform: UniformSpec | None = None
-    normal: NormalSpec | None = None
+    uniform: UniformSpec | None = Field(None, description="Uniform on an interval.")
+    normal: NormalSpec | None = Field(None, description="Normal about the nominal value.")
 
     @model_validator(mode="after")
     def _exactly_one(self) -> UncertainParameter:

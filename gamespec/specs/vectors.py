@@ -154,11 +154,11 @@ class _Lowering:
                 lowered[component(name, i)] = other | {k: v[i] for k, v in values.items()}
         return lowered
 
-    def definitions(self, raw: Mapping[str, Any], where: str, start: float) -> dict[str, Any]:
+    def definitions(self, raw: Mapping[str, Any], where: str, start: sp.Expr) -> dict[str, Any]:
         """Each definition as text, a vector one as one definition per component; the running
         symbols then know each definition (a vector one as the vector of its components), and the
         end symbols its values at the ends (``h_0``, ``h_f``: the definition over the states and
-        controls at ``t_0 = start`` and ``t_f``, eq. (end-point definitions) of GPOPS-II's events)."""
+        controls at ``t_0 = start`` and ``t_f``, as GPOPS-II's end-point functions)."""
         lowered: dict[str, Any] = {}
         inlined = dict(self.running)
         for name, text in raw.items():
@@ -174,13 +174,13 @@ class _Lowering:
                 self.running[name] = symbol(name)
         return lowered
 
-    def _at_ends(self, name: str, value: Any, start: float) -> None:
+    def _at_ends(self, name: str, value: Any, start: sp.Expr) -> None:
         """``name_0`` and ``name_f`` among the end symbols: ``value`` (a definition with the earlier
         ones substituted) over the end values at ``t_0 = start`` and ``t_f``; none for a definition
         of grid inputs, which have no end values."""
         if {str(s) for s in sp.sympify(value).free_symbols} & self.inputs:
             return
-        for end, time in (("_0", _number(start)), ("_f", symbol("t_f"))):
+        for end, time in (("_0", start), ("_f", symbol("t_f"))):
             mapping = {symbol(v): symbol(v + end) for v in self.scalar_variables} | {symbol("t"): time}
             self.ends[name + end] = value.xreplace(mapping)
 
@@ -196,7 +196,7 @@ class _Lowering:
                     linked[name] = symbol(name)
             self.ends |= linked | {f"phases.{phase}.t_0": symbol(f"phases.{phase}.t_0")}
 
-    def sections(self, raw: Mapping[str, Any], field: str, start: float) -> dict[str, Any]:
+    def sections(self, raw: Mapping[str, Any], field: str, start: sp.Expr) -> dict[str, Any]:
         """The sections of a problem (or of a phase) that hold variables and expressions, lowered."""
         out = dict(raw)
         keys = ("initial", "final", "lower", "upper", "scale")
@@ -248,7 +248,7 @@ class _Lowering:
         own = copy.copy(self)
         own.running = dict(self.running)
         own.ends = self.ends | {"t_0": symbol("t_0")}
-        return own.sections(raw, field, 0.0)
+        return own.sections(raw, field, sp.Integer(0))
 
     def guess(self, raw: dict[str, Any], where: str) -> dict[str, Any]:
         """A guess's ``states`` and ``controls`` with each vector's value given per component."""
@@ -303,6 +303,18 @@ def _uses_end_definitions(problem: Mapping[str, Any]) -> bool:
     return False
 
 
+def _start(problem: Mapping[str, Any]) -> sp.Expr:
+    """The initial time as SymPy: the file's number, or the symbol ``t_0`` when it is free."""
+    initial = (problem.get("time") or {}).get("initial", 0.0)
+    if initial == "free":
+        return symbol("t_0")
+    return (
+        _number(float(initial))
+        if isinstance(initial, int | float) and not isinstance(initial, bool)
+        else sp.Integer(0)
+    )
+
+
 def _number(value: float) -> sp.Expr:
     return sp.Integer(int(value)) if value == int(value) else sp.Float(value)
 
@@ -328,9 +340,7 @@ def lower_problem(
     low = _Lowering(problem, sizes)
     if phases:
         low.link_phases([ph.get("name") for ph in problem.get("phases", []) if isinstance(ph, Mapping)])
-    start = (problem.get("time") or {}).get("initial", 0.0)
-    start = float(start) if isinstance(start, int | float) and not isinstance(start, bool) else 0.0
-    out = low.sections(problem, field, start)
+    out = low.sections(problem, field, _start(problem))
     if phases and isinstance(problem.get("phases"), list):
         out["phases"] = [low.phase(ph, f"{field}.phases.{k}") for k, ph in enumerate(problem["phases"])]
     return out, low.guess

@@ -34,7 +34,10 @@ class SuboptimalStudySpec(SpecBase):
     """Table 2.1 (kind ``pursuit_suboptimal_study``): P1 at (0, 0), E at (r1, 0), both pursuers at
     speed u on pure pursuit, the evader at each of ``speeds``."""
 
-    kind: Literal["pursuit_suboptimal_study"] = "pursuit_suboptimal_study"
+    kind: Literal["pursuit_suboptimal_study"] = Field(
+        "pursuit_suboptimal_study",
+        description="The problem kind; selects the schema of the rest of the file.",
+    )
     r1: Number = Field(1.0, gt=0, description="Initial distance r1(0) from P1 to the evader.")
     u: Number = Field(1.0, gt=0, description="Speed of both pursuers.")
     speeds: list[Number] = Field(
@@ -42,9 +45,16 @@ class SuboptimalStudySpec(SpecBase):
         min_length=1,
         description="Evader speeds v, each in (0, u).",
     )
-    capture_radius: Number = Field(0.001, gt=0)
-    grid: StudyGrid = Field(default_factory=StudyGrid)
-    method: MethodSpec = Field(default_factory=lambda: MethodSpec(intervals=40, grading=10.0))
+    capture_radius: Number = Field(
+        0.001, gt=0, description="Distance at which a pursuer captures the evader."
+    )
+    grid: StudyGrid = Field(
+        default_factory=StudyGrid, description="The study's grid of speeds and positions."
+    )
+    method: MethodSpec = Field(
+        default_factory=lambda: MethodSpec(intervals=40, grading=10.0),
+        description="The transcription of each point's optimal-control problem.",
+    )
     refinements: list[MethodChange] = Field(
         default_factory=lambda: [{"intervals": 80}, {"intervals": 60, "grading": 100}],
         description="Changes to method tried in turn when a solution fails the defect check.",

@@ -122,7 +122,7 @@ def rk4(
     u_open = controls.on_steps(t).reshape(m, len(h), 3)
     w_open = inputs.on_steps(t) if inputs else np.empty((0, len(h), 3))
     if feedback is None and _shared_path(ocp, x0, params):
-        return _one_path(ocp, x0, params, t, stages, u_open, w_open, keep)
+        return _one_path(ocp, x0, params, t, stages, u_open, w_open, keep, tolerance)
     X = np.empty((len(t), n, keep))
     U = np.empty((len(t), m, keep))
     running, energy, violation = np.zeros(samples), np.zeros(samples), np.zeros(samples)
@@ -188,6 +188,7 @@ def _one_path(
     u_open: np.ndarray,
     w_open: np.ndarray,
     keep: int,
+    tolerance: float,
 ) -> Trajectories:
     """:func:`rk4` for samples that share one path (:func:`_shared_path`): the path integrated once
     by :func:`_rk4_path`, the path constraints of every sample evaluated on it."""
@@ -209,11 +210,12 @@ def _one_path(
     energy = float(np.sum(h / 6 * (squares[:, 0] + 2 * squares[:, 1] + 2 * squares[:, 1] + squares[:, 2])))
     u_path = np.concatenate([u_open[:, :, 0], u_open[:, -1:, 2]], axis=1)  # at each step's start
     w_path = np.concatenate([w_open[:, :, 0], w_open[:, -1:, 2]], axis=1)
-    violation = _path_violation(ocp, x_path, u_path, w_path, t, params, samples)
+    violation, violated = _path_violation(ocp, x_path, u_path, w_path, t, params, samples, tolerance)
     X = np.repeat(x_path.T[:, :, None], keep, axis=2)
     U = np.repeat(u_path.T[:, :, None], keep, axis=2)
     final = np.repeat(x_path[:, -1:], samples, axis=1)
-    return Trajectories(t, X, U, final, np.full(samples, y[n, -1]), np.full(samples, energy), violation)
+    running, energies = np.full(samples, y[n, -1]), np.full(samples, energy)
+    return Trajectories(t, X, U, final, running, energies, violation, violated)
 
 
 CHUNK = 1 << 16
@@ -229,12 +231,15 @@ def _path_violation(
     t: np.ndarray,
     params: Values,
     samples: int,
-) -> np.ndarray:
+    tolerance: float,
+) -> tuple[np.ndarray, np.ndarray]:
     """Each sample's largest path-constraint violation over the times ``t`` of one shared path
-    ``x`` (n, len(t)) under ``u`` and ``w`` (the parameters per sample, broadcast along ``t``)."""
-    violation = np.zeros(samples)
+    ``x`` (n, len(t)) under ``u`` and ``w`` (the parameters per sample, broadcast along ``t``), and
+    at each time the fraction of samples whose violation so far exceeds ``tolerance``
+    (``Trajectories.violated``)."""
+    violation, violated = np.zeros(samples), np.zeros(len(t))
     if not ocp.path:
-        return violation
+        return violation, violated
     function = numeric_function([rel.expr for rel in ocp.path], [*ocp.p, *ocp.w, *ocp.x, *ocp.u, TIME])
     lower = np.array([rel.lower for rel in ocp.path])[:, None, None]
     upper = np.array([rel.upper for rel in ocp.path])[:, None, None]
@@ -245,8 +250,10 @@ def _path_violation(
         along = [v[cut, None] for v in (*w, *x, *u, t)]
         g = np.broadcast_to(function(*fixed, *along), (len(ocp.path), len(t[cut]), samples))
         excess = np.maximum(lower - g, 0.0) + np.maximum(g - upper, 0.0)
-        np.maximum(violation, excess.max(axis=(0, 1)), out=violation)
-    return violation
+        so_far = np.maximum.accumulate(np.maximum(excess.max(axis=0), violation), axis=0)
+        violated[cut] = np.count_nonzero(so_far > tolerance, axis=1) / samples
+        violation = so_far[-1]
+    return violation, violated
 
 
 Symbols = tuple[sp.Symbol, ...]

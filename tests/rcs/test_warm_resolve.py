@@ -61,8 +61,9 @@ def test_one_path_equals_the_per_sample_loop(compiled):
     wide = {"rho": UncertainParameter.model_validate({"normal": {"std": 0.3}})}
     d = draws(ocp, result, wide, options)
     args = (ocp, d.x0, d.controls, d.params, d.t0, d.tf, 400)
-    shared = rk4(*args, keep=20)
-    loop = rk4(*args, keep=20, feedback=lambda k, x: np.zeros((len(ocp.u), 1)))
+    shared = rk4(*args, keep=20, tolerance=1e-6)
+    loop = rk4(*args, keep=20, feedback=lambda k, x: np.zeros((len(ocp.u), 1)), tolerance=1e-6)
     assert np.ptp(shared.violation) > 0  # the samples differ where it matters
-    for name in ("x", "u", "final", "running", "energy", "violation"):
+    assert 0 < shared.violated[-1] < 1  # some samples collide, not all
+    for name in ("x", "u", "final", "running", "energy", "violation", "violated"):
         np.testing.assert_allclose(getattr(shared, name), getattr(loop, name), rtol=1e-12, atol=1e-12)

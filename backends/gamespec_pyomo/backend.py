@@ -50,7 +50,13 @@ class PyomoOptions(StrictModel):
     )
     tol: float = Field(1e-8, gt=0, description="The solver's tol.")
     max_iter: int = Field(3000, ge=1)
-    max_wall_time: float = Field(300.0, gt=0, description="The solver's wall-time limit in seconds.")
+    max_wall_time: float = Field(
+        300.0,
+        gt=0,
+        description="Wall-clock limit of a solve in seconds, NL file writing included: the solver gets"
+        " 90% of what is left as its own limit (it checks it once an iteration) and is killed at the"
+        " limit (status time_limit).",
+    )
     options: dict[str, Any] = Field(
         default_factory=dict, description="Further solver options (key=value on its command line)."
     )
@@ -63,6 +69,11 @@ class PyomoOptions(StrictModel):
         if options and "solver" in info.data:
             check_options(info.data["solver"], options)
         return options
+
+
+SOLVER_SHARE = 0.9
+"""The share of the time left when the solver starts that it gets as its own ``max_wall_time``: it
+stops itself (with its iterate) before the process is killed at the limit."""
 
 
 def _bound(value: float) -> float | None:
@@ -162,19 +173,22 @@ class PyomoModel(CollocationModel):
             return None
         return np.array([-m.dual[m.integral[r]] for r in range(len(m.integral))], dtype=float)
 
-    def _solver_options(self) -> dict[str, Any]:
+    def _solver_options(self, remaining: float) -> dict[str, Any]:
         name = self.executable.name
         opts = {"tol": self.options.tol, "max_iter": self.options.max_iter, "print_level": PRINT_LEVEL[name]}
-        opts["max_wall_time"] = self.options.max_wall_time
+        opts["max_wall_time"] = max(SOLVER_SHARE * remaining, 1e-3)
         if name == "ipopt":
             # Through Ipopt's options file (Pyomo's OF_ prefix), which takes every Ipopt option.
             opts |= {f"OF_{k}": v for k, v in IPOPT_DEFAULTS.items() if k not in self.options.options}
         return opts | self.options.options
 
-    def _execute(self) -> Run:
-        """Run the executable on the NL file of the model as it stands; load the solution it finds."""
-        run = run_solver(self.executable, self.nl.text(), self._solver_options())
-        if len(run.results.solution) > 0:
+    def _execute(self, deadline: float) -> Run:
+        """Run the executable on the NL file of the model as it stands, killed at ``deadline`` (a
+        ``time.perf_counter`` value); load the solution it finds."""
+        text = self.nl.text()
+        remaining = deadline - time.perf_counter()
+        run = run_solver(self.executable, text, self._solver_options(remaining), remaining)
+        if not run.stopped and len(run.results.solution) > 0:
             self.nl.load(run.results.solution(0))
         return run
 
@@ -209,8 +223,10 @@ class PyomoModel(CollocationModel):
                 iterations=0,
                 solver_stats={"solver": "highs (LP feasibility check)"},
             )
-        run = self._execute()
+        run = self._execute(tic + self.options.max_wall_time)
         elapsed = time.perf_counter() - tic
+        if run.stopped:
+            return self._stopped(params, Win, run, elapsed)
         results, log = run.results, run.log
         loaded = len(results.solution) > 0
         self._solved = self._solved or loaded
@@ -239,6 +255,25 @@ class PyomoModel(CollocationModel):
                 "process_time_s": run.seconds,
                 "solver_time_s": solver_seconds_in(log),
             },
+        )
+
+    def _stopped(self, params: dict[str, float], Win: np.ndarray, run: Run, elapsed: float) -> Result:
+        """The Result of a run killed at the wall-clock limit: the starting point, no objective."""
+        X, U, T = self._values()
+        name = self.executable.name
+        return self.tr.result(
+            X=X,
+            U=U,
+            T=T,
+            objective=None,
+            params=params,
+            inputs=Win,
+            status=Status.TIME_LIMIT,
+            message=f"{name} stopped at the wall-clock limit of {self.options.max_wall_time:g} s"
+            " (solver.options.pyomo.max_wall_time)",
+            solve_time_s=elapsed,
+            iterations=iterations_in(run.log),
+            solver_stats={"solver": name, "executable": self.executable.path, "process_time_s": run.seconds},
         )
 
 

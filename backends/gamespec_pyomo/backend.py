@@ -26,6 +26,7 @@ from gamespec.ocp.transcription import Bounds, Transcription
 from gamespec.result import Result, Status
 from gamespec.specs.base import StrictModel
 from gamespec.specs.ocp import OptimalControlSpec
+from gamespec_pyomo.feasibility import TRIGGERS, ElasticFeasibility
 from gamespec_pyomo.model import build_model
 from gamespec_pyomo.nlfile import NLFile
 from gamespec_pyomo.solvers import (
@@ -102,6 +103,8 @@ class PyomoModel(CollocationModel):
         self.model = build_model(self.tr, self.tr.ocp.parameter_values())
         self.nl = NLFile(self.model)
         self.linear = LinearFeasibility(self.model)
+        self.elastic = ElasticFeasibility(self.model)
+        self._elastic_nl: NLFile | None = None
         self._solved = False
 
     def _set_data(self, params: Mapping[str, float], Win: np.ndarray) -> None:
@@ -192,6 +195,24 @@ class PyomoModel(CollocationModel):
             self.nl.load(run.results.solution(0))
         return run
 
+    def _solve_elastic(self, elastic: Any, deadline: float) -> bool:
+        """Run the solver on the elastic model (:mod:`gamespec_pyomo.feasibility`) until
+        ``deadline``; True when it ends at a local minimum (its solution then loaded)."""
+        if self._elastic_nl is None:
+            self._elastic_nl = NLFile(elastic)
+        remaining = deadline - time.perf_counter()
+        if remaining <= 0:
+            return False
+        run = run_solver(self.executable, self._elastic_nl.text(), self._solver_options(remaining), remaining)
+        if run.stopped or len(run.results.solution) == 0:
+            return False
+        termination = str(run.results.solver.termination_condition)
+        message = str(run.results.solver.message or termination)
+        if not status_of(termination, message).ok:
+            return False
+        self._elastic_nl.load(run.results.solution(0))
+        return True
+
     def solve_once(
         self, parameters: dict[str, float] | None = None, guess: Result | None = None, inputs: Inputs = None
     ) -> Result:
@@ -233,6 +254,12 @@ class PyomoModel(CollocationModel):
         termination = str(results.solver.termination_condition)
         # Pyomo's SOL reader stores the solver's message with ':' escaped as '\x3a'.
         message = str(results.solver.message or termination).replace("\\x3a", ":")
+        status = status_of(termination, message)
+        if status in TRIGGERS:
+            verdict = self.elastic.verdict(lambda e: self._solve_elastic(e, tic + self.options.max_wall_time))
+            if verdict is not None and verdict.infeasible:
+                status, message = Status.LOCALLY_INFEASIBLE, f"{message}; {verdict.message()}"
+            elapsed = time.perf_counter() - tic
         X, U, T = self._values()
         return tr.result(
             X=X,
@@ -242,7 +269,7 @@ class PyomoModel(CollocationModel):
             params=params,
             inputs=Win,
             design=np.array([m.d[n].value for n in tr.ocp.design], dtype=float),
-            status=status_of(termination, message),
+            status=status,
             message=message,
             solve_time_s=elapsed,
             iterations=iterations_in(log),

@@ -18,6 +18,7 @@ import numpy as np
 from gamespec.errors import ExpressionError, SpecError
 from gamespec.ocp.checks import Trajectory, check_tolerances, control_basis, solution_checks, verdicts
 from gamespec.ocp.collocation import Grid
+from gamespec.ocp.diagnostics import Point, non_finite_report
 from gamespec.ocp.inputs import InputGrid, InputValue, on_grid
 from gamespec.ocp.scaling import Scaling, variable_scaling
 from gamespec.ocp.symbolic import SymbolicOcp
@@ -277,6 +278,16 @@ class Transcription:
         them (``metrics["scaling"]``, where any is not 1) and their warning."""
         return self.scaling(self.ocp.parameter_values())
 
+    def _with_non_finite(self, message: str, at: Point) -> str:
+        """``message`` with the file's expression that is NaN or infinite at ``at``, else at the
+        starting point (:mod:`gamespec.ocp.diagnostics`), where one is."""
+        report = non_finite_report(self, at)
+        if report is None:
+            start = self.guess(dict(at.values))
+            report = non_finite_report(self, Point(start.X, start.U, start.T, at.inputs, at.values))
+            report = None if report is None else f"at the starting point, {report}"
+        return message if report is None else f"{message}: {report}"
+
     def _scaling_metrics(self) -> dict[str, Any]:
         found = self.compiled_scaling
         scaled = {
@@ -353,6 +364,8 @@ class Transcription:
         tolerances = check_tolerances(checks, refine.tolerance if refine else None)
         if lam is not None:
             arrays["costate_time"] = t_eval
+        if status in (Status.NUMERICAL_ERROR, Status.ERROR):
+            message = self._with_non_finite(message, Point(X, U, T, inputs, {**params, **optimized}))
         warning = self.compiled_scaling.warning
         return Result(
             status=status,

@@ -165,8 +165,9 @@ class PyomoModel(CollocationModel):
         if not all(con in m.dual for con in m.defect.values()):
             return None
         rows = len(m.defect) // self.tr.n_x
-        duals = np.array([[m.dual[m.defect[i, r]] for r in range(rows)] for i in range(self.tr.n_x)])
-        return duals / self.tr.compiled_scaling.states[:, None]  # of rows divided by the state scales
+        duals = np.array([[m.dual[m.defect[i, r]] for r in range(rows)] for i in range(self.tr.n_x)], float)
+        scaled: np.ndarray = duals / self.tr.compiled_scaling.states[:, None]  # rows divided by the scales
+        return scaled
 
     def _integral_multipliers(self) -> np.ndarray | None:
         """The multipliers of the integral constraints as the CasADi backend has them (of the row

@@ -1,0 +1,48 @@
+"""Betts' shuttle reentry, maximum crossrange (problems/ocp/shuttle_reentry.yaml; issue 25, item 4),
+with the default scaling (``method.scale: auto``: h by 1e5, v by 1e4 and their defect rows) against
+``method.scale: none``, on both collocation backends, build + solve from the file's guess.
+``extra_info`` holds the status, the iterations, the CPU seconds (ripopt's included) and the final latitude against Betts' 34.1412°
+(the published value, quoted from the file header's source, not from a run).
+
+Run: ``python -m pytest benchmarks/test_bench_shuttle.py --benchmark-enable``; compare the means
+and iterations within each backend's group (goal: the default faster and in fewer iterations).
+Measured once (2 shared cores, one round each; the full comparison in the report of issue 25):
+casadi auto 85 iterations, none 192; pyomo auto 81 iterations (4 s), none time_limit at 300 s.
+"""
+
+from __future__ import annotations
+
+import resource
+
+import pytest
+
+import gamespec
+from tests.conftest import PROBLEMS
+
+SHUTTLE = PROBLEMS / "ocp" / "shuttle_reentry.yaml"
+BETTS_CROSSRANGE_DEG = 34.1412
+LIMIT = ["solver.options.casadi.max_wall_time=120", "solver.options.pyomo.max_wall_time=120"]
+
+
+def _cpu_seconds() -> float:
+    usage = [resource.getrusage(who) for who in (resource.RUSAGE_SELF, resource.RUSAGE_CHILDREN)]
+    return sum(u.ru_utime + u.ru_stime for u in usage)
+
+
+def _solve(backend: str, scale: str) -> gamespec.Result:
+    return gamespec.solve(gamespec.load(SHUTTLE, [f"method.scale={scale}", *LIMIT]), backend)
+
+
+@pytest.mark.parametrize("backend", ["casadi", "pyomo"])
+@pytest.mark.parametrize("scale", ["auto", "none"])
+def test_shuttle_scaling(benchmark, backend: str, scale: str) -> None:
+    benchmark.group = f"shuttle reentry on {backend}: default scaling against none"
+    start = _cpu_seconds()
+    result = benchmark.pedantic(_solve, args=(backend, scale), rounds=1, warmup_rounds=0)
+    benchmark.extra_info["cpu_s"] = _cpu_seconds() - start
+    benchmark.extra_info["status"] = result.status.value
+    benchmark.extra_info["iterations"] = result.iterations
+    if result.objective is not None:
+        benchmark.extra_info["relative_error"] = abs(result.objective / BETTS_CROSSRANGE_DEG - 1)
+    if scale == "auto":
+        assert result.objective == pytest.approx(BETTS_CROSSRANGE_DEG, rel=1e-5)

@@ -1,8 +1,8 @@
 """Betts' shuttle reentry, maximum crossrange (problems/ocp/shuttle_reentry.yaml; issue 25, item 4),
 with the default scaling (``method.scale: auto``: h by 1e5, v by 1e4 and their defect rows) against
 ``method.scale: none``, on both collocation backends, build + solve from the file's guess.
-``extra_info`` holds the status, the iterations, the CPU seconds (ripopt's included) and the final latitude against Betts' 34.1412°
-(the published value, quoted from the file header's source, not from a run).
+``extra_info`` holds the status, the iterations, the CPU seconds (ripopt's included) and the final
+latitude against Betts' 34.1412° (the published value, quoted from the file header's source).
 
 Run: ``python -m pytest benchmarks/test_bench_shuttle.py --benchmark-enable``; compare the means
 and iterations within each backend's group (goal: the default faster and in fewer iterations).

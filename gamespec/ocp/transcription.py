@@ -278,14 +278,18 @@ class Transcription:
         them (``metrics["scaling"]``, where any is not 1) and their warning."""
         return self.scaling(self.ocp.parameter_values())
 
-    def _with_non_finite(self, message: str, at: Point) -> str:
+    def _with_non_finite(self, message: str, at: Point, params: Mapping[str, float]) -> str:
         """``message`` with the file's expression that is NaN or infinite at ``at``, else at the
-        starting point (:mod:`gamespec.ocp.diagnostics`), where one is."""
-        report = non_finite_report(self, at)
-        if report is None:
-            start = self.guess(dict(at.values))
-            report = non_finite_report(self, Point(start.X, start.U, start.T, at.inputs, at.values))
-            report = None if report is None else f"at the starting point, {report}"
+        file's starting point for ``params`` (:mod:`gamespec.ocp.diagnostics`), where one is."""
+        try:
+            report = non_finite_report(self, at)
+            if report is None:
+                start = self.guess(params)
+                values = dict(params) | dict(zip(self.ocp.design, map(float, start.d), strict=True))
+                report = non_finite_report(self, Point(start.X, start.U, start.T, at.inputs, values))
+                report = None if report is None else f"at the starting point, {report}"
+        except (SpecError, ExpressionError, ArithmeticError, ValueError, TypeError):
+            return message  # the diagnosis is a courtesy: a failed Result stays a Result
         return message if report is None else f"{message}: {report}"
 
     def _scaling_metrics(self) -> dict[str, Any]:
@@ -365,7 +369,7 @@ class Transcription:
         if lam is not None:
             arrays["costate_time"] = t_eval
         if status in (Status.NUMERICAL_ERROR, Status.ERROR):
-            message = self._with_non_finite(message, Point(X, U, T, inputs, {**params, **optimized}))
+            message = self._with_non_finite(message, Point(X, U, T, inputs, {**params, **optimized}), params)
         warning = self.compiled_scaling.warning
         return Result(
             status=status,

@@ -362,9 +362,10 @@ def test_scale_factors_from_the_file_the_bounds_and_the_guess() -> None:
 @pytest.mark.parametrize("backend", ["casadi", "pyomo"])
 def test_scaling_leaves_the_optimum_where_it_is(backend: str) -> None:
     unscaled = [
-        "problem.states.x.scale=null",
-        "problem.states.y.scale=null",
-        "problem.controls.cL.scale=null",
+        "problem.states.x.scale=none",
+        "problem.states.y.scale=none",
+        "problem.controls.cL.scale=none",
+        "method.scale=none",
     ]
     scaled = gamespec.solve(gamespec.load(HANG_GLIDER, SMALL), backend)
     plain = gamespec.solve(gamespec.load(HANG_GLIDER, [*SMALL, *unscaled]), backend)

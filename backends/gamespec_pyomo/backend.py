@@ -6,7 +6,9 @@ is built once, and so is its NL file (:mod:`gamespec_pyomo.nlfile`). A solve fix
 the grid inputs and a fixed horizon through equal bounds, sets the bounds, starts from the last
 solution (or from a guess Result of any backend), rewrites the NL file's bounds and start segments
 and runs the executable. Costates come from the defect multipliers the SOL file returns (Suffix
-``dual``), as in the CasADi backend.
+``dual``), as in the CasADi backend. A solve is bounded by ``max_wall_time`` on the wall clock (the
+process is killed there); an infeasible linear transcription is found by an LP before the solver
+runs, a nonlinear one by the elastic problem after it failed (:mod:`gamespec_pyomo.feasibility`).
 """
 
 from __future__ import annotations

@@ -28,7 +28,7 @@ from gamespec.ocp.transcription import Bounds, Transcription
 from gamespec.result import Result, Status
 from gamespec.specs.base import StrictModel
 from gamespec.specs.ocp import OptimalControlSpec
-from gamespec_pyomo.feasibility import TRIGGERS, ElasticFeasibility
+from gamespec_pyomo.feasibility import ELASTIC_SHARE, ElasticFeasibility, wants_verdict
 from gamespec_pyomo.model import build_model
 from gamespec_pyomo.nlfile import NLFile
 from gamespec_pyomo.solvers import (
@@ -258,8 +258,10 @@ class PyomoModel(CollocationModel):
         # Pyomo's SOL reader stores the solver's message with ':' escaped as '\x3a'.
         message = str(results.solver.message or termination).replace("\\x3a", ":")
         status = status_of(termination, message)
-        if status in TRIGGERS:
-            verdict = self.elastic.verdict(lambda e: self._solve_elastic(e, tic + self.options.max_wall_time))
+        if wants_verdict(status, message):
+            limit = tic + self.options.max_wall_time
+            deadline = min(limit, time.perf_counter() + ELASTIC_SHARE * run.seconds)
+            verdict = self.elastic.verdict(lambda e: self._solve_elastic(e, deadline))
             if verdict is not None and verdict.infeasible:
                 status, message = Status.LOCALLY_INFEASIBLE, f"{message}; {verdict.message()}"
             elapsed = time.perf_counter() - tic

@@ -3,8 +3,9 @@ none: ripopt has no infeasibility detection (Ipopt's restoration phase that conv
 of the constraint violation and says ``Infeasible_Problem_Detected``); on a nonlinear infeasible
 problem it ends ``Restoration Failed`` or at its iteration limit.
 
-After such an end, :class:`ElasticFeasibility` solves the ℓ1 elastic problem Ipopt's restoration
-phase solves, from the point the solver stopped at:
+After such an end (:func:`wants_verdict`), :class:`ElasticFeasibility` solves the ℓ1 elastic
+problem Ipopt's restoration phase solves, from the point the solver stopped at, in at most the
+failed run's time again (:data:`ELASTIC_SHARE`):
 
     min  Σ_i (p_i + n_i)   s.t.   lb_i <= g_i(x) - p_i + n_i <= ub_i,   p, n >= 0,   x in its bounds,
 
@@ -26,8 +27,20 @@ from gamespec.result import Status
 VIOLATION = 1e-6
 """The largest elastic slack at the elastic problem's minimum that still counts as feasible."""
 
-TRIGGERS = (Status.NUMERICAL_ERROR, Status.ITERATION_LIMIT)
-"""The ends of a solve after which the elastic problem is solved."""
+ELASTIC_SHARE = 1.0
+"""The elastic solve may take at most this multiple of the failed run's seconds (and never past the
+solve's wall-clock limit): the verdict costs at most as much again as the failure did."""
+
+
+def wants_verdict(status: Status, message: str) -> bool:
+    """Whether a solve's end calls for the elastic problem: the iteration limit, or a numerical
+    error in ripopt's restoration phase (``Restoration Failed``: where IPOPT's infeasibility
+    detection works), not other numerical trouble (the car-vs-train file on pyomo ends ``Numerical
+    Difficulties`` after 118 iterations, 115 s CPU; an elastic solve after it raised that to 401 s
+    and changed no status)."""
+    if status is Status.ITERATION_LIMIT:
+        return True
+    return status is Status.NUMERICAL_ERROR and "restoration failed" in message.lower()
 
 
 @dataclass(frozen=True)

@@ -116,7 +116,7 @@ class CasadiModel(CollocationModel):
         self.ca = ca
         self.tr = tr = Transcription(spec)
         self.options = options
-        self.sx, self.su = tr.scales(tr.ocp.parameter_values())
+        self.sx, self.su = tr.compiled_scaling.states, tr.compiled_scaling.controls
         outer = ca.SX if options.graph == "sx" else ca.MX
         nlp = collocation_nlp(tr, casadi_library(ca), outer, self.sx, self.su)
         self.n_defects, self.lbg, self.ubg = nlp.n_defects, nlp.lbg, nlp.ubg
@@ -175,7 +175,8 @@ class CasadiModel(CollocationModel):
         X, U, d, T = self._unpack(w, b.t_lower)
         nx = self.shape[0]
         lam_g = np.asarray(sol["lam_g"]).ravel()
-        nu_def = lam_g[: self.n_defects].reshape((nx, -1), order="F")
+        # the defect rows of state i are divided by its scale (gamespec.ocp.scaling)
+        nu_def = lam_g[: self.n_defects].reshape((nx, -1), order="F") / self.sx[:, None]
         n_int = len(tr.ocp.running_structure.integrands)
         return tr.result(
             X=X,

@@ -12,7 +12,7 @@ parameters) to
 
 and the NLP is linear in the outputs ``O = [o_1 ... o_k]`` (constant coefficients):
 
-    g = [vec(X D^T - O_f W^T); vec(O_path^T); boundary(ends, interior); O_integrand q],
+    g = [vec((X D^T - O_f W^T) / s_x); vec(O_path^T); boundary(ends, interior); O_integrand q],
     J = mayer(ends) + O_L q + rate penalty(U) + misfit(interior),
 
 the defects ``D X - T W F`` and the Lagrange quadrature of :mod:`gamespec.ocp.collocation` (the
@@ -147,15 +147,17 @@ def _point_selection(tr: Transcription, sx: np.ndarray, su: np.ndarray, n_var: i
     return Coo.of(np.concatenate(rows), np.concatenate(cols), np.concatenate(vals), (n_v * k, n_var))
 
 
-def _output_weights(tr: Transcription, n_o: int, n_boundary: int) -> tuple[Coo, np.ndarray]:
-    """C and c with ``g = ... + C vec(O)`` (the defects' ``- vec(O_f W^T)``, the path rows
+def _output_weights(tr: Transcription, n_o: int, n_boundary: int, sx: np.ndarray) -> tuple[Coo, np.ndarray]:
+    """C and c with ``g = ... + C vec(O)`` (the defects' ``- vec(O_f W^T)``, each state's rows
+    divided by its scale ``sx``, the path rows
     ``vec(O_path^T)``, the integrals ``O_integrand q``) and ``f = ... + c^T vec(O)`` (``O_L q``)."""
     structure = tr.ocp.running_structure
     nx, n_path, n_int = tr.n_x, len(structure.path), len(structure.integrands)
     _, W, q = tr.grid.triplets
     k = len(q)
     rows, cols, values, shape = W
-    defects = Coo.of(rows, cols, -values, shape).kron(Coo.eye(nx, n_o))
+    unscale = Coo.of(np.arange(nx), np.arange(nx), 1.0 / sx, (nx, n_o))
+    defects = Coo.of(rows, cols, -values, shape).kron(unscale)
     r, i = np.meshgrid(np.arange(n_path), np.arange(k), indexing="ij")
     path = Coo.of(i + k * r, nx + 1 + r + n_o * i, 1.0, (k * n_path, k * n_o))
     boundary = Coo.of([], [], [], (n_boundary, k * n_o))
@@ -196,9 +198,9 @@ def collocation_nlp(
 
     D = Coo.of(*grid.triplets[0])
     n_defects = D.shape[0] * nx
-    weights, cost_weights = _output_weights(tr, n_o, len(rows))
-    scales = Coo.of(np.arange(nx), np.arange(nx), sx, (nx, nx))
-    linear = D.kron(scales).resized((weights.shape[0], w.numel()))
+    weights, cost_weights = _output_weights(tr, n_o, len(rows), sx)
+    # the defects D X - T W F of state i divided by its scale: D (X / s_x) - T W F / s_x
+    linear = D.kron(Coo.eye(nx, nx)).resized((weights.shape[0], w.numel()))
     lower, upper = [np.zeros(n_defects)], [np.zeros(n_defects)]
     for r in running.path:
         lower.append(np.full(k, r.lower))

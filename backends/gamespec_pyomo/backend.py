@@ -6,7 +6,9 @@ is built once, and so is its NL file (:mod:`gamespec_pyomo.nlfile`). A solve fix
 the grid inputs and a fixed horizon through equal bounds, sets the bounds, starts from the last
 solution (or from a guess Result of any backend), rewrites the NL file's bounds and start segments
 and runs the executable. Costates come from the defect multipliers the SOL file returns (Suffix
-``dual``), as in the CasADi backend.
+``dual``), as in the CasADi backend. A solve is bounded by ``max_wall_time`` on the wall clock (the
+process is killed there); an infeasible linear transcription is found by an LP before the solver
+runs, a nonlinear one by the elastic problem after it failed (:mod:`gamespec_pyomo.feasibility`).
 """
 
 from __future__ import annotations
@@ -26,6 +28,7 @@ from gamespec.ocp.transcription import Bounds, Transcription
 from gamespec.result import Result, Status
 from gamespec.specs.base import StrictModel
 from gamespec.specs.ocp import OptimalControlSpec
+from gamespec_pyomo.feasibility import ELASTIC_SHARE, ElasticFeasibility, wants_verdict
 from gamespec_pyomo.model import build_model
 from gamespec_pyomo.nlfile import NLFile
 from gamespec_pyomo.solvers import (
@@ -50,7 +53,13 @@ class PyomoOptions(StrictModel):
     )
     tol: float = Field(1e-8, gt=0, description="The solver's tol.")
     max_iter: int = Field(3000, ge=1, description="The NLP solver's iteration limit.")
-    max_wall_time: float = Field(300.0, gt=0, description="The solver's wall-time limit in seconds.")
+    max_wall_time: float = Field(
+        300.0,
+        gt=0,
+        description="Wall-clock limit of a solve in seconds, NL file writing included: the solver gets"
+        " 90% of what is left as its own limit (it checks it once an iteration) and is killed at the"
+        " limit (status time_limit).",
+    )
     options: dict[str, Any] = Field(
         default_factory=dict, description="Further solver options (key=value on its command line)."
     )
@@ -63,6 +72,11 @@ class PyomoOptions(StrictModel):
         if options and "solver" in info.data:
             check_options(info.data["solver"], options)
         return options
+
+
+SOLVER_SHARE = 0.9
+"""The share of the time left when the solver starts that it gets as its own ``max_wall_time``: it
+stops itself (with its iterate) before the process is killed at the limit."""
 
 
 def _bound(value: float) -> float | None:
@@ -91,6 +105,8 @@ class PyomoModel(CollocationModel):
         self.model = build_model(self.tr, self.tr.ocp.parameter_values())
         self.nl = NLFile(self.model)
         self.linear = LinearFeasibility(self.model)
+        self.elastic = ElasticFeasibility(self.model)
+        self._elastic_nl: NLFile | None = None
         self._solved = False
 
     def _set_data(self, params: Mapping[str, float], Win: np.ndarray) -> None:
@@ -151,7 +167,9 @@ class PyomoModel(CollocationModel):
         if not all(con in m.dual for con in m.defect.values()):
             return None
         rows = len(m.defect) // self.tr.n_x
-        return np.array([[m.dual[m.defect[i, r]] for r in range(rows)] for i in range(self.tr.n_x)])
+        duals = np.array([[m.dual[m.defect[i, r]] for r in range(rows)] for i in range(self.tr.n_x)], float)
+        scaled: np.ndarray = duals / self.tr.compiled_scaling.states[:, None]  # rows divided by the scales
+        return scaled
 
     def _integral_multipliers(self) -> np.ndarray | None:
         """The multipliers of the integral constraints as the CasADi backend has them (of the row
@@ -161,21 +179,42 @@ class PyomoModel(CollocationModel):
             return None
         return np.array([-m.dual[m.integral[r]] for r in range(len(m.integral))], dtype=float)
 
-    def _solver_options(self) -> dict[str, Any]:
+    def _solver_options(self, remaining: float) -> dict[str, Any]:
         name = self.executable.name
         opts = {"tol": self.options.tol, "max_iter": self.options.max_iter, "print_level": PRINT_LEVEL[name]}
-        opts["max_wall_time"] = self.options.max_wall_time
+        opts["max_wall_time"] = max(SOLVER_SHARE * remaining, 1e-3)
         if name == "ipopt":
             # Through Ipopt's options file (Pyomo's OF_ prefix), which takes every Ipopt option.
             opts |= {f"OF_{k}": v for k, v in IPOPT_DEFAULTS.items() if k not in self.options.options}
         return opts | self.options.options
 
-    def _execute(self) -> Run:
-        """Run the executable on the NL file of the model as it stands; load the solution it finds."""
-        run = run_solver(self.executable, self.nl.text(), self._solver_options())
-        if len(run.results.solution) > 0:
+    def _execute(self, deadline: float) -> Run:
+        """Run the executable on the NL file of the model as it stands, killed at ``deadline`` (a
+        ``time.perf_counter`` value); load the solution it finds."""
+        text = self.nl.text()
+        remaining = deadline - time.perf_counter()
+        run = run_solver(self.executable, text, self._solver_options(remaining), remaining)
+        if not run.stopped and len(run.results.solution) > 0:
             self.nl.load(run.results.solution(0))
         return run
+
+    def _solve_elastic(self, elastic: Any, deadline: float) -> bool:
+        """Run the solver on the elastic model (:mod:`gamespec_pyomo.feasibility`) until
+        ``deadline``; True when it ends at a local minimum (its solution then loaded)."""
+        if self._elastic_nl is None:
+            self._elastic_nl = NLFile(elastic)
+        remaining = deadline - time.perf_counter()
+        if remaining <= 0:
+            return False
+        run = run_solver(self.executable, self._elastic_nl.text(), self._solver_options(remaining), remaining)
+        if run.stopped or len(run.results.solution) == 0:
+            return False
+        termination = str(run.results.solver.termination_condition)
+        message = str(run.results.solver.message or termination)
+        if not status_of(termination, message).ok:
+            return False
+        self._elastic_nl.load(run.results.solution(0))
+        return True
 
     def solve_once(
         self, parameters: dict[str, float] | None = None, guess: Result | None = None, inputs: Inputs = None
@@ -208,14 +247,24 @@ class PyomoModel(CollocationModel):
                 iterations=0,
                 solver_stats={"solver": "highs (LP feasibility check)"},
             )
-        run = self._execute()
+        run = self._execute(tic + self.options.max_wall_time)
         elapsed = time.perf_counter() - tic
+        if run.stopped:
+            return self._stopped(params, Win, run, elapsed)
         results, log = run.results, run.log
         loaded = len(results.solution) > 0
         self._solved = self._solved or loaded
         termination = str(results.solver.termination_condition)
         # Pyomo's SOL reader stores the solver's message with ':' escaped as '\x3a'.
         message = str(results.solver.message or termination).replace("\\x3a", ":")
+        status = status_of(termination, message)
+        if wants_verdict(status, message):
+            limit = tic + self.options.max_wall_time
+            deadline = min(limit, time.perf_counter() + ELASTIC_SHARE * run.seconds)
+            verdict = self.elastic.verdict(lambda e: self._solve_elastic(e, deadline))
+            if verdict is not None and verdict.infeasible:
+                status, message = Status.LOCALLY_INFEASIBLE, f"{message}; {verdict.message()}"
+            elapsed = time.perf_counter() - tic
         X, U, T = self._values()
         return tr.result(
             X=X,
@@ -225,7 +274,7 @@ class PyomoModel(CollocationModel):
             params=params,
             inputs=Win,
             design=np.array([m.d[n].value for n in tr.ocp.design], dtype=float),
-            status=status_of(termination, message),
+            status=status,
             message=message,
             solve_time_s=elapsed,
             iterations=iterations_in(log),
@@ -238,6 +287,25 @@ class PyomoModel(CollocationModel):
                 "process_time_s": run.seconds,
                 "solver_time_s": solver_seconds_in(log),
             },
+        )
+
+    def _stopped(self, params: dict[str, float], Win: np.ndarray, run: Run, elapsed: float) -> Result:
+        """The Result of a run killed at the wall-clock limit: the starting point, no objective."""
+        X, U, T = self._values()
+        name = self.executable.name
+        return self.tr.result(
+            X=X,
+            U=U,
+            T=T,
+            objective=None,
+            params=params,
+            inputs=Win,
+            status=Status.TIME_LIMIT,
+            message=f"{name} stopped at the wall-clock limit of {self.options.max_wall_time:g} s"
+            " (solver.options.pyomo.max_wall_time)",
+            solve_time_s=elapsed,
+            iterations=iterations_in(run.log),
+            solver_stats={"solver": name, "executable": self.executable.path, "process_time_s": run.seconds},
         )
 
 

@@ -9,10 +9,11 @@ too, that the solve step fixes through equal bounds: an NL file holds a fixed Va
 constant in its expressions but a bounded Var's value in its bounds segment, so the file is written
 once and a re-solve rewrites only its bounds and start (:mod:`gamespec_pyomo.nlfile`); the solver
 eliminates variables with equal bounds before it starts.
-Constraints: the defects ``D X - T W F(X, U, t) = 0``, path constraints at every evaluation point,
-boundary constraints over the end values and integral constraints ``T q^T g``; objective ``Phi + T
-q^T L`` in minimization form. The ``scaling_factor`` Suffix (``1/scale``, written to the NL file as
-a suffix, which ripopt reads) gives the solver the scaled variables the casadi backend gives IPOPT.
+Constraints: the defects ``(D X - T W F(X, U, t)) / s_x = 0`` (s_x: the state scales), path
+constraints at every evaluation point, boundary constraints over the end values and integral
+constraints ``T q^T g``; objective ``Phi + T q^T L`` in minimization form. The ``scaling_factor``
+Suffix (``1/scale``, written to the NL file as a suffix, which ripopt reads) gives the solver the
+scaled variables the casadi backend gives IPOPT.
 """
 
 from __future__ import annotations
@@ -109,9 +110,12 @@ def build_model(tr: Transcription, params: Mapping[str, float]) -> Any:
         integrands.append(terms.integrands)
     n_path, n_int = len(ocp.running_structure.path), range(len(ocp.running_structure.integrands))
 
+    sx, su = tr.compiled_scaling.states, tr.compiled_scaling.controls
+
     def defect(_m: Any, i: int, row: int) -> Any:
-        dx = sum(v * m.X[i, int(c)] for c, v in _row(D, row))
-        return dx - m.T * sum(v * F[i, int(c)] for c, v in _row(W, row)) == 0
+        """The defect row divided by its state's scale (:mod:`gamespec.ocp.scaling`)."""
+        dx = sum(float(v / sx[i]) * m.X[i, int(c)] for c, v in _row(D, row))
+        return dx - m.T * sum(float(v / sx[i]) * F[i, int(c)] for c, v in _row(W, row)) == 0
 
     m.defect = pyo.Constraint(range(tr.n_x), range(D.shape[0]), rule=defect)
     m.path = pyo.Constraint(range(n_path), range(k), rule=lambda _m, r, col: path[col][r])
@@ -127,7 +131,6 @@ def build_model(tr: Transcription, params: Mapping[str, float]) -> Any:
     m.objective = pyo.Objective(expr=ends.mayer + m.T * running + tr.rate_penalty(m.U))
     m.dual = pyo.Suffix(direction=pyo.Suffix.IMPORT)
     m.scaling_factor = pyo.Suffix(direction=pyo.Suffix.EXPORT)
-    sx, su = tr.scales(params)
     for (i, _), var in m.X.items():
         m.scaling_factor[var] = 1.0 / sx[i]
     for (j, _), var in m.U.items():

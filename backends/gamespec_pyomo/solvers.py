@@ -141,19 +141,29 @@ def check_options(choice: str, options: dict[str, Any]) -> None:
 
 @dataclass(frozen=True)
 class Run:
-    """One run of an executable on an NL file: Pyomo's reading of the SOL file, the log and the
-    seconds the process took."""
+    """One run of an executable on an NL file: Pyomo's reading of the SOL file (None when the run
+    was stopped at its wall-clock limit), the log and the seconds the process took."""
 
     results: Any
     log: str
     seconds: float
 
+    @property
+    def stopped(self) -> bool:
+        """Whether the process was killed at the wall-clock limit (no SOL file)."""
+        return self.results is None
 
-def run_solver(exe: Executable, nl_text: str, options: dict[str, Any]) -> Run:
+
+def run_solver(exe: Executable, nl_text: str, options: dict[str, Any], wall_time: float | None = None) -> Run:
     """Run ``exe`` on the NL file ``nl_text`` as Pyomo's AMPL solvers do (``key=value`` on the command
     line and in ``<name>_options``; an ``OF_key`` option in the options file ``<name>.opt`` in the
     working directory, where Ipopt reads every option it has) and read its SOL file with Pyomo's
-    reader (duals included); BackendError when it exits with an error or writes no SOL file."""
+    reader (duals included); BackendError when it exits with an error or writes no SOL file.
+
+    ``wall_time``: the seconds the process may run; it is killed then (a :attr:`Run.stopped` run).
+    The solver's own ``max_wall_time`` is checked once an iteration (2-4 s an iteration on
+    definition-heavy models, and after its setup: runs given 300 s ended at 330-420 s, issue 25), so
+    only a kill makes the limit one."""
     from pyomo.opt.plugins.sol import ResultsReader_sol
 
     in_file = {key.removeprefix("OF_"): value for key, value in options.items() if key.startswith("OF_")}
@@ -172,8 +182,17 @@ def run_solver(exe: Executable, nl_text: str, options: dict[str, Any]) -> Run:
         tic = time.perf_counter()
         try:
             done = subprocess.run(
-                cmd, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True, env=env, cwd=tmp
+                cmd,
+                stdout=subprocess.PIPE,
+                stderr=subprocess.STDOUT,
+                text=True,
+                env=env,
+                cwd=tmp,
+                timeout=None if wall_time is None else max(wall_time, 0.0),
             )
+        except subprocess.TimeoutExpired as stopped:
+            log = stopped.stdout if isinstance(stopped.stdout, str) else (stopped.stdout or b"").decode()
+            return Run(None, log, time.perf_counter() - tic)
         except OSError as err:
             raise BackendError(f"{exe.name} failed to run: {err}") from None
         seconds = time.perf_counter() - tic

@@ -148,6 +148,11 @@ class SymbolicOcp:
             return dict(values)
         return {**values, name: algebra.binary(ast.Add, values[name], values[INITIAL_TIME])}
 
+    def definitions(self, values: Mapping[str, Any], algebra: Algebra) -> dict[str, Any]:
+        """Each definition by name, built over ``values`` and the earlier ones."""
+        scope = self._scope(values, algebra)
+        return {name: scope[name] for name in self.spec.problem.definitions}
+
     def running_terms(self, values: Mapping[str, Any], algebra: Algebra) -> RunningTerms:
         """The running terms over ``values`` (each of :attr:`running_names` by name)."""
         problem = self.spec.problem

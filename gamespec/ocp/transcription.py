@@ -18,8 +18,10 @@ import numpy as np
 from gamespec.errors import ExpressionError, SpecError
 from gamespec.ocp.checks import Trajectory, check_tolerances, control_basis, solution_checks, verdicts
 from gamespec.ocp.collocation import Grid
+from gamespec.ocp.diagnostics import Point, non_finite_report
 from gamespec.ocp.events import InteriorPoints, with_event_breaks
 from gamespec.ocp.inputs import InputGrid, InputValue, on_grid
+from gamespec.ocp.scaling import Scaling, variable_scaling
 from gamespec.ocp.symbolic import SymbolicOcp
 from gamespec.result import Result, Status
 from gamespec.specs.ocp import INITIAL_TIME, NORMALIZED_TIME, OptimalControlSpec, bounds_midpoint
@@ -279,26 +281,48 @@ class Transcription:
         return first, last
 
     def scales(self, params: Mapping[str, float]) -> tuple[np.ndarray, np.ndarray]:
-        """Per state and per control, the factor the NLP divides the variable by (``scale:``; 1 when
-        unset). ``auto`` takes the largest finite bound magnitude, else the largest magnitude of the
-        guess, else 1; the same factors on every backend."""
-        start = self.guess(params)
-        found = []
-        for group, values, limits in (
-            (self.spec.problem.states, start.X, self.ocp.state_bounds(params)),
-            (self.spec.problem.controls, start.U, self.ocp.control_bounds(params)),
-        ):
-            row = []
-            for spec, guess, (lo, hi, *_) in zip(group.values(), values, limits, strict=True):
-                if spec.scale is None:
-                    row.append(1.0)
-                elif spec.scale != "auto":
-                    row.append(abs(float(spec.scale)) or 1.0)
-                else:
-                    finite = [abs(b) for b in (lo, hi) if np.isfinite(b) and b != 0]
-                    row.append(max(finite) if finite else float(np.max(np.abs(guess), initial=0.0)) or 1.0)
-            found.append(np.array(row, dtype=float))
-        return found[0], found[1]
+        """Per state and per control, the factor the NLP divides the variable (and a state's defect
+        rows) by: :func:`gamespec.ocp.scaling.variable_scaling`, the same factors on every backend."""
+        found = self.scaling(params)
+        return found.states, found.controls
+
+    def scaling(self, params: Mapping[str, float]) -> Scaling:
+        """The scale factors with the warning :mod:`gamespec.ocp.scaling` gives."""
+        return variable_scaling(self, params)
+
+    @cached_property
+    def compiled_scaling(self) -> Scaling:
+        """The factors a backend compiles with (the file's parameter values): the Result reports
+        them (``metrics["scaling"]``, where any is not 1) and their warning."""
+        return self.scaling(self.ocp.parameter_values())
+
+    def _with_non_finite(self, message: str, at: Point, params: Mapping[str, float]) -> str:
+        """``message`` with the file's expression that is NaN or infinite at ``at``, else at the
+        file's starting point for ``params`` (:mod:`gamespec.ocp.diagnostics`), where one is."""
+        try:
+            report = non_finite_report(self, at)
+            if report is None:
+                start = self.guess(params)
+                values = dict(params) | dict(zip(self.ocp.design, map(float, start.d), strict=True))
+                report = non_finite_report(self, Point(start.X, start.U, start.T, at.inputs, values))
+                report = None if report is None else f"at the starting point, {report}"
+        except (SpecError, ExpressionError, ArithmeticError, ValueError, TypeError):
+            return message  # the diagnosis is a courtesy: a failed Result stays a Result
+        return message if report is None else f"{message}: {report}"
+
+    def _scaling_metrics(self) -> dict[str, Any]:
+        found = self.compiled_scaling
+        scaled = {
+            group: {n: float(s) for n, s in zip(names, factors, strict=True) if s != 1.0}
+            for group, names, factors in (
+                ("states", self.ocp.states, found.states),
+                ("controls", self.ocp.controls, found.controls),
+            )
+        }
+        entry: dict[str, Any] = {k: v for k, v in scaled.items() if v}
+        if found.warning:
+            entry["warning"] = found.warning
+        return {"scaling": entry} if entry else {}
 
     def rate_penalty(self, U: Any) -> Any:
         """``w * sum_j sum_k (U[j, k+1] - U[j, k])**2 / (tau_{k+1} - tau_k)`` over consecutive
@@ -363,9 +387,12 @@ class Transcription:
         tolerances = check_tolerances(checks, refine.tolerance if refine else None)
         if lam is not None:
             arrays["costate_time"] = t_eval
+        if status in (Status.NUMERICAL_ERROR, Status.ERROR):
+            message = self._with_non_finite(message, Point(X, U, T, inputs, {**params, **optimized}), params)
+        warning = self.compiled_scaling.warning
         return Result(
             status=status,
-            message=message,
+            message=f"{message}; scaling: {warning}" if warning else message,
             objective=objective,
             t_final=origin + T,
             solve_time_s=solve_time_s,
@@ -381,6 +408,7 @@ class Transcription:
             metrics=({"design": optimized} if optimized else {})
             | {"checks_passed": verdicts(checks, tolerances), "check_tolerances": tolerances}
             | ({"checks_skipped": skipped} if skipped else {})
+            | self._scaling_metrics()
             | {
                 "plot": {
                     **self.spec.plot.as_metrics(),

@@ -65,8 +65,10 @@ class StateSpec(StrictModel):
     )
     lower: Value | None = Field(None, description="Lower bound; omitted: none.")
     upper: Value | None = Field(None, description="Upper bound; omitted: none.")
-    scale: Number | Literal["auto"] | None = Field(
-        None, description="The NLP sees this variable divided by scale; auto: from the bounds or the guess."
+    scale: Number | Literal["auto", "none"] | None = Field(
+        None,
+        description="The NLP sees this variable divided by scale; auto: a power of ten from the guess and"
+        " the fixed end values, else the bounds (gamespec.ocp.scaling); none: 1; unset: method.scale.",
     )
 
 
@@ -80,8 +82,10 @@ class ControlSpec(StrictModel):
     upper: Value | None = Field(
         None, description="Upper bound (a number or an expression of the parameters); omitted: none."
     )
-    scale: Number | Literal["auto"] | None = Field(
-        None, description="The NLP sees this variable divided by scale; auto: from the bounds or the guess."
+    scale: Number | Literal["auto", "none"] | None = Field(
+        None,
+        description="The NLP sees this variable divided by scale; auto: a power of ten from the guess and"
+        " the fixed end values, else the bounds (gamespec.ocp.scaling); none: 1; unset: method.scale.",
     )
 
 
@@ -755,6 +759,11 @@ class MethodSpec(StrictModel):
         None, description="Radau degree of each interval (one per interval; from hp refinement)."
     )
     refine: RefineSpec | None = Field(None, description="Adaptive mesh refinement on the defect estimate.")
+    scale: Literal["auto", "none"] = Field(
+        "auto",
+        description="Scaling of the states and controls whose own scale is unset (auto: each by a power of"
+        " ten of its magnitude, with its defect rows; none: unscaled).",
+    )
 
     @model_validator(mode="before")
     @classmethod

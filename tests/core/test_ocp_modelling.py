@@ -354,16 +354,18 @@ def test_each_check_has_a_verdict_against_its_tolerance() -> None:
 def test_scale_factors_from_the_file_the_bounds_and_the_guess() -> None:
     tr = Transcription(gamespec.load(HANG_GLIDER))
     sx, su = tr.scales(tr.ocp.parameter_values())
-    assert list(sx) == [1000.0, 1000.0, 1.0, 1.0]  # given; auto from the guess (1000 -> 900); unset
-    assert list(su) == [1.4]  # auto from the bounds [0, 1.4]
+    # given; auto from the guess (1000 -> 900: 10^3); unset, so auto, of magnitude ~10: 1
+    assert list(sx) == [1000.0, 1000.0, 1.0, 1.0]
+    assert list(su) == [1.0]  # auto from the guess 0.7 (the middle of [0, 1.4]): within 10^±2 of 1
 
 
 @pytest.mark.parametrize("backend", ["casadi", "pyomo"])
 def test_scaling_leaves_the_optimum_where_it_is(backend: str) -> None:
     unscaled = [
-        "problem.states.x.scale=null",
-        "problem.states.y.scale=null",
-        "problem.controls.cL.scale=null",
+        "problem.states.x.scale=none",
+        "problem.states.y.scale=none",
+        "problem.controls.cL.scale=none",
+        "method.scale=none",
     ]
     scaled = gamespec.solve(gamespec.load(HANG_GLIDER, SMALL), backend)
     plain = gamespec.solve(gamespec.load(HANG_GLIDER, [*SMALL, *unscaled]), backend)

@@ -59,3 +59,40 @@ def test_feasible_linear_transcription_is_solved_and_agrees_with_casadi() -> Non
 def test_casadi_agrees_that_it_is_infeasible() -> None:
     spec = gamespec.spec_from_dict(_double_integrator(1.0, 1.0))
     assert gamespec.solve(spec, "casadi").status is Status.LOCALLY_INFEASIBLE
+
+
+def _cubic_decay(x_final: float) -> dict:
+    """``x' = -x^3 + u``, ``|u| <= 1/2``, from x(0) = 0 to x(1) = x_final: while x >= 0 the slope is
+    at most 1/2, so x(1) <= 1/2 (a comparison argument, no solver): x_final = 2 is infeasible."""
+    return {
+        "kind": "optimal_control",
+        "name": "cubic_decay",
+        "problem": {
+            "states": {"x": {"initial": 0.0, "final": x_final}},
+            "controls": {"u": {"lower": -0.5, "upper": 0.5}},
+            "dynamics": {"x": "-x**3 + u"},
+            "objective": {"lagrange": "u**2"},
+            "time": {"final": 1.0},
+        },
+        "method": {"intervals": 20, "degree": 3},
+    }
+
+
+def test_infeasible_nonlinear_problem_is_locally_infeasible_in_seconds() -> None:
+    """ripopt alone ends ``Restoration Failed`` (numerical_error); the elastic problem of
+    :mod:`gamespec_pyomo.feasibility` finds a positive least violation, as IPOPT does on casadi."""
+    spec = gamespec.spec_from_dict(_cubic_decay(2.0))
+    start = _cpu_seconds()
+    result = gamespec.solve(spec, "pyomo")
+    assert result.status is Status.LOCALLY_INFEASIBLE, result.message
+    assert "l1 norm of the constraint violation" in result.message
+    assert _cpu_seconds() - start < 20
+    assert gamespec.solve(spec, "casadi").status is Status.LOCALLY_INFEASIBLE
+
+
+def test_feasible_nonlinear_counterpart_is_solved() -> None:
+    """x_final = 0.3 is below the bound 1/2: both backends solve it and agree."""
+    spec = gamespec.spec_from_dict(_cubic_decay(0.3))
+    pyomo, casadi = gamespec.solve(spec, "pyomo"), gamespec.solve(spec, "casadi")
+    assert pyomo.status is Status.OPTIMAL and casadi.status is Status.OPTIMAL
+    assert pyomo.objective == pytest.approx(casadi.objective, rel=1e-6)

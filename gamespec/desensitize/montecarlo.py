@@ -27,6 +27,10 @@ from gamespec.symbolic.language import symbol
 BUNDLE = 50
 """How many sampled trajectories are kept for plots."""
 
+DRAWS_KEPT = 200
+"""How many of the drawn parameter values (the first ones) are kept, with each one's verdict, for
+plots of where the uncertainty is (e.g. the sampled obstacles of the rcs figure)."""
+
 VIOLATION_TOL = 1e-6
 """A sample violates the path constraints when its largest violation exceeds this."""
 
@@ -92,9 +96,13 @@ def monte_carlo(
 ) -> tuple[dict[str, Any], dict[str, np.ndarray]]:
     """``metrics.monte_carlo`` for the open-loop control of ``result``, and the trajectories of the
     first :data:`BUNDLE` samples (``monte_carlo_<state>``, (steps+1, samples) each, on
-    ``monte_carlo_time``) for plots; with path constraints, the fraction of all samples that have
-    violated one by each time (``monte_carlo_violated``, on ``monte_carlo_time``: its last value is
-    ``violation_probability``)."""
+    ``monte_carlo_time``) and the first :data:`DRAWS_KEPT` draws of each uncertain parameter
+    (``monte_carlo_draw_<name>``) for plots; with path constraints, the fraction of all samples that
+    have violated one by each time (``monte_carlo_violated``, on ``monte_carlo_time``: its last
+    value is ``violation_probability``), whether each kept draw violated one
+    (``monte_carlo_draw_violated``, 1 or 0), and the largest violation of the same open-loop
+    re-simulation at the nominal parameters (``metrics.nominal_violation``, with
+    ``nominal_violated``: the deterministic nominal's own verdict on the same grid)."""
     d = draws(ocp, result, uncertain, options)
     run = rk4(
         ocp,
@@ -119,9 +127,23 @@ def monte_carlo(
     metrics.update(_outcome(ocp, d.x0, run, d.params))
     metrics["control_energy_mean"] = float(run.energy.mean())
     arrays = {"monte_carlo_time": run.t} | _bundle("monte_carlo", ocp, run)
+    arrays |= {f"monte_carlo_draw_{k}": v[:DRAWS_KEPT] for k, v in d.drawn.items()}
     if ocp.path:
         arrays["monte_carlo_violated"] = run.violated
+        arrays["monte_carlo_draw_violated"] = (run.violation[:DRAWS_KEPT] > VIOLATION_TOL).astype(float)
+        nominal = _nominal_violation(ocp, result, d, options.steps)
+        metrics["nominal_violation"] = nominal
+        metrics["nominal_violated"] = nominal > VIOLATION_TOL
     return metrics, arrays
+
+
+def _nominal_violation(ocp: SymbolicOcp, result: Result, d: Draws, steps: int) -> float:
+    """The largest path-constraint violation of the open-loop re-simulation at the nominal
+    parameters (one sample, the grid of the Monte Carlo's)."""
+    params = {symbol(k): v for k, v in d.nominal.items()}
+    x0 = initial_state(ocp, result, params, 1)
+    run = rk4(ocp, x0, d.controls, params, d.t0, d.tf, steps, keep=0, inputs=d.inputs)
+    return float(run.violation[0])
 
 
 def _bundle(prefix: str, ocp: SymbolicOcp, run: Trajectories) -> dict[str, np.ndarray]:

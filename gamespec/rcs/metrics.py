@@ -21,9 +21,22 @@ class Rcs(BaseModel):
     relevance: str = Field(description="Name or expression of r̃(w).")
 
 
+class ObstacleSamples(BaseModel):
+    """One entry of ``metrics.obstacle_samples`` (:class:`gamespec.rcs.transform.MovingObstacles`):
+    where the figure draws the obstacle's sampled centres (``obstacle_<name>_sampled_x``/``_y``)."""
+
+    model_config = ConfigDict(extra="forbid")
+
+    time: Finite = Field(description="Time of the agent's closest approach to the nominal centre.")
+    clearance: Finite | None = Field(
+        None, description="Centre distance less r_o there (none for an obstacle on a track)."
+    )
+
+
 def check_obstacles(result: Result, obstacles: dict[str, float]) -> None:
     """The tracks of ``obstacles`` (one point per time point) and the path and S_g/S_r curves that
-    :func:`gamespec.rcs.plotting.plot_rcs` draws with them."""
+    :func:`gamespec.rcs.plotting.plot_rcs` draws with them, and the obstacles' sampled centres
+    (one per kept Monte Carlo draw, with its verdict) where ``metrics.obstacle_samples`` has them."""
     if result.time is None:
         raise ValueError("an rcs Result without a time grid")
     points = len(result.time)
@@ -37,6 +50,13 @@ def check_obstacles(result: Result, obstacles: dict[str, float]) -> None:
     for name in obstacles:
         array(result, f"obstacle_{name}_x", 1, rows=points)
         array(result, f"obstacle_{name}_y", 1, rows=points)
+    samples = result.metrics.get("obstacle_samples", {})
+    for name, entry in samples.items():
+        ObstacleSamples.model_validate(entry)
+        if f"obstacle_{name}_sampled_x" in result.arrays:
+            sampled = array(result, f"obstacle_{name}_sampled_x", 1)
+            array(result, f"obstacle_{name}_sampled_y", 1, rows=len(sampled))
+            array(result, "monte_carlo_draw_violated", 1, rows=len(sampled))
     if result.t_final is None:
         raise ValueError("an rcs Result with obstacles has no t_final")
 

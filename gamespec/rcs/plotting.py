@@ -112,20 +112,58 @@ def _draw_path(ax, result: Result, label: str | None = None, color=None, snapsho
     line.set_zorder(3)
 
 
+def _draw_samples(ax, result: Result) -> None:
+    """Where the uncertainty is: each obstacle's centre for the Monte Carlo's kept draws at the
+    agent's closest approach to its nominal centre (``metrics.obstacle_samples``), the draws whose
+    open-loop run collided (anywhere along it) in red, the others in grey, and the nominal
+    obstacle's outline and the agent there."""
+    plt = _pyplot()
+    verdicts = result.arrays.get("monte_carlo_draw_violated")
+    for name, entry in result.metrics.get("obstacle_samples", {}).items():
+        if f"obstacle_{name}_sampled_x" not in result.arrays or verdicts is None:
+            continue
+        sx, sy = result.arrays[f"obstacle_{name}_sampled_x"], result.arrays[f"obstacle_{name}_sampled_y"]
+        hit = verdicts > 0
+        when = f"{name} at t = {entry['time']:.3g}"
+        for chosen, colour, what in ((hit, "tab:red", "collided"), (~hit, "0.35", "clear")):
+            ax.scatter(
+                sx[chosen],
+                sy[chosen],
+                s=9,
+                color=colour,
+                alpha=0.6,
+                zorder=4,
+                label=f"sampled centre, {when}: {what} ({np.count_nonzero(chosen)} of {hit.size})",
+            )
+        k = int(np.argmin(np.abs(np.asarray(result.time) - entry["time"])))
+        centre = (result.arrays[f"obstacle_{name}_x"][k], result.arrays[f"obstacle_{name}_y"][k])
+        radius = result.metrics["obstacles"][name]
+        ax.add_patch(
+            plt.Circle(centre, radius, fill=False, ls="--", color="k", label=f"nominal {when}", zorder=4)
+        )
+
+
 def plot_rcs(result: Result, output_dir: Path) -> list[Path]:
-    """A Result of the ``rcs`` transform: the path among the obstacles, S_g and S_r along it, and
-    the map of Fig. 6.6 about its first obstacle at the time of closest approach."""
+    """A Result of the ``rcs`` transform: the path among the obstacles with the obstacles' sampled
+    centres at the closest approach, S_g and S_r along it, and the map of Fig. 6.6 about its first
+    obstacle at the time of closest approach."""
     plt = _pyplot()
     output_dir.mkdir(parents=True, exist_ok=True)
     paths = []
     if "x" in result.states and _obstacle_names(result):
         fig, ax = plt.subplots(figsize=(6.5, 5))
         _draw_path(ax, result, label="nominal path")
+        _draw_samples(ax, result)
         ax.set_aspect("equal", adjustable="datalim")
         ax.set_xlabel("x")
         ax.set_ylabel("y")
         ax.set_title(
             f"{headline(result)}\nobstacles at {OBSTACLE_SNAPSHOTS} times (same colour as the agent)"
+            + (
+                "; sampled obstacles at the closest approach"
+                if result.metrics.get("obstacle_samples")
+                else ""
+            )
             + collision_note(result).replace(", ", "\n", 1),
             fontsize="medium",
         )

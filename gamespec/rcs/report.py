@@ -16,7 +16,15 @@ Rows = list[tuple[str, object]]
 
 
 def rcs_summary(result: Result) -> Rows:
-    """P_c with its interval and sample count, and which constraints the regularizer weighted."""
+    """P_c with its interval and sample count, the nominal's verdict, and which constraints the
+    regularizer weighted.
+
+    "The nominal's" (issue 28) is read as the deterministic nominal's own verdict, not as P_c of an
+    undesensitized (Q = 0) solve, which a single solve does not compute: the same open-loop
+    re-simulation at the nominal parameters collides or not (its largest path-constraint violation
+    on the Monte Carlo's grid, ``metrics.monte_carlo.nominal_violation``), and, for each obstacle
+    off a track, the clearance (centre distance less r_o) at the agent's closest approach
+    (``metrics.obstacle_samples``)."""
     m = result.metrics
     mc = m.get("monte_carlo", {})
     rows: Rows = []
@@ -25,6 +33,19 @@ def rcs_summary(result: Result) -> Rows:
         interval = f" [{low:.3g}, {high:.3g}]" if low is not None and high is not None else ""
         rows.append(("collision probability P_c", f"{mc['collision_probability']:.4g}{interval}"))
         rows.append(("Monte Carlo samples", mc.get("samples")))
+    if "nominal_violated" in mc:
+        verdict = "collides" if mc["nominal_violated"] else "no collision"
+        rows.append(
+            (
+                "nominal (parameters at their values)",
+                f"{verdict}, largest violation {mc['nominal_violation']:.3g}",
+            )
+        )
+    for name, entry in m.get("obstacle_samples", {}).items():
+        if entry.get("clearance") is not None:
+            rows.append(
+                (f"nominal clearance to {name}", f"{entry['clearance']:.4g} at t = {entry['time']:.4g}")
+            )
     rcs = m.get("rcs", {})
     if rcs.get("constraints"):
         rows.append(("regularized constraints", ", ".join(rcs["constraints"])))

@@ -2,7 +2,13 @@
 
 ``moving_obstacles`` appends one avoidance path constraint ``g <= 0`` per declared obstacle
 (:mod:`gamespec.rcs.obstacles`: eqs. 6.39, 6.41, 6.43-6.44) and, on the way back, puts the
-obstacles' positions along the solution in the Result (``obstacle_<name>_x``/``_y``) for plots.
+obstacles' positions along the solution in the Result (``obstacle_<name>_x``/``_y``) for plots,
+the time of the agent's closest approach to each nominal obstacle centre and, for an obstacle off
+a track, the clearance there (centre distance less r_o: ``metrics.obstacle_samples``, typed by
+:class:`gamespec.rcs.metrics.ObstacleSamples`). When a Monte Carlo ran upstream (the ``rcs``
+transform's ``monte_carlo``, whose kept draws are ``monte_carlo_draw_<name>``), it adds each
+obstacle's centre for those draws at that time (``obstacle_<name>_sampled_x``/``_y``): where the
+uncertainty is, in the plane.
 
 ``rcs`` adds the state sensitivities the desensitize transform builds (eq. 6.12, the identically
 zero ones left out) and the cost ``∫‖vec S_r‖²_Q`` with ``S_r = R S_g`` (eqs. 6.31-6.36), or
@@ -86,6 +92,9 @@ class ObstacleData:
     positions: dict[str, tuple[sp.Expr, sp.Expr]]
     radii: dict[str, sp.Expr]
     power: sp.Expr
+    agent: tuple[sp.Expr, sp.Expr]
+    on_track: frozenset[str]
+    """The obstacles moving along a track (eqs. 6.43-6.44), whose clearance is not a distance."""
 
 
 class MovingObstacles(
@@ -112,7 +121,8 @@ class MovingObstacles(
         new.with_source(spec.source, spec.file_hash)
         positions = {n: geometry.position(o, read, t0) for n, o in options.obstacles.items()}
         radii = {n: read(o.radius) for n, o in options.obstacles.items()}
-        return new, ObstacleData(positions, radii, power)
+        tracks = frozenset(n for n, o in options.obstacles.items() if o.track is not None)
+        return new, ObstacleData(positions, radii, power, agent, tracks)
 
     def invert(self, result: Result, spec: OptimalControlSpec, inverse_data: ObstacleData) -> Result:
         arrays, metrics = dict(result.arrays), dict(result.metrics)
@@ -127,9 +137,48 @@ class MovingObstacles(
             metrics["obstacles"] = {
                 n: float(evaluate([r], params, ())[0]) for n, r in inverse_data.radii.items()
             }
+            values |= {symbol(k): v for k, v in result.states.items()}
+            agent = evaluate(list(inverse_data.agent), values, t.shape)
+            samples = _sampled(result, inverse_data, agent, arrays, metrics["obstacles"])
+            metrics["obstacle_samples"], sampled = samples
+            arrays |= sampled
         return result.model_copy(
             update={"arrays": arrays, "metrics": metrics, "kind": spec.kind, "problem": spec.name}
         )
+
+
+def _sampled(
+    result: Result,
+    data: ObstacleData,
+    agent: np.ndarray,
+    positions: dict[str, np.ndarray],
+    radii: dict[str, float],
+) -> tuple[dict[str, dict[str, float]], dict[str, np.ndarray]]:
+    """Per obstacle: the time of the agent's closest approach to its nominal centre (the first
+    when several tie), the clearance there (off a track), and its centre at that time for each
+    kept Monte Carlo draw (the draws of ``monte_carlo_draw_<name>``, the other parameters at their
+    values)."""
+    t = np.asarray(result.time)
+    prefix = "monte_carlo_draw_"
+    drawn = {k.removeprefix(prefix): v for k, v in result.arrays.items() if k.startswith(prefix)}
+    drawn = {k: v for k, v in drawn.items() if k in result.parameters}
+    count = min((len(v) for v in drawn.values()), default=0)
+    params: dict[sp.Symbol, np.ndarray | float] = {
+        symbol(k): drawn[k][:count] if k in drawn else v for k, v in result.parameters.items()
+    }
+    metrics: dict[str, dict[str, float]] = {}
+    arrays: dict[str, np.ndarray] = {}
+    for name, (px, py) in data.positions.items():
+        ox, oy = positions[f"obstacle_{name}_x"], positions[f"obstacle_{name}_y"]
+        gap = np.hypot(agent[0] - ox, agent[1] - oy)
+        k = int(np.argmin(gap))
+        metrics[name] = {"time": float(t[k])}
+        if name not in data.on_track:
+            metrics[name]["clearance"] = float(gap[k] - radii[name])
+        if count:
+            xy = evaluate([px, py], {**params, TIME: float(t[k])}, (count,))
+            arrays[f"obstacle_{name}_sampled_x"], arrays[f"obstacle_{name}_sampled_y"] = xy[0], xy[1]
+    return metrics, arrays
 
 
 @dataclass(frozen=True)

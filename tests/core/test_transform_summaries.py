@@ -4,6 +4,8 @@ probability with the interval — read from real solves, every row naming a numb
 
 from __future__ import annotations
 
+import numpy as np
+
 import gamespec
 from gamespec.summaries import outcome
 from tests.conftest import PROBLEMS
@@ -36,3 +38,20 @@ def test_rcs_summary_has_the_collision_probability_with_its_interval() -> None:
     low, high = mc["collision_probability_ci"]
     assert rows["collision probability P_c"] == f"{mc['collision_probability']:.4g} [{low:.3g}, {high:.3g}]"
     assert rows["Monte Carlo samples"] == 200
+
+
+def test_rcs_summary_has_the_nominal_verdict_and_its_clearance() -> None:
+    """The nominal's row (the deterministic nominal, :func:`gamespec.rcs.report.rcs_summary`): its
+    verdict is the saved re-simulation's, and the clearance is the smallest distance between the
+    agent and the nominal obstacle centre (eq. 6.38 at ρ̂) less r_o, recomputed from the states."""
+    from tests.plots import fixtures
+
+    result = fixtures.saved(PROBLEMS / "ch6/rcs_constraint_form.yaml")
+    rows = dict(outcome(result))
+    mc, p = result.metrics["monte_carlo"], result.parameters
+    verdict = "collides" if mc["nominal_violation"] > 1e-6 else "no collision"
+    assert rows["nominal (parameters at their values)"].startswith(verdict + ", largest violation")
+    x, y, t = result.states["x"], result.states["y"], result.time
+    gap = np.hypot(x - p["c"], y + p["d"] - p["rho"] * t) - p["r_o"]
+    assert rows["nominal clearance to obstacle"] == f"{gap.min():.4g} at t = {t[np.argmin(gap)]:.4g}"
+    assert gap.min() > 0 and not mc["nominal_violated"], "the solved path clears the nominal obstacle"

@@ -416,3 +416,41 @@ def test_the_collision_probability_is_drawn_along_the_path(name, tmp_path) -> No
     )
     assert np.array_equal(line.get_ydata(), along)
     assert np.array_equal(line.get_xdata(), result.arrays["monte_carlo_time"])
+
+
+@pytest.mark.parametrize(
+    "name", ["ch6/car_vs_train.yaml", "ch6/rcs_single_obstacle.yaml", "ch6/rcs_constraint_form.yaml"]
+)
+def test_the_sampled_obstacles_are_drawn_at_the_closest_approach(name, tmp_path) -> None:
+    """Uncertainty drawn where it is: the saved sampled centres are the obstacle's motion
+    (eq. 6.38: ``center + velocity·t``) recomputed from the kept draws at the saved time of closest
+    approach, that time is where the agent is nearest the nominal centre, the saved verdicts are as
+    many as the kept draws and collide at the rate P_c within sampling error, and the obstacle
+    figure draws exactly those centres, split by verdict, with counts in the legend."""
+    result = fixtures.saved(PROBLEMS / name)
+    spec = fixtures.spec_of(PROBLEMS / name)
+    ((obstacle, entry),) = result.metrics["obstacle_samples"].items()
+    declared = spec.transforms[0]["moving_obstacles"]["obstacles"][obstacle]
+    rho = result.arrays["monte_carlo_draw_rho"]
+    p = dict(result.parameters)
+    assert declared["center"] == ["c", "-d"] and declared["velocity"] == [0, "rho"]
+    sx, sy = result.arrays[f"obstacle_{obstacle}_sampled_x"], result.arrays[f"obstacle_{obstacle}_sampled_y"]
+    assert np.allclose(sx, p["c"]) and np.allclose(sy, -p["d"] + rho * entry["time"])
+    y = result.states.get("y", np.zeros_like(result.states["x"]))
+    gap = np.hypot(result.states["x"] - p["c"], y + p["d"] - p["rho"] * result.time)
+    assert entry["time"] == result.time[int(np.argmin(gap))]
+    verdicts = result.arrays["monte_carlo_draw_violated"]
+    mc = result.metrics["monte_carlo"]
+    assert set(np.unique(verdicts)) <= {0.0, 1.0} and len(verdicts) == len(rho) == min(200, mc["samples"])
+    p_c = mc["collision_probability"]
+    assert abs(verdicts.mean() - p_c) <= 4 * np.sqrt(max(p_c * (1 - p_c), 1e-3) / len(verdicts))
+    with recording() as saved:
+        plot_result(result, tmp_path)
+    (ax,) = next(s for s in saved if s.name == f"{result.problem}_obstacles.png").axes
+    clouds = {c.get_label().split(": ")[-1].split(" (")[0]: c.get_offsets() for c in ax.collections}
+    hit = verdicts > 0
+    assert np.array_equal(clouds["collided"], np.column_stack([sx[hit], sy[hit]]))
+    assert np.array_equal(clouds["clear"], np.column_stack([sx[~hit], sy[~hit]]))
+    labels = legend_texts(ax)
+    assert any(f"collided ({np.count_nonzero(hit)} of {hit.size})" in label for label in labels)
+    assert any(label.startswith(f"nominal {obstacle} at t = ") for label in labels)

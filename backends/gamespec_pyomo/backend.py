@@ -233,20 +233,8 @@ class PyomoModel(CollocationModel):
         tic = time.perf_counter()
         why = self.linear.infeasibility()
         if why is not None:
-            X, U, T = self._values()
-            return tr.result(
-                X=X,
-                U=U,
-                T=T,
-                objective=None,
-                params=params,
-                inputs=Win,
-                status=Status.INFEASIBLE,
-                message=why,
-                solve_time_s=time.perf_counter() - tic,
-                iterations=0,
-                solver_stats={"solver": "highs (LP feasibility check)"},
-            )
+            stats = {"solver": "highs (LP feasibility check)"}
+            return self._unsolved(params, Win, Status.INFEASIBLE, why, time.perf_counter() - tic, 0, stats)
         run = self._execute(tic + self.options.max_wall_time)
         elapsed = time.perf_counter() - tic
         if run.stopped:
@@ -291,8 +279,26 @@ class PyomoModel(CollocationModel):
 
     def _stopped(self, params: dict[str, float], Win: np.ndarray, run: Run, elapsed: float) -> Result:
         """The Result of a run killed at the wall-clock limit: the starting point, no objective."""
-        X, U, T = self._values()
         name = self.executable.name
+        message = (
+            f"{name} stopped at the wall-clock limit of {self.options.max_wall_time:g} s"
+            " (solver.options.pyomo.max_wall_time)"
+        )
+        stats = {"solver": name, "executable": self.executable.path, "process_time_s": run.seconds}
+        return self._unsolved(params, Win, Status.TIME_LIMIT, message, elapsed, iterations_in(run.log), stats)
+
+    def _unsolved(
+        self,
+        params: dict[str, float],
+        Win: np.ndarray,
+        status: Status,
+        message: str,
+        elapsed: float,
+        iterations: int | None,
+        stats: dict[str, Any],
+    ) -> Result:
+        """A Result with no solution (no objective): the model's current values, ``status`` and why."""
+        X, U, T = self._values()
         return self.tr.result(
             X=X,
             U=U,
@@ -300,12 +306,11 @@ class PyomoModel(CollocationModel):
             objective=None,
             params=params,
             inputs=Win,
-            status=Status.TIME_LIMIT,
-            message=f"{name} stopped at the wall-clock limit of {self.options.max_wall_time:g} s"
-            " (solver.options.pyomo.max_wall_time)",
+            status=status,
+            message=message,
             solve_time_s=elapsed,
-            iterations=iterations_in(run.log),
-            solver_stats={"solver": name, "executable": self.executable.path, "process_time_s": run.seconds},
+            iterations=iterations,
+            solver_stats=stats,
         )
 
 

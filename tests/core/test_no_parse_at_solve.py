@@ -1,0 +1,50 @@
+"""Issue 27, item 3: a file's text is parsed when the problem is compiled, never when the compiled
+model solves. Every evaluation of an expression's text goes through the grammar's tree walker
+(:func:`gamespec.symbolic.grammar.expression` and ``relation``, whatever module imports them), so
+the walker is made to raise and the compiled model must still solve, twice."""
+
+from __future__ import annotations
+
+import pytest
+
+from gamespec.loader import load
+from gamespec.solving import compile_spec
+from gamespec.symbolic import grammar
+from tests.conftest import PROBLEMS
+
+
+def _refuse_parsing(monkeypatch: pytest.MonkeyPatch) -> None:
+    def refused(self: object, text: str, *args: object) -> None:
+        raise AssertionError(f"an expression's text was parsed at solve time: {text!r}")
+
+    monkeypatch.setattr(grammar._Walker, "__init__", refused)
+
+
+def test_iterative_lq_games_solve_without_parsing_text(monkeypatch):
+    """The feedback game of a non-LQ file (iterative LQ games): its discrete game is built from the
+    expressions parsed at compile (:mod:`gamespec.games.expressions`), the first solve included."""
+    path = PROBLEMS / "ch7" / "unicycle_pursuit_evasion.yaml"
+    compiled = compile_spec(load(path, ["game.information=feedback", "method.intervals=5"]))
+    _refuse_parsing(monkeypatch)
+    first = compiled.solve()
+    assert first.status.ok and first.metrics["method"] == "iterative_lq", first.message
+    again = compiled.solve()
+    assert again.status == first.status
+    assert again.objective == pytest.approx(first.objective, rel=1e-12)
+
+
+@pytest.mark.xfail(
+    strict=True,
+    reason="issue 27 item 3, open for optimal_control: the constraint-violation check evaluates the "
+    "Mayer term and boundary constraints from their text at every solve (gamespec/ocp/checks.py, "
+    "max_constraint_violation → SymbolicOcp.end_terms over NumPy)",
+)
+def test_an_optimal_control_problem_solves_again_without_parsing_text(monkeypatch):
+    """After the first solve (which builds the compiled checks on first use) a re-solve of the
+    compiled model walks no text."""
+    compiled = compile_spec(load(PROBLEMS / "ocp" / "bryson_denham.yaml", ["method.intervals=10"]))
+    first = compiled.solve()
+    assert first.status.ok, first.message
+    _refuse_parsing(monkeypatch)
+    again = compiled.solve()
+    assert again.status == first.status

@@ -345,6 +345,12 @@ class NominalSpec(StrictModel):
     )
     pursuer: NominalPath = Field(description="The pursuer's nominal path.")
     evader: NominalPath = Field(description="The evader's nominal path.")
+    wall_time: float = Field(
+        0.0,
+        ge=0,
+        description="Wall seconds the reachability stage took: the covariance game may take what is left "
+        "of the backend's max_wall_time.",
+    )
 
     @model_validator(mode="after")
     def _nodes(self) -> NominalSpec:

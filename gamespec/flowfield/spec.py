@@ -29,7 +29,7 @@ from __future__ import annotations
 
 from collections.abc import Mapping
 from dataclasses import dataclass
-from typing import Literal
+from typing import Any, Literal
 
 import numpy as np
 import sympy as sp
@@ -431,6 +431,15 @@ class FlowCovarianceGameSpec(ProblemParameters, SpecBase):
     def objective_sense(self) -> str:
         """``saddle``, as the ``flow_field_game``'s."""
         return "saddle"
+
+    def structure(self, with_guess: bool = False) -> dict[str, Any]:
+        """:meth:`SpecBase.structure` without ``problem.nominal.wall_time``: the reachability
+        stage's time is a record of one run (a re-solve of a compiled chain keeps the compile's,
+        the covariance game's time limit erring on the short side), not what the game is."""
+        data = super().structure(with_guess)
+        if data["problem"]["nominal"] is not None:
+            data["problem"]["nominal"]["wall_time"] = None
+        return data
 
     @model_validator(mode="after")
     def _evaluates(self) -> FlowCovarianceGameSpec:

@@ -29,6 +29,7 @@ from __future__ import annotations
 
 from collections.abc import Mapping
 from dataclasses import dataclass
+from functools import lru_cache
 from typing import Any, Literal
 
 import numpy as np
@@ -512,8 +513,16 @@ class CovarianceGameValues:
     capture_radius: float
 
 
+@lru_cache(maxsize=4096, typed=True)
+def _parsed(value: Value, names: tuple[str, ...]) -> sp.Expr:
+    """``value`` in SymPy over the symbols ``names``, parsed once per process (at load, where the
+    spec's validator evaluates it): a solve substitutes new parameter values into the same
+    expression and parses no text again (issue 27, item 3)."""
+    return sp.sympify(parse(value, {name: symbol(name) for name in names}))
+
+
 class _Evaluator:
-    """Parses every entry and substitutes the parameter values (no eval)."""
+    """Substitutes the parameter values into every entry, each parsed once (:func:`_parsed`)."""
 
     def __init__(self, spec: FlowGameSpec | FlowCovarianceGameSpec, values: Mapping[str, float]) -> None:
         self.spec = spec
@@ -522,13 +531,9 @@ class _Evaluator:
         self.substitution = {symbol(name): sp.Float(v) for name, v in values.items()}
 
     def expression(self, value: Value, field: str, position: bool) -> sp.Expr:
-        symbols = (
-            {**self.symbols, **dict(zip(self.spec.problem.position, self.position, strict=True))}
-            if position
-            else self.symbols
-        )
+        names = [*self.symbols, *(self.spec.problem.position if position else ())]
         try:
-            return sp.sympify(parse(value, symbols)).xreplace(self.substitution)
+            return _parsed(value, tuple(dict.fromkeys(names))).xreplace(self.substitution)
         except ExpressionError as err:
             raise SpecError(str(err), field=f"problem.{field}") from None
 

@@ -7,10 +7,11 @@ from __future__ import annotations
 
 import pytest
 
-from gamespec.loader import load
+from gamespec.loader import load, spec_from_dict
 from gamespec.solving import compile_spec
 from gamespec.symbolic import grammar
 from tests.conftest import PROBLEMS
+from tests.flowfield.test_stages import _spec
 
 
 def _refuse_parsing(monkeypatch: pytest.MonkeyPatch) -> None:
@@ -48,3 +49,15 @@ def test_an_optimal_control_problem_solves_again_without_parsing_text(monkeypatc
     _refuse_parsing(monkeypatch)
     again = compiled.solve()
     assert again.status == first.status
+
+
+def test_a_flow_field_game_solves_again_without_parsing_text(monkeypatch):
+    """The staged chapter-5 chain (:mod:`gamespec.flowfield.transform`): each stage's flow,
+    players and ε are parsed once (at load) and re-evaluated at new parameter values by
+    substitution, here a new noise level that re-solves the covariance game."""
+    compiled = compile_spec(spec_from_dict(_spec()))
+    _refuse_parsing(monkeypatch)
+    first = compiled.solve()
+    assert "capture_time" in first.metrics, first.message
+    noisier = compiled.solve(parameters={"noise": 0.1})
+    assert noisier.objective > first.objective

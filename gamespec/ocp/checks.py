@@ -37,7 +37,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from gamespec.ocp.compiled_checks import point_values, reintegrate
+from gamespec.ocp.compiled_checks import boundary_values, point_values, reintegrate
 from gamespec.specs.ocp import INITIAL_TIME
 from gamespec.symbolic.grammar import FLOATS, Relation, dependencies, unknowns
 from gamespec.symbolic.library import NUMPY, LibraryAlgebra
@@ -226,8 +226,7 @@ def max_constraint_violation(
     worst += [
         _violation(row, r.lower, r.upper) for row, r in zip(values[first_path:], structure.path, strict=True)
     ]
-    ends = tr.ocp.end_terms(_end_values(tr, X, U, T, params), ARRAYS)
-    worst += [_relation_violation(r, ()) for r in ends.boundary]
+    worst += [_relation_violation(r, ()) for r in boundary_values(tr, _end_values(tr, X, U, T, params))]
     interior = tr.interior.terms(X, _arrays(params), ARRAYS)
     worst += [_relation_violation(r, ()) for r in interior.constraints]
     q = tr.grid.triplets[2]

@@ -16,10 +16,12 @@ numbers agree to rounding.
 from __future__ import annotations
 
 import weakref
+from collections.abc import Mapping
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
+from gamespec.symbolic.grammar import Relation
 from gamespec.symbolic.library import LibraryAlgebra, casadi_library
 
 if TYPE_CHECKING:
@@ -142,3 +144,32 @@ def _point_function(tr: Transcription) -> Any:
     terms = ocp.running_terms(dict(zip(ocp.running_names, slots, strict=True)), algebra)
     rows = [*terms.dynamics, terms.lagrange, *terms.integrands, *(r.expr for r in terms.path)]
     return ca.Function("point", [x, u, w, p, t], [ca.vertcat(*rows)])
+
+
+_BOUNDARIES: weakref.WeakKeyDictionary[Transcription, tuple[Any, list[Relation]]] = (
+    weakref.WeakKeyDictionary()
+)
+"""Each live transcription's compiled boundary constraints and their relations."""
+
+
+def boundary_values(tr: Transcription, values: Mapping[str, Any]) -> list[Relation]:
+    """The boundary constraints (:attr:`~gamespec.ocp.symbolic.EndTerms.boundary`) at the end
+    ``values`` (by :attr:`~gamespec.ocp.symbolic.SymbolicOcp.end_names`), their expressions one
+    CasADi SX function built once per transcription: a re-solve walks no text (issue 27, item 3)."""
+    if tr not in _BOUNDARIES:
+        _BOUNDARIES[tr] = _boundary_function(tr)
+    function, relations = _BOUNDARIES[tr]
+    point = np.array([float(values[n]) for n in tr.ocp.end_names])
+    found = np.asarray(function(point), dtype=float).reshape(-1)
+    return [Relation(v, r.lower, r.upper) for v, r in zip(found, relations, strict=True)]
+
+
+def _boundary_function(tr: Transcription) -> tuple[Any, list[Relation]]:
+    import casadi as ca
+
+    names = tr.ocp.end_names
+    ends = ca.SX.sym("ends", len(names))
+    algebra = LibraryAlgebra(casadi_library(ca))
+    terms = tr.ocp.end_terms(dict(zip(names, _split(ends, len(names)), strict=True)), algebra)
+    rows = [ca.SX(r.expr) for r in terms.boundary]
+    return ca.Function("boundary", [ends], [ca.vertcat(*rows) if rows else ca.SX(0, 1)]), terms.boundary

@@ -34,15 +34,10 @@ def test_iterative_lq_games_solve_without_parsing_text(monkeypatch):
     assert again.objective == pytest.approx(first.objective, rel=1e-12)
 
 
-@pytest.mark.xfail(
-    strict=True,
-    reason="issue 27 item 3, open for optimal_control: the constraint-violation check evaluates the "
-    "Mayer term and boundary constraints from their text at every solve (gamespec/ocp/checks.py, "
-    "max_constraint_violation → SymbolicOcp.end_terms over NumPy)",
-)
 def test_an_optimal_control_problem_solves_again_without_parsing_text(monkeypatch):
-    """After the first solve (which builds the compiled checks on first use) a re-solve of the
-    compiled model walks no text."""
+    """After the first solve (which builds the compiled checks on first use, from the text) a
+    re-solve of the compiled model walks no text: the constraint-violation check evaluates the
+    boundary constraints by a compiled function (:func:`gamespec.ocp.compiled_checks.boundary_values`)."""
     compiled = compile_spec(load(PROBLEMS / "ocp" / "bryson_denham.yaml", ["method.intervals=10"]))
     first = compiled.solve()
     assert first.status.ok, first.message

@@ -13,7 +13,7 @@ same nominal paths. Without nominal paths (no capture in stage 1) the Result is 
 
 The stage takes what is left of the backend's ``max_wall_time`` after the reachability stage
 (``problem.nominal.wall_time``), checked after each best-response iteration, each step of the lower
-value's ascent and each Monte Carlo ensemble (:class:`~gamespec.flowfield.budget.Budget`), with a
+value's ascent and each control step of the Monte Carlo (:class:`~gamespec.flowfield.budget.Budget`), with a
 progress line on stderr: past it, what is left is skipped and the Result is ``time_limit``, its
 message naming the part the limit cut short (the point reached so far is still reported).
 """
@@ -296,16 +296,21 @@ def _game(
             ("open_loop", [(carlo.samples, open_loop)]),
             ("closed_loop", [(n, s) for n, (_, s) in zip(draws, closed, strict=True) if n]),
         ):
-            if budget.expired():
-                cut.append(f"Monte Carlo, {name} not simulated")
-                continue
             x0 = data.origins.reshape(-1)
             ensembles = []
             for j, (n, s) in enumerate(plays):
-                ensembles.append(
-                    simulate(data.field, model, x0, *game.controls(s), n, carlo.seed + j, carlo.substeps)
+                controls = game.controls(s)
+                ensemble = (
+                    None
+                    if budget.expired()
+                    else simulate(data.field, model, x0, *controls, n, carlo.seed + j, carlo.substeps, budget)
                 )
-                budget.advance(f"Monte Carlo, {name}")
+                if ensemble is None:
+                    break
+                ensembles.append(ensemble)
+            if len(ensembles) < len(plays):
+                cut.append(f"Monte Carlo, {name} not finished")
+                continue
             hit = proportion(np.concatenate([e.separation()[:, -1] <= eps for e in ensembles]))
             estimates[name] = {"estimate": hit.estimate, "low": hit.low, "high": hit.high, "samples": hit.n}
             kept = [-(-DISPERSION_PATHS * len(e.positions) // carlo.samples) for e in ensembles]

@@ -7,10 +7,16 @@ from __future__ import annotations
 import copy
 import time
 
+from gamespec_levelset.game import linearized_game
+
+from gamespec.flowfield.budget import Budget
+from gamespec.flowfield.problem import evaluate_game
+from gamespec.flowfield.simulation import simulate
 from gamespec.flowfield.stages import covariance_game_spec, reachability_spec
 from gamespec.loader import spec_from_dict
 from gamespec.result import Status
 from gamespec.solving import solve
+from gamespec.terminal import Tracker
 from tests.flowfield.test_stages import _spec
 
 
@@ -37,7 +43,7 @@ def test_a_tiny_limit_stops_the_covariance_game_with_the_status_time_limit() -> 
     assert result.status is Status.TIME_LIMIT
     assert "max_wall_time" in result.message
     assert "covariance game, best responses after 1 iterations" in result.message
-    assert "Monte Carlo, open_loop not simulated" in result.message
+    assert "Monte Carlo, open_loop not finished" in result.message
     assert result.metrics["best_response"]["outcome"] == "time_limit"
     assert result.metrics["monte_carlo_capture_probability"] == {}
     assert used < 10.0
@@ -60,3 +66,21 @@ def test_the_game_takes_only_what_the_reachability_stage_left() -> None:
     full = solve(game)
     assert full.status is not Status.TIME_LIMIT, full.message
     assert set(full.metrics["monte_carlo_capture_probability"]) == {"open_loop", "closed_loop"}
+
+
+def test_the_monte_carlo_counts_its_control_steps_and_stops_at_the_limit() -> None:
+    """:func:`~gamespec.flowfield.simulation.simulate` advances the progress once per control step
+    and, with no time left, stops after the first (None)."""
+    spec, reach = _stages(100.0)
+    game_spec = covariance_game_spec(spec, reach)
+    data = evaluate_game(game_spec, game_spec.problem.parameters)
+    stage = linearized_game(data)
+    V, K = stage.game.controls(stage.game.nominal())
+    x0 = data.origins.reshape(-1)
+    tracker = Tracker("Monte Carlo", None)
+    ensemble = simulate(data.field, stage.model, x0, V, K, 50, 0, 2, Budget(None, tracker))
+    assert ensemble is not None and ensemble.positions.shape[0] == 50
+    assert tracker.completed == stage.model.N > 1
+    stopped = Tracker("Monte Carlo", None)
+    assert simulate(data.field, stage.model, x0, V, K, 50, 0, 2, Budget(0.0, stopped)) is None
+    assert stopped.completed == 1

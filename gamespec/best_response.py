@@ -43,8 +43,8 @@ or the largest change over the last ``window`` iterations is no smaller than ove
 before); ``diverged`` (a non-finite change, the largest change grown at least ``growth`` times in
 each of the last ``growth_sweeps`` sweeps — so a geometric blow-up stops before a player's solver
 fails on huge iterates — or the largest change over the last ``window`` at least ``growth`` times
-the one before); or ``player_failed`` (a response
-whose status carries no solution). :class:`BestResponseRun` maps the outcome to a
+the one before); ``player_failed`` (a response whose status carries no solution); or ``time_limit``
+(the caller's ``stop`` said so). :class:`BestResponseRun` maps the outcome to a
 :class:`~gamespec.result.Status` and packs the history for ``Result.metrics["best_response"]``.
 
 It sits in the bottom layer, beside :mod:`gamespec.result` (the only gamespec module it imports):
@@ -78,6 +78,7 @@ class Outcome(StrEnum):
     CYCLING = "cycling"
     DIVERGED = "diverged"
     PLAYER_FAILED = "player_failed"
+    TIME_LIMIT = "time_limit"
 
 
 class Response(Protocol):
@@ -470,6 +471,7 @@ _STATUS = {
     Outcome.ITERATION_LIMIT: Status.ITERATION_LIMIT,
     Outcome.CYCLING: Status.NOT_CONVERGED,
     Outcome.DIVERGED: Status.NOT_CONVERGED,
+    Outcome.TIME_LIMIT: Status.TIME_LIMIT,
 }
 
 
@@ -499,6 +501,8 @@ def _message(outcome: Outcome, it: _Iterator, failed: str) -> str:
         return f"best responses stopped at iteration {n + 1}: {failed} failed ({record.status.value}){reason}"
     if outcome is Outcome.ITERATION_LIMIT:
         return f"best responses did not converge in {n} iterations (last change {last:.3g}){_slow(it)}"
+    if outcome is Outcome.TIME_LIMIT:
+        return f"best responses stopped by their time limit after {n} iterations (last change {last:.3g})"
     if outcome is Outcome.CYCLING:
         return f"best responses cycle: no progress after {n} iterations (last change {last:.3g})"
     rate = it.rate()
@@ -511,8 +515,11 @@ def iterate(
     start: Mapping[str, Any],
     settings: Settings | None = None,
     payoff: Callable[[Strategies], float] | None = None,
+    stop: Callable[[], bool] | None = None,
 ) -> BestResponseRun:
-    """Iterate best responses from ``start`` (strategies by player name) until an outcome.
+    """Iterate best responses from ``start`` (strategies by player name) until an outcome;
+    ``stop``, asked after every iteration, ends the run with the outcome ``time_limit`` when it
+    returns True (a caller's time limit).
 
     A converged run is ``optimal`` when every player's last response was, else ``feasible``; a run
     stopped by a player's failure has that player's status; the others map as in ``_STATUS``. The
@@ -524,6 +531,8 @@ def iterate(
     outcome = Outcome.ITERATION_LIMIT
     for _ in range(settings.max_iterations):
         stopped = it.step()
+        if stopped is None and stop is not None and stop():
+            stopped = Outcome.TIME_LIMIT
         if stopped is not None:
             outcome = stopped
             break

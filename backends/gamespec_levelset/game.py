@@ -10,6 +10,12 @@ under each solution, the closed loop being the one of ``method.game.scheme``, an
 the nonlinear SDE in open and closed loop (the samples split among the evader's mixture for the
 minimax). The spec's diffusion is evaluated at each solve, so a new α re-solves the game about the
 same nominal paths. Without nominal paths (no capture in stage 1) the Result is ``infeasible``.
+
+The stage takes what is left of the backend's ``max_wall_time`` after the reachability stage
+(``problem.nominal.wall_time``), checked after each best-response iteration, each step of the lower
+value's ascent and each control step of the Monte Carlo (:class:`~gamespec.flowfield.budget.Budget`), with a
+progress line on stderr: past it, what is left is skipped and the Result is ``time_limit``, its
+message naming the part the limit cut short (the point reached so far is still reported).
 """
 
 from __future__ import annotations
@@ -20,8 +26,9 @@ from typing import Any
 
 import numpy as np
 
-from gamespec.best_response import Outcome, Settings, iterate
+from gamespec.best_response import Outcome, Settings, StepReport, iterate
 from gamespec.compiling import CompiledModel, Inputs, refuse_inputs
+from gamespec.flowfield.budget import Budget
 from gamespec.flowfield.capture_probability import capture_probabilities
 from gamespec.flowfield.concepts import saddle_gap, solution_concept
 from gamespec.flowfield.covariance_game import PLAYERS, CovarianceGame, Strategy
@@ -31,6 +38,7 @@ from gamespec.flowfield.simulation import simulate
 from gamespec.flowfield.spec import FlowCovarianceGameSpec
 from gamespec.montecarlo import proportion
 from gamespec.result import Result, Status
+from gamespec.terminal import progress
 from gamespec_levelset.options import FlowGameOptions
 from gamespec_levelset.players import (
     EvaderStep,
@@ -141,10 +149,12 @@ class Concepts:
     message: str
 
 
-def _concepts(spec: FlowCovarianceGameSpec, game: CovarianceGame, cast: Players) -> tuple[Concepts, Any]:
+def _concepts(
+    spec: FlowCovarianceGameSpec, game: CovarianceGame, cast: Players, budget: Budget, cut: list[str]
+) -> tuple[Concepts, Any]:
     """The iteration of the scheme and the lower value (eqs. 5.34–5.36 and
     :mod:`gamespec.flowfield.concepts`), the values and the solution concept; the run is returned
-    for its metrics."""
+    for its metrics. What the ``budget`` cut short is appended to ``cut``."""
     m = spec.method.game
     open_loop = game.nominal()
     scale = cast.scale
@@ -152,7 +162,13 @@ def _concepts(spec: FlowCovarianceGameSpec, game: CovarianceGame, cast: Players)
     def payoff(strategies: dict[str, Strategy]) -> float:
         return game.value((strategies["pursuer"], strategies["evader"]))
 
-    run = iterate(cast.players, dict(zip(PLAYERS, open_loop, strict=True)), cast.settings, payoff)
+    def stop() -> bool:
+        budget.advance("covariance game, best responses")
+        return budget.expired()
+
+    run = iterate(cast.players, dict(zip(PLAYERS, open_loop, strict=True)), cast.settings, payoff, stop)
+    if run.outcome is Outcome.TIME_LIMIT:
+        cut.append(f"covariance game, best responses after {len(run.history)} iterations")
     p_star = run.strategies["pursuer"]
     iteration = "gauss_seidel" if m.scheme == "gauss_seidel" else "minimax_mixed"
     plays: dict[str, Plays] = {
@@ -161,7 +177,13 @@ def _concepts(spec: FlowCovarianceGameSpec, game: CovarianceGame, cast: Players)
     answered = cast.evader.log.responses  # the last answered the run's last pursuer unless a step failed
     failed = run.outcome is Outcome.PLAYER_FAILED
     upper = game.value((p_star, answered[-1])) if answered and not failed else None
-    lower_point = lower_value(cast.answer, cast.evader, open_loop[1], m.gap, m.max_iterations)
+    if budget.expired():
+        lower_point: LowerValue | StepReport = StepReport(Status.TIME_LIMIT, "not computed (time limit)")
+        cut.append("covariance game, the lower value not computed")
+    else:
+        lower_point = lower_value(cast.answer, cast.evader, open_loop[1], m.gap, m.max_iterations, budget)
+        if isinstance(lower_point, LowerValue) and not lower_point.converged and budget.expired():
+            cut.append(f"covariance game, the lower value's ascent after {len(lower_point.values)} steps")
     lower = None
     metrics: dict[str, Any] = {"best_response": run.as_metrics(), "minimax_lower_bound": None}
     checks: dict[str, tuple[float | None, float]] = {}
@@ -216,9 +238,11 @@ def _concepts(spec: FlowCovarianceGameSpec, game: CovarianceGame, cast: Players)
     return Concepts(plays, chosen, lower, upper, metrics, checks, status, message), run
 
 
-def _game(spec: FlowCovarianceGameSpec, options: FlowGameOptions, data: CovarianceGameData) -> Result:
+def _game(
+    spec: FlowCovarianceGameSpec, options: FlowGameOptions, data: CovarianceGameData, budget: Budget
+) -> Result:
     """Linearization, the covariance game (both solution concepts), capture probabilities and
-    Monte Carlo."""
+    Monte Carlo, within the ``budget`` (module doc)."""
     T = data.paths.final_time
     stage = linearized_game(data)
     model, game, tau = stage.model, stage.game, stage.time
@@ -226,7 +250,8 @@ def _game(spec: FlowCovarianceGameSpec, options: FlowGameOptions, data: Covarian
     m = spec.method
     cast = game_players(spec, options, game)
     evader, scale = cast.evader, cast.scale
-    found, run = _concepts(spec, game, cast)
+    cut: list[str] = []
+    found, run = _concepts(spec, game, cast, budget, cut)
     eps = data.capture_radius
 
     def probability(plays: Plays) -> np.ndarray:
@@ -272,10 +297,20 @@ def _game(spec: FlowCovarianceGameSpec, options: FlowGameOptions, data: Covarian
             ("closed_loop", [(n, s) for n, (_, s) in zip(draws, closed, strict=True) if n]),
         ):
             x0 = data.origins.reshape(-1)
-            ensembles = [
-                simulate(data.field, model, x0, *game.controls(s), n, carlo.seed + j, carlo.substeps)
-                for j, (n, s) in enumerate(plays)
-            ]
+            ensembles = []
+            for j, (n, s) in enumerate(plays):
+                controls = game.controls(s)
+                ensemble = (
+                    None
+                    if budget.expired()
+                    else simulate(data.field, model, x0, *controls, n, carlo.seed + j, carlo.substeps, budget)
+                )
+                if ensemble is None:
+                    break
+                ensembles.append(ensemble)
+            if len(ensembles) < len(plays):
+                cut.append(f"Monte Carlo, {name} not finished")
+                continue
             hit = proportion(np.concatenate([e.separation()[:, -1] <= eps for e in ensembles]))
             estimates[name] = {"estimate": hit.estimate, "low": hit.low, "high": hit.high, "samples": hit.n}
             kept = [-(-DISPERSION_PATHS * len(e.positions) // carlo.samples) for e in ensembles]
@@ -289,9 +324,13 @@ def _game(spec: FlowCovarianceGameSpec, options: FlowGameOptions, data: Covarian
     controls = {f"{p}_v{j + 1}": V[:, 2 * i + j] for i, p in enumerate(PLAYERS) for j in range(2)}
     checks = {"max_constraint_violation": (max(0.0, *game.violations(heaviest).values()), 1e-6)}
     checks |= found.checks
+    status, message = found.status, found.message
+    if cut:
+        status = Status.TIME_LIMIT
+        message = "; ".join([budget.message("; ".join(cut)), *([message] if message else [])])
     return Result(
-        status=found.status,
-        message=found.message,
+        status=status,
+        message=message,
         objective=objective,
         t_final=T,
         iterations=run.iterations,
@@ -336,5 +375,9 @@ class CovarianceGameModel(CompiledModel):
                 metrics={"game_converged": False},
                 solve_time_s=time.perf_counter() - start,
             )
-        result = _game(self.spec, self.options, data)
+        assert self.spec.problem.nominal is not None, "nominal paths come with the steps"
+        limit = self.options.max_wall_time
+        left = None if limit is None else max(0.0, limit - self.spec.problem.nominal.wall_time)
+        with progress(f"{self.spec.name} (covariance game)") as tracker:
+            result = _game(self.spec, self.options, data, Budget(left, tracker))
         return result.model_copy(update={"parameters": values, "solve_time_s": time.perf_counter() - start})

@@ -13,7 +13,8 @@ from gamespec.specs.base import StrictModel
 class FlowGameOptions(StrictModel):
     """The conic solver of the players' steps and its keyword arguments (the covariance game);
     ``cross_check`` also runs the other reachability method and reports the difference of ``T̂``,
-    ``max_wall_time`` and ``engine`` (the reachability stage)."""
+    ``max_wall_time`` (both stages, the game taking what the reachability stage left) and ``engine``
+    (the reachability stage)."""
 
     solver: str = Field("CLARABEL", description="The CVXPY conic solver of the players' steps.")
     solver_options: dict[str, Any] = Field(
@@ -25,9 +26,10 @@ class FlowGameOptions(StrictModel):
     max_wall_time: float | None = Field(
         300.0,
         gt=0,
-        description="Seconds of wall time the reachability stage may take (level sets, the coarser "
-        "grid of the grid-error estimate, the cross-check), checked after every step: past it the run "
-        "stops with the status time_limit (null: no limit).",
+        description="Seconds of wall time the run may take: the reachability stage (level sets, the "
+        "coarser grid of the grid-error estimate, the cross-check, checked after every step), then what "
+        "is left of it for the covariance game (best responses, the lower value, the Monte Carlo): past "
+        "it the run stops with the status time_limit (null: no limit).",
     )
     engine: Literal["auto", "compiled", "numpy"] = Field(
         "auto",

@@ -32,6 +32,7 @@ import numpy as np
 from gamespec_cvxpy.backend import STATUS_MAP
 
 from gamespec.best_response import StepReport
+from gamespec.flowfield.budget import UNLIMITED, Budget
 from gamespec.flowfield.concepts import copy_room, lower_value_bound
 from gamespec.flowfield.covariance_game import PLAYERS, CovarianceGame, Strategy
 from gamespec.result import Status
@@ -369,7 +370,12 @@ class LowerValue:
 
 
 def lower_value(
-    pursuer: PursuerStep, evader: EvaderStep, start: Strategy, tolerance: float, max_iterations: int
+    pursuer: PursuerStep,
+    evader: EvaderStep,
+    start: Strategy,
+    tolerance: float,
+    max_iterations: int,
+    budget: Budget = UNLIMITED,
 ) -> LowerValue | StepReport:
     """``v₋ = max_e min_p J(p, e)``: the evader commits, the pursuer's feedback answers (the thesis'
     reading of Algorithm 3 and Fig. 5.2). ``φ(e) = min_p J(p, e)`` is convex in ``e`` (``J`` is jointly
@@ -379,7 +385,7 @@ def lower_value(
     evader's set, and stop when ``φ`` rises by at most ``tolerance · φ``. The first point certifies
     itself when :func:`~gamespec.flowfield.concepts.copy_room` ≤ 1: then ``φ(start) ≤ v₋ ≤ bound``
     (:func:`~gamespec.flowfield.concepts.lower_value_bound`). A failed pursuer or tangent step
-    returns its report."""
+    returns its report; past the ``budget``'s time limit the ascent stops, not converged."""
     game, scale = pursuer.game, pursuer.scale
     answer, report = pursuer.respond(start)
     if answer is None:
@@ -418,4 +424,7 @@ def lower_value(
             break
         point = (answer, committed)
         values.append(value)
+        budget.advance("covariance game, lower value")
+        if budget.expired():
+            break
     return LowerValue(point[1], point[0], values, converged, residual, room, defect, bound)

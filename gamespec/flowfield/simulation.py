@@ -18,6 +18,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from gamespec.flowfield.budget import UNLIMITED, Budget
 from gamespec.flowfield.field import FlowField
 from gamespec.flowfield.linearize import DiscreteModel
 from gamespec.montecarlo import Normal, sample
@@ -43,8 +44,10 @@ def simulate(
     samples: int,
     seed: int,
     substeps: int = 5,
-) -> Ensemble:
-    """``samples`` paths with ``substeps`` steps per control step."""
+    budget: Budget = UNLIMITED,
+) -> Ensemble | None:
+    """``samples`` paths with ``substeps`` steps per control step; the ``budget`` counts each
+    control step (its progress line) and, past its time limit, stops the paths (None)."""
     N, dt = model.N, model.step / substeps
     noise = sample({"w": Normal(0.0, 1.0, shape=(N, substeps, 2, 2))}, samples, seed)["w"]
     x = np.tile(np.asarray(x0, dtype=float), (samples, 1))
@@ -67,4 +70,7 @@ def simulate(
             )
         y = y @ model.A[k].T + (x - start @ model.A[k].T - u @ model.B[k].T - model.r[k])
         out.append(x)
+        budget.advance(f"Monte Carlo, step {k + 1} of {N}")
+        if budget.expired():
+            return None
     return Ensemble(np.stack(out, axis=1))

@@ -29,7 +29,8 @@ from __future__ import annotations
 
 from collections.abc import Mapping
 from dataclasses import dataclass
-from typing import Literal
+from functools import lru_cache
+from typing import Any, Literal
 
 import numpy as np
 import sympy as sp
@@ -345,6 +346,12 @@ class NominalSpec(StrictModel):
     )
     pursuer: NominalPath = Field(description="The pursuer's nominal path.")
     evader: NominalPath = Field(description="The evader's nominal path.")
+    wall_time: float = Field(
+        0.0,
+        ge=0,
+        description="Wall seconds the reachability stage took: the covariance game may take what is left "
+        "of the backend's max_wall_time.",
+    )
 
     @model_validator(mode="after")
     def _nodes(self) -> NominalSpec:
@@ -426,6 +433,15 @@ class FlowCovarianceGameSpec(ProblemParameters, SpecBase):
         """``saddle``, as the ``flow_field_game``'s."""
         return "saddle"
 
+    def structure(self, with_guess: bool = False) -> dict[str, Any]:
+        """:meth:`SpecBase.structure` without ``problem.nominal.wall_time``: the reachability
+        stage's time is a record of one run (a re-solve of a compiled chain keeps the compile's,
+        the covariance game's time limit erring on the short side), not what the game is."""
+        data = super().structure(with_guess)
+        if data["problem"]["nominal"] is not None:
+            data["problem"]["nominal"]["wall_time"] = None
+        return data
+
     @model_validator(mode="after")
     def _evaluates(self) -> FlowCovarianceGameSpec:
         self.values()
@@ -497,8 +513,16 @@ class CovarianceGameValues:
     capture_radius: float
 
 
+@lru_cache(maxsize=4096, typed=True)
+def _parsed(value: Value, names: tuple[str, ...]) -> sp.Expr:
+    """``value`` in SymPy over the symbols ``names``, parsed once per process (at load, where the
+    spec's validator evaluates it): a solve substitutes new parameter values into the same
+    expression and parses no text again (issue 27, item 3)."""
+    return sp.sympify(parse(value, {name: symbol(name) for name in names}))
+
+
 class _Evaluator:
-    """Parses every entry and substitutes the parameter values (no eval)."""
+    """Substitutes the parameter values into every entry, each parsed once (:func:`_parsed`)."""
 
     def __init__(self, spec: FlowGameSpec | FlowCovarianceGameSpec, values: Mapping[str, float]) -> None:
         self.spec = spec
@@ -507,13 +531,9 @@ class _Evaluator:
         self.substitution = {symbol(name): sp.Float(v) for name, v in values.items()}
 
     def expression(self, value: Value, field: str, position: bool) -> sp.Expr:
-        symbols = (
-            {**self.symbols, **dict(zip(self.spec.problem.position, self.position, strict=True))}
-            if position
-            else self.symbols
-        )
+        names = [*self.symbols, *(self.spec.problem.position if position else ())]
         try:
-            return sp.sympify(parse(value, symbols)).xreplace(self.substitution)
+            return _parsed(value, tuple(dict.fromkeys(names))).xreplace(self.substitution)
         except ExpressionError as err:
             raise SpecError(str(err), field=f"problem.{field}") from None
 

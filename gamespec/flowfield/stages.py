@@ -62,6 +62,7 @@ def covariance_game_spec(spec: FlowGameSpec, reach: Result) -> FlowCovarianceGam
         nominal = {
             "times": times.tolist(),
             "speeds": data.nominal_speeds.tolist(),
+            "wall_time": reach.solve_time_s or 0.0,
             **{
                 player: {"positions": positions[i].tolist(), "directions": directions[i].tolist()}
                 for i, player in enumerate(("pursuer", "evader"))

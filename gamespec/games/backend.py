@@ -12,13 +12,15 @@ parameters are the game's ``problem.parameters``.
 
 from __future__ import annotations
 
-from typing import Any, ClassVar
+from functools import cached_property
+from typing import TYPE_CHECKING, Any, ClassVar
 
 import numpy as np
 
 from gamespec.compiling import Backend, CompiledModel, Inputs, NoOptions, refuse_inputs
 from gamespec.games.equilibrium import GameModel, GameSolution, equilibrium_report, status_of
 from gamespec.games.existence import existence
+from gamespec.games.expressions import game_expressions
 from gamespec.games.feedback import LQGame
 from gamespec.games.feedback_game import feedback_equilibrium
 from gamespec.games.lq_structure import LQForm, lq_form, lq_game
@@ -27,6 +29,9 @@ from gamespec.games.simulate import ControlPlan, TrueSystem, grid_of, true_param
 from gamespec.result import Result, Status
 from gamespec.specs.base import SpecBase
 from gamespec.specs.differential_game import DifferentialGameSpec
+
+if TYPE_CHECKING:
+    from gamespec.games.iterative_lq import DiscreteGame
 
 
 def open_loop(model: GameModel) -> Result:
@@ -121,11 +126,21 @@ class GameCompiled(CompiledModel):
     def __init__(self, game: DifferentialGameSpec) -> None:
         self.game = game
         feedback = game.game.information == "feedback"
-        form = lq_form(game) if feedback else None
+        self.expressions = game_expressions(game) if feedback else None
+        form = lq_form(game, self.expressions) if feedback else None
         self.feedback = form if isinstance(form, LQForm) else None
         self.iterative = feedback
         self.model = GameModel(game) if not feedback else None
         self.parameters = dict(game.problem.parameters)
+
+    @cached_property
+    def discrete_game(self) -> DiscreteGame:
+        """The discrete game of iterative LQ games (a feedback game that is not LQ), its functions
+        built on first use from the expressions parsed at compile."""
+        from gamespec.games.iterative_lq import DiscreteGame
+
+        assert self.expressions is not None, "a feedback game has its expressions"
+        return DiscreteGame(self.game, self.expressions, self.game.game.iterative_lq == "second_order")
 
     def solve(
         self, parameters: dict[str, float] | None = None, guess: Result | None = None, inputs: Inputs = None
@@ -144,7 +159,7 @@ class GameCompiled(CompiledModel):
                 return feedback_equilibrium(self.game, self.feedback, self.parameters)
             from gamespec.games.iterative_lq import feedback_nash_nonlinear
 
-            return feedback_nash_nonlinear(self.game, self.parameters)
+            return feedback_nash_nonlinear(self.discrete_game, self.parameters)
         assert self.model is not None, "an open-loop game has its model"
         if parameters:
             self.model.parameters = {**self.model.parameters, **parameters}

@@ -75,6 +75,8 @@ class GameExpressions:
     parameters: list[str] = field(default_factory=list)
     """The game's parameter names, the uncertain ones last (the order of the compiled functions'
     parameter vector)."""
+    control_bounds: dict[str, tuple[sp.Expr | None, sp.Expr | None]] = field(default_factory=dict)
+    """Each control's lower and upper bound over the running names (None where it has none)."""
 
 
 def _payoff(payoff: PayoffSpec, sym: Symbols) -> Payoff:
@@ -101,10 +103,15 @@ def _stop_rules(game: DifferentialGameSpec) -> StopRules:
     return StopRules(capture, obstacle)
 
 
+def _bound(value: str | float | None, sym: Symbols) -> sp.Expr | None:
+    return None if value is None else sp.sympify(parse(value, sym.running))
+
+
 def game_expressions(game: DifferentialGameSpec) -> GameExpressions:
     """The game's expressions parsed into SymPy (see module doc)."""
     p = game.problem
     sym = symbols_of(game)
+    controls = {c: spec for pl in p.players.values() for c, spec in pl.controls.items()}
     return GameExpressions(
         symbols=sym,
         dynamics={s: sp.sympify(parse(p.dynamics[s], sym.running)) for s in p.states},
@@ -115,4 +122,5 @@ def game_expressions(game: DifferentialGameSpec) -> GameExpressions:
         final_time=sp.sympify(parse(p.time.final, sym.running)),
         stop=_stop_rules(game),
         parameters=[*p.parameters, *p.uncertain],
+        control_bounds={c: (_bound(b.lower, sym), _bound(b.upper, sym)) for c, b in controls.items()},
     )

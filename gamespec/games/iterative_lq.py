@@ -35,16 +35,21 @@ the payoffs' scale (issue 23's policy).
 
 from __future__ import annotations
 
+from collections.abc import Mapping
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
+import sympy as sp
 
 from gamespec.errors import UnsupportedFeature
+from gamespec.games.expressions import GameExpressions
 from gamespec.games.nash_gap import nash_gap
 from gamespec.games.problems import initial_state
 from gamespec.result import Result, Status
 from gamespec.specs.differential_game import DifferentialGameSpec
-from gamespec.symbolic.grammar import expression
+from gamespec.symbolic.library import casadi_library
+from gamespec.symbolic.translate import translate
 
 TRUST = 1.0
 """The most any state may move in one iteration, relative to ``max(1, ‖x̂‖∞)``."""
@@ -74,18 +79,27 @@ class FeedbackStrategies:
 
 
 class DiscreteGame:
-    """The discrete game of the module doc, its functions built once with CasADi."""
+    """The discrete game of the module doc. Its CasADi functions are built once per compiled game
+    from the game's parsed ``expressions`` (:mod:`gamespec.games.expressions`: no text is parsed
+    here or at solve time), the parameters their last argument; :meth:`bind` sets the parameter
+    values of a solve. UnsupportedFeature names what of the game the method does not take."""
 
-    def __init__(self, game: DifferentialGameSpec, parameters: dict[str, float], second_order: bool) -> None:
+    def __init__(self, game: DifferentialGameSpec, expressions: GameExpressions, second_order: bool) -> None:
         import casadi as ca
 
-        from gamespec.symbolic.library import LibraryAlgebra, casadi_library
-
+        why = unsupported(game)
+        if why:
+            raise UnsupportedFeature(
+                f"game.information: feedback: {game.name!r} is not linear-quadratic, and iterative LQ "
+                f"games take no {why}: solve the open-loop game instead (game.information: open_loop)"
+            )
         self.ca = ca
+        self.game = game
+        self.expressions = expressions
         p = game.problem
         self.second_order = second_order
-        values = {n: float(v) for n, v in parameters.items()}
-        algebra = LibraryAlgebra(casadi_library(ca))
+        library = casadi_library(ca)
+        names = expressions.symbols.running
         self.states = list(p.states)
         self.players = list(p.players)
         self.controls = [c for pl in p.players.values() for c in pl.controls]
@@ -95,67 +109,100 @@ class DiscreteGame:
             start += len(pl.controls)
         n, m = len(self.states), len(self.controls)
         x, u, t, h = ca.SX.sym("x", n), ca.SX.sym("u", m), ca.SX.sym("t"), ca.SX.sym("h")
-        running = values | dict(zip(self.states, ca.vertsplit(x), strict=True))
-        running |= dict(zip(self.controls, ca.vertsplit(u), strict=True))
+        par = ca.SX.sym("p", len(expressions.parameters))
+        params = {names[name]: par[i] for i, name in enumerate(expressions.parameters)}
+        controls = dict(zip((names[c] for c in self.controls), ca.vertsplit(u), strict=True))
 
-        def f(xv, tv):
-            table = values | dict(zip(self.states, ca.vertsplit(xv), strict=True))
-            table |= dict(zip(self.controls, ca.vertsplit(u), strict=True)) | {"t": tv}
-            return ca.vertcat(*(expression(p.dynamics[s], table, algebra) for s in self.states))
+        def table(xv: Any, tv: Any) -> dict[sp.Symbol, Any]:
+            states = dict(zip((names[s] for s in self.states), ca.vertsplit(xv), strict=True))
+            return params | controls | states | {names["t"]: tv}
+
+        def f(xv: Any, tv: Any) -> Any:
+            values = table(xv, tv)
+            return ca.vertcat(*(translate(expressions.dynamics[s], values, library) for s in self.states))
 
         k1 = f(x, t)
         k2 = f(x + h / 2 * k1, t + h / 2)
         k3 = f(x + h / 2 * k2, t + h / 2)
         k4 = f(x + h * k3, t + h)
         step = x + h / 6 * (k1 + 2 * k2 + 2 * k3 + k4)
-        self.step = ca.Function("step", [x, u, t, h], [step])
+        args = [x, u, t, h, par]
+        self._step = ca.Function("step", args, [step])
         z = ca.vertcat(x, u)
         lam = ca.SX.sym("lam", n)
-        self.linear = ca.Function("linear", [x, u, t, h], [ca.jacobian(step, x), ca.jacobian(step, u)])
-        self.curvature = ca.Function("curvature", [x, u, t, h, lam], [ca.hessian(ca.dot(lam, step), z)[0]])
-        T = float(expression(p.time.final, values, algebra)) - p.time.initial
-        self.t0, self.T = float(p.time.initial), T
-        ends = values | {f"{s}_f": v for s, v in zip(self.states, ca.vertsplit(x), strict=True)}
-        ends |= {"t_f": self.t0 + T}
-        self.lower = np.full(m, -np.inf)
-        self.upper = np.full(m, np.inf)
-        specs = [player.controls[c] for player in p.players.values() for c in player.controls]
-        for j, spec in enumerate(specs):
-            self.lower[j] = -np.inf if spec.lower is None else float(expression(spec.lower, values, algebra))
-            self.upper[j] = np.inf if spec.upper is None else float(expression(spec.upper, values, algebra))
+        self._linear = ca.Function("linear", args, [ca.jacobian(step, x), ca.jacobian(step, u)])
+        self._curvature = ca.Function("curvature", [*args, lam], [ca.hessian(ca.dot(lam, step), z)[0]])
+        self.t0 = float(p.time.initial)
+        final = translate(expressions.final_time, params, library)
+        finals = (expressions.symbols.ends[f"{s}_f"] for s in self.states)
+        ends = params | dict(zip(finals, ca.vertsplit(x), strict=True))
+        ends[expressions.symbols.ends["t_f"]] = final
+        bounds = [expressions.control_bounds[c] for c in self.controls]
+        lower = [None if lo is None else translate(lo, params, library) for lo, _ in bounds]
+        upper = [None if hi is None else translate(hi, params, library) for _, hi in bounds]
+        self._limits = ca.Function(
+            "limits",
+            [par],
+            [
+                ca.vertcat(*(-ca.inf if lo is None else lo for lo in lower)),
+                ca.vertcat(*(ca.inf if hi is None else hi for hi in upper)),
+                final,
+            ],
+        )
         stage, terminal, barrier = [], [], []
-        running["t"] = t
+        running = table(x, t)
         for name, pl in p.players.items():
-            payoff = pl.payoff or p.payoff
+            payoff = expressions.payoffs.get(name, expressions.payoff)
             sign = 1.0 if pl.objective == "minimize" else -1.0
-            stage.append(h * sign * expression(payoff.lagrange, running, algebra))
-            terminal.append(ca.SX(sign * expression(payoff.mayer, ends, algebra)))
+            stage.append(h * sign * translate(payoff.lagrange, running, library))
+            terminal.append(ca.SX(sign * translate(payoff.mayer, ends, library)))
             own = self.slices[self.players.index(name)]
-            finite = [
-                side
-                for j in range(own.start, own.stop)
-                for side, bound in (
-                    (u[j] - self.lower[j], self.lower[j]),
-                    (self.upper[j] - u[j], self.upper[j]),
-                )
-                if np.isfinite(bound)
-            ]
-            barrier.append(-h * BARRIER * ca.sum1(ca.log(ca.vertcat(*finite))) if finite else ca.SX(0))
-        self.stage_cost = ca.Function("stage", [x, u, t, h], [ca.vertcat(*stage)])
-        self.terminal_cost = ca.Function("terminal", [x], [ca.vertcat(*terminal)])
+            sides = [u[j] - lower[j] for j in range(own.start, own.stop) if lower[j] is not None]
+            sides += [upper[j] - u[j] for j in range(own.start, own.stop) if upper[j] is not None]
+            barrier.append(-h * BARRIER * ca.sum1(ca.log(ca.vertcat(*sides))) if sides else ca.SX(0))
+        self._stage_cost = ca.Function("stage", args, [ca.vertcat(*stage)])
+        self._terminal_cost = ca.Function("terminal", [x, par], [ca.vertcat(*terminal)])
         quadratic = []
         for i in range(len(self.players)):
-            total = stage[i] + barrier[i]
-            hess, grad = ca.hessian(total, z)
+            hess, grad = ca.hessian(stage[i] + barrier[i], z)
             quadratic += [hess, grad]
-        self.stage_quadratic = ca.Function("stage_q", [x, u, t, h], quadratic)
+        self._stage_quadratic = ca.Function("stage_q", args, quadratic)
         terminal_q = []
         for i in range(len(self.players)):
             hess, grad = ca.hessian(terminal[i], x)
             terminal_q += [hess, grad]
-        self.terminal_quadratic = ca.Function("terminal_q", [x], terminal_q)
+        self._terminal_quadratic = ca.Function("terminal_q", [x, par], terminal_q)
         self.n, self.m = n, m
-        self.x0 = np.array([initial_state(game, parameters)[s] for s in self.states])
+
+    def bind(self, parameters: Mapping[str, float]) -> DiscreteGame:
+        """Set the parameter values of a solve: the bounds, the horizon and the initial state."""
+        self.p = np.array([float(parameters[n]) for n in self.expressions.parameters])
+        lower, upper, final = self._limits(self.p)
+        self.lower, self.upper = np.asarray(lower).ravel(), np.asarray(upper).ravel()
+        self.T = float(final) - self.t0
+        self.x0 = np.array([initial_state(self.game, parameters)[s] for s in self.states])
+        return self
+
+    def step(self, x: Any, u: Any, t: Any, h: Any) -> Any:
+        return self._step(x, u, t, h, self.p)
+
+    def linear(self, x: Any, u: Any, t: Any, h: Any) -> Any:
+        return self._linear(x, u, t, h, self.p)
+
+    def curvature(self, x: Any, u: Any, t: Any, h: Any, lam: Any) -> Any:
+        return self._curvature(x, u, t, h, self.p, lam)
+
+    def stage_cost(self, x: Any, u: Any, t: Any, h: Any) -> Any:
+        return self._stage_cost(x, u, t, h, self.p)
+
+    def stage_quadratic(self, x: Any, u: Any, t: Any, h: Any) -> Any:
+        return self._stage_quadratic(x, u, t, h, self.p)
+
+    def terminal_cost(self, x: Any) -> Any:
+        return self._terminal_cost(x, self.p)
+
+    def terminal_quadratic(self, x: Any) -> Any:
+        return self._terminal_quadratic(x, self.p)
 
     def grid(self, steps: int) -> tuple[np.ndarray, float]:
         h = self.T / steps
@@ -319,18 +366,12 @@ def unsupported(game: DifferentialGameSpec) -> str:
     return next((why for hit, why in reasons if hit), "")
 
 
-def feedback_nash_nonlinear(game: DifferentialGameSpec, parameters: dict[str, float]) -> Result:
-    """The game's feedback equilibrium by iterative LQ games as a Result (module doc): concept
-    ``feedback_saddle`` (zero-sum) or ``feedback_nash``, ``metrics.method = iterative_lq``;
-    UnsupportedFeature naming what the method does not take."""
-    why = unsupported(game)
-    if why:
-        raise UnsupportedFeature(
-            f"game.information: feedback: {game.name!r} is not linear-quadratic, and iterative LQ games "
-            f"take no {why}: solve the open-loop game instead (game.information: open_loop)"
-        )
+def feedback_nash_nonlinear(discrete: DiscreteGame, parameters: Mapping[str, float]) -> Result:
+    """The game's feedback equilibrium by iterative LQ games at ``parameters`` as a Result (module
+    doc): concept ``feedback_saddle`` (zero-sum) or ``feedback_nash``, ``metrics.method =
+    iterative_lq``."""
+    game = discrete.bind(parameters).game
     settings = game.game
-    discrete = DiscreteGame(game, parameters, settings.iterative_lq == "second_order")
     steps = STEPS_PER_POINT * game.method.intervals * max(1, game.method.degree)
     start = np.array(
         [[pl.start.get(c, 0.0) for pl in game.problem.players.values() for c in pl.controls]] * steps,

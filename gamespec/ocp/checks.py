@@ -37,9 +37,9 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from gamespec.ocp.compiled_checks import point_values, reintegrate
+from gamespec.ocp.compiled_checks import end_terms, mayer_names, point_values, reintegrate
 from gamespec.specs.ocp import INITIAL_TIME
-from gamespec.symbolic.grammar import FLOATS, Relation, dependencies, unknowns
+from gamespec.symbolic.grammar import Relation, dependencies
 from gamespec.symbolic.library import NUMPY, LibraryAlgebra
 
 ARRAYS = LibraryAlgebra(NUMPY)
@@ -226,8 +226,7 @@ def max_constraint_violation(
     worst += [
         _violation(row, r.lower, r.upper) for row, r in zip(values[first_path:], structure.path, strict=True)
     ]
-    ends = tr.ocp.end_terms(_end_values(tr, X, U, T, params), ARRAYS)
-    worst += [_relation_violation(r, ()) for r in ends.boundary]
+    worst += [_relation_violation(r, ()) for r in end_terms(tr, _end_values(tr, X, U, T, params)).boundary]
     interior = tr.interior.terms(X, _arrays(params), ARRAYS)
     worst += [_relation_violation(r, ()) for r in interior.constraints]
     q = tr.grid.triplets[2]
@@ -277,12 +276,12 @@ truncation error, h**2/6 times the third derivative, against its rounding error 
 def mayer_slope(tr: Transcription, ends: Mapping[str, float], name: str) -> float:
     """``dPhi/d name`` of the minimization form's Mayer term at the end values ``ends`` (by name):
     exactly 0 when the term does not depend on ``name``, else a central difference with step
-    ``STEP max(1, |value|)`` in NumPy (the term evaluated as the checks evaluate every term)."""
-    if name not in dependencies(tr.ocp.end_terms(unknowns(tr.ocp.end_names), FLOATS).mayer):
+    ``STEP max(1, |value|)`` (the term compiled once, :func:`~gamespec.ocp.compiled_checks.end_terms`)."""
+    if name not in mayer_names(tr):
         return 0.0
     at = float(ends[name])
     h = STEP * max(1.0, abs(at))
-    mayer = (float(tr.ocp.end_terms({**ends, name: np.float64(at + s)}, ARRAYS).mayer) for s in (h, -h))
+    mayer = (end_terms(tr, {**ends, name: at + s}).mayer for s in (h, -h))
     return (next(mayer) - next(mayer)) / (2 * h)
 
 

@@ -16,10 +16,14 @@ numbers agree to rounding.
 from __future__ import annotations
 
 import weakref
+from collections.abc import Mapping
+from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
+from gamespec.ocp.symbolic import EndTerms
+from gamespec.symbolic.grammar import Relation
 from gamespec.symbolic.library import LibraryAlgebra, casadi_library
 
 if TYPE_CHECKING:
@@ -142,3 +146,52 @@ def _point_function(tr: Transcription) -> Any:
     terms = ocp.running_terms(dict(zip(ocp.running_names, slots, strict=True)), algebra)
     rows = [*terms.dynamics, terms.lagrange, *terms.integrands, *(r.expr for r in terms.path)]
     return ca.Function("point", [x, u, w, p, t], [ca.vertcat(*rows)])
+
+
+@dataclass(frozen=True)
+class _EndFunction:
+    """The end-point terms as one CasADi function of the end values, the boundary relations it
+    evaluates (their bounds) and the names the Mayer term depends on."""
+
+    function: Any
+    boundary: list[Relation]
+    mayer_names: frozenset[str]
+
+
+_END_FUNCTIONS: weakref.WeakKeyDictionary[Transcription, _EndFunction] = weakref.WeakKeyDictionary()
+"""Each live transcription's compiled end-point terms."""
+
+
+def end_terms(tr: Transcription, values: Mapping[str, Any]) -> EndTerms:
+    """The end-point terms (:class:`~gamespec.ocp.symbolic.EndTerms`: the Mayer term, ``sign``
+    applied, and the boundary constraints) at the end ``values`` (by
+    :attr:`~gamespec.ocp.symbolic.SymbolicOcp.end_names`), one CasADi SX function built once per
+    transcription: a re-solve walks no text (issue 27, item 3)."""
+    compiled = _end_function(tr)
+    point = np.array([float(values[n]) for n in tr.ocp.end_names])
+    mayer, found = (np.asarray(v, dtype=float).reshape(-1) for v in compiled.function(point))
+    boundary = [Relation(v, r.lower, r.upper) for v, r in zip(found, compiled.boundary, strict=True)]
+    return EndTerms(mayer=float(mayer[0]), boundary=boundary)
+
+
+def mayer_names(tr: Transcription) -> frozenset[str]:
+    """The end names the Mayer term depends on."""
+    return _end_function(tr).mayer_names
+
+
+def _end_function(tr: Transcription) -> _EndFunction:
+    import casadi as ca
+
+    if tr in _END_FUNCTIONS:
+        return _END_FUNCTIONS[tr]
+    names = tr.ocp.end_names
+    ends = ca.SX.sym("ends", len(names))
+    slots = _split(ends, len(names))
+    algebra = LibraryAlgebra(casadi_library(ca))
+    terms = tr.ocp.end_terms(dict(zip(names, slots, strict=True)), algebra)
+    mayer = ca.SX(terms.mayer)
+    rows = [ca.SX(r.expr) for r in terms.boundary]
+    function = ca.Function("ends", [ends], [mayer, ca.vertcat(*rows) if rows else ca.SX(0, 1)])
+    used = frozenset(n for n, slot in zip(names, slots, strict=True) if ca.depends_on(mayer, slot))
+    _END_FUNCTIONS[tr] = _EndFunction(function, terms.boundary, used)
+    return _END_FUNCTIONS[tr]

@@ -34,6 +34,7 @@ from __future__ import annotations
 
 from collections.abc import Callable
 from dataclasses import dataclass, replace
+from functools import cached_property
 from typing import Any, ClassVar
 
 import numpy as np
@@ -195,6 +196,12 @@ class RcsData:
     unit: sp.Expr
     """The integrand of the sensitivity measure (unit weights)."""
 
+    @cached_property
+    def starting_points(self) -> list[Result]:
+        """The ``restarts`` on the target's mesh (:func:`starting_point`), built once: a re-solve
+        parses no guess text again (issue 27, item 3)."""
+        return [starting_point(self.target, g) for g in self.options.restarts]
+
 
 class Rcs(KeepsParameters[OptimalControlSpec, "RcsData"], OcpRewrite[RcsOptions, "RcsData"]):
     """Relevant constraint sensitivity (eqs. 6.31-6.36), or eq. 6.32 with ``relevant: false``;
@@ -234,7 +241,7 @@ class Rcs(KeepsParameters[OptimalControlSpec, "RcsData"], OcpRewrite[RcsOptions,
     def restarts(self, spec: OptimalControlSpec, inverse_data: RcsData) -> list[Result]:
         """The starting points of ``restarts`` (each a ``guess`` section of the file's problem) on
         the target's mesh, in the file's order."""
-        return [starting_point(inverse_data.target, g) for g in inverse_data.options.restarts]
+        return inverse_data.starting_points
 
 
 FIELD = "transforms.rcs"

@@ -21,6 +21,7 @@ import math
 import numpy as np
 import pytest
 
+from gamespec.games.expressions import game_expressions
 from gamespec.games.feedback import LQPlayer, discrete_feedback_nash
 from gamespec.games.iterative_lq import DiscreteGame, iterative_lq
 from gamespec.loader import load
@@ -44,7 +45,7 @@ def _rk4_matrices(A: np.ndarray, B: np.ndarray, h: float) -> tuple[np.ndarray, n
 def test_on_an_lq_game_it_reproduces_the_discrete_coupled_riccati_solution(steps):
     spec = load(SADDLE)
     p = spec.problem.parameters
-    game = DiscreteGame(spec, dict(p), second_order=False)
+    game = DiscreteGame(spec, game_expressions(spec), second_order=False).bind(p)
     solution = iterative_lq(game, steps, np.zeros((steps, 2)), 1e-12, 20)
     assert solution.converged and solution.iterations <= 2
     h = p["T"] / steps
@@ -80,7 +81,7 @@ def test_its_value_approaches_the_continuous_feedback_saddle_as_the_steps_shrink
     continuous = compile_spec(load(SADDLE, ["game.information=feedback"])).solve().objective
     errors = []
     for steps in (50, 100):
-        game = DiscreteGame(spec, dict(spec.problem.parameters), second_order=False)
+        game = DiscreteGame(spec, game_expressions(spec), False).bind(spec.problem.parameters)
         errors.append(abs(iterative_lq(game, steps, np.zeros((steps, 2)), 1e-12, 20).costs[0] - continuous))
     assert errors[1] < 0.6 * errors[0] and errors[1] < 0.05
 

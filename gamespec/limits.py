@@ -37,8 +37,10 @@ MAX_INTERVALS = 10_000
 """Most intervals of a grid: collocation intervals of an ``optimal_control`` transcription (and of the
 OCP an ``engagement`` becomes), steps of an ``lq_stochastic_game`` horizon."""
 
-MAX_VECTOR_SIZE = 1_000
-"""Most components of one vector state or control (``size:``)."""
+MAX_VECTOR_SIZE = 32
+"""Most components of one vector state or control (``size:``): an expression such as ``norm(r)``
+in every component grows as the square of the size, and the checks at load with it (a size of 100
+validated in 28 s)."""
 
 MAX_SIMULATION_VALUES = 2_000_000
 """Most positions a ``pursuit_scenario`` simulation records: time steps (``horizon / time_step``)

@@ -6,6 +6,7 @@ SymPy)."""
 
 from __future__ import annotations
 
+import ast
 import copy
 from collections.abc import Callable, Mapping
 from typing import Any
@@ -13,9 +14,12 @@ from typing import Any
 import sympy as sp
 
 from gamespec.errors import ExpressionError, SpecError
+from gamespec.symbolic.grammar import syntax_tree
 from gamespec.symbolic.language import symbol
 from gamespec.symbolic.printer import relation_texts, to_text
-from gamespec.symbolic.vectors import Vector, is_vector, parse_vector, parse_vector_relation
+from gamespec.symbolic.vectors import VECTORS, Vector, is_vector, parse_vector, parse_vector_relation
+
+VECTOR_FUNCTIONS = frozenset(VECTORS.functions)
 
 COMPONENT = "__"
 """Joins a vector's name and a component's index (``r__0``)."""
@@ -34,8 +38,11 @@ class _Lowering:
     """The vector reading of one problem (module doc); each method's ``where`` is the field of the
     value it reads, named by a SpecError."""
 
-    def __init__(self, problem: Mapping[str, Any], sizes: dict[str, int]) -> None:
+    def __init__(self, problem: Mapping[str, Any], sizes: dict[str, int], phases: bool) -> None:
         self.sizes = sizes
+        self.end_definitions = not phases
+        """Whether a definition's end values (``h_0``, ``h_f``) are made: in one phase only (a phase
+        may replace a definition, so that a multi-phase file's end value would be ambiguous)."""
         scalars = [
             *problem.get("parameters", {}),
             *problem.get("design", {}),
@@ -48,11 +55,14 @@ class _Lowering:
         self.running |= {n: _vector(n, k) for n, k in sizes.items()}
         variables = [*problem.get("states", {}), *problem.get("controls", {})]
         self.ends: dict[str, Any] = dict(self.params) | {"t_f": symbol("t_f")}
+        if _start(problem) == symbol("t_0"):
+            self.ends["t_0"] = symbol("t_0")
         for name in variables:
             for end in ("_0", "_f"):
                 k = sizes.get(name)
                 self.ends[name + end] = symbol(name + end) if k is None else _vector(name, k, end)
         self.timed = self.params | {"t": symbol("t"), "tau": symbol("tau")}
+        self.defined_ends: set[str] = set()
         self.inputs = set(problem.get("inputs", {}))
         self.scalar_variables = [
             m
@@ -71,13 +81,34 @@ class _Lowering:
             raise self.fail(err, where) from None
 
     def scalar(self, text: Any, symbols: Mapping[str, Any], where: str) -> Any:
-        """``text`` as the language's text of a scalar (numbers stay numbers)."""
+        """``text`` as the language's text of a scalar (numbers stay numbers; a text that names no
+        vector and no definition's end value is kept as written, so that SymPy's simplification
+        never changes its domain: ``x/x`` stays ``x/x``)."""
         if not isinstance(text, str):
             return text
         value = self.value(text, symbols, where)
         if is_vector(value):
             raise SpecError("is a vector where a scalar is needed", field=where)
-        return to_text(value)
+        return to_text(value) if self._rewritten(text, symbols) else text
+
+    def _rewritten(self, text: str, symbols: Mapping[str, Any]) -> bool:
+        """Whether ``text`` must be written out again: it uses a vector (a name that stands for
+        one, an index, a list, a vector function) or a definition's end value."""
+        tree = syntax_tree(text)
+        for node in ast.walk(tree):
+            if isinstance(node, ast.Subscript | ast.List):
+                return True
+            if isinstance(node, ast.Name) and (
+                is_vector(symbols.get(node.id)) or node.id in self.defined_ends
+            ):
+                return True
+            if (
+                isinstance(node, ast.Call)
+                and isinstance(node.func, ast.Name)
+                and node.func.id in VECTOR_FUNCTIONS
+            ):
+                return True
+        return False
 
     def components(self, raw: Any, n: int, symbols: Mapping[str, Any], where: str) -> list[Any]:
         """``n`` component values of ``raw``: a list of ``n``, a vector expression of size ``n``, or
@@ -86,11 +117,11 @@ class _Lowering:
             if len(raw) != n:
                 raise SpecError(f"has {len(raw)} values for a vector of size {n}", field=where)
             return [self.scalar(v, symbols, f"{where}.{i}") for i, v in enumerate(raw)]
-        if not isinstance(raw, str) or raw == "linear":
+        if not isinstance(raw, str) or raw in ("linear", "auto", "none"):
             return [raw] * n
         value = self.value(raw, symbols, where)
         if not is_vector(value):
-            return [to_text(value)] * n
+            return [to_text(value) if self._rewritten(raw, symbols) else raw] * n
         if value.shape[0] != n:
             raise SpecError(f"is a vector of size {value.shape[0]}, not {n}", field=where)
         return [to_text(c) for c in value]
@@ -101,6 +132,8 @@ class _Lowering:
             found = parse_vector_relation(text, symbols)
         except ExpressionError as err:
             raise self.fail(err, where) from None
+        if not self._rewritten(text, symbols):
+            return [text]
         return [t for r in found for t in relation_texts(r)]
 
     def variables(self, group: dict[str, Any], keys: tuple[str, ...], where: str) -> dict[str, Any]:
@@ -119,8 +152,15 @@ class _Lowering:
             }
             other = {k: v for k, v in spec.items() if k not in keys}
             for i in range(n):
+                self._new(component(name, i), group, lowered, where)
                 lowered[component(name, i)] = other | {k: v[i] for k, v in values.items()}
         return lowered
+
+    @staticmethod
+    def _new(name: str, given: Mapping[str, Any], lowered: Mapping[str, Any], where: str) -> None:
+        """Refuse a component whose name the file also gives (state ``r__0`` beside vector ``r``)."""
+        if name in given or name in lowered:
+            raise SpecError(f"names used twice: {name} is a vector's component", field=f"{where}.{name}")
 
     def definitions(self, raw: Mapping[str, Any], where: str, start: sp.Expr) -> dict[str, Any]:
         """Each definition as text, a vector one as one definition per component; the running
@@ -135,10 +175,12 @@ class _Lowering:
             value = self.value(text, self.running, f"{where}.{name}")
             if is_vector(value):
                 n = value.shape[0]
-                lowered |= {component(name, i): to_text(c) for i, c in enumerate(value)}
+                for i, c in enumerate(value):
+                    self._new(component(name, i), raw, lowered, where)
+                    lowered[component(name, i)] = to_text(c)
                 self.running[name] = _vector(name, n)
             else:
-                lowered[name] = to_text(value) if isinstance(text, str) else text
+                lowered[name] = self.scalar(text, self.running, f"{where}.{name}")
                 self.running[name] = symbol(name)
         return lowered
 
@@ -146,8 +188,9 @@ class _Lowering:
         """``name_0`` and ``name_f`` among the end symbols: ``value`` (a definition with the earlier
         ones substituted) over the end values at ``t_0 = start`` and ``t_f``; none for a definition
         of grid inputs, which have no end values."""
-        if {str(s) for s in sp.sympify(value).free_symbols} & self.inputs:
+        if not self.end_definitions or {str(s) for s in sp.sympify(value).free_symbols} & self.inputs:
             return
+        self.defined_ends |= {name + "_0", name + "_f"}
         for end, time in (("_0", start), ("_f", symbol("t_f"))):
             mapping = {symbol(v): symbol(v + end) for v in self.scalar_variables} | {symbol("t"): time}
             self.ends[name + end] = value.xreplace(mapping)
@@ -246,7 +289,9 @@ class _Lowering:
                 lowered[name] = self.scalar(text, symbols, f"{where}.{name}")
                 continue
             values = self.components(text, n, symbols, f"{where}.{name}")
-            lowered |= {component(name, i): v for i, v in enumerate(values)}
+            for i, v in enumerate(values):
+                self._new(component(name, i), raw, lowered, where)
+                lowered[component(name, i)] = v
         return lowered
 
 
@@ -270,7 +315,7 @@ def lowered(
     problem: dict[str, Any], sizes: dict[str, int], field: str, phases: bool
 ) -> tuple[dict[str, Any], Callable[[dict[str, Any], str], dict[str, Any]]]:
     """:func:`gamespec.specs.vectors.lower_problem` once it is known to have work to do."""
-    low = _Lowering(problem, sizes)
+    low = _Lowering(problem, sizes, phases)
     if phases:
         low.link_phases([ph.get("name") for ph in problem.get("phases", []) if isinstance(ph, Mapping)])
     out = low.sections(problem, field, _start(problem))

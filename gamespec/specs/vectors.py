@@ -23,6 +23,7 @@ vectors cannot have ``tables:`` yet (refused with the reason).
 from __future__ import annotations
 
 import ast
+import math
 from collections.abc import Callable, Mapping
 from typing import Any
 
@@ -31,8 +32,11 @@ from gamespec.limits import MAX_VECTOR_SIZE
 from gamespec.symbolic.grammar import syntax_tree
 
 
-def _sizes(group: Mapping[str, Any], where: str) -> dict[str, int]:
-    sizes = {}
+def _sizes(group: Any, where: str) -> dict[str, int]:
+    """The vectors of ``group`` (states or controls) by name and size."""
+    sizes: dict[str, int] = {}
+    if not isinstance(group, Mapping):
+        return sizes
     for name, spec in group.items():
         if isinstance(spec, Mapping) and spec.get("size") is not None:
             n = spec["size"]
@@ -44,25 +48,90 @@ def _sizes(group: Mapping[str, Any], where: str) -> dict[str, int]:
     return sizes
 
 
+def _end_texts(problem: Mapping[str, Any]) -> list[str]:
+    """The Mayer term and the boundary constraints, as texts."""
+    objective = problem.get("objective")
+    texts = [objective.get("mayer") if isinstance(objective, Mapping) else None]
+    boundary = problem.get("boundary_constraints")
+    texts += list(boundary) if isinstance(boundary, list) else []
+    return [t for t in texts if isinstance(t, str)]
+
+
+def _names_in(text: str) -> list[ast.AST]:
+    try:
+        return list(ast.walk(syntax_tree(text)))
+    except ExpressionError:
+        return []
+
+
+def _uses_times(problem: Mapping[str, Any]) -> bool:
+    """Whether an end term has a value at a fixed time (``x(t=5)``)."""
+    return any(
+        isinstance(n, ast.Call) and any(k.arg == "t" for k in n.keywords)
+        for text in _end_texts(problem)
+        for n in _names_in(text)
+    )
+
+
 def _uses_end_definitions(problem: Mapping[str, Any]) -> bool:
     """Whether the Mayer term or a boundary constraint names a definition at an end (``h_f``)."""
     definitions = problem.get("definitions")
     if not isinstance(definitions, Mapping) or not definitions:
         return False
     wanted = {f"{d}{end}" for d in definitions for end in ("_0", "_f")}
-    objective = problem.get("objective")
-    texts = [objective.get("mayer") if isinstance(objective, Mapping) else None]
-    boundary = problem.get("boundary_constraints")
-    texts += list(boundary) if isinstance(boundary, list) else []
-    for text in texts:
-        if isinstance(text, str):
-            try:
-                tree = syntax_tree(text)
-            except ExpressionError:
+    return any(
+        isinstance(n, ast.Name) and n.id in wanted for text in _end_texts(problem) for n in _names_in(text)
+    )
+
+
+_EXPRESSION = (str, int, float)
+_MAPS = ("parameters", "definitions", "states", "controls", "inputs", "design", "dynamics")
+_LISTS = ("path_constraints", "boundary_constraints")
+
+
+def _expression(value: Any) -> bool:
+    return isinstance(value, _EXPRESSION) and not isinstance(value, bool)
+
+
+def _well_formed(problem: Mapping[str, Any], phases: bool) -> bool:
+    """Whether the sections the lowering reads have the shapes it reads (mappings with string keys,
+    lists of constraint texts, expressions as texts or numbers, a numeric or free initial time);
+    anything else is left to the schema, which names the field in one line."""
+
+    def section_ok(raw: Mapping[str, Any]) -> bool:
+        for key in _MAPS:
+            value = raw.get(key, {})
+            if value is None and key == "controls" and phases:
                 continue
-            if any(isinstance(n, ast.Name) and n.id in wanted for n in ast.walk(tree)):
-                return True
-    return False
+            if not isinstance(value, Mapping) or not all(isinstance(k, str) for k in value):
+                return False
+        for key in ("definitions", "dynamics", "jump"):
+            values = raw.get(key, {})
+            if not isinstance(values, Mapping) or not all(
+                _expression(v) or (key != "definitions" and isinstance(v, list) and all(map(_expression, v)))
+                for v in values.values()
+            ):
+                return False
+        for key in _LISTS:
+            if not isinstance(raw.get(key, []), list) or not all(
+                isinstance(c, str) for c in raw.get(key, [])
+            ):
+                return False
+        integrals = raw.get("integral_constraints", [])
+        return isinstance(integrals, list) and all(isinstance(c, Mapping) for c in integrals)
+
+    time = problem.get("time", {})
+    if not isinstance(time, Mapping):
+        return False
+    initial = time.get("initial", 0.0)
+    if initial != "free" and not (
+        isinstance(initial, int | float) and not isinstance(initial, bool) and math.isfinite(initial)
+    ):
+        return False
+    phase_list = problem.get("phases", []) if phases else []
+    if not isinstance(phase_list, list) or not all(isinstance(p, Mapping) for p in phase_list):
+        return False
+    return section_ok(problem) and all(section_ok(p) for p in phase_list)
 
 
 def lower_problem(
@@ -77,11 +146,20 @@ def lower_problem(
     )
     if not sizes and (phases or not _uses_end_definitions(problem)):
         return problem, lambda guess, where: guess
-    if sizes and problem.get("tables"):
+    if not _well_formed(problem, phases):
+        return problem, lambda guess, where: guess
+    for key, what in (("tables", "tables"), ("at", "interior-point constraints (at:)")):
+        if problem.get(key):
+            raise SpecError(
+                f"{what} in a file with vector states or end-point definitions are not supported yet: "
+                "write the components as scalar states and the definitions out",
+                field=f"{field}.{key}",
+            )
+    if _uses_times(problem):
         raise SpecError(
-            "tables in a file with vector states or controls are not supported yet: write the "
-            "vectors' components as scalar states",
-            field=f"{field}.tables",
+            "x(t=...) in a file with vector states or end-point definitions is not supported yet: "
+            "use at: in a file of scalar states",
+            field=f"{field}.boundary_constraints",
         )
     from gamespec.specs.vector_lowering import lowered
 

@@ -230,3 +230,72 @@ def test_vector_orbit_raising_equals_its_polar_form() -> None:
     assert vector.objective == pytest.approx(scalar.objective, rel=1e-4)
     radius = np.hypot(vector.states["r__0"], vector.states["r__1"])
     np.testing.assert_allclose(radius, np.interp(vector.time, scalar.time, scalar.states["r"]), atol=1e-3)
+
+
+def test_a_component_name_given_by_the_file_is_refused() -> None:
+    """A state ``r__0`` beside the vector ``r`` would replace its component (found in review)."""
+    states = {**VECTOR["states"], "r__0": {"initial": 7}}
+    with pytest.raises(SpecError, match="names used twice"):
+        _spec({**VECTOR, "states": states, "dynamics": {**VECTOR["dynamics"], "r__0": 1}})
+    with pytest.raises(SpecError, match="names used twice"):
+        _spec({**VECTOR, "definitions": {**VECTOR["definitions"], "a__0": "1"}})
+
+
+def test_what_names_no_vector_is_kept_as_written() -> None:
+    """SymPy would simplify ``x/x`` to 1 and drop its singularity: a text without vectors is kept."""
+    spec = _spec(
+        {**VECTOR, "parameters": {"w": 0.7, "k": 2.0}, "definitions": {**VECTOR["definitions"], "q": "k/k"}}
+    )
+    assert spec.problem.definitions["q"] == "k/k"
+
+
+def test_scale_and_a_free_initial_time_in_a_vector_file() -> None:
+    problem = {
+        **VECTOR,
+        "controls": {"u": {"size": 3, "lower": -2, "upper": 2, "scale": "auto"}},
+        "time": {"initial": "free", "initial_bounds": [0, 0.5], "final": 1.5},
+        "boundary_constraints": ["r_f[2] == 0", "t_0 >= 0.1"],
+    }
+    spec = _spec(problem)
+    assert spec.problem.controls["u__1"].scale == "auto"
+    assert "t_0 >= 0.1" in spec.problem.boundary_constraints
+
+
+def test_a_multiphase_file_has_no_definitions_at_the_ends() -> None:
+    """A phase may replace a definition, so ``h_f`` of a multi-phase file would be ambiguous: it is
+    an undefined name, with vectors as without."""
+    problem = {
+        "states": {"r": {"size": 2, "initial": 0}},
+        "controls": {"u": {"size": 2}},
+        "dynamics": {"r": "u"},
+        "definitions": {"h": "r[0] + t"},
+        "objective": {"mayer": "h_f", "lagrange": "dot(u, u)"},
+        "phases": [
+            {"name": "a", "duration": 1.0},
+            {"name": "b", "duration": 1.0, "definitions": {"h": "r[1]"}},
+        ],
+    }
+    with pytest.raises(SpecError, match="undefined symbol 'h_f'"):
+        _phases(problem)
+
+
+@pytest.mark.parametrize(
+    "change",
+    [
+        {"states": ["x"]},
+        {"definitions": [1, 2]},
+        {"definitions": {"h": [1, 2]}},
+        {"path_constraints": [[1]]},
+        {"integral_constraints": [5]},
+        {"time": "x"},
+        {"time": {"initial": float("inf")}},
+    ],
+)
+def test_a_malformed_vector_file_is_one_schema_error(change: dict) -> None:
+    with pytest.raises(SpecError):
+        _spec({**VECTOR, **change})
+
+
+def test_interior_points_with_vectors_are_refused_with_the_reason() -> None:
+    with pytest.raises(SpecError, match="not supported yet"):
+        _spec({**VECTOR, "at": [{"time": 0.5, "constraints": ["r__0 == 0.5"]}]})

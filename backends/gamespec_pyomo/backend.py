@@ -28,7 +28,7 @@ from gamespec.ocp.transcription import Bounds, Transcription
 from gamespec.result import Result, Status
 from gamespec.specs.base import StrictModel
 from gamespec.specs.ocp import OptimalControlSpec
-from gamespec_pyomo.feasibility import ELASTIC_SHARE, ElasticFeasibility, wants_verdict
+from gamespec_pyomo.feasibility import ELASTIC_FLOOR_S, ELASTIC_SHARE, ElasticFeasibility, wants_verdict
 from gamespec_pyomo.model import build_model
 from gamespec_pyomo.nlfile import NLFile
 from gamespec_pyomo.solvers import (
@@ -248,7 +248,7 @@ class PyomoModel(CollocationModel):
         status = status_of(termination, message)
         if wants_verdict(status, message):
             limit = tic + self.options.max_wall_time
-            deadline = min(limit, time.perf_counter() + ELASTIC_SHARE * run.seconds)
+            deadline = min(limit, time.perf_counter() + max(ELASTIC_SHARE * run.seconds, ELASTIC_FLOOR_S))
             verdict = self.elastic.verdict(lambda e: self._solve_elastic(e, deadline))
             if verdict is not None and verdict.infeasible:
                 status, message = Status.LOCALLY_INFEASIBLE, f"{message}; {verdict.message()}"

@@ -28,8 +28,13 @@ VIOLATION = 1e-6
 """The largest elastic slack at the elastic problem's minimum that still counts as feasible."""
 
 ELASTIC_SHARE = 1.0
-"""The elastic solve may take at most this multiple of the failed run's seconds (and never past the
-solve's wall-clock limit): the verdict costs at most as much again as the failure did."""
+"""The elastic solve may take at most this multiple of the failed run's seconds, or
+:data:`ELASTIC_FLOOR_S` when that is more (and never past the solve's wall-clock limit): the
+verdict costs at most as much again as a long failure did."""
+
+ELASTIC_FLOOR_S = 10.0
+"""Seconds the elastic solve may always take: a failure that ended in a second on an idle machine
+must not lose its verdict on a loaded one (the deadline is wall-clock time)."""
 
 
 def wants_verdict(status: Status, message: str) -> bool:

@@ -73,7 +73,12 @@ def test_gauss_seidel_cycles_in_a_linear_flow():
 
 
 @pytest.mark.parametrize(
-    ("field", "payoff"), [(linear_field, "trace"), (vortex_field, "trace"), (vortex_field, "frobenius")]
+    ("field", "payoff"),
+    [
+        (linear_field, "trace"),
+        (vortex_field, "trace"),
+        pytest.param(vortex_field, "frobenius", marks=pytest.mark.slow),
+    ],
 )
 def test_minimax_stops_with_a_certified_value(field, payoff):
     """At the stop: the multipliers are a mixed strategy (≥ 0, sum 1) on the support points where
@@ -142,7 +147,7 @@ def test_symmetry_alone_does_not_rule_out_a_saddle():
             assert saddle_gap(lower, upper) == pytest.approx(1.0)
 
 
-@pytest.mark.parametrize("name", ["linear_flow", "hurricane_hugo"])
+@pytest.mark.parametrize("name", ["linear_flow", pytest.param("hurricane_hugo", marks=pytest.mark.slow)])
 def test_the_feasibility_condition_holds_on_the_shipped_files(name):
     """On both chapter-5 files the pursuer's answer ``p₀`` to the open-loop evader leaves room to
     copy every evader gain (``p₀ + ℰ ⊆ 𝒫``), so the lower value is certified: exactly ``J(p₀, 0)`` in

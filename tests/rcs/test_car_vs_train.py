@@ -63,6 +63,7 @@ def reduced_optimum(p: dict[str, float], gamma: int) -> tuple[float, float]:
     return float(best.fun), float(best.x + (10.0 - x_s) / p["v_max"])
 
 
+@pytest.mark.slow
 def test_q10_is_the_wait_then_full_speed_optimum():
     """The file's solve at Q = 10 against the reduction (its Monte Carlo of 1000 samples left out:
     nothing here reads it)."""

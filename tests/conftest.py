@@ -1,11 +1,18 @@
 """Shared fixtures: paths of the shipped problem files, a CLI runner, and the status policy's
-invariant asserted on every Result the solving chain returns anywhere in the suite."""
+invariant asserted on every Result the solving chain returns anywhere in the suite. Hypothesis runs
+derandomized: the same examples on every machine and run, so that a random tree SymPy takes
+minutes to evaluate (seen once in the printer's random trees) cannot stall one CI run and not the
+next."""
 
 from __future__ import annotations
 
 from pathlib import Path
 
 import pytest
+from hypothesis import settings
+
+settings.register_profile("gamespec", derandomize=True)
+settings.load_profile("gamespec")
 
 ROOT = Path(__file__).resolve().parents[1]
 PROBLEMS = ROOT / "problems"

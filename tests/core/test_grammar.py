@@ -109,8 +109,11 @@ def test_numbers_agree_with_sympy(text: str) -> None:
 @given(trees(REAL_UNARY + MORE_UNARY, REAL_BINARY + MORE_BINARY))
 def test_building_from_the_text_equals_translating_its_sympy(expr: sp.Expr) -> None:
     """Two routes from one text to NumPy values: the grammar's walk with NumPy's library, and
-    SymPy (with its simplifications) translated to NumPy; they agree wherever both are finite."""
+    SymPy (with its simplifications) translated to NumPy; they agree wherever both are finite.
+    Numbers beyond 1e6 are left out: ``sin(8615125/(y**2 + 1)**3)`` is exact on both routes up
+    to a rounding of its argument that the sine turns into 2e-9 (its conditioning, not a fault)."""
     assume(representable(expr))
+    assume(all(abs(n) <= 1e6 for n in expr.atoms(sp.Number)))
     text = to_text(expr)
     symbols = {n: symbol(n) for n in NAMES_XYT}
     try:

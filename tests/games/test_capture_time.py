@@ -92,10 +92,6 @@ def chauffeur():
     return {ell: model.solve({"l": ell}) for ell in (0.15, 0.4)}
 
 
-def test_the_two_radii_lie_on_both_sides_of_the_barrier():
-    assert 0.15 < BARRIER < 0.4
-
-
 def test_below_the_barrier_the_pedestrian_escapes(chauffeur):
     result = chauffeur[0.15]
     assert result.status is Status.OPTIMAL, result.message

@@ -88,10 +88,6 @@ def chauffeur():
     return {ell: model.solve({"l": ell}) for ell in (0.15, 0.4)}
 
 
-def test_the_barrier_threshold_lies_between_the_two_cases():
-    assert 0.15 < BARRIER < 0.4
-
-
 def test_below_the_barrier_the_capture_region_stops_growing(chauffeur):
     region = chauffeur[0.15].metrics["capture_region"]
     assert region["area"] == region["area_at_half_horizon"]

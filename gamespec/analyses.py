@@ -139,7 +139,7 @@ def as_override(text: str) -> str:
     return f"analyses={chosen if isinstance(chosen, str) else '[' + ', '.join(chosen) + ']'}"
 
 
-def for_study(chosen: Selection | None, needed: Sequence[str]) -> Selection:
+def for_study(chosen: str | list[str] | None, needed: Sequence[str]) -> Selection:
     """The analyses a study's points run: the ``needed`` ones its table is made of, and those the
     study file (or ``--analyses``) chooses on top (``all``: every one; ``none`` or nothing: only
     the needed ones)."""

@@ -14,6 +14,7 @@ from collections.abc import Callable
 from functools import lru_cache
 from typing import Any, ClassVar, cast
 
+import numpy as np
 from pydantic import BaseModel, ConfigDict, model_validator
 
 from gamespec.analyses import for_study
@@ -71,13 +72,14 @@ def evaluate(point: StudyPoint) -> dict[str, Any]:
     spec = RcsStudySpec.model_validate_json(point.study)
     tic = time.perf_counter()
     solver, starts = compiled_point(point.study, point.obstacles)
-    best: tuple[float, Result] | None = None
+    best: tuple[float, Result, np.ndarray] | None = None
     tried = []
     for amplitude, start in zip(spec.guesses, starts, strict=True):
         result = solver.solve(parameters={"alpha": point.alpha}, guess=start)
         tried.append({"guess": amplitude, "status": result.status.value, "objective": result.objective})
-        if result.ok and (best is None or result.objective < best[0]):
-            best = (result.objective, result)
+        objective, grid = result.objective, result.time
+        if result.ok and objective is not None and grid is not None and (best is None or objective < best[0]):
+            best = (objective, result, grid)
     row: dict[str, Any] = {
         "obstacles": point.obstacles,
         "alpha": point.alpha,
@@ -87,7 +89,7 @@ def evaluate(point: StudyPoint) -> dict[str, Any]:
     }
     if best is None:
         return row | {"status": "error"}
-    result = best[1]
+    _, result, time_grid = best
     mc = result.metrics["monte_carlo"]
     return row | {
         "status": result.status.value,
@@ -97,7 +99,7 @@ def evaluate(point: StudyPoint) -> dict[str, Any]:
         "collision_probability": mc["collision_probability"],
         "collision_probability_ci": mc["collision_probability_ci"],
         "path": {"x": list(map(float, result.states["x"])), "y": list(map(float, result.states["y"]))},
-        "time": list(map(float, result.time)),
+        "time": list(map(float, time_grid)),
     }
 
 
@@ -130,7 +132,7 @@ class StoredRow(BaseModel):
         return self
 
 
-class RcsStudyModel(PointStudyModel):
+class RcsStudyModel(PointStudyModel[RcsStudySpec]):
     """The §6.4.4 study ready to run (or resume) into its store."""
 
     row_model = StoredRow
@@ -178,7 +180,7 @@ class RcsStudy(PointStudy):
 
     name: ClassVar[str] = "rcs_study"
     kinds: ClassVar[frozenset[str]] = frozenset({"rcs_multi_obstacle_study"})
-    model: ClassVar[type[PointStudyModel]] = RcsStudyModel
+    model: ClassVar[type[PointStudyModel[Any]]] = RcsStudyModel
 
 
 def rcs_study_summary(result: Result) -> Rows:

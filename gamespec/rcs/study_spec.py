@@ -24,11 +24,11 @@ from pydantic import Field, model_validator
 from gamespec.errors import SpecError
 from gamespec.limits import MAX_RCS_OBSTACLES, MAX_SAMPLE_VALUES, MAX_STUDY_POINTS
 from gamespec.registry import Kind
-from gamespec.specs.base import BackendName, Number, SpecBase
+from gamespec.specs.base import BackendName, Number, StudySpecBase
 from gamespec.specs.ocp import MethodSpec
 
 
-class RcsStudySpec(SpecBase):
+class RcsStudySpec(StudySpecBase):
     """Fig. 6.11: travel time against collision probability per number of obstacles and weight."""
 
     kind: Literal["rcs_multi_obstacle_study"] = Field(

@@ -7,6 +7,7 @@ dotted location and the nearest valid key (see :func:`gamespec.loader.format_val
 from __future__ import annotations
 
 from collections.abc import Mapping
+from pathlib import Path
 from typing import Annotated, Any, ClassVar, Protocol, TypeVar
 
 from pydantic import AfterValidator, BaseModel, ConfigDict, Field, FiniteFloat, PrivateAttr, model_validator
@@ -218,6 +219,14 @@ class SpecBase(StrictModel):
                 node = node[int(part)] if isinstance(node, list) else node[part]
             node[int(last) if isinstance(node, list) else last] = None
         return data
+
+
+class StudySpecBase(SpecBase):
+    """A study kind's spec (its points solved on ``ocp_backend``, saved under ``store``); each kind
+    declares both fields again with its own default and description."""
+
+    ocp_backend: BackendName
+    store: Path
 
 
 SpecT = TypeVar("SpecT", bound=SpecBase)

@@ -9,7 +9,7 @@ from __future__ import annotations
 import time
 from abc import abstractmethod
 from collections.abc import Callable, Mapping
-from typing import Any, ClassVar
+from typing import Any, ClassVar, Generic, TypeVar, cast
 
 from pydantic import BaseModel, Field, ValidationError
 
@@ -17,7 +17,7 @@ from gamespec.compiling import Availability, CompiledModel, Inputs, refuse_input
 from gamespec.errors import SpecError, UnsupportedFeature
 from gamespec.result import Result
 from gamespec.solving import get_backend
-from gamespec.specs.base import SpecBase, StrictModel
+from gamespec.specs.base import SpecBase, StrictModel, StudySpecBase
 from gamespec.specs.hashing import spec_hash
 from gamespec.studies.executors import SCHEDULER_ENV, executor
 from gamespec.studies.runner import StudyRun, run_study
@@ -61,11 +61,13 @@ class StudyRunOptions(StudyOptions):
     )
 
 
-class PointStudyModel(CompiledModel):
-    """A study ready to run (or resume) into its store; ``options`` has ``executor``, ``workers``,
-    ``scheduler`` and ``progress``."""
+StudySpecT = TypeVar("StudySpecT", bound=StudySpecBase)
 
-    def __init__(self, spec: SpecBase, options: StrictModel) -> None:
+
+class PointStudyModel(CompiledModel, Generic[StudySpecT]):
+    """A study of a ``StudySpecT`` spec ready to run (or resume) into its store."""
+
+    def __init__(self, spec: StudySpecT, options: StudyRunOptions) -> None:
         self.spec = spec
         self.options = options
 
@@ -132,7 +134,7 @@ class PointStudy:
     kinds: ClassVar[frozenset[str]]
     features: ClassVar[frozenset[str]] = frozenset()
     options_model: ClassVar[type[StrictModel]] = StudyOptions
-    model: ClassVar[type[PointStudyModel]]
+    model: ClassVar[type[PointStudyModel[Any]]]
 
     @classmethod
     def available(cls) -> Availability:
@@ -158,12 +160,13 @@ class PointStudy:
         except ValidationError as err:
             raise SpecError(_first_error(err), field="options", source=spec.source) from None
 
-    def compile(self, spec: SpecBase, options: StrictModel) -> PointStudyModel:
+    def compile(self, spec: SpecBase, options: StrictModel) -> PointStudyModel[Any]:
         """The study of ``spec`` ready to run; UnsupportedFeature for a kind it does not run."""
         if spec.kind not in self.kinds:
             raise UnsupportedFeature(f"study {self.name!r} does not run kind {spec.kind!r}")
-        get_backend(spec.ocp_backend)
-        return self.model(spec, options)
+        study = cast(StudySpecBase, spec)
+        get_backend(study.ocp_backend)
+        return self.model(study, cast(StudyRunOptions, options))
 
 
 def _first_error(err: ValidationError) -> str:

@@ -16,7 +16,7 @@ from pydantic import Field, ValidationError, ValidationInfo, field_validator, mo
 from gamespec.errors import SpecError
 from gamespec.limits import MAX_STUDY_POINTS
 from gamespec.registry import Kind
-from gamespec.specs.base import BackendName, Number, SpecBase, StrictModel
+from gamespec.specs.base import BackendName, Number, StudySpecBase, StrictModel
 from gamespec.specs.ocp import MethodSpec
 
 MethodChange = dict[str, int | float | str]
@@ -30,7 +30,7 @@ class StudyGrid(StrictModel):
     fractions: int = Field(9, ge=1, description="Values of r2(0) per angle, between F and E.")
 
 
-class SuboptimalStudySpec(SpecBase):
+class SuboptimalStudySpec(StudySpecBase):
     """Table 2.1 (kind ``pursuit_suboptimal_study``): P1 at (0, 0), E at (r1, 0), both pursuers at
     speed u on pure pursuit, the evader at each of ``speeds``."""
 

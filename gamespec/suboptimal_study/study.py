@@ -35,6 +35,7 @@ from gamespec.studies.point_study import PointStudy, PointStudyModel
 from gamespec.studies.runner import StudyRun
 from gamespec.studies.store import ResultStore
 from gamespec.suboptimal_study.points import DEFECT_TOL, StudyPoint, point_engagement, study_points, summarize
+from gamespec.suboptimal_study.spec import SuboptimalStudySpec
 
 POINT_ARRAYS = ("v", "r2", "psi", "t_suboptimal", "t_optimal", "variation_percent")
 """Per-point values copied into ``Result.arrays`` (the plot's scatter)."""
@@ -70,9 +71,15 @@ def _first_accepted(point: StudyPoint, parameters: dict[str, float], guess: Resu
     for attempt, method in enumerate(point.methods):
         solver = _solver(point.v, point.r1, point.u, point.eps, method, point.backend)
         result = solver.solve(parameters=parameters, guess=guess)
-        if result.ok and result.checks["max_defect"] < DEFECT_TOL:
+        if _accepted(result):
             return attempt, result
     return len(point.methods) - 1, result
+
+
+def _accepted(result: Result) -> bool:
+    """Whether a point's solve is an optimum that passes the defect check."""
+    defect = result.checks.get("max_defect")
+    return result.ok and result.t_final is not None and defect is not None and defect < DEFECT_TOL
 
 
 def evaluate(point: StudyPoint) -> dict[str, Any]:
@@ -99,7 +106,7 @@ def evaluate(point: StudyPoint) -> dict[str, Any]:
         "attempt": attempt,
         "max_defect": result.checks.get("max_defect"),
     }
-    if not (result.ok and row["max_defect"] < DEFECT_TOL):
+    if not _accepted(result) or result.t_final is None:
         return row
     return row | {
         "t_optimal": result.t_final,
@@ -136,7 +143,7 @@ SOLVED_FIELDS = ("max_defect", "t_optimal", "simultaneous_capture_gap", "resimul
 """What a solved point's row carries besides its variation (the checks are maxima over them)."""
 
 
-class StudyModel(PointStudyModel):
+class StudyModel(PointStudyModel[SuboptimalStudySpec]):
     """The Table 2.1 study ready to run (or resume) into its store."""
 
     row_model = StoredRow
@@ -185,4 +192,4 @@ class SuboptimalStudy(PointStudy):
 
     name: ClassVar[str] = "study"
     kinds: ClassVar[frozenset[str]] = frozenset({"pursuit_suboptimal_study"})
-    model: ClassVar[type[PointStudyModel]] = StudyModel
+    model: ClassVar[type[PointStudyModel[Any]]] = StudyModel

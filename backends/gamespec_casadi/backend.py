@@ -124,8 +124,9 @@ class CasadiModel(CollocationModel):
         self.shape = (tr.n_x, tr.grid.n_nodes, tr.n_u, len(tr.grid.eval_index))
         self._last: np.ndarray | None = None
 
-    def _pack(self, X: np.ndarray, U: np.ndarray, d: np.ndarray, T: float) -> np.ndarray:
-        """The NLP's variables: X and U divided by their scale factors."""
+    def pack(self, X: np.ndarray, U: np.ndarray, d: np.ndarray, T: float) -> np.ndarray:
+        """The NLP's variables: X and U divided by their scale factors (also the joint game
+        scheme's way in, :mod:`gamespec.games.joint`)."""
         parts = [(X / self.sx[:, None]).ravel(order="F"), (U / self.su[:, None]).ravel(order="F"), d]
         return np.concatenate([*parts, [T]] if self.tr.free_time else parts)
 
@@ -137,8 +138,9 @@ class CasadiModel(CollocationModel):
         T = float(w[-1]) if self.tr.free_time else params_T
         return X, U, d, T
 
-    def _constraint_bounds(self, params: dict[str, float]) -> tuple[np.ndarray, np.ndarray]:
-        """``lbg, ubg`` with the integral constraints' bounds (the last rows of g) for ``params``."""
+    def constraint_bounds(self, params: dict[str, float]) -> tuple[np.ndarray, np.ndarray]:
+        """``lbg, ubg`` with the integral constraints' bounds (the last rows of g) for ``params``
+        (also read by the joint game scheme)."""
         n = len(self.tr.ocp.running_structure.integrands)
         if not n:
             return self.lbg, self.ubg
@@ -157,13 +159,13 @@ class CasadiModel(CollocationModel):
             w0 = self._last
         else:
             start: Guess = tr.guess(params, guess)
-            w0 = self._pack(start.X, start.U, start.d, start.T)
-        lbx = self._pack(b.x_lower, b.u_lower, b.d_lower, b.t_lower)
-        ubx = self._pack(b.x_upper, b.u_upper, b.d_upper, b.t_upper)
+            w0 = self.pack(start.X, start.U, start.d, start.T)
+        lbx = self.pack(b.x_lower, b.u_lower, b.d_lower, b.t_lower)
+        ubx = self.pack(b.x_upper, b.u_upper, b.d_upper, b.t_upper)
         horizon = [] if tr.free_time else [b.t_lower]
         p_val = np.concatenate([[params[n] for n in tr.ocp.parameters], Win.ravel(order="F"), horizon])
         tic = time.perf_counter()
-        lbg, ubg = self._constraint_bounds(params)
+        lbg, ubg = self.constraint_bounds(params)
         sol = self.solver(x0=np.clip(w0, lbx, ubx), lbx=lbx, ubx=ubx, lbg=lbg, ubg=ubg, p=p_val)
         elapsed = time.perf_counter() - tic
         stats = self.solver.stats()

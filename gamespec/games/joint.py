@@ -162,7 +162,7 @@ def _values(r: BestResponder) -> dict[str, float]:
 
 def _casadi_model(r: BestResponder) -> Any:
     model = r.solver.compiled
-    if r.solver.backend.name != "casadi" or not hasattr(model, "_pack"):
+    if r.solver.backend.name != "casadi" or not hasattr(model, "pack"):
         raise UnsupportedFeature("game.scheme: joint needs every player's problem compiled on casadi")
     if model.tr.free_time:
         raise UnsupportedFeature("game.scheme: joint does not handle a free final time")
@@ -185,9 +185,9 @@ class _Numbers:
 def _numbers(model: Any, values: dict[str, float]) -> _Numbers:
     tr = model.tr
     b = tr.bounds(values)
-    lbx = model._pack(b.x_lower, b.u_lower, b.d_lower, b.t_lower)
-    ubx = model._pack(b.x_upper, b.u_upper, b.d_upper, b.t_upper)
-    lbg, ubg = model._constraint_bounds(values)
+    lbx = model.pack(b.x_lower, b.u_lower, b.d_lower, b.t_lower)
+    ubx = model.pack(b.x_upper, b.u_upper, b.d_upper, b.t_upper)
+    lbg, ubg = model.constraint_bounds(values)
     p = np.array([*(values[n] for n in tr.ocp.parameters), b.t_lower])
     return _Numbers(values, p, lbx, ubx, np.asarray(lbg, float), np.asarray(ubg, float))
 
@@ -355,7 +355,7 @@ class JointSystem:
                 U = np.asarray(strategies[player.name], dtype=float)
                 X = states_at(tr, num.params, U, Win, guess.X)
                 X = guess.X if X is None else X
-            w = np.clip(model._pack(X, U, guess.d, guess.T), num.lbx, num.ubx)
+            w = np.clip(model.pack(X, U, guess.d, guess.T), num.lbx, num.ubx)
             z[block["w"]] = w
             p_full = np.concatenate([num.p[:-1], Win.ravel(order="F"), num.p[-1:]])
             gv = np.asarray(g(w, p_full)).ravel()

@@ -24,6 +24,7 @@ from pydantic import Field, ValidationInfo, field_validator
 from gamespec.compiling import Availability, Inputs
 from gamespec.compiling.collocation import IPOPT_DEFAULTS, CollocationBackend, CollocationModel
 from gamespec.errors import BackendError
+from gamespec.ocp.compiled_checks import prepare as prepare_checks
 from gamespec.ocp.transcription import Bounds, Transcription
 from gamespec.result import Result, Status
 from gamespec.specs.base import StrictModel
@@ -100,6 +101,7 @@ class PyomoModel(CollocationModel):
 
         self.pyo = pyo
         self.tr = Transcription(spec)
+        prepare_checks(self.tr)
         self.options = options
         self.executable = find_executable(options.solver)
         self.model = build_model(self.tr, self.tr.ocp.parameter_values())

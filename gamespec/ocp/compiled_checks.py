@@ -7,10 +7,12 @@ each of the ``4 · RK4_STEPS`` stages costs one pass over every operation of the
 small problems re-solved often (a receding-horizon game's thousand NLPs) that was most of a
 solve's time. Here the whole re-integration of one interval is one CasADi SX function of the
 interval's start ``y0``, its control and input points, its length ``h``, its start time ``t0``
-and the parameter values, built once per transcription and interval degree from the file's text
-(:class:`~gamespec.symbolic.library.LibraryAlgebra` over CasADi), and mapped over the intervals:
-one call of compiled code per check. The arithmetic is the same as the NumPy route's, so the
-numbers agree to rounding.
+and the parameter values, built once per transcription and interval degree from the running
+terms' function at one point, and mapped over the intervals: one call of compiled code per check.
+That function and the end-point terms' are built from the file's expressions
+(:class:`~gamespec.symbolic.library.LibraryAlgebra` over CasADi) when the model is compiled
+(:func:`prepare`), so no solve walks text (issue 27, item 3). The arithmetic is the same as the
+NumPy route's, so the numbers agree to rounding.
 """
 
 from __future__ import annotations
@@ -46,12 +48,28 @@ def rk4_function(tr: Transcription, degree: int, steps: int, bases: np.ndarray) 
     return functions[degree, steps]
 
 
+def prepare(tr: Transcription) -> None:
+    """Build the checks' compiled functions of ``tr`` from the file's expressions now, when the
+    model is compiled (the running terms and the end-point terms, each walked once): the re-
+    integrations of every interval degree are built from the running function later, and no solve
+    walks text (issue 27, item 3)."""
+    _running_function(tr)
+    _end_function(tr)
+
+
+def _running_function(tr: Transcription) -> Any:
+    """The running terms at one point (:func:`point_values`' rows), built once per transcription."""
+    functions = _FUNCTIONS.setdefault(tr, {})
+    if () not in functions:
+        functions[()] = _point_function(tr)
+    return functions[()]
+
+
 def _build(tr: Transcription, degree: int, steps: int, bases: np.ndarray) -> Any:
     import casadi as ca
 
     ocp = tr.ocp
-    algebra = LibraryAlgebra(casadi_library(ca))
-    names = ocp.running_names
+    running = _running_function(tr)
     nx, nu, nw = len(ocp.states), len(ocp.controls), len(ocp.inputs)
     n_p = len(ocp.parameters) + len(ocp.design)
     n_int = len(ocp.running_structure.integrands)
@@ -62,17 +80,10 @@ def _build(tr: Transcription, degree: int, steps: int, bases: np.ndarray) -> Any
     ds = 1.0 / steps
 
     def f(y: Any, half: int) -> Any:
-        u = U @ bases[half] if nu else []
-        w = W @ bases[half] if nw else []
-        slots = [
-            *ca.vertsplit(y[:nx]),
-            *_split(u, nu),
-            *_split(w, nw),
-            *ca.vertsplit(p),
-            t0 + half * ds / 2 * h,
-        ]
-        terms = ocp.running_terms(dict(zip(names, slots, strict=True)), algebra)
-        return ca.vertcat(*terms.dynamics, *terms.integrands)
+        u = U @ bases[half] if nu else ca.SX(0, 1)
+        w = W @ bases[half] if nw else ca.SX(0, 1)
+        rows = running(y[:nx], u, w, p, t0 + half * ds / 2 * h)
+        return ca.vertcat(rows[:nx], rows[nx + 1 : nx + 1 + n_int])
 
     y = y0
     for step in range(steps):
@@ -127,9 +138,7 @@ def point_values(
     k = t.size
     functions = _FUNCTIONS.setdefault(tr, {})
     if (k,) not in functions:
-        if () not in functions:
-            functions[()] = _point_function(tr)
-        functions[k,] = functions[()].map(k)
+        functions[k,] = _running_function(tr).map(k)
     out = functions[k,](x, u, w, p, t[None, :])
     return np.asarray(out, dtype=float).reshape(-1, k)
 

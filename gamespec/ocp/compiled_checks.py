@@ -55,6 +55,7 @@ def prepare(tr: Transcription) -> None:
     walks text (issue 27, item 3)."""
     _running_function(tr)
     _end_function(tr)
+    _interior_function(tr)
 
 
 def _running_function(tr: Transcription) -> Any:
@@ -204,3 +205,48 @@ def _end_function(tr: Transcription) -> _EndFunction:
     used = frozenset(n for n, slot in zip(names, slots, strict=True) if ca.depends_on(mayer, slot))
     _END_FUNCTIONS[tr] = _EndFunction(function, terms.boundary, used)
     return _END_FUNCTIONS[tr]
+
+
+@dataclass(frozen=True)
+class _InteriorFunction:
+    """The interior-point constraints (``at:``, ``x(t=5)`` in boundary constraints;
+    :mod:`gamespec.ocp.events`) as one CasADi function of the state nodes and the parameter and
+    design values, and the relations it evaluates (their bounds)."""
+
+    function: Any
+    constraints: list[Relation]
+
+
+_INTERIOR_FUNCTIONS: weakref.WeakKeyDictionary[Transcription, _InteriorFunction] = weakref.WeakKeyDictionary()
+"""Each live transcription's compiled interior-point constraints."""
+
+
+def interior_constraints(tr: Transcription, X: np.ndarray, params: Mapping[str, float]) -> list[Relation]:
+    """The interior-point constraints at the state nodes ``X`` (unscaled) and the parameter and
+    design values ``params`` (by name), by one CasADi function built when the model is compiled
+    (:func:`prepare`): a solve walks no text (issue 27, item 3)."""
+    compiled = _interior_function(tr)
+    if not compiled.constraints:
+        return []
+    p = np.array([float(params[n]) for n in [*tr.ocp.parameters, *tr.ocp.design]])
+    found = np.asarray(compiled.function(np.asarray(X, dtype=float), p), dtype=float).reshape(-1)
+    return [Relation(v, r.lower, r.upper) for v, r in zip(found, compiled.constraints, strict=True)]
+
+
+def _interior_function(tr: Transcription) -> _InteriorFunction:
+    import casadi as ca
+
+    if tr in _INTERIOR_FUNCTIONS:
+        return _INTERIOR_FUNCTIONS[tr]
+    problem = tr.spec.problem
+    constraints: list[Relation] = []
+    function = None
+    if problem.at or problem.measurements is not None or problem.inline_points():
+        names = [*tr.ocp.parameters, *tr.ocp.design]
+        X, p = ca.SX.sym("X", tr.n_x, tr.grid.n_nodes), ca.SX.sym("p", len(names))
+        others = dict(zip(names, _split(p, len(names)), strict=True))
+        constraints = tr.interior.terms(X, others, LibraryAlgebra(casadi_library(ca))).constraints
+        rows = [ca.SX(r.expr) for r in constraints]
+        function = ca.Function("interior", [X, p], [ca.vertcat(*rows) if rows else ca.SX(0, 1)])
+    _INTERIOR_FUNCTIONS[tr] = _InteriorFunction(function, constraints)
+    return _INTERIOR_FUNCTIONS[tr]

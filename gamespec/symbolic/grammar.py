@@ -597,4 +597,5 @@ def numeric_value(text: str | float, values: Mapping[str, float]) -> float:
     value = expression(text, values, FLOATS) if walked is None else taken(walked, values, text)
     if isinstance(value, Dependent):
         raise ExpressionError(str(text), "is not a number here")
-    return value
+    number: float = value
+    return number

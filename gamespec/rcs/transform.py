@@ -252,7 +252,7 @@ def regularized(spec: OptimalControlSpec, options: RcsOptions) -> tuple[OptimalC
     uncertain = list(spec.problem.uncertain)
     if not uncertain:
         raise SpecError("rcs needs uncertain parameters (problem.uncertain)", field=FIELD, source=spec.source)
-    ocp = SymbolicOcp(spec)
+    ocp = SymbolicOcp(spec).parsed()
     chosen = _chosen(spec, ocp, options)
     aug = nonzero(sensitivity_functions(ocp, uncertain))
     g = [q.g for q in chosen]
@@ -279,6 +279,7 @@ def regularized(spec: OptimalControlSpec, options: RcsOptions) -> tuple[OptimalC
         DesensitizeOptions(monte_carlo=options.monte_carlo),
         len(spec.problem.states),
         len(new.problem.states),
+        ocp,
     )
     return new, RcsData(data, [q.label for q in chosen], uncertain, S_g, S_r, options, new, unit)
 

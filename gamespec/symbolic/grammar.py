@@ -281,40 +281,42 @@ def deferred_name(name: str) -> Deferred:
     return Deferred(None, (name,))
 
 
-def _call(name: str, *args: Value) -> Value:
-    return FLOATS.call(name, list(args))
-
-
-def _tabulated(function: FileFunction, *args: Value) -> Value:
-    return FLOATS.tabulated(function, list(args))
-
-
 class DeferredAlgebra:
-    """:data:`FLOATS`, each step kept for later (:class:`Deferred`): the walk builds the function
-    of the names' values that a walk of :data:`FLOATS` over those values computes. A step it cannot
-    keep (the time of ``x(t=...)`` or a chained constraint's outer term that depends on a
-    parameter, which the walk itself needs as a number) is refused."""
+    """An algebra (``base``, :data:`FLOATS` by default), each step kept for later
+    (:class:`Deferred`): the walk builds the function of the names' values that a walk of ``base``
+    over those values computes. A step it cannot keep (the time of ``x(t=...)`` or a chained
+    constraint's outer term that depends on a parameter, which the walk itself needs as a number)
+    is refused."""
+
+    def __init__(self, base: Algebra = FLOATS) -> None:
+        self.base = base
+
+    def _call(self, name: str, *args: Any) -> Any:
+        return self.base.call(name, list(args))
+
+    def _tabulated(self, function: FileFunction, *args: Any) -> Any:
+        return self.base.tabulated(function, list(args))
 
     def number(self, value: int | float) -> Deferred:
-        return Deferred(FLOATS.number, (value,))
+        return Deferred(self.base.number, (value,))
 
     def constant(self, name: str) -> Deferred:
-        return Deferred(FLOATS.constant, (name,))
+        return Deferred(self.base.constant, (name,))
 
     def binary(self, op: type[ast.operator], left: Any, right: Any) -> Deferred:
-        return Deferred(FLOATS.binary, (op, left, right))
+        return Deferred(self.base.binary, (op, left, right))
 
     def negate(self, value: Any) -> Deferred:
-        return Deferred(FLOATS.negate, (value,))
+        return Deferred(self.base.negate, (value,))
 
     def power(self, base: Any, exponent: Any) -> Deferred:
-        return Deferred(FLOATS.power, (base, exponent))
+        return Deferred(self.base.power, (base, exponent))
 
     def call(self, name: str, args: list[Any]) -> Deferred:
-        return Deferred(_call, (name, *args))
+        return Deferred(self._call, (name, *args))
 
     def tabulated(self, function: FileFunction, args: list[Any]) -> Deferred:
-        return Deferred(_tabulated, (function, *args))
+        return Deferred(self._tabulated, (function, *args))
 
     def scalar(self, value: Any) -> float | None:
         """A value the walk needs as a number now: one made of numbers only (an outer term or a
@@ -323,7 +325,7 @@ class DeferredAlgebra:
             number = value({}) if type(value) is Deferred else value
         except KeyError:
             raise Refused("depends on a parameter's value") from None
-        return FLOATS.scalar(number)
+        return self.base.scalar(number)
 
 
 DEFERRED = DeferredAlgebra()
@@ -584,10 +586,17 @@ def taken(value: Any, values: Mapping[str, Any], text: str | float) -> Any:
         raise ExpressionError(str(text)[:40] + "...", "expression nested too deeply") from None
 
 
+def kept_expression(text: str | float, names: Iterable[str], algebra: Algebra = FLOATS) -> Any:
+    """The walk of ``text`` in ``algebra`` over ``names`` kept for later (:func:`kept`; taken with
+    :func:`taken` at the names' values), None when the walk refuses it."""
+    deferred = DeferredAlgebra(algebra)
+    return kept(lambda: expression(text, {n: deferred_name(n) for n in names}, deferred), text)
+
+
 @lru_cache(maxsize=4096, typed=True)
 def _kept_value(text: str | float, names: tuple[str, ...]) -> Any:
     """The walk of ``text`` over ``names`` kept once per text and names (:func:`numeric_value`)."""
-    return kept(lambda: expression(text, {n: deferred_name(n) for n in names}, DEFERRED), text)
+    return kept_expression(text, names)
 
 
 def numeric_value(text: str | float, values: Mapping[str, float]) -> float:

@@ -29,6 +29,7 @@ from __future__ import annotations
 
 import ast
 import math
+import threading
 from collections import OrderedDict
 from collections.abc import Callable, Iterable, Mapping
 from dataclasses import dataclass
@@ -273,6 +274,8 @@ class _KeptCheck:
 
 
 _KEPT: OrderedDict[tuple[Any, ...], _KeptCheck] = OrderedDict()
+_KEPT_LOCK = threading.Lock()
+"""Held while :data:`_KEPT` changes (a study's threads check at once)."""
 KEPT_CHECKS = 4096
 """How many texts-over-a-scope :func:`check` keeps (the least recently used go first)."""
 
@@ -281,15 +284,18 @@ def _kept_check(key: tuple[Any, ...], tables: Mapping[str, FileFunction]) -> _Ke
     """The kept check of ``key`` (text, names, those with values, constraint, definitions, the
     tables the text uses: a table is its own object, so a file's tables rebuilt are new keys),
     walked in :data:`~gamespec.symbolic.grammar.DEFERRED` on first use."""
-    if key in _KEPT:
-        _KEPT.move_to_end(key)
-        return _KEPT[key]
+    with _KEPT_LOCK:
+        if key in _KEPT:
+            _KEPT.move_to_end(key)
+            return _KEPT[key]
     _, text, names, valued, constraint, definitions, _ = key
     symbols = {n: deferred_name(n) if n in valued else unknown(n) for n in names}
     walked = kept(lambda: _kept_walk(text, symbols | dict(tables), constraint, dict(definitions)), text)
-    _KEPT[key] = found = _KeptCheck(walked)
-    if len(_KEPT) > KEPT_CHECKS:
-        _KEPT.popitem(last=False)
+    found = _KeptCheck(walked)
+    with _KEPT_LOCK:
+        _KEPT[key] = found
+        if len(_KEPT) > KEPT_CHECKS:
+            _KEPT.popitem(last=False)
     return found
 
 

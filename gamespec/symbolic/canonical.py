@@ -245,7 +245,7 @@ def check(
     used = _names(text).union(*map(_names, definitions.values()))
     tables = {n: f for n, f in (functions or {}).items() if n in used}
     valued = tuple(n for n in names if n in values)
-    scope = (tuple(names), valued, constraint, tuple(definitions.items()), tuple(tables.items()))
+    scope = (tuple(names), valued, constraint, tuple(definitions.items()), _tables_key(tables))
     key = (type(text), text, *scope)
     kept = _kept_check(key, tables)
     if kept.floats is None:
@@ -280,10 +280,26 @@ KEPT_CHECKS = 4096
 """How many texts-over-a-scope :func:`check` keeps (the least recently used go first)."""
 
 
+def _tables_key(tables: Mapping[str, FileFunction]) -> tuple[Any, ...]:
+    """The tables a text uses as part of a kept check's key: a table by its data (a spec validated
+    again at new parameter values rebuilds its tables, with the same data), another file
+    function by itself."""
+    import numpy as np
+
+    def data(function: FileFunction) -> Any:
+        axes, values = getattr(function, "axes", None), getattr(function, "values", None)
+        if axes is None or values is None:
+            return function
+        arrays = [np.asarray(a, dtype=float) for a in (*axes, values)]
+        return (getattr(function, "method", None), *((a.shape, a.tobytes()) for a in arrays))
+
+    return tuple((name, data(function)) for name, function in tables.items())
+
+
 def _kept_check(key: tuple[Any, ...], tables: Mapping[str, FileFunction]) -> _KeptCheck:
     """The kept check of ``key`` (text, names, those with values, constraint, definitions, the
-    tables the text uses: a table is its own object, so a file's tables rebuilt are new keys),
-    walked in :data:`~gamespec.symbolic.grammar.DEFERRED` on first use."""
+    tables the text uses, :func:`_tables_key`), walked in
+    :data:`~gamespec.symbolic.grammar.DEFERRED` on first use."""
     with _KEPT_LOCK:
         if key in _KEPT:
             _KEPT.move_to_end(key)

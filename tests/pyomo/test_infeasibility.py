@@ -101,8 +101,9 @@ def test_feasible_nonlinear_counterpart_is_solved() -> None:
 def _scaled_control(t_final: float) -> dict:
     """``x'' = u (1 + x^2/10)``, ``|u| <= 1``, from rest at x = 1 to rest at 0: on [0, 1] the
     acceleration is at most 1.1 in size, so a path that stays there needs the bang-bang time
-    ``2 sqrt(1/1.1) = 1.91`` of the double integrator with that bound (leaving [0, 1] only lengthens
-    the way): ``t_final = 1`` is infeasible (IPOPT on casadi agrees), 3 feasible."""
+    ``2 sqrt(1/1.1) = 1.91`` of the double integrator with that bound; ``t_final = 1`` is far below
+    it (not a proof for paths that leave [0, 1]: IPOPT on casadi's local infeasibility is asserted
+    beside), 3 above it."""
     data = _double_integrator(1.0, t_final)
     data["problem"]["dynamics"]["v"] = "u*(1 + 0.1*x**2)"
     return data

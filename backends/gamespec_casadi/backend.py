@@ -21,6 +21,7 @@ from pydantic import Field, ValidationInfo, field_validator
 from gamespec.compiling import Availability, Inputs
 from gamespec.compiling.collocation import IPOPT_DEFAULTS, CollocationBackend, CollocationModel
 from gamespec.errors import BackendError
+from gamespec.ocp.compiled_checks import prepare as prepare_checks
 from gamespec.ocp.transcription import Guess, Transcription
 from gamespec.result import Result, Status
 from gamespec.specs.base import StrictModel
@@ -115,6 +116,7 @@ class CasadiModel(CollocationModel):
             raise BackendError(f"casadi has no NLP solver plugin {options.solver!r}")
         self.ca = ca
         self.tr = tr = Transcription(spec)
+        prepare_checks(tr)
         self.options = options
         self.sx, self.su = tr.compiled_scaling.states, tr.compiled_scaling.controls
         outer = ca.SX if options.graph == "sx" else ca.MX

@@ -64,7 +64,7 @@ import sympy as sp
 from pydantic import Field, model_validator
 
 from gamespec.compiling import Backend, CompiledModel, Inputs, refuse_inputs
-from gamespec.errors import SpecError, UnsupportedFeature
+from gamespec.errors import ExpressionError, SpecError, UnsupportedFeature
 from gamespec.flowfield.grid import Grid
 from gamespec.flowfield.scratch import Scratch
 from gamespec.flowfield.tvd_rk import tvd_rk3_step
@@ -73,7 +73,10 @@ from gamespec.result import Result, Status
 from gamespec.specs.base import StrictModel
 from gamespec.specs.differential_game import DifferentialGameSpec
 from gamespec.symbolic.calculus import numeric_function
+from gamespec.symbolic.grammar import Relation
 from gamespec.symbolic.language import parse, parse_relation, symbol
+
+ONE_SIDED = "a set is one one-sided relation (g <= c or g >= c)"
 
 
 class HJIOptions(StrictModel):
@@ -172,6 +175,56 @@ def _samples(
 
 
 @dataclass(frozen=True)
+class ParsedGame:
+    """The game's expressions parsed once, when the model is compiled, over the parameters as
+    symbols (issue 27, item 3): the dynamics, the control bounds (None: none) and the sets
+    (``problem.capture``, ``problem.avoid``) by field; a solve substitutes the parameter values."""
+
+    states: list[str]
+    dynamics: list[sp.Expr]
+    minimizers: list[str]
+    maximizers: list[str]
+    bounds: dict[str, tuple[sp.Expr | None, sp.Expr | None]]
+    sets: dict[str, Relation]
+
+
+def parsed_game(game: DifferentialGameSpec) -> ParsedGame:
+    """:class:`ParsedGame` of ``game`` (a set that is not one one-sided relation is refused)."""
+    p = game.problem
+    controls = [c for pl in p.players.values() for c in pl.controls]
+    table = {n: symbol(n) for n in [*p.parameters, *p.states, *controls]}
+    sets = {}
+    for field, text in (("problem.capture", p.capture), ("problem.avoid", p.avoid)):
+        if text is None:
+            continue
+        try:
+            sets[field] = parse_relation(text, table)
+        except ExpressionError:
+            raise SpecError(ONE_SIDED, field=field) from None
+    return ParsedGame(
+        states=list(p.states),
+        dynamics=[sp.sympify(parse(p.dynamics[s], table)) for s in p.states],
+        minimizers=[c for pl in p.players.values() if pl.objective == "minimize" for c in pl.controls],
+        maximizers=[c for pl in p.players.values() if pl.objective == "maximize" for c in pl.controls],
+        bounds={
+            c: (_parsed(ctl.lower, table), _parsed(ctl.upper, table))
+            for pl in p.players.values()
+            for c, ctl in pl.controls.items()
+        },
+        sets=sets,
+    )
+
+
+def _parsed(raw: float | str | None, table: dict[str, Any]) -> sp.Expr | None:
+    return None if raw is None else sp.sympify(parse(raw, table))
+
+
+def _at(expr: sp.Expr, parameters: dict[str, float]) -> sp.Expr:
+    """``expr`` at these parameter values."""
+    return expr.xreplace({symbol(n): sp.Float(v) for n, v in parameters.items()})
+
+
+@dataclass(frozen=True)
 class ControlSamples:
     """The game's dynamics as SymPy expressions over the states and controls (the parameters
     substituted), and the samples of the minimizers' (``us``) and maximizers' (``ds``) controls
@@ -185,21 +238,12 @@ class ControlSamples:
     separable: bool
 
 
-def control_samples(game: DifferentialGameSpec, samples: int, parameters: dict[str, float]) -> ControlSamples:
+def control_samples(game: ParsedGame, samples: int, parameters: dict[str, float]) -> ControlSamples:
     """The dynamics and the samples of the players' control boxes (:class:`ControlSamples`)."""
-    p = game.problem
-    states = list(p.states)
-    table = {n: sp.Float(v) for n, v in parameters.items()} | {
-        n: symbol(n) for n in [*states, *(c for pl in p.players.values() for c in pl.controls)]
-    }
-    exprs = [sp.sympify(parse(p.dynamics[s], table)) for s in states]
-    minimizers = [c for pl in p.players.values() if pl.objective == "minimize" for c in pl.controls]
-    maximizers = [c for pl in p.players.values() if pl.objective == "maximize" for c in pl.controls]
-    bounds = {
-        c: (_number(ctl.lower, parameters), _number(ctl.upper, parameters))
-        for pl in p.players.values()
-        for c, ctl in pl.controls.items()
-    }
+    states = game.states
+    exprs = [_at(e, parameters) for e in game.dynamics]
+    minimizers, maximizers = game.minimizers, game.maximizers
+    bounds = {c: (_bound(lo, parameters), _bound(hi, parameters)) for c, (lo, hi) in game.bounds.items()}
     us, ds = _samples(exprs, minimizers, bounds, samples), _samples(exprs, maximizers, bounds, samples)
     separable = all(
         sp.diff(e, symbol(u), symbol(d)) == 0 for e in exprs for u in minimizers for d in maximizers
@@ -208,7 +252,7 @@ def control_samples(game: DifferentialGameSpec, samples: int, parameters: dict[s
 
 
 def sampled_hamiltonian(
-    game: DifferentialGameSpec, grid: Grid, samples: int, parameters: dict[str, float]
+    game: ParsedGame, grid: Grid, samples: int, parameters: dict[str, float]
 ) -> SampledHamiltonian:
     """The dynamics of ``game`` sampled at ``grid``'s nodes over the players' control boxes (module doc)."""
     sampled = control_samples(game, samples, parameters)
@@ -249,28 +293,31 @@ def _number(
     return value
 
 
-def target(game: DifferentialGameSpec, grid: Grid, parameters: dict[str, float]) -> np.ndarray:
+def _bound(expr: sp.Expr | None, parameters: dict[str, float]) -> float:
+    """A control bound parsed once (:class:`ParsedGame`) at these parameter values; finite."""
+    value = math.inf if expr is None else float(_at(expr, parameters))
+    if not math.isfinite(value):
+        raise SpecError("the hji backend needs finite bounds on every control", field="problem.players")
+    return value
+
+
+def target(game: ParsedGame, grid: Grid, parameters: dict[str, float]) -> np.ndarray:
     """``l / |∇l|`` of ``problem.capture`` at the nodes (:func:`relation_level`)."""
-    assert game.problem.capture is not None, "checked by the backend"
-    return relation_level(game, game.problem.capture, "problem.capture", grid, parameters)
+    return relation_level(game, "problem.capture", grid, parameters)
 
 
-def relation_level(
-    game: DifferentialGameSpec, relation: str, field: str, grid: Grid, parameters: dict[str, float]
-) -> np.ndarray:
+def relation_level(game: ParsedGame, field: str, grid: Grid, parameters: dict[str, float]) -> np.ndarray:
     """``l / |∇l|`` at the nodes for the set ``relation`` (``g ≤ c``: ``l = g − c``; ``g ≥ c``:
     ``l = c − g``): negative inside the set, the signed distance to its edge to first order there
     (module doc), so the level set's slope is about one at the front."""
-    p = game.problem
-    table = {n: sp.Float(v) for n, v in parameters.items()} | {s: symbol(s) for s in p.states}
-    rel = parse_relation(relation, table)
-    expr, names = sp.sympify(rel.expr), [symbol(s) for s in p.states]
+    rel = game.sets[field]
+    expr, names = _at(sp.sympify(rel.expr), parameters), [symbol(s) for s in game.states]
     if math.isfinite(rel.upper) and not math.isfinite(rel.lower):
         level = expr - rel.upper
     elif math.isfinite(rel.lower) and not math.isfinite(rel.upper):
         level = rel.lower - expr
     else:
-        raise SpecError("a set is one one-sided relation (g <= c or g >= c)", field=field)
+        raise SpecError(ONE_SIDED, field=field)
     gradient = sp.sqrt(sum(sp.diff(level, n) ** 2 for n in names))
     f = numeric_function([level, gradient], names)
     values = np.broadcast_to(f(grid.points[..., 0], grid.points[..., 1]), (2, *grid.shape)).astype(float)
@@ -394,6 +441,7 @@ class HJIModel(CompiledModel):
 
     def __init__(self, game: DifferentialGameSpec, options: HJIOptions) -> None:
         self.game, self.options = game, options
+        self.parsed = parsed_game(game)
         self.parameters = dict(game.problem.parameters)
         p = game.problem
 
@@ -415,12 +463,10 @@ class HJIModel(CompiledModel):
         """The grid, the reach (–avoid) run on it and whether the min and max were taken separately
         (Isaacs' condition holds for the sampled controls)."""
         grid = Grid(self.box[0], self.box[1], (nodes, nodes))
-        ham = sampled_hamiltonian(self.game, grid, self.options.control_samples, parameters)
-        start = target(self.game, grid, parameters)
+        ham = sampled_hamiltonian(self.parsed, grid, self.options.control_samples, parameters)
+        start = target(self.parsed, grid, parameters)
         avoid = self.game.problem.avoid
-        barrier = (
-            None if avoid is None else -relation_level(self.game, avoid, "problem.avoid", grid, parameters)
-        )
+        barrier = None if avoid is None else -relation_level(self.parsed, "problem.avoid", grid, parameters)
         o = self.options
         if o.engine == "hj_reachability":
             run = self._hj_reachability(grid, start, horizon, parameters, barrier, probe)
@@ -440,7 +486,7 @@ class HJIModel(CompiledModel):
         """:func:`reach_value`'s run by hj_reachability (:mod:`gamespec_levelset.hji_jax`)."""
         from gamespec_levelset.hji_jax import reach_values_hj
 
-        sampled = control_samples(self.game, self.options.control_samples, parameters)
+        sampled = control_samples(self.parsed, self.options.control_samples, parameters)
         pairs = [[[(u | d)[c] for c in sampled.controls] for d in sampled.ds] for u in sampled.us]
         taus = np.linspace(0.0, horizon, 2 * self.options.hj_outputs + 1)
         box = (grid.lower, grid.upper, grid.shape)

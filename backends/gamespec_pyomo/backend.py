@@ -24,11 +24,20 @@ from pydantic import Field, ValidationInfo, field_validator
 from gamespec.compiling import Availability, Inputs
 from gamespec.compiling.collocation import IPOPT_DEFAULTS, CollocationBackend, CollocationModel
 from gamespec.errors import BackendError
+from gamespec.ocp.compiled_checks import prepare as prepare_checks
 from gamespec.ocp.transcription import Bounds, Transcription
 from gamespec.result import Result, Status
 from gamespec.specs.base import StrictModel
 from gamespec.specs.ocp import OptimalControlSpec
-from gamespec_pyomo.feasibility import ELASTIC_FLOOR_S, ELASTIC_SHARE, ElasticFeasibility, wants_verdict
+from gamespec_pyomo.feasibility import (
+    ELASTIC_FLOOR_S,
+    ELASTIC_SHARE,
+    PROBE_ITERATIONS,
+    ElasticFeasibility,
+    Verdict,
+    stagnated,
+    wants_verdict,
+)
 from gamespec_pyomo.model import build_model
 from gamespec_pyomo.nlfile import NLFile
 from gamespec_pyomo.solvers import (
@@ -83,6 +92,14 @@ def _bound(value: float) -> float | None:
     return float(value) if math.isfinite(value) else None
 
 
+def _outcome(run: Run) -> tuple[Status, str, str]:
+    """A finished run's Status, termination condition and the solver's message."""
+    termination = str(run.results.solver.termination_condition)
+    # Pyomo's SOL reader stores the solver's message with ':' escaped as '\x3a'.
+    message = str(run.results.solver.message or termination).replace("\\x3a", ":")
+    return status_of(termination, message), termination, message
+
+
 def _fix(var: Any, value: float) -> None:
     """Hold ``var`` at ``value`` by equal bounds (a fixed Var would be a constant of the NL file)."""
     var.setlb(float(value))
@@ -100,6 +117,7 @@ class PyomoModel(CollocationModel):
 
         self.pyo = pyo
         self.tr = Transcription(spec)
+        prepare_checks(self.tr)
         self.options = options
         self.executable = find_executable(options.solver)
         self.model = build_model(self.tr, self.tr.ocp.parameter_values())
@@ -188,15 +206,49 @@ class PyomoModel(CollocationModel):
             opts |= {f"OF_{k}": v for k, v in IPOPT_DEFAULTS.items() if k not in self.options.options}
         return opts | self.options.options
 
-    def _execute(self, deadline: float) -> Run:
-        """Run the executable on the NL file of the model as it stands, killed at ``deadline`` (a
-        ``time.perf_counter`` value); load the solution it finds."""
-        text = self.nl.text()
+    def _execute(self, deadline: float, text: str, max_iter: int | None = None) -> Run:
+        """Run the executable on the NL file ``text`` (the model's, with its starting point), killed
+        at ``deadline`` (a ``time.perf_counter`` value), at most ``max_iter`` iterations when given;
+        load the solution it finds."""
         remaining = deadline - time.perf_counter()
-        run = run_solver(self.executable, text, self._solver_options(remaining), remaining)
+        options = self._solver_options(remaining) | ({} if max_iter is None else {"max_iter": max_iter})
+        run = run_solver(self.executable, text, options, remaining)
         if not run.stopped and len(run.results.solution) > 0:
             self.nl.load(run.results.solution(0))
         return run
+
+    def _probed(self, deadline: float, text: str) -> tuple[Run, str | None]:
+        """The solver's run on ``text``, by way of a probe (:mod:`gamespec_pyomo.feasibility`)
+        where ripopt, which has no infeasibility detection, may run many iterations: a first run of
+        at most :data:`PROBE_ITERATIONS`; when it ends before them, it is the run (the same
+        iterates as one run); when it stops there with the constraint violation stagnant, the
+        elastic problem decides from its point: a locally infeasible verdict's message is returned
+        with the probe's run; else the full run follows from the same start."""
+        full = int(self._solver_options(1.0)["max_iter"])
+        if self.executable.name != "ripopt" or full <= PROBE_ITERATIONS:
+            return self._execute(deadline, text), None
+        before = self.elastic.violation()
+        probe = self._execute(deadline, text, PROBE_ITERATIONS)
+        if probe.stopped or len(probe.results.solution) == 0:
+            return probe, None
+        if _outcome(probe)[0] is not Status.ITERATION_LIMIT:
+            return probe, None
+        after = self.elastic.violation()
+        if stagnated(before, after):
+            verdict = self._verdict(probe, deadline)
+            if verdict is not None and verdict.infeasible:
+                note = (
+                    f"ripopt's first {PROBE_ITERATIONS} iterations left the l1 norm of the constraint"
+                    f" violation at {after:.3g} (from {before:.3g} at the start)"
+                )
+                return probe, f"{note}; {verdict.message()}"
+        return self._execute(deadline, text), None
+
+    def _verdict(self, run: Run, limit: float) -> Verdict | None:
+        """The elastic problem's verdict from the model's values, in at most :data:`ELASTIC_SHARE`
+        of ``run``'s seconds (or :data:`ELASTIC_FLOOR_S`), never past ``limit``."""
+        deadline = min(limit, time.perf_counter() + max(ELASTIC_SHARE * run.seconds, ELASTIC_FLOOR_S))
+        return self.elastic.verdict(lambda e: self._solve_elastic(e, deadline))
 
     def _solve_elastic(self, elastic: Any, deadline: float) -> bool:
         """Run the solver on the elastic model (:mod:`gamespec_pyomo.feasibility`) until
@@ -235,24 +287,22 @@ class PyomoModel(CollocationModel):
         if why is not None:
             stats = {"solver": "highs (LP feasibility check)"}
             return self._unsolved(params, Win, Status.INFEASIBLE, why, time.perf_counter() - tic, 0, stats)
-        run = self._execute(tic + self.options.max_wall_time)
+        limit = tic + self.options.max_wall_time
+        run, decided = self._probed(limit, self.nl.text())
         elapsed = time.perf_counter() - tic
         if run.stopped:
             return self._stopped(params, Win, run, elapsed)
         results, log = run.results, run.log
         loaded = len(results.solution) > 0
         self._solved = self._solved or loaded
-        termination = str(results.solver.termination_condition)
-        # Pyomo's SOL reader stores the solver's message with ':' escaped as '\x3a'.
-        message = str(results.solver.message or termination).replace("\\x3a", ":")
-        status = status_of(termination, message)
-        if wants_verdict(status, message):
-            limit = tic + self.options.max_wall_time
-            deadline = min(limit, time.perf_counter() + max(ELASTIC_SHARE * run.seconds, ELASTIC_FLOOR_S))
-            verdict = self.elastic.verdict(lambda e: self._solve_elastic(e, deadline))
+        status, termination, message = _outcome(run)
+        if decided is not None:
+            status, message = Status.LOCALLY_INFEASIBLE, decided
+        elif wants_verdict(status, message):
+            verdict = self._verdict(run, limit)
+            elapsed = time.perf_counter() - tic
             if verdict is not None and verdict.infeasible:
                 status, message = Status.LOCALLY_INFEASIBLE, f"{message}; {verdict.message()}"
-            elapsed = time.perf_counter() - tic
         X, U, T = self._values()
         return tr.result(
             X=X,

@@ -34,7 +34,7 @@ import sympy as sp
 
 from gamespec.ocp.symbolic import SymbolicOcp
 from gamespec.symbolic.calculus import jacobian
-from gamespec.symbolic.language import parse, symbol
+from gamespec.symbolic.language import symbol
 
 
 @dataclass(frozen=True)
@@ -64,15 +64,6 @@ class Augmentation:
     """The state count the thesis's formula gives for this method."""
 
 
-def initial_values(ocp: SymbolicOcp) -> list[sp.Expr | None]:
-    """Each state's initial value as an expression of the parameters (None when free)."""
-    values = []
-    params = {n: symbol(n) for n in ocp.parameters}
-    for spec in ocp.spec.problem.states.values():
-        values.append(None if spec.initial is None else sp.sympify(parse(spec.initial, params)))
-    return values
-
-
 def sensitivity_name(state: str, parameter: str) -> str:
     return f"S_{state}_{parameter}"
 
@@ -83,7 +74,7 @@ def sensitivity_functions(ocp: SymbolicOcp, uncertain: list[str]) -> Augmentatio
     rho = [symbol(p) for p in uncertain]
     S = sp.Matrix(len(x), len(rho), lambda i, j: symbol(sensitivity_name(ocp.states[i], uncertain[j])))
     rhs = jacobian(f, x) * S + jacobian(f, rho)
-    x0 = initial_values(ocp)
+    x0 = ocp.initial_values
     states, running, final = [], {}, {}
     for j, p in enumerate(rho):
         for i, name in enumerate(ocp.states):
@@ -111,7 +102,7 @@ def seywald_matrix(ocp: SymbolicOcp, uncertain: list[str]) -> Augmentation:
     for c in range(m):
         for r in range(m):
             states.append(NewState(str(Phi[r, c]), sp.expand(rhs[r, c]), None, sp.Integer(int(r == c))))
-    x0 = initial_values(ocp)
+    x0 = ocp.initial_values
     running, final = {}, {}
     n = len(ocp.states)
     for j, p in enumerate(uncertain):

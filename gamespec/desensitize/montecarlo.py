@@ -13,7 +13,6 @@ from typing import Any
 
 import numpy as np
 
-from gamespec.desensitize.augment import initial_values
 from gamespec.desensitize.simulate import Trajectories, cost, evaluate, rk4
 from gamespec.desensitize.spec import MonteCarloOptions
 from gamespec.desensitize.tracking import linearization, riccati_gains
@@ -52,7 +51,7 @@ def initial_state(ocp: SymbolicOcp, result: Result, params: Mapping[Any, Any], s
     """The initial state of each sample: the solution's, or the file's expression of the (sampled)
     parameters when the initial value depends on them."""
     x0 = np.empty((len(ocp.states), samples))
-    for i, (name, expr) in enumerate(zip(ocp.states, initial_values(ocp), strict=True)):
+    for i, (name, expr) in enumerate(zip(ocp.states, ocp.initial_values, strict=True)):
         x0[i] = result.states[name][0] if expr is None else evaluate([expr], params, (samples,))[0]
     return x0
 

@@ -56,6 +56,10 @@ class InverseData:
     options: DesensitizeOptions
     original_states: int
     augmented_states: int
+    ocp: SymbolicOcp
+    """The source problem's expressions, parsed when it was compiled (their SymPy forms built
+    there): the Monte Carlo analyses re-simulate from them, so no solve parses text (issue 27, item
+    3; a re-solve changes parameter values and distributions only, never an expression)."""
 
 
 def augmented_spec(
@@ -143,7 +147,7 @@ def open_loop_monte_carlo(result: Result, spec: OptimalControlSpec, inverse: Inv
     carlo = inverse.options.monte_carlo
     if not carlo.samples or result.time is None:
         return Outputs()
-    metrics, arrays = monte_carlo(SymbolicOcp(spec), result, spec.problem.uncertain, carlo)
+    metrics, arrays = monte_carlo(inverse.ocp, result, spec.problem.uncertain, carlo)
     return Outputs(metrics={"monte_carlo": metrics}, arrays=arrays)
 
 
@@ -153,7 +157,7 @@ def lqr_tracking(result: Result, spec: OptimalControlSpec, inverse: InverseData)
     carlo = inverse.options.monte_carlo
     if not (carlo.samples and carlo.tracking) or "monte_carlo" not in result.metrics:
         return Outputs()
-    metrics, arrays = tracking(SymbolicOcp(spec), result, spec.problem.uncertain, carlo)
+    metrics, arrays = tracking(inverse.ocp, result, spec.problem.uncertain, carlo)
     return Outputs(
         metrics={"monte_carlo": {**result.metrics["monte_carlo"], "tracking": metrics}}, arrays=arrays
     )

@@ -74,7 +74,7 @@ def desensitize(
         raise SpecError(
             "desensitization needs uncertain parameters (problem.uncertain)", field=FIELD, source=spec.source
         )
-    ocp = SymbolicOcp(spec)
+    ocp = SymbolicOcp(spec).parsed()
     aug = METHODS[options.method](ocp, uncertain)
     _check_terms(spec, options, aug)
     params = {n: symbol(n) for n in spec.problem.parameters}
@@ -93,7 +93,8 @@ def desensitize(
     )
     fixed = {key: _parse(raw, params, spec, f"fixed.{key}") for key, raw in options.fixed.items()}
     new = augmented_spec(spec, aug, penalty, fixed)
-    inverse = InverseData(aug, penalty, measure, options, len(spec.problem.states), len(new.problem.states))
+    counts = len(spec.problem.states), len(new.problem.states)
+    inverse = InverseData(aug, penalty, measure, options, *counts, ocp)
     return new, inverse
 
 

@@ -37,7 +37,13 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from gamespec.ocp.compiled_checks import end_terms, mayer_names, point_values, reintegrate
+from gamespec.ocp.compiled_checks import (
+    end_terms,
+    interior_constraints,
+    mayer_names,
+    point_values,
+    reintegrate,
+)
 from gamespec.specs.ocp import INITIAL_TIME
 from gamespec.symbolic.grammar import Relation, dependencies
 from gamespec.symbolic.library import NUMPY, LibraryAlgebra
@@ -227,8 +233,7 @@ def max_constraint_violation(
         _violation(row, r.lower, r.upper) for row, r in zip(values[first_path:], structure.path, strict=True)
     ]
     worst += [_relation_violation(r, ()) for r in end_terms(tr, _end_values(tr, X, U, T, params)).boundary]
-    interior = tr.interior.terms(X, _arrays(params), ARRAYS)
-    worst += [_relation_violation(r, ()) for r in interior.constraints]
+    worst += [_relation_violation(r, ()) for r in interior_constraints(tr, X, params)]
     q = tr.grid.triplets[2]
     if integrals is None:
         integrals = [T * q @ row for row in values[tr.n_x + 1 : first_path]]

@@ -7,10 +7,12 @@ each of the ``4 · RK4_STEPS`` stages costs one pass over every operation of the
 small problems re-solved often (a receding-horizon game's thousand NLPs) that was most of a
 solve's time. Here the whole re-integration of one interval is one CasADi SX function of the
 interval's start ``y0``, its control and input points, its length ``h``, its start time ``t0``
-and the parameter values, built once per transcription and interval degree from the file's text
-(:class:`~gamespec.symbolic.library.LibraryAlgebra` over CasADi), and mapped over the intervals:
-one call of compiled code per check. The arithmetic is the same as the NumPy route's, so the
-numbers agree to rounding.
+and the parameter values, built once per transcription and interval degree from the running
+terms' function at one point, and mapped over the intervals: one call of compiled code per check.
+That function and the end-point terms' are built from the file's expressions
+(:class:`~gamespec.symbolic.library.LibraryAlgebra` over CasADi) when the model is compiled
+(:func:`prepare`), so no solve walks text (issue 27, item 3). The arithmetic is the same as the
+NumPy route's, so the numbers agree to rounding.
 """
 
 from __future__ import annotations
@@ -46,12 +48,29 @@ def rk4_function(tr: Transcription, degree: int, steps: int, bases: np.ndarray) 
     return functions[degree, steps]
 
 
+def prepare(tr: Transcription) -> None:
+    """Build the checks' compiled functions of ``tr`` from the file's expressions now, when the
+    model is compiled (the running terms and the end-point terms, each walked once): the re-
+    integrations of every interval degree are built from the running function later, and no solve
+    walks text (issue 27, item 3)."""
+    _running_function(tr)
+    _end_function(tr)
+    _interior_function(tr)
+
+
+def _running_function(tr: Transcription) -> Any:
+    """The running terms at one point (:func:`point_values`' rows), built once per transcription."""
+    functions = _FUNCTIONS.setdefault(tr, {})
+    if () not in functions:
+        functions[()] = _point_function(tr)
+    return functions[()]
+
+
 def _build(tr: Transcription, degree: int, steps: int, bases: np.ndarray) -> Any:
     import casadi as ca
 
     ocp = tr.ocp
-    algebra = LibraryAlgebra(casadi_library(ca))
-    names = ocp.running_names
+    running = _running_function(tr)
     nx, nu, nw = len(ocp.states), len(ocp.controls), len(ocp.inputs)
     n_p = len(ocp.parameters) + len(ocp.design)
     n_int = len(ocp.running_structure.integrands)
@@ -62,17 +81,10 @@ def _build(tr: Transcription, degree: int, steps: int, bases: np.ndarray) -> Any
     ds = 1.0 / steps
 
     def f(y: Any, half: int) -> Any:
-        u = U @ bases[half] if nu else []
-        w = W @ bases[half] if nw else []
-        slots = [
-            *ca.vertsplit(y[:nx]),
-            *_split(u, nu),
-            *_split(w, nw),
-            *ca.vertsplit(p),
-            t0 + half * ds / 2 * h,
-        ]
-        terms = ocp.running_terms(dict(zip(names, slots, strict=True)), algebra)
-        return ca.vertcat(*terms.dynamics, *terms.integrands)
+        u = U @ bases[half] if nu else ca.SX(0, 1)
+        w = W @ bases[half] if nw else ca.SX(0, 1)
+        rows = running(y[:nx], u, w, p, t0 + half * ds / 2 * h)
+        return ca.vertcat(rows[:nx], rows[nx + 1 : nx + 1 + n_int])
 
     y = y0
     for step in range(steps):
@@ -127,9 +139,7 @@ def point_values(
     k = t.size
     functions = _FUNCTIONS.setdefault(tr, {})
     if (k,) not in functions:
-        if () not in functions:
-            functions[()] = _point_function(tr)
-        functions[k,] = functions[()].map(k)
+        functions[k,] = _running_function(tr).map(k)
     out = functions[k,](x, u, w, p, t[None, :])
     return np.asarray(out, dtype=float).reshape(-1, k)
 
@@ -195,3 +205,48 @@ def _end_function(tr: Transcription) -> _EndFunction:
     used = frozenset(n for n, slot in zip(names, slots, strict=True) if ca.depends_on(mayer, slot))
     _END_FUNCTIONS[tr] = _EndFunction(function, terms.boundary, used)
     return _END_FUNCTIONS[tr]
+
+
+@dataclass(frozen=True)
+class _InteriorFunction:
+    """The interior-point constraints (``at:``, ``x(t=5)`` in boundary constraints;
+    :mod:`gamespec.ocp.events`) as one CasADi function of the state nodes and the parameter and
+    design values, and the relations it evaluates (their bounds)."""
+
+    function: Any
+    constraints: list[Relation]
+
+
+_INTERIOR_FUNCTIONS: weakref.WeakKeyDictionary[Transcription, _InteriorFunction] = weakref.WeakKeyDictionary()
+"""Each live transcription's compiled interior-point constraints."""
+
+
+def interior_constraints(tr: Transcription, X: np.ndarray, params: Mapping[str, float]) -> list[Relation]:
+    """The interior-point constraints at the state nodes ``X`` (unscaled) and the parameter and
+    design values ``params`` (by name), by one CasADi function built when the model is compiled
+    (:func:`prepare`): a solve walks no text (issue 27, item 3)."""
+    compiled = _interior_function(tr)
+    if not compiled.constraints:
+        return []
+    p = np.array([float(params[n]) for n in [*tr.ocp.parameters, *tr.ocp.design]])
+    found = np.asarray(compiled.function(np.asarray(X, dtype=float), p), dtype=float).reshape(-1)
+    return [Relation(v, r.lower, r.upper) for v, r in zip(found, compiled.constraints, strict=True)]
+
+
+def _interior_function(tr: Transcription) -> _InteriorFunction:
+    import casadi as ca
+
+    if tr in _INTERIOR_FUNCTIONS:
+        return _INTERIOR_FUNCTIONS[tr]
+    problem = tr.spec.problem
+    constraints: list[Relation] = []
+    function = None
+    if problem.at or problem.measurements is not None or problem.inline_points():
+        names = [*tr.ocp.parameters, *tr.ocp.design]
+        X, p = ca.SX.sym("X", tr.n_x, tr.grid.n_nodes), ca.SX.sym("p", len(names))
+        others = dict(zip(names, _split(p, len(names)), strict=True))
+        constraints = tr.interior.terms(X, others, LibraryAlgebra(casadi_library(ca))).constraints
+        rows = [ca.SX(r.expr) for r in constraints]
+        function = ca.Function("interior", [X, p], [ca.vertcat(*rows) if rows else ca.SX(0, 1)])
+    _INTERIOR_FUNCTIONS[tr] = _InteriorFunction(function, constraints)
+    return _INTERIOR_FUNCTIONS[tr]

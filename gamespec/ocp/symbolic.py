@@ -223,6 +223,25 @@ class SymbolicOcp:
         """The end cost in SymPy, in minimization form (``sign`` applied)."""
         return self._sympy[1].mayer
 
+    def parsed(self) -> SymbolicOcp:
+        """This problem with its SymPy forms (:attr:`dynamics`, :attr:`mayer`, ...,
+        :attr:`initial_values`) built now, when it is compiled, so that what uses them later parses
+        no text."""
+        self._sympy  # noqa: B018 (a cached property, built here)
+        self.initial_values  # noqa: B018
+        return self
+
+    @cached_property
+    def initial_values(self) -> list[Any]:
+        """Each state's initial value in SymPy, an expression of the parameters (None when free),
+        parsed on first use only (a desensitized problem's Monte Carlo re-simulations use the
+        compiled problem's)."""
+        from gamespec.symbolic.language import SYMPY
+
+        params = {n: self._symbols[n] for n in self.parameters}
+        initial = [spec.initial for spec in self.spec.problem.states.values()]
+        return [None if raw is None else expression(raw, params, SYMPY) for raw in initial]
+
     @cached_property
     def _symbols(self) -> dict[str, Any]:
         from gamespec.symbolic.language import symbol

@@ -16,7 +16,14 @@ from typing import Any
 import numpy as np
 
 from gamespec.errors import ExpressionError, SpecError
-from gamespec.ocp.checks import Trajectory, check_tolerances, control_basis, solution_checks, verdicts
+from gamespec.ocp.checks import (
+    ARRAYS,
+    Trajectory,
+    check_tolerances,
+    control_basis,
+    solution_checks,
+    verdicts,
+)
 from gamespec.ocp.collocation import Grid
 from gamespec.ocp.diagnostics import Point, non_finite_report
 from gamespec.ocp.events import InteriorPoints, with_event_breaks
@@ -25,8 +32,15 @@ from gamespec.ocp.scaling import Scaling, variable_scaling
 from gamespec.ocp.symbolic import SymbolicOcp
 from gamespec.result import Result, Status
 from gamespec.specs.ocp import INITIAL_TIME, NORMALIZED_TIME, OptimalControlSpec, bounds_midpoint
-from gamespec.symbolic.grammar import FLOATS, dependencies, expression, relation, unknowns
-from gamespec.symbolic.library import NUMPY, LibraryAlgebra
+from gamespec.symbolic.grammar import (
+    FLOATS,
+    dependencies,
+    expression,
+    kept_expression,
+    relation,
+    taken,
+    unknowns,
+)
 
 
 @dataclass(frozen=True)
@@ -65,6 +79,14 @@ class Transcription:
         grid = Grid(m.scheme, m.intervals, m.degree if m.scheme == "radau" else 1, m.grading, mesh, degrees)
         self.grid = with_event_breaks(grid, spec) if mesh is None and degrees is None else grid
         self.t0 = spec.problem.time.origin
+        # The guess's expressions walked once, here, by field (issue 27, item 3).
+        names = [*spec.problem.parameters, NORMALIZED_TIME]
+        self._profiles = {
+            f"guess.{group}.{name}": kept_expression(raw, names, ARRAYS)
+            for group in ("states", "controls")
+            for name, raw in getattr(spec.guess, group).items()
+            if isinstance(raw, str) and raw != "linear"
+        }
         self._last_bounds: tuple[tuple[tuple[str, float], ...], Bounds] | None = None
 
     @cached_property
@@ -238,8 +260,10 @@ class Transcription:
         if raw == "linear":
             a, b = _linear_ends(start, end, lo, hi)
             return a + (b - a) * tau
+        kept = self._profiles.get(field)
+        values = dict(params) | {NORMALIZED_TIME: tau}
         try:
-            value = expression(raw, dict(params) | {NORMALIZED_TIME: tau}, LibraryAlgebra(NUMPY))
+            value = expression(raw, values, ARRAYS) if kept is None else taken(kept, values, raw)
         except ExpressionError as err:
             raise SpecError(str(err), field=field, source=self.spec.source) from None
         return np.broadcast_to(np.asarray(value, dtype=float), tau.shape).copy()

@@ -20,7 +20,7 @@ from gamespec.rcs.relevance import relevance
 from gamespec.rcs.spec import Obstacle
 from gamespec.result import Result
 from gamespec.symbolic.calculus import numeric_function
-from gamespec.symbolic.language import TIME, parse, symbol
+from gamespec.symbolic.language import SYMPY, TIME, symbol
 
 OBSTACLE_SNAPSHOTS = 5
 """How many times the obstacles are drawn along a path (agent and obstacle in the same colour)."""
@@ -49,12 +49,12 @@ def sensitivity_map(
     along y at speed ρ (Fig. 6.6's setting by default: (0, 1), r_o = 0.6, t = 1): S_g = ∂g/∂ρ
     (eq. 6.40; eq. 6.42 for β ≠ 1), S_r = r(g) S_g. At the obstacle's centre (inside the infeasible
     disc the figure leaves white) eq. 6.42 divides by zero: that value is not drawn, and no warning
-    is printed for it."""
+    is printed for it. The obstacle's numbers and its speed's name ``rho`` are built in SymPy as
+    they stand, no text parsed (issue 27, item 3)."""
     x, y, r = symbol("x"), symbol("y"), symbol("rho")
-    names = {"rho": r}
     start = (center[0], center[1] - rho * t)
     obstacle = Obstacle(center=start, velocity=(0.0, "rho"), radius=radius)
-    g = avoidance(obstacle, (x, y), sp.sympify(power), lambda v: sp.sympify(parse(v, names)), 0.0)
+    g = avoidance(obstacle, (x, y), sp.sympify(power), lambda v: r if v == "rho" else SYMPY.number(v), 0.0)
     S_g = sp.diff(g, r)
     f = numeric_function([g, S_g, relevance(choice, g) * S_g], [x, y, r, TIME])
     X, Y = np.meshgrid(

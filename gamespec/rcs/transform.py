@@ -198,8 +198,8 @@ class RcsData:
 
     @cached_property
     def starting_points(self) -> list[Result]:
-        """The ``restarts`` on the target's mesh (:func:`starting_point`), built once: a re-solve
-        parses no guess text again (issue 27, item 3)."""
+        """The ``restarts`` on the target's mesh (:func:`starting_point`), built once, at compile
+        (:func:`regularized`): no solve parses a guess's text (issue 27, item 3)."""
         return [starting_point(self.target, g) for g in self.options.restarts]
 
 
@@ -252,7 +252,7 @@ def regularized(spec: OptimalControlSpec, options: RcsOptions) -> tuple[OptimalC
     uncertain = list(spec.problem.uncertain)
     if not uncertain:
         raise SpecError("rcs needs uncertain parameters (problem.uncertain)", field=FIELD, source=spec.source)
-    ocp = SymbolicOcp(spec)
+    ocp = SymbolicOcp(spec).parsed()
     chosen = _chosen(spec, ocp, options)
     aug = nonzero(sensitivity_functions(ocp, uncertain))
     g = [q.g for q in chosen]
@@ -279,8 +279,11 @@ def regularized(spec: OptimalControlSpec, options: RcsOptions) -> tuple[OptimalC
         DesensitizeOptions(monte_carlo=options.monte_carlo),
         len(spec.problem.states),
         len(new.problem.states),
+        ocp,
     )
-    return new, RcsData(data, [q.label for q in chosen], uncertain, S_g, S_r, options, new, unit)
+    rcs = RcsData(data, [q.label for q in chosen], uncertain, S_g, S_r, options, new, unit)
+    rcs.starting_points  # noqa: B018 (built now, at compile: no solve parses a guess's text)
+    return new, rcs
 
 
 def starting_point(target: OptimalControlSpec, guess: GuessSpec) -> Result:

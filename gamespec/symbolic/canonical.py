@@ -29,19 +29,26 @@ from __future__ import annotations
 
 import ast
 import math
-from collections.abc import Iterable, Mapping
+import threading
+from collections import OrderedDict
+from collections.abc import Callable, Iterable, Mapping
 from dataclasses import dataclass
 from typing import Any
 
 from gamespec.errors import ExpressionError
 from gamespec.limits import MAX_MAGNITUDE
 from gamespec.symbolic.grammar import (
+    DEFERRED,
     FLOATS,
+    Deferred,
     FileFunction,
     Refused,
+    deferred_name,
     expression,
+    kept,
     relation,
     syntax_tree,
+    taken,
     unknown,
 )
 
@@ -233,15 +240,79 @@ def check(
     derivatives finite and real. ``functions`` are the file's tables by name
     (:mod:`gamespec.symbolic.tables`)."""
     values = dict(values or {})
-    tables = dict(functions or {})
     names = [*dict.fromkeys([*names, *values])]
     definitions = _used(text, dict(definitions or {}))
-    floats = {n: values[n] if n in values else unknown(n) for n in names}
-    _walk(text, floats | tables, FLOATS, constraint, definitions)
-    try:
-        _walk(text, dict.fromkeys(names, NAME) | tables, SCREEN, constraint, definitions)
-    except Undecided:
-        _check_in_sympy(text, names, constraint, definitions, tables)
+    used = _names(text).union(*map(_names, definitions.values()))
+    tables = {n: f for n, f in (functions or {}).items() if n in used}
+    valued = tuple(n for n in names if n in values)
+    scope = (tuple(names), valued, constraint, tuple(definitions.items()), _tables_key(tables))
+    key = (type(text), text, *scope)
+    kept = _kept_check(key, tables)
+    if kept.floats is None:
+        floats = {n: values[n] if n in values else unknown(n) for n in names}
+        _walk(text, floats | tables, FLOATS, constraint, definitions)
+    else:
+        taken(kept.floats, {n: values[n] for n in valued}, text)
+    if not kept.defined:
+        try:
+            _walk(text, dict.fromkeys(names, NAME) | tables, SCREEN, constraint, definitions)
+        except Undecided:
+            _check_in_sympy(text, names, constraint, definitions, tables)
+        kept.defined = True
+
+
+@dataclass
+class _KeptCheck:
+    """What :func:`check` keeps of a text over one scope: its walk in floats as a function of the
+    parameters' values (:class:`~gamespec.symbolic.grammar.Deferred`; None: walked each time), and
+    whether its solve path was found defined, which does not depend on those values (the screen
+    and SymPy see every name as a symbol): a check at new parameter values walks no text (issue 27,
+    item 3)."""
+
+    floats: Any
+    defined: bool = False
+
+
+_KEPT: OrderedDict[tuple[Any, ...], _KeptCheck] = OrderedDict()
+_KEPT_LOCK = threading.Lock()
+"""Held while :data:`_KEPT` changes (a study's threads check at once)."""
+KEPT_CHECKS = 4096
+"""How many texts-over-a-scope :func:`check` keeps (the least recently used go first)."""
+
+
+def _tables_key(tables: Mapping[str, FileFunction]) -> tuple[Any, ...]:
+    """The tables a text uses as part of a kept check's key: a table by its data (a spec validated
+    again at new parameter values rebuilds its tables, with the same data), another file
+    function by itself."""
+    import numpy as np
+
+    def data(function: FileFunction) -> Any:
+        axes, values = getattr(function, "axes", None), getattr(function, "values", None)
+        if axes is None or values is None:
+            return function
+        arrays = [np.asarray(a, dtype=float) for a in (*axes, values)]
+        return (getattr(function, "method", None), *((a.shape, a.tobytes()) for a in arrays))
+
+    return tuple((name, data(function)) for name, function in tables.items())
+
+
+def _kept_check(key: tuple[Any, ...], tables: Mapping[str, FileFunction]) -> _KeptCheck:
+    """The kept check of ``key`` (text, names, those with values, constraint, definitions, the
+    tables the text uses, :func:`_tables_key`), walked in
+    :data:`~gamespec.symbolic.grammar.DEFERRED` on first use."""
+    with _KEPT_LOCK:
+        if key in _KEPT:
+            _KEPT.move_to_end(key)
+            return _KEPT[key]
+    _, text, names, valued, constraint, definitions, _ = key
+    symbols = {n: deferred_name(n) if n in valued else unknown(n) for n in names}
+    walked = kept(lambda: _kept_walk(text, symbols | dict(tables), constraint, dict(definitions)), text)
+    found = _KeptCheck(walked)
+    with _KEPT_LOCK:
+        _KEPT[key] = found
+        if len(_KEPT) > KEPT_CHECKS:
+            _KEPT.popitem(last=False)
+    return found
 
 
 def _used(text: str | float, definitions: dict[str, str | float]) -> dict[str, str | float]:
@@ -266,6 +337,27 @@ def _walk(
     for name, raw in definitions.items():
         scope[name] = expression(raw, scope, algebra)
     return relation(str(text), scope, algebra).expr if constraint else expression(text, scope, algebra)
+
+
+def _kept_walk(
+    text: str | float, symbols: dict[str, Any], constraint: bool, definitions: Mapping[str, Any]
+) -> Callable[[Mapping[str, Any]], Any]:
+    """:func:`_walk` in :data:`~gamespec.symbolic.grammar.DEFERRED`: taken at values, it computes
+    the definitions in their order, each once, then ``text``, as :func:`_walk` in floats does."""
+    scope = dict(symbols)
+    steps = []
+    for name, raw in definitions.items():
+        steps.append((name, expression(raw, scope, DEFERRED)))
+        scope[name] = deferred_name(name)
+    last = relation(str(text), scope, DEFERRED).expr if constraint else expression(text, scope, DEFERRED)
+
+    def run(values: Mapping[str, Any]) -> Any:
+        scope = dict(values)
+        for name, step in steps:
+            scope[name] = step(scope) if type(step) is Deferred else step
+        return last(scope) if type(last) is Deferred else last
+
+    return run
 
 
 def _check_in_sympy(

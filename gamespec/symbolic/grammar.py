@@ -18,6 +18,7 @@ so that one walker decides what an expression may be.
 from __future__ import annotations
 
 import ast
+import dataclasses
 import math
 import operator
 from abc import ABC, abstractmethod
@@ -242,6 +243,94 @@ class FloatAlgebra:
 FLOATS = FloatAlgebra()
 
 
+@dataclass(frozen=True)
+class Deferred:
+    """A value of :data:`DEFERRED`: one step of a walk of :data:`FLOATS` kept for later, ``step``
+    applied to ``args`` (each a :class:`Deferred`, taken first, or a value as it is), or the value of
+    the name ``args[0]`` when ``step`` is None. Called with the names' values it computes what the
+    walk of :data:`FLOATS` over them computes, without walking the text again (issue 27, item 3),
+    with the same refusals: a step's :class:`Refused` is the
+    :class:`~gamespec.errors.ExpressionError` the walk names in ``text`` at ``column``. One frame per
+    level of the tree, as the walk."""
+
+    step: Callable[..., Any] | None
+    args: tuple[Any, ...]
+    text: str | None = None
+    column: int | None = None
+
+    def __call__(self, values: Mapping[str, Any]) -> Any:
+        if self.step is None:
+            return values[self.args[0]]
+        args = []
+        for a in self.args:
+            args.append(a(values) if type(a) is Deferred else a)
+        try:
+            return self.step(*args)
+        except Refused as err:
+            if self.text is None:
+                raise
+            raise ExpressionError(self.text, str(err), self.column) from None
+
+    def located(self, text: str, column: int | None) -> Deferred:
+        """This step, its refusal named in ``text`` at ``column``."""
+        return dataclasses.replace(self, text=text, column=column)
+
+
+def deferred_name(name: str) -> Deferred:
+    """A name's :class:`Deferred` value: its value among those given."""
+    return Deferred(None, (name,))
+
+
+class DeferredAlgebra:
+    """An algebra (``base``, :data:`FLOATS` by default), each step kept for later
+    (:class:`Deferred`): the walk builds the function of the names' values that a walk of ``base``
+    over those values computes. A step it cannot keep (the time of ``x(t=...)`` or a chained
+    constraint's outer term that depends on a parameter, which the walk itself needs as a number)
+    is refused."""
+
+    def __init__(self, base: Algebra = FLOATS) -> None:
+        self.base = base
+
+    def _call(self, name: str, *args: Any) -> Any:
+        return self.base.call(name, list(args))
+
+    def _tabulated(self, function: FileFunction, *args: Any) -> Any:
+        return self.base.tabulated(function, list(args))
+
+    def number(self, value: int | float) -> Deferred:
+        return Deferred(self.base.number, (value,))
+
+    def constant(self, name: str) -> Deferred:
+        return Deferred(self.base.constant, (name,))
+
+    def binary(self, op: type[ast.operator], left: Any, right: Any) -> Deferred:
+        return Deferred(self.base.binary, (op, left, right))
+
+    def negate(self, value: Any) -> Deferred:
+        return Deferred(self.base.negate, (value,))
+
+    def power(self, base: Any, exponent: Any) -> Deferred:
+        return Deferred(self.base.power, (base, exponent))
+
+    def call(self, name: str, args: list[Any]) -> Deferred:
+        return Deferred(self._call, (name, *args))
+
+    def tabulated(self, function: FileFunction, args: list[Any]) -> Deferred:
+        return Deferred(self._tabulated, (function, *args))
+
+    def scalar(self, value: Any) -> float | None:
+        """A value the walk needs as a number now: one made of numbers only (an outer term or a
+        time that depends on a parameter is refused here)."""
+        try:
+            number = value({}) if type(value) is Deferred else value
+        except KeyError:
+            raise Refused("depends on a parameter's value") from None
+        return self.base.scalar(number)
+
+
+DEFERRED = DeferredAlgebra()
+
+
 @lru_cache(maxsize=4096, typed=True)
 def syntax_tree(text: str | float) -> ast.expr:
     """The syntax tree of ``text`` (a number as a constant), within the limits on length and size;
@@ -273,11 +362,15 @@ class _Walker:
         return ExpressionError(self.text, reason, getattr(node, "col_offset", None))
 
     def apply(self, node: ast.AST, build: Callable[..., Any], *args: Any) -> Any:
-        """``build(*args)`` in the algebra, a refusal named at ``node``'s column."""
+        """``build(*args)`` in the algebra, a refusal named at ``node``'s column (a
+        :class:`Deferred` step's refusal too, when it is taken)."""
         try:
-            return build(*args)
+            value = build(*args)
         except Refused as err:
             raise self.fail(node, str(err)) from None
+        if isinstance(value, Deferred):
+            return value.located(self.text, getattr(node, "col_offset", None))
+        return value
 
     def __call__(self, node: ast.AST) -> Any:
         """The value of ``node`` (one frame per level of the tree, as deep sums need)."""
@@ -474,9 +567,44 @@ def unknowns(names: Iterable[str]) -> dict[str, Dependent]:
     return {n: unknown(n) for n in names}
 
 
+def kept(walk: Callable[[], Any], text: str | float) -> Any:
+    """``walk()``, a walk of :data:`DEFERRED`, as its :class:`Deferred` value; None when the walk
+    refuses the text (the text is then walked in :data:`FLOATS` each time, which names the
+    refusal as before: a text refused at load, or a step :class:`DeferredAlgebra` cannot keep)."""
+    try:
+        return walk()
+    except ExpressionError:
+        return None
+
+
+def taken(value: Any, values: Mapping[str, Any], text: str | float) -> Any:
+    """A kept walk (:func:`kept`: a function of the names' values such as a :class:`Deferred`, or a
+    value that needs none of them) at ``values``: what the walk of :data:`FLOATS` over them gives."""
+    try:
+        return value(values) if callable(value) else value
+    except RecursionError:
+        raise ExpressionError(str(text)[:40] + "...", "expression nested too deeply") from None
+
+
+def kept_expression(text: str | float, names: Iterable[str], algebra: Algebra = FLOATS) -> Any:
+    """The walk of ``text`` in ``algebra`` over ``names`` kept for later (:func:`kept`; taken with
+    :func:`taken` at the names' values), None when the walk refuses it."""
+    deferred = DeferredAlgebra(algebra)
+    return kept(lambda: expression(text, {n: deferred_name(n) for n in names}, deferred), text)
+
+
+@lru_cache(maxsize=4096, typed=True)
+def _kept_value(text: str | float, names: tuple[str, ...]) -> Any:
+    """The walk of ``text`` over ``names`` kept once per text and names (:func:`numeric_value`)."""
+    return kept_expression(text, names)
+
+
 def numeric_value(text: str | float, values: Mapping[str, float]) -> float:
-    """The value of a number-only expression over ``values`` (name → float)."""
-    value = expression(text, values, FLOATS)
+    """The value of a number-only expression over ``values`` (name → float): the text is walked
+    once per set of names (:func:`_kept_value`), then evaluated at each ``values``."""
+    walked = _kept_value(text, tuple(sorted(values)))
+    value = expression(text, values, FLOATS) if walked is None else taken(walked, values, text)
     if isinstance(value, Dependent):
         raise ExpressionError(str(text), "is not a number here")
-    return value
+    number: float = value
+    return number

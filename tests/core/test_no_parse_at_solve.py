@@ -1,15 +1,22 @@
 """Issue 27, item 3: a file's text is parsed when the problem is compiled, never when the compiled
 model solves. Every evaluation of an expression's text goes through the grammar's tree walker
 (:func:`gamespec.symbolic.grammar.expression` and ``relation``, whatever module imports them), so
-the walker is made to raise and the compiled model must still solve, twice."""
+the walker is made to raise and the compiled model must still solve: the first solve after
+compile, again, and again with new parameter values (whose checks take the walks kept at load,
+:class:`gamespec.symbolic.grammar.Deferred`), each answer the one a fresh compile gives."""
 
 from __future__ import annotations
 
+import math
+
+import numpy as np
 import pytest
 
+from gamespec.errors import ExpressionError, SpecError
 from gamespec.loader import load, spec_from_dict
+from gamespec.result import Result
 from gamespec.solving import compile_spec
-from gamespec.symbolic import grammar
+from gamespec.symbolic import canonical, grammar
 from tests.conftest import PROBLEMS
 from tests.flowfield.test_stages import _spec
 
@@ -40,14 +47,13 @@ def test_iterative_lq_games_solve_without_parsing_text(monkeypatch):
     ids=["optimal_control", "rcs_transform"],
 )
 def test_an_optimal_control_problem_solves_again_without_parsing_text(monkeypatch, path):
-    """After the first solve (which builds the compiled checks on first use, from the text) a
-    re-solve of the compiled model walks no text: the checks evaluate the end-point terms by a
-    compiled function (:func:`gamespec.ocp.compiled_checks.end_terms`), and the RCS transform's
+    """The compiled model's solves walk no text, the first included: the checks' functions are
+    built at compile (:func:`gamespec.ocp.compiled_checks.prepare`), and the RCS transform's
     restarts are built once per inverse data (``RcsData.starting_points``)."""
     compiled = compile_spec(load(path, ["method.intervals=10"]))
+    _refuse_parsing(monkeypatch)
     first = compiled.solve()
     assert first.status.ok, first.message
-    _refuse_parsing(monkeypatch)
     again = compiled.solve()
     assert again.status.ok, again.message
 
@@ -62,3 +68,139 @@ def test_a_flow_field_game_solves_again_without_parsing_text(monkeypatch):
     assert "capture_time" in first.metrics, first.message
     noisier = compiled.solve(parameters={"noise": 0.1})
     assert noisier.objective > first.objective
+
+
+def _event_spec(a: float) -> dict:
+    """A rest-to-rest double integrator through ``x(1) = sqrt(a)`` (an ``at:`` event) with a
+    boundary constraint at a fixed time (``v(t=1.5)``)."""
+    return {
+        "kind": "optimal_control",
+        "name": "through_a_point",
+        "problem": {
+            "parameters": {"a": a},
+            "states": {"x": {"initial": 0.0, "final": 0.0}, "v": {"initial": 0.0, "final": 0.0}},
+            "controls": {"u": {}},
+            "dynamics": {"x": "v", "v": "u"},
+            "objective": {"lagrange": "u**2"},
+            "time": {"final": 2.0},
+            "at": [{"time": 1.0, "constraints": ["x == sqrt(a)"]}],
+            "boundary_constraints": ["v(t=1.5) <= a + 10"],
+        },
+        "method": {"intervals": 10, "degree": 3},
+    }
+
+
+CASES = {
+    "bryson_denham": (
+        lambda: load(PROBLEMS / "ocp" / "bryson_denham.yaml", ["method.intervals=10"]),
+        {"l": 0.12},
+    ),
+    "feedback_game": (
+        lambda: load(
+            PROBLEMS / "ch7" / "unicycle_pursuit_evasion.yaml",
+            ["game.information=feedback", "method.intervals=5"],
+        ),
+        {"q": 5.0},
+    ),
+    "at_event": (lambda: spec_from_dict(_event_spec(0.49)), {"a": 0.25}),
+    "hji_chauffeur": (
+        lambda: load(
+            PROBLEMS / "ch7" / "homicidal_chauffeur_capture_time.yaml", ["solver.options.hji.nodes=21"]
+        ),
+        {"l": 0.3},
+    ),
+    "desensitized": (
+        lambda: load(
+            PROBLEMS / "ch6" / "zermelo_fixed_final_sensitivity.yaml",
+            ["transforms.0.desensitize.monte_carlo.samples=50", "method.intervals=10"],
+        ),
+        {"s1_final": 0.04},
+    ),
+}
+
+
+@pytest.mark.parametrize("case", list(CASES))
+def test_first_solve_and_a_solve_at_new_values_walk_no_text(monkeypatch, case):
+    """Compiled, the model solves first, then at new parameter values (warm-started from the first,
+    as a re-solve is), with the walker refused; both answers equal those of the same two solves of
+    a fresh compile with the walker allowed, to the bit."""
+    spec_of, new = CASES[case]
+    compiled = compile_spec(spec_of())
+    with monkeypatch.context() as patched:
+        _refuse_parsing(patched)
+        solved = [compiled.solve(), compiled.solve(parameters=new)]
+    reference = compile_spec(spec_of())
+    fresh = [reference.solve(), reference.solve(parameters=new)]
+    for mine, theirs in zip(solved, fresh, strict=True):
+        assert mine.status == theirs.status and mine.status.ok, mine.message
+        assert mine.message == theirs.message
+        assert mine.objective == theirs.objective or (
+            math.isinf(mine.objective) and math.isinf(theirs.objective)
+        )
+    assert solved[1].objective != solved[0].objective
+
+
+def test_the_rcs_plot_of_a_saved_result_walks_no_text(monkeypatch, tmp_path):
+    """The RCS figures of a saved Result (the Fig. 6.6 map included) parse no text."""
+    from gamespec.plotting import plot_result
+
+    result = Result.load(PROBLEMS.parent / "tests" / "data" / "results" / "rcs_single_obstacle")
+    _refuse_parsing(monkeypatch)
+    paths = plot_result(result, tmp_path)
+    assert any(p.name.endswith("_sensitivity_map.png") for p in paths)
+
+
+def test_a_refusal_at_new_values_reads_as_the_text_walk_says(monkeypatch):
+    """``sqrt(a)`` at a = -1 is refused by the kept walk with the message and field a fresh load
+    (every kept walk forgotten: the text walked) gives."""
+    compiled = compile_spec(spec_from_dict(_event_spec(0.49)))
+    with monkeypatch.context() as patched:
+        _refuse_parsing(patched)
+        with pytest.raises(SpecError) as kept:
+            compiled.solve(parameters={"a": -1.0})
+    canonical._KEPT.clear()
+    grammar._kept_value.cache_clear()
+    with pytest.raises(SpecError) as walked:
+        spec_from_dict(_event_spec(-1.0))
+    assert str(kept.value) == str(walked.value) and "not real" in str(kept.value)
+
+
+TEXTS = [
+    "sqrt(a) + x",
+    "log(a - 1)*x + exp(a)",
+    "x/(a - 2) + a**0.5",
+    "atan2(a, a - 1) + sqrt(x*a)",
+    "1e300*a*a",
+]
+VALUES = [-1.0, 0.0, 1.0, 2.0, 3.0, 1e200]
+
+
+@pytest.mark.parametrize("text", TEXTS)
+def test_kept_walk_refuses_and_computes_as_the_float_walk(text):
+    """A kept walk (:func:`gamespec.symbolic.grammar.kept_expression`) at each value of ``a`` gives
+    the float walk's value, or its refusal with the same message and column."""
+    kept = grammar.kept_expression(text, ["a", "x"])
+    for a in VALUES:
+        values = {"a": a, "x": grammar.unknown("x")}
+        try:
+            expected = grammar.expression(text, values, grammar.FLOATS)
+        except ExpressionError as err:
+            with pytest.raises(ExpressionError) as found:
+                grammar.taken(kept, values, text)
+            assert (str(found.value), found.value.column) == (str(err), err.column)
+        else:
+            assert grammar.taken(kept, values, text) == expected
+
+
+def test_kept_guess_profiles_equal_the_text_walk():
+    """The guess's expressions kept at transcription give the text walk's profile to the bit."""
+    from gamespec.ocp.checks import ARRAYS
+    from gamespec.ocp.transcription import Transcription
+
+    spec = load(PROBLEMS / "ch6" / "zermelo_fixed_final_sensitivity.yaml")
+    tr = Transcription(spec)
+    params = spec.problem.parameter_values()
+    start = tr.guess(params)
+    tau = tr.grid.eval_tau
+    walked = grammar.expression(spec.guess.controls["u"], dict(params) | {"tau": tau}, ARRAYS)
+    assert np.array_equal(start.U[0], np.broadcast_to(walked, tau.shape))

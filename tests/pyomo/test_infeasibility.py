@@ -96,3 +96,46 @@ def test_feasible_nonlinear_counterpart_is_solved() -> None:
     pyomo, casadi = gamespec.solve(spec, "pyomo"), gamespec.solve(spec, "casadi")
     assert pyomo.status is Status.OPTIMAL and casadi.status is Status.OPTIMAL
     assert pyomo.objective == pytest.approx(casadi.objective, rel=1e-6)
+
+
+def _scaled_control(t_final: float) -> dict:
+    """``x'' = u (1 + x^2/10)``, ``|u| <= 1``, from rest at x = 1 to rest at 0: on [0, 1] the
+    acceleration is at most 1.1 in size, so a path that stays there needs the bang-bang time
+    ``2 sqrt(1/1.1) = 1.91`` of the double integrator with that bound; ``t_final = 1`` is far below
+    it (not a proof for paths that leave [0, 1]: IPOPT on casadi's local infeasibility is asserted
+    beside), 3 above it."""
+    data = _double_integrator(1.0, t_final)
+    data["problem"]["dynamics"]["v"] = "u*(1 + 0.1*x**2)"
+    return data
+
+
+def test_ripopt_probe_finds_local_infeasibility_without_running_its_iteration_limit() -> None:
+    """ripopt has no infeasibility detection: it ran its 3000 iterations here (9.7 s CPU, against
+    IPOPT's 24 on casadi). The probe (:data:`gamespec_pyomo.feasibility.PROBE_ITERATIONS`) stops it
+    early, the violation stagnant, and the elastic problem proves local infeasibility."""
+    from gamespec_pyomo.feasibility import PROBE_ITERATIONS
+
+    spec = gamespec.spec_from_dict(_scaled_control(1.0))
+    gamespec.solve(gamespec.spec_from_dict(_scaled_control(3.0)), "pyomo")  # imports and first builds
+    start = _cpu_seconds()
+    result = gamespec.solve(spec, "pyomo")
+    assert result.status is Status.LOCALLY_INFEASIBLE, result.message
+    assert result.iterations is not None and result.iterations <= PROBE_ITERATIONS
+    assert "l1 norm of the constraint violation" in result.message
+    assert _cpu_seconds() - start < 5
+    assert gamespec.solve(spec, "casadi").status is Status.LOCALLY_INFEASIBLE
+
+
+def test_a_feasible_problem_past_the_probe_is_the_single_run_answer(monkeypatch) -> None:
+    """With a probe shorter than the solve (2 iterations) the feasible counterpart ends as one run
+    ends: the same objective and iteration count to the bit, the full run starting where the probe
+    did."""
+    import gamespec_pyomo.backend as backend
+
+    spec = gamespec.spec_from_dict(_scaled_control(3.0))
+    single = gamespec.solve(spec, "pyomo")
+    monkeypatch.setattr(backend, "PROBE_ITERATIONS", 2)
+    probed = gamespec.solve(spec, "pyomo")
+    assert single.status is Status.OPTIMAL and probed.status is Status.OPTIMAL
+    assert single.iterations is not None and single.iterations > 2
+    assert probed.objective == single.objective and probed.iterations == single.iterations

@@ -6,23 +6,31 @@ disk of radius ``c`` about ``x₀`` (``T = 0`` on its edge): the set reached at 
 marching after Sethian (1996) with the anisotropic Godunov update of Sethian & Vladimirsky (2003)
 on the four-neighbour stencil, compiled by Numba:
 
-- in each quadrant the one-sided differences (second order, ``(3T − 4T₁ + T₂)/2h``, where the next
-  node has a value, as scikit-fmm's ``order=2``; first order otherwise)
+- in each quadrant the one-sided differences (``order`` 2: ``(3T − 4T₁ + T₂)/2h`` where the next
+  node has a value, as scikit-fmm's ``order=2``; ``order`` 3: ``(11T − 18T₁ + 9T₂ − 2T₃)/6h``
+  where two more have one; the highest the valued nodes allow otherwise, first order at least)
   make eq. 5.22 a quadratic in ``T``; its larger root counts only when the group velocity
   ``∂H/∂p = v̂ p/|p| + f`` points from both neighbours into the node (the update is upwind);
 - along one axis the characteristic runs along that axis at the speed ``f·e + √(v̂² − (f·e⊥)²)``;
 - ``T`` is the least of the admissible candidates (the viscosity solution of a convex ``H``).
 
-A node is re-opened whenever a neighbour's new value changes its own (a label-correcting march):
-with a drift the upwind neighbour of the characteristic may carry the larger value, and the
-second-order update is not monotone in ``T₂``, so a value set early is corrected, not frozen.
+A node is re-opened whenever a neighbour's new value changes its own by more than ``REOPEN`` of
+it (a label-correcting march): with a drift the upwind neighbour of the characteristic may carry
+the larger value, and the higher-order updates are not monotone in ``T₂``, ``T₃``, so a value set
+early is corrected, not frozen. Corrections below ``REOPEN`` (1e-9) are left: re-opening on every
+change above 1e-12 took 3 (order 2) to 10 (order 3) heap pops a node and 1.5–4× the CPU, for the
+same errors to four digits up to 401²; at 1e-7 the third-order error at 401² grows fourfold.
 
 The nodes within 1.5 cells of the disk's edge start from the closed form of a uniform flow with the
 node's own drift, ``|x − x₀ − fT| = c + v̂T`` (exact there; second-order accurate in a smooth
 flow, the distance to the edge being a cell or two). The drift must stay below v̂ in magnitude
 (the agent can move against it); the disk must lie inside the grid. Measured against the exact
 disks of a uniform flow with ``|f| = v̂/2`` (``tests/flowfield/test_marching.py``,
-``benchmarks/test_bench_reach.py``): second order in the largest error.
+``benchmarks/test_bench_reach.py``), the largest error over ``0.05 ≤ T ≤ 1.5`` falls at order
+1.7–1.9 per halving of the spacing with ``order`` 2 and 2.4–2.8 with ``order`` 3 (51² … 401²);
+fourth- and fifth-order one-sided differences were tried and diverge (errors of 1e11 or
+unreached nodes from 51² on), so 3 is the highest order offered. The largest error sits near
+the diagonals, where the four-neighbour stencil's two one-sided differences meet.
 """
 
 from __future__ import annotations
@@ -37,6 +45,8 @@ from gamespec.flowfield.grid import Grid
 
 _FAR, _VALUED, _START = 0, 1, 2
 """A node without a value yet, with one, and a start node (fixed)."""
+REOPEN = 1e-9
+"""The relative change of a node's value that re-opens it (module doc)."""
 
 
 @njit(cache=True, error_model="numpy")
@@ -53,30 +63,47 @@ def _axis_speed(along: float, across: float, speed: float) -> float:
     return along + math.sqrt(max(speed * speed - across * across, 0.0))
 
 
+_BACKWARD = np.array(
+    [
+        [1.0, 1.0, 0.0, 0.0],
+        [1.5, 2.0, -0.5, 0.0],
+        [11.0 / 6.0, 3.0, -1.5, 1.0 / 3.0],
+    ]
+)
+"""The one-sided differences ``(αT − Σ c_k T_k)/h`` of order 1, 2, 3 in the nodes behind: each row
+``α, c₁, c₂, c₃`` (the backward differentiation formulas)."""
+
+
 @njit(cache=True, error_model="numpy")
 def _one_sided(
     values: np.ndarray, state: np.ndarray, i: int, j: int, di: int, dj: int, order: int
 ) -> tuple[float, float, float]:
     """``(α, β, T₁)`` of the upwind difference ``(αT − β)/h`` towards node (i, j) from the
-    neighbour (i − di, j − dj) of value ``T₁``: ``(1.5, 2T₁ − T₂/2)`` at second order where the
-    node beyond has a value ``T₂``, ``(1, T₁)`` otherwise; zeros when the neighbour has none."""
+    neighbour (i − di, j − dj) of value ``T₁``, with as many valued nodes beyond it as ``order``
+    allows (a row of ``_BACKWARD``); zeros when the neighbour has none."""
     nx, ny = values.shape
     i1, j1 = i - di, j - dj
     if i1 < 0 or j1 < 0 or i1 >= nx or j1 >= ny or state[i1, j1] == _FAR:
         return 0.0, 0.0, 0.0
     t1 = values[i1, j1]
-    i2, j2 = i1 - di, j1 - dj
-    if order == 2 and 0 <= i2 < nx and 0 <= j2 < ny and state[i2, j2] != _FAR:
-        t2 = values[i2, j2]
-        if math.isfinite(t2):
-            return 1.5, 2.0 * t1 - 0.5 * t2, t1
-    return 1.0, t1, t1
+    got = 1
+    ik, jk = i1, j1
+    while got < order:
+        ik, jk = ik - di, jk - dj
+        if not (0 <= ik < nx and 0 <= jk < ny) or state[ik, jk] == _FAR or not math.isfinite(values[ik, jk]):
+            break
+        got += 1
+    row = _BACKWARD[got - 1]
+    beta = 0.0
+    for k in range(got):
+        beta += row[k + 1] * values[i1 - k * di, j1 - k * dj]
+    return row[0], beta, t1
 
 
 @njit(cache=True, error_model="numpy")
 def _along(alpha: float, beta: float, neighbour: float, travel: float) -> float:
     """The one-dimensional candidate ``(β + h/s)/α`` along an axis, which the characteristic leaves
-    from the neighbour: first order (``T₁ + h/s``) where the second-order one is below ``T₁``."""
+    from the neighbour: first order (``T₁ + h/s``) where the higher-order one is below ``T₁``."""
     candidate = (beta + travel) / alpha
     return candidate if candidate >= neighbour else neighbour + travel
 
@@ -138,11 +165,13 @@ def _march(
     spacing: tuple[float, float],
     t_max: float,
     order: int,
+    reopen: float,
 ) -> int:
     """Marching from the start nodes in the order of the values, a node re-opened whenever a
-    neighbour's new value changes its own (the second-order update is not monotone, and with a
-    drift the upwind neighbour may carry the larger value), until no value at or below ``t_max``
-    changes (at most 50 updates a node); returns the number of nodes taken from the heap."""
+    neighbour's new value changes its own by more than ``reopen`` of it (the higher-order updates
+    are not monotone, and with a drift the upwind neighbour may carry the larger value), until no
+    value at or below ``t_max`` changes (at most 50 updates a node); returns the number of nodes
+    taken from the heap."""
     nx, ny = values.shape
     heap = [(0.0, 0, 0)]
     heap.pop()
@@ -164,7 +193,7 @@ def _march(
             if not (0 <= a < nx and 0 <= b < ny) or state[a, b] == _START:
                 continue
             t_new = _update(values, state, flow, speed, spacing, a, b, order)
-            if abs(t_new - values[a, b]) > 1e-12 * max(1.0, abs(t_new)) and taken < limit:
+            if abs(t_new - values[a, b]) > reopen * max(1.0, abs(t_new)) and taken < limit:
                 values[a, b] = t_new
                 state[a, b] = _VALUED
                 heapq.heappush(heap, (t_new, a, b))
@@ -204,12 +233,14 @@ def time_to_reach(
     *,
     t_max: float = np.inf,
     order: int = 2,
+    reopen: float = REOPEN,
 ) -> np.ndarray:
     """``T`` at the nodes (nx, ny) for an agent of speed ``speed`` starting on the disk of
     ``radius`` about ``origin`` in the drift tabulated on the grid (nx, ny, 2) (NaN inside the
-    disk beyond the start band, +inf where ``T > t_max``). ``order``: 1 or 2."""
-    if order not in (1, 2):
-        raise ValueError("order must be 1 or 2")
+    disk beyond the start band, +inf where ``T > t_max``). ``order``: 1, 2 or 3 (the one-sided
+    differences); ``reopen``: the relative change that re-opens a node (module doc)."""
+    if order not in (1, 2, 3):
+        raise ValueError("order must be 1, 2 or 3")
     flow = np.ascontiguousarray(np.moveaxis(np.asarray(drift, dtype=float), -1, 0))
     if np.hypot(flow[0], flow[1]).max() >= speed:
         raise ValueError("the drift must stay below the agent's speed for a time-to-reach map")
@@ -219,6 +250,6 @@ def time_to_reach(
     reach = 1.5 * max(spacing)
     origin_xy = (float(origin[0]), float(origin[1]))
     _start(grid.points, flow, float(speed), origin_xy, float(radius), reach, values, state)
-    _march(values, state, flow, float(speed), spacing, float(t_max), order)
+    _march(values, state, flow, float(speed), spacing, float(t_max), order, float(reopen))
     values[values > t_max] = np.inf
     return values

@@ -6,9 +6,8 @@ disk of radius ``c`` about ``x₀`` (``T = 0`` on its edge): the set reached at 
 marching after Sethian (1996) with the anisotropic Godunov update of Sethian & Vladimirsky (2003)
 on the four-neighbour stencil, compiled by Numba:
 
-- in each quadrant the one-sided differences (``order`` 2: ``(3T − 4T₁ + T₂)/2h`` where the next
-  node has a value, as scikit-fmm's ``order=2``; ``order`` 3: ``(11T − 18T₁ + 9T₂ − 2T₃)/6h``
-  where two more have one; the highest the valued nodes allow otherwise, first order at least)
+- in each quadrant the one-sided differences (second order, ``(3T − 4T₁ + T₂)/2h``, where the next
+  node has a value, as scikit-fmm's ``order=2``; first order otherwise)
   make eq. 5.22 a quadratic in ``T``; its larger root counts only when the group velocity
   ``∂H/∂p = v̂ p/|p| + f`` points from both neighbours into the node (the update is upwind);
 - along one axis the characteristic runs along that axis at the speed ``f·e + √(v̂² − (f·e⊥)²)``;
@@ -16,10 +15,10 @@ on the four-neighbour stencil, compiled by Numba:
 
 A node is re-opened whenever a neighbour's new value changes its own by more than ``REOPEN`` of
 it (a label-correcting march): with a drift the upwind neighbour of the characteristic may carry
-the larger value, and the higher-order updates are not monotone in ``T₂``, ``T₃``, so a value set
+the larger value, and the second-order update is not monotone in ``T₂``, so a value set
 early is corrected, not frozen. Corrections below ``REOPEN`` (1e-9) are left: re-opening on every
-change above 1e-12 took 3 (order 2) to 10 (order 3) heap pops a node and 1.5–4× the CPU, for the
-same errors to four digits up to 401²; at 1e-7 the third-order error at 401² grows fourfold.
+change above 1e-12 took 3.3 heap pops a node at 201² and 401² and 1.4–1.6× the CPU, for the
+same maps to 1.3e-7 up to 401² (``order`` 2, marched past the ``T`` compared).
 
 The nodes within 1.5 cells of the disk's edge start from the closed form of a uniform flow with the
 node's own drift, ``|x − x₀ − fT| = c + v̂T`` (exact there; second-order accurate in a smooth
@@ -27,10 +26,13 @@ flow, the distance to the edge being a cell or two). The drift must stay below v
 (the agent can move against it); the disk must lie inside the grid. Measured against the exact
 disks of a uniform flow with ``|f| = v̂/2`` (``tests/flowfield/test_marching.py``,
 ``benchmarks/test_bench_reach.py``), the largest error over ``0.05 ≤ T ≤ 1.5`` falls at order
-1.7–1.9 per halving of the spacing with ``order`` 2 and 2.4–2.8 with ``order`` 3 (51² … 401²);
-fourth- and fifth-order one-sided differences were tried and diverge (errors of 1e11 or
-unreached nodes from 51² on), so 3 is the highest order offered. The largest error sits near
-the diagonals, where the four-neighbour stencil's two one-sided differences meet.
+1.7–1.9 per halving of the spacing (51² … 401²); it sits near the diagonals, where the
+four-neighbour stencil's two one-sided differences meet. Third-order one-sided differences
+(``(11T − 18T₁ + 9T₂ − 2T₃)/6h``) were tried: order 2.4–2.8 from 51² to 401² (8.4e-5 at 201²,
+ten times below second order), but at 801² an oblique wave of about six cells grows along the
+characteristics from T ≈ 0.6 (2.6e-3 at T = 1.5, two hundred times the 401² error); fourth
+order leaves nodes unreached from 201², fifth diverges from 26². Hence second order is the
+highest offered.
 """
 
 from __future__ import annotations
@@ -63,47 +65,30 @@ def _axis_speed(along: float, across: float, speed: float) -> float:
     return along + math.sqrt(max(speed * speed - across * across, 0.0))
 
 
-_BACKWARD = np.array(
-    [
-        [1.0, 1.0, 0.0, 0.0],
-        [1.5, 2.0, -0.5, 0.0],
-        [11.0 / 6.0, 3.0, -1.5, 1.0 / 3.0],
-    ]
-)
-"""The one-sided differences ``(αT − Σ c_k T_k)/h`` of order 1, 2, 3 in the nodes behind: each row
-``α, c₁, c₂, c₃`` (the backward differentiation formulas)."""
-
-
 @njit(cache=True, error_model="numpy")
 def _one_sided(
     values: np.ndarray, state: np.ndarray, i: int, j: int, di: int, dj: int, order: int
 ) -> tuple[float, float, float]:
     """``(α, β, T₁)`` of the upwind difference ``(αT − β)/h`` towards node (i, j) from the
-    neighbour (i − di, j − dj) of value ``T₁``, with as many valued nodes beyond it as ``order``
-    allows (a row of ``_BACKWARD``); zeros when the neighbour has none."""
+    neighbour (i − di, j − dj) of value ``T₁``: ``(1.5, 2T₁ − T₂/2)`` at second order where the
+    node beyond has a value ``T₂``, ``(1, T₁)`` otherwise; zeros when the neighbour has none."""
     nx, ny = values.shape
     i1, j1 = i - di, j - dj
     if i1 < 0 or j1 < 0 or i1 >= nx or j1 >= ny or state[i1, j1] == _FAR:
         return 0.0, 0.0, 0.0
     t1 = values[i1, j1]
-    got = 1
-    ik, jk = i1, j1
-    while got < order:
-        ik, jk = ik - di, jk - dj
-        if not (0 <= ik < nx and 0 <= jk < ny) or state[ik, jk] == _FAR or not math.isfinite(values[ik, jk]):
-            break
-        got += 1
-    row = _BACKWARD[got - 1]
-    beta = 0.0
-    for k in range(got):
-        beta += row[k + 1] * values[i1 - k * di, j1 - k * dj]
-    return row[0], beta, t1
+    i2, j2 = i1 - di, j1 - dj
+    if order == 2 and 0 <= i2 < nx and 0 <= j2 < ny and state[i2, j2] != _FAR:
+        t2 = values[i2, j2]
+        if math.isfinite(t2):
+            return 1.5, 2.0 * t1 - 0.5 * t2, t1
+    return 1.0, t1, t1
 
 
 @njit(cache=True, error_model="numpy")
 def _along(alpha: float, beta: float, neighbour: float, travel: float) -> float:
     """The one-dimensional candidate ``(β + h/s)/α`` along an axis, which the characteristic leaves
-    from the neighbour: first order (``T₁ + h/s``) where the higher-order one is below ``T₁``."""
+    from the neighbour: first order (``T₁ + h/s``) where the second-order one is below ``T₁``."""
     candidate = (beta + travel) / alpha
     return candidate if candidate >= neighbour else neighbour + travel
 
@@ -168,8 +153,8 @@ def _march(
     reopen: float,
 ) -> int:
     """Marching from the start nodes in the order of the values, a node re-opened whenever a
-    neighbour's new value changes its own by more than ``reopen`` of it (the higher-order updates
-    are not monotone, and with a drift the upwind neighbour may carry the larger value), until no
+    neighbour's new value changes its own by more than ``reopen`` of it (the second-order update
+    is not monotone, and with a drift the upwind neighbour may carry the larger value), until no
     value at or below ``t_max`` changes (at most 50 updates a node); returns the number of nodes
     taken from the heap."""
     nx, ny = values.shape
@@ -237,10 +222,10 @@ def time_to_reach(
 ) -> np.ndarray:
     """``T`` at the nodes (nx, ny) for an agent of speed ``speed`` starting on the disk of
     ``radius`` about ``origin`` in the drift tabulated on the grid (nx, ny, 2) (NaN inside the
-    disk beyond the start band, +inf where ``T > t_max``). ``order``: 1, 2 or 3 (the one-sided
-    differences); ``reopen``: the relative change that re-opens a node (module doc)."""
-    if order not in (1, 2, 3):
-        raise ValueError("order must be 1, 2 or 3")
+    disk beyond the start band, +inf where ``T > t_max``). ``order``: 1 or 2; ``reopen``: the
+    relative change that re-opens a node (module doc)."""
+    if order not in (1, 2):
+        raise ValueError("order must be 1 or 2")
     flow = np.ascontiguousarray(np.moveaxis(np.asarray(drift, dtype=float), -1, 0))
     if np.hypot(flow[0], flow[1]).max() >= speed:
         raise ValueError("the drift must stay below the agent's speed for a time-to-reach map")

@@ -108,15 +108,18 @@ def _update(
     dx, dy = spacing
     fx, fy = flow[0, i, j], flow[1, i, j]
     best = np.inf
+    below = _one_sided(values, state, i, j, 0, -1, order)
+    above = _one_sided(values, state, i, j, 0, 1, order)
+    for sy, (ay, by, ty) in ((-1, below), (1, above)):
+        if ay > 0.0:
+            best = min(best, _along(ay, by, ty, dy / _axis_speed(sy * fy, fx, speed)))
     for sx in (-1, 1):
         ax, bx, tx = _one_sided(values, state, i, j, sx, 0, order)
-        if ax > 0.0:
-            best = min(best, _along(ax, bx, tx, dx / _axis_speed(sx * fx, fy, speed)))
-        for sy in (-1, 1):
-            ay, by, ty = _one_sided(values, state, i, j, 0, sy, order)
-            if sx == -1 and ay > 0.0:  # each y-neighbour's own 1-D candidate once
-                best = min(best, _along(ay, by, ty, dy / _axis_speed(sy * fy, fx, speed)))
-            if ax == 0.0 or ay == 0.0:
+        if ax == 0.0:
+            continue
+        best = min(best, _along(ax, bx, tx, dx / _axis_speed(sx * fx, fy, speed)))
+        for sy, (ay, by, _) in ((-1, below), (1, above)):
+            if ay == 0.0:
                 continue
             # p = (kx T − mx, ky T − my): p_x = sx (αx T − βx)/dx, likewise y
             kx, mx = sx * ax / dx, sx * bx / dx

@@ -11,13 +11,19 @@ of radius ``c`` the time-to-reach ``T`` solves ``|x − x₀ − fT| = c + v̂T`
 - ``test_level_sets_against_hj_reachability``: the same solve by hj_reachability (JAX, CPU, the
   whole grid; cold = first solve with tracing and XLA compilation, warm = best of the next two).
   Goal: the compiled narrow band at least as fast as hj_reachability warm, in CPU seconds.
-- ``test_time_to_reach``: the map ``T`` to 1.5 by fast marching (second order,
-  :mod:`gamespec.flowfield.marching`) against the level-set route (eq. 5.22 from ``|x − x₀| − c``
-  on the whole grid by the NumPy operator, each node's crossing of 0 interpolated in time), the
-  error the largest ``|T − T_exact|`` over the nodes reached in 0.05 … 1.5. Goal (issue 29): ≥ 20×
-  faster at an error no larger; the ratio at equal error (the cheapest level-set grid at most as
-  far off) is printed and kept in ``extra_info``, not asserted: the level-set route is fifth
-  order on this smooth problem, the marching second, and the goal is not met.
+- ``test_time_to_reach``: the map ``T`` to 1.5, the error the largest ``|T − T_exact|`` over the
+  nodes reached in 0.05 … 1.5. The baseline is issue 29's "today's arrival engine" as the issue
+  defines it, measured in the same run: the level-set route (eq. 5.22 from ``|x − x₀| − c`` on the
+  whole grid by the NumPy operator, each node's crossing of 0 interpolated in time) at 201². The
+  same route on coarser grids gives its cost at each error; fast marching
+  (:mod:`gamespec.flowfield.marching`, second order) runs on 51² … 801².
+  Goal (issue 29): the marching ≥ 20× faster than the baseline at equal error. Printed and kept
+  in ``extra_info``, not asserted (the goal is not met): the ratio to the baseline of the
+  cheapest marching run at most as far off (none: the baseline's error on this smooth problem is
+  near 1e-6, the level-set route being fifth order, and the grid the marching would need at its
+  measured order is printed), and for each marching run the ratio at equal error to the cheapest
+  level-set run at most as far off. Asserted: the marching's order, at least 1.7 per halving of
+  dx on every step (as the tests).
 - ``test_time_to_reach_against_scikit_fmm``: in still air (scikit-fmm's eikonal has no drift),
   scikit-fmm's ``travel_time(order=2)`` beside ours.
 
@@ -51,9 +57,18 @@ SPEED, ORIGIN, RADIUS = 1.0, np.array([-0.5, 0.3]), 0.5
 LOWER, UPPER = (-2.5, -2.5), (2.5, 2.5)
 DURATION, LEVELS, T_MAX = 1.0, (0.3, 0.8), 1.5
 NODES = (101, 201, 401)
-ARRIVAL_NODES = (26, 51, 101, 201)
-"""The level-set route to the time-to-reach map runs the whole grid to 1.5 (half a minute at 401²);
-it is fifth order on this smooth problem, so its coarse grids meet the marching's error."""
+ARRIVAL_NODES = (26, 36, 51, 71, 101, 141, 201)
+"""The level-set route to the time-to-reach map on the whole grid to 1.5 (the last is the
+baseline's grid; half a minute at 401²): fifth order on this smooth problem, so its coarse grids
+meet the marching's error."""
+BASELINE_NODES = 201
+"""Issue 29's "today's arrival engine": the level-set route at 201² (4.2 s and an error of
+1.8e-3 as the issue quotes it, on the machine and with the error of that day)."""
+ISSUE_QUOTED_ERROR = 1.8e-3
+"""The baseline's error as issue 29 quotes it (not what the route measures here): the ratio at
+that error is printed beside the one at the error measured in the run, for the record."""
+MARCHING_NODES = (51, 101, 201, 401, 801)
+GOAL = 20.0
 ROUNDS = 2
 
 
@@ -166,12 +181,6 @@ def arrival_by_level_sets(n: int) -> Callable[[], np.ndarray]:
     return run
 
 
-def marching_run(n: int, drift: np.ndarray = DRIFT) -> Callable[[], np.ndarray]:
-    grid = _grid(n)
-    tabulated = np.broadcast_to(drift, (n, n, 2))
-    return lambda: time_to_reach(grid, tabulated, SPEED, ORIGIN, RADIUS, t_max=T_MAX + 0.1)
-
-
 def skfmm_run(n: int) -> Callable[[], np.ndarray]:
     import skfmm
 
@@ -203,17 +212,22 @@ def hj_rows(n: int) -> list[Row]:
 
 
 def arrival_rows(nodes: tuple[int, ...] = ARRIVAL_NODES) -> list[Row]:
-    """The level-set route to ``T`` (the baseline) on each grid."""
+    """The level-set route to ``T`` on each grid (the one on ``BASELINE_NODES`` the baseline)."""
     rows = []
     for n in nodes:
         found, cpu, wall = _timed(arrival_by_level_sets(n), rounds=1)
-        rows.append(
-            Row("time to reach", n, "level-set arrival (baseline)", cpu, wall, time_error(_grid(n), found))
-        )
+        name = "level-set arrival" + (" (baseline)" if n == BASELINE_NODES else "")
+        rows.append(Row("time to reach", n, name, cpu, wall, time_error(_grid(n), found)))
     return rows
 
 
-def marching_rows(nodes: tuple[int, ...] = NODES) -> list[Row]:
+def marching_run(n: int, drift: np.ndarray = DRIFT) -> Callable[[], np.ndarray]:
+    grid = _grid(n)
+    tabulated = np.broadcast_to(drift, (n, n, 2))
+    return lambda: time_to_reach(grid, tabulated, SPEED, ORIGIN, RADIUS, t_max=T_MAX + 0.1)
+
+
+def marching_rows(nodes: tuple[int, ...] = MARCHING_NODES) -> list[Row]:
     rows = []
     for n in nodes:
         found, cpu, wall = _timed(marching_run(n))
@@ -228,6 +242,31 @@ def at_equal_error(marching: Row, arrivals: list[Row]) -> float | None:
     return min(matching) / marching.cpu if matching else None
 
 
+def against_baseline(baseline: Row, marching: list[Row], error: float) -> tuple[Row | None, float | None]:
+    """The cheapest marching run at most ``error`` off and the baseline's CPU over its (Nones
+    when no marching grid measured is that fine)."""
+    matching = [row for row in marching if row.error <= error]
+    if not matching:
+        return None, None
+    cheapest = min(matching, key=lambda row: row.cpu)
+    return cheapest, baseline.cpu / cheapest.cpu
+
+
+def measured_orders(rows: list[Row]) -> np.ndarray:
+    """The order between successive grids, ``log(e₁/e₂) / log(dx₁/dx₂)`` (``n`` nodes: ``n − 1``
+    cells)."""
+    errors = np.array([row.error for row in rows])
+    cells = np.array([row.nodes - 1 for row in rows], dtype=float)
+    return np.log(errors[:-1] / errors[1:]) / np.log(cells[1:] / cells[:-1])
+
+
+def nodes_for(rows: list[Row], error: float) -> int:
+    """The grid at which the finest run's error would fall to ``error`` at the last measured order
+    (an extrapolation, printed as such)."""
+    order = float(measured_orders(rows)[-1])
+    return int(np.ceil((rows[-1].nodes - 1) * (rows[-1].error / error) ** (1 / order))) + 1
+
+
 def still_air_rows(n: int) -> list[Row]:
     grid, still = _grid(n), np.zeros(2)
     found, cpu, wall = _timed(marching_run(n, still))
@@ -240,9 +279,10 @@ def still_air_rows(n: int) -> list[Row]:
 def _report(benchmark: Any, rows: list[Row], baseline: Row) -> None:
     for row in rows:
         print(row.line(baseline))
-        benchmark.extra_info[f"{row.engine} cpu_s"] = row.cpu
-        benchmark.extra_info[f"{row.engine} error"] = row.error
-        benchmark.extra_info[f"{row.engine} over baseline"] = row.cpu / baseline.cpu
+        name = f"{row.engine} at {row.nodes}²"
+        benchmark.extra_info[f"{name} cpu_s"] = row.cpu
+        benchmark.extra_info[f"{name} error"] = row.error
+        benchmark.extra_info[f"{name} over baseline"] = row.cpu / baseline.cpu
 
 
 @pytest.mark.parametrize("n", NODES)
@@ -267,23 +307,49 @@ def test_level_sets_against_hj_reachability(benchmark, n: int) -> None:
     assert compiled_band.cpu <= hj[-1].cpu
 
 
+def time_to_reach_report(arrivals: list[Row], marching: list[Row]) -> dict[str, Any]:
+    """Print the ratios of ``test_time_to_reach`` and return them by name."""
+    baseline = next(row for row in arrivals if row.nodes == BASELINE_NODES)
+    orders = measured_orders(marching)
+    print("fast marching: measured order per halving of dx " + ", ".join(f"{p:.2f}" for p in orders))
+    ratios: dict[str, Any] = {"marching measured orders": orders.tolist()}
+    for error, what in ((baseline.error, "measured here"), (ISSUE_QUOTED_ERROR, "as issue 29 quotes it")):
+        row, ratio = against_baseline(baseline, marching, error)
+        ratios[f"baseline over marching at the baseline's error {what}"] = ratio
+        if row is None:
+            print(
+                f"the baseline's error {what} ({error:.2e}): no marching grid measured is as accurate "
+                f"(≈ {nodes_for(marching, error)}² at the last measured order)"
+            )
+        else:
+            print(f"the baseline's error {what} ({error:.2e}): marching at {row.nodes}², {ratio:.1f}× faster")
+    for row in marching:
+        ratio = at_equal_error(row, arrivals)
+        ratios[f"marching at {row.nodes}²: level sets at equal error over marching"] = ratio
+        shown = "no level-set grid that coarse" if ratio is None else f"{ratio:.2f}×"
+        print(
+            f"marching at {row.nodes}² (error {row.error:.2e}): level sets at equal error / marching {shown}"
+        )
+    met = ratios["baseline over marching at the baseline's error measured here"]
+    ratios["goal met"] = met is not None and met >= GOAL
+    print(
+        f"issue 29's goal ({GOAL:.0f}× the baseline at its error, measured in this run): "
+        + ("met" if ratios["goal met"] else "not met")
+    )
+    return ratios
+
+
 def test_time_to_reach(benchmark) -> None:
-    """Both routes on their grids; the ratio at equal error is the level-set run that is at most
-    as far off, over the marching run (the goal of issue 29: 20)."""
+    """The baseline (the level-set route at 201²), the same route on coarser grids, the marching;
+    the ratios at equal error printed and kept (module doc); the marching's order asserted."""
     benchmark.group = "time-to-reach map, uniform flow"
     arrivals = benchmark.pedantic(arrival_rows, rounds=1, warmup_rounds=0)
     marching = marching_rows()
-    _report(benchmark, [*arrivals, *marching], arrivals[0])
-    for row in marching:
-        ratio = at_equal_error(row, arrivals)
-        benchmark.extra_info[f"equal error ratio at {row.nodes}"] = ratio
-        same_grid = next((a for a in arrivals if a.nodes == row.nodes), None)
-        if same_grid is not None:
-            print(f"{row.nodes}²: the same grid, level sets / marching {same_grid.cpu / row.cpu:.1f}× in CPU")
-        shown = "no level-set grid that coarse" if ratio is None else f"{ratio:.2f}×"
-        print(f"{row.nodes}²: at equal error, level sets / marching {shown}")
-    errors = np.array([row.error for row in marching])
-    assert np.all(np.log2(errors[:-1] / errors[1:]) >= 1.7)  # second order, as the tests
+    baseline = next(row for row in arrivals if row.nodes == BASELINE_NODES)
+    _report(benchmark, [*arrivals, *marching], baseline)
+    for name, value in time_to_reach_report(arrivals, marching).items():
+        benchmark.extra_info[name] = value
+    assert np.all(measured_orders(marching) >= 1.7)
 
 
 @pytest.mark.parametrize("n", NODES)
@@ -305,8 +371,11 @@ def main() -> None:
         for row in rows:
             print(row.line(rows[0]))
     arrivals = arrival_rows()
-    for row in [*arrivals, *marching_rows()]:
-        print(row.line(arrivals[0]))
+    marching = marching_rows()
+    baseline = next(row for row in arrivals if row.nodes == BASELINE_NODES)
+    for row in [*arrivals, *marching]:
+        print(row.line(baseline))
+    time_to_reach_report(arrivals, marching)
     for n in NODES:
         try:
             rows = still_air_rows(n)

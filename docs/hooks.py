@@ -9,7 +9,10 @@
 - ``gallery/<stem>.md``: one page per shipped problem file: the command, and the summary and the
   figures of its saved Result under ``tests/data/results/`` (:mod:`tests.plots.fixtures`; a study
   has none), drawn by the kind's plotter (:meth:`gamespec.Result.plot`), so the build solves
-  nothing; ``gallery/index.md`` lists them by chapter;
+  nothing; ``gallery/index.md`` lists them by chapter. ``GAMESPEC_GALLERY_FIGURES`` (problem
+  stems, comma-separated) draws only those files' figures, the others' pages saying so: the test
+  suite's build (``tests/docs/test_docs_build.py``) draws a few, since ``tests/plots`` draws every
+  saved Result's figures already;
 - the navigation's ``Problem kinds``, ``Transforms`` and ``Gallery`` sections list those pages
   (:func:`on_config`), so a kind, transform or problem file added later is in the nav;
 - ``<!-- example: NAME -->`` in a page is replaced by ``docs/examples/NAME`` as a code block (the
@@ -19,6 +22,7 @@
 from __future__ import annotations
 
 import inspect
+import os
 import re
 import sys
 from pathlib import Path
@@ -36,6 +40,8 @@ ROOT = Path(__file__).resolve().parents[1]
 EXAMPLE = re.compile(r"<!-- example: ([\w.]+) -->")
 RESULTS = ROOT / "tests" / "data" / "results"
 """The saved Results the gallery is drawn from (written by ``python -m tests.plots.fixtures``)."""
+FIGURES_ENV = "GAMESPEC_GALLERY_FIGURES"
+"""Names the problem stems whose figures the gallery draws (all when unset)."""
 CHAPTERS = {"ocp": "Optimal-control classics"}
 """Gallery headings of the ``problems/`` folders that are not a thesis chapter (``chN``)."""
 
@@ -280,13 +286,23 @@ def _summary(path: Path, result: Result | None) -> list[str]:
     ]
 
 
+def _drawn(stem: str) -> bool:
+    """Whether this build draws ``stem``'s figures (:data:`FIGURES_ENV`)."""
+    chosen = os.environ.get(FIGURES_ENV)
+    return chosen is None or stem in chosen.split(",")
+
+
+NOT_DRAWN = "The figures are not drawn in this build ({env} is set); the command above draws them."
+
+
 def gallery_page(path: Path, result: Result | None, figures: list[str]) -> str:
     """A problem file's page: what it is, the command, the summary of its saved Result and its
-    figures."""
+    figures (or, where this build does not draw them, :data:`NOT_DRAWN`)."""
     relative = path.relative_to(ROOT)
     data = yaml.safe_load(path.read_text())
     kind = data.get("kind", "")
     plot = " --plot" if result is not None else ""
+    undrawn = result is not None and not _drawn(path.stem)
     text = [
         f"# `{path.stem}`\n",
         _cell(data.get("description", "")) + "\n",
@@ -294,8 +310,9 @@ def gallery_page(path: Path, result: Result | None, figures: list[str]) -> str:
         "## Command\n",
         f"```bash\ngamespec solve {relative} --out runs/{path.stem}{plot}\n```\n",
         *_summary(path, result),
-        *(["## Figures\n"] if figures else []),
+        *(["## Figures\n"] if figures or undrawn else []),
         *(f"![{name}]({path.stem}/{name})\n" for name in figures),
+        *([NOT_DRAWN.format(env=f"`{FIGURES_ENV}`") + "\n"] if undrawn else []),
     ]
     return "\n".join(text)
 
@@ -313,7 +330,7 @@ def gallery(config) -> list[File]:
     chapter = None
     for stem, path in sorted(_problem_files().items(), key=lambda item: (str(item[1].parent), item[0])):
         result = _saved(stem)
-        figures = result.plot().images if result is not None else []
+        figures = result.plot().images if result is not None and _drawn(stem) else []
         for name, data in figures:
             generated.append(File.generated(config, f"gallery/{stem}/{name}", content=data))
         page = gallery_page(path, result, [name for name, _ in figures])

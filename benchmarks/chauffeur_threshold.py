@@ -11,8 +11,8 @@ the gap point is the same to 1e-4 on [−1, 1]², [−1.5, 1.5]² and [−3, 3]�
 spacing: the numerical dissipation fills in the narrow neck between the arcs, so the switch lies
 above ℓ* by an error that falls under refinement more slowly than the spacing (about as h^(2/3)).
 
-Run: ``python -m benchmarks.chauffeur_threshold [--box 1.0] [--nodes 41 81 161] [--horizon 4]``
-(minutes; not part of the test suite).
+Run: ``python -m benchmarks.chauffeur_threshold [--box 1.0] [--nodes 41 81 161] [--horizon 8]
+[--within 0.2 0.4]`` (minutes; not part of the test suite).
 """
 
 from __future__ import annotations
@@ -59,8 +59,9 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__)
     parser.add_argument("--box", type=float, nargs="+", default=[1.0], help="half-widths of the box")
     parser.add_argument("--nodes", type=int, nargs="+", default=[41, 81, 161], help="odd nodes per axis")
-    parser.add_argument("--horizon", type=float, nargs="+", default=[4.0], help="horizons T")
+    parser.add_argument("--horizon", type=float, nargs="+", default=[8.0], help="horizons T")
     parser.add_argument("--width", type=float, default=0.0025, help="the bracket's width in ℓ")
+    parser.add_argument("--within", type=float, nargs=2, default=[0.2, 0.4], help="the ℓ to bisect")
     args = parser.parse_args()
     spec = load(FILE)
     gamma = float(spec.problem.parameters["gamma"])
@@ -72,7 +73,7 @@ def main() -> None:
         for horizon in args.horizon:
             for nodes in args.nodes:
                 start = time.process_time()
-                low, high = switch_bracket(chauffeur_model(box, nodes, horizon), 0.2, 0.4, args.width)
+                low, high = switch_bracket(chauffeur_model(box, nodes, horizon), *args.within, args.width)
                 print(
                     f"| ±{box:g} | {nodes} | {2 * box / (nodes - 1):.4f} | {horizon:g} | "
                     f"[{low:.4f}, {high:.4f}] | {(low + high) / 2 - star:+.4f} | "

@@ -31,9 +31,12 @@ A game of degree (``time.final: free`` within ``bounds``; the payoff the capture
 time to reach, ``T(x) = min{τ : φ(x, τ) ≤ 0}`` (linear in τ between steps), is the minimum time to
 capture (``arrays.capture_time``, +∞ where not reached within the upper bound), and the game from
 the initial state (φ interpolated bilinearly there) is decided: ``capture`` at ``T(x₀)``,
-``escape`` (the capture time +∞) when it is not reached and the captured set has converged (the
-same at the bound as at half of it, clear of the grid's edge: :func:`converged`), else
-``undecided`` (``iteration_limit``). The concept is ``saddle`` when the min and max separate
+``escape`` (the capture time +∞) when it is not reached and the captured set has converged (its
+part connected to the target the same at the bound as at half of it, clear of the grid's edge:
+:func:`converged`), else ``undecided`` (``iteration_limit``). The bound must exceed twice the time
+the set takes to settle: a set still creeping into a narrow neck at T/2 reads as growing (the
+chauffeur's study over ℓ, ``benchmarks/chauffeur_threshold.py``, switches 0.005 lower at T = 4
+than at T = 8 or 16 at spacing 0.05). The concept is ``saddle`` when the min and max separate
 (Isaacs' minimax condition, under which the upper and lower values of eqs. 4.9–4.10 agree), else
 ``upper_value`` (eq. 4.9's order: the maximizer answers the minimizer's control); the information
 pattern is feedback. The value generalizes the reachability front of eq. 5.22 (the level of the

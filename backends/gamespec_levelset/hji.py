@@ -31,9 +31,12 @@ A game of degree (``time.final: free`` within ``bounds``; the payoff the capture
 time to reach, ``T(x) = min{τ : φ(x, τ) ≤ 0}`` (linear in τ between steps), is the minimum time to
 capture (``arrays.capture_time``, +∞ where not reached within the upper bound), and the game from
 the initial state (φ interpolated bilinearly there) is decided: ``capture`` at ``T(x₀)``,
-``escape`` (the capture time +∞) when it is not reached and the captured set has converged (the
-same at the bound as at half of it, clear of the grid's edge: :func:`converged`), else
-``undecided`` (``iteration_limit``). The concept is ``saddle`` when the min and max separate
+``escape`` (the capture time +∞) when it is not reached and the captured set has converged (its
+part connected to the target the same at the bound as at half of it, clear of the grid's edge:
+:func:`converged`), else ``undecided`` (``iteration_limit``). The bound must exceed twice the time
+the set takes to settle: a set still creeping into a narrow neck at T/2 reads as growing (the
+chauffeur's study over ℓ, ``benchmarks/chauffeur_threshold.py``, switches 0.005 lower at T = 4
+than at T = 8 or 16 at spacing 0.05). The concept is ``saddle`` when the min and max separate
 (Isaacs' minimax condition, under which the upper and lower values of eqs. 4.9–4.10 agree), else
 ``upper_value`` (eq. 4.9's order: the maximizer answers the minimizer's control); the information
 pattern is feedback. The value generalizes the reachability front of eq. 5.22 (the level of the
@@ -47,7 +50,9 @@ grid and on one with half the nodes per axis (the same box, every other node) ar
 ``refinement_tolerance`` coarse cells apart (:func:`boundary_shift`,
 ``checks.capture_region_refinement``). ``metrics.capture_region`` holds the captured area, its share
 of the grid, and the area captured within half the horizon (equal when the region has stopped
-growing: every capture from it happens within T/2) and whether it has :func:`converged`; a game of
+growing: every capture from it happens within T/2), whether it has :func:`converged`, and
+``detached_nodes``, the captured nodes not connected to the target (:func:`attached`: the edge's
+guess, left out of the convergence test); a game of
 degree also checks that the half-resolution grid decides the same, with a capture time within
 ``capture_time_tolerance`` of it (``checks.capture_time_refinement``).
 """
@@ -62,6 +67,7 @@ from typing import Any, ClassVar, Literal
 import numpy as np
 import sympy as sp
 from pydantic import Field, model_validator
+from scipy import ndimage
 
 from gamespec.compiling import Backend, CompiledModel, Inputs, refuse_inputs
 from gamespec.errors import ExpressionError, SpecError, UnsupportedFeature
@@ -527,6 +533,7 @@ class HJIModel(CompiledModel):
             "states": list(self.game.problem.states),
             "avoid": self.game.problem.avoid is not None,
             "converged": converged(run),
+            "detached_nodes": int((captured & ~attached(captured, run.arrival == 0)).sum()),
         }
         tolerance = self.options.refinement_tolerance
         result = Result(
@@ -565,15 +572,30 @@ def outcome(run: ReachRun, grid: Grid) -> Literal["capture", "escape", "undecide
     return "escape" if converged(run) else "undecided"
 
 
+def attached(captured: np.ndarray, target: np.ndarray) -> np.ndarray:
+    """The nodes of ``captured`` connected to ``target`` (through captured nodes, diagonal
+    neighbours included). The set captured within τ is the union of the paths that end in the
+    target, so it is connected to it; a piece apart from it is the ghost nodes' guess at the grid's
+    edge (on [−3, 3]² with 81 nodes the chauffeur's far corners are captured so between τ = 7 and 14)."""
+    labels, _ = ndimage.label(captured, structure=np.ones((3, 3), dtype=bool))
+    keep = np.unique(labels[target & captured])
+    joined: np.ndarray = np.isin(labels, keep[keep > 0])
+    return joined
+
+
 def converged(run: ReachRun) -> bool:
-    """Whether the captured set has stopped growing: the same at the horizon as at half of it, and
-    clear of the grid's two outer rings of nodes (where the ghost nodes' extrapolation guesses what
-    lies outside). Below Isaacs' barrier threshold the barrier closes it off and the rest escapes;
-    above it the set keeps growing (``metrics.capture_region.converged``)."""
-    captured = run.value <= 0
+    """Whether the captured set has stopped growing: its part connected to the target
+    (:func:`attached`) is the same at the horizon as at half of it, and clear of the grid's two
+    outer rings of nodes (where the ghost nodes' extrapolation guesses what lies outside). Below
+    Isaacs' barrier threshold the barrier closes it off and the rest escapes; above it the set
+    leaks through the gap between the barrier's arcs and keeps growing
+    (``metrics.capture_region.converged``)."""
+    target = run.arrival == 0
+    captured = attached(run.value <= 0, target)
     ring = np.ones_like(captured)
     ring[2:-2, 2:-2] = False
-    return bool(np.array_equal(captured, run.half <= 0)) and not bool(np.any(captured & ring))
+    same = np.array_equal(captured, attached(run.half <= 0, target))
+    return bool(same) and not bool(np.any(captured & ring))
 
 
 def game_of_degree(

@@ -190,9 +190,10 @@ def hermite(
     h = (edges[k + 1] - edges[k])[:, None]
     s = (t - edges[k])[:, None] / h
     s2, s3 = s * s, s * s * s
-    return (
+    rows: np.ndarray = (
         (2 * s3 - 3 * s2 + 1) * states[k]
         + (s3 - 2 * s2 + s) * h * starts[k]
         + (-2 * s3 + 3 * s2) * states[k + 1]
         + (s3 - s2) * h * ends[k]
     )
+    return rows

@@ -59,7 +59,8 @@ class ScheduledHeading:
     def along(self, t: np.ndarray, P: np.ndarray, E: np.ndarray) -> np.ndarray:
         """The headings at times ``t`` along positions ``P`` (k, n, 2) and ``E`` (k, 2)."""
         offset = np.arctan2(E[:, 1] - P[:, 0, 1], E[:, 0] - P[:, 0, 0]) if self.line_of_sight else 0.0
-        return self.signal(t)[0] + offset
+        headings: np.ndarray = self.signal(t)[0] + offset
+        return headings
 
 
 @dataclass(frozen=True)

@@ -26,7 +26,6 @@ from scipy.integrate import solve_ivp
 
 from gamespec.ocp.control_signal import TranscribedSignal
 from gamespec.pursuit.bearing import constant_bearing_headings, line_of_sight_angles
-from gamespec.pursuit.integrator import CONSTANT_BEARING, PURE_PURSUIT, STATIONARY, hermite, integrate
 from gamespec.specs.engagement import EngagementSpec
 
 HeadingLaw = Callable[[float, np.ndarray, np.ndarray], float]
@@ -173,6 +172,9 @@ def simulate(
 
 
 def _compiled(players: Players, heading: ScheduledHeading, t_max: float, samples: int) -> Trajectory:
+    # Numba is imported on first use: importing the pursuit package (the CLI does) stays cheap
+    from gamespec.pursuit.integrator import CONSTANT_BEARING, PURE_PURSUIT, STATIONARY, hermite, integrate
+
     n = len(players.names)
     codes = {"pp": PURE_PURSUIT, "cb": CONSTANT_BEARING, "stationary": STATIONARY}
     strategy = np.array([codes[s] for s in players.strategies], dtype=np.int64)

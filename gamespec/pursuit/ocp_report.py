@@ -20,7 +20,7 @@ from gamespec.ocp.control_signal import transcribed_signal
 from gamespec.pursuit.reduced import Reduction
 from gamespec.pursuit.relay import detect_arcs
 from gamespec.pursuit.report import simulation_report, terminal_metrics
-from gamespec.pursuit.simulation import HeadingLaw, Players, simulate_to_capture
+from gamespec.pursuit.simulation import Players, ScheduledHeading, simulate_to_capture
 from gamespec.result import Result
 from gamespec.specs.engagement import EngagementSpec
 
@@ -28,14 +28,11 @@ ARC_TOL = 1e-5
 """|S| below this counts as on the Voronoi boundary when splitting a relay path into arcs."""
 
 
-def heading_law(red: Reduction, result: Result) -> HeadingLaw:
+def heading_law(red: Reduction, result: Result) -> ScheduledHeading:
     """The OCP's evader heading as a law for re-simulation, as the transcription holds it
     (:mod:`gamespec.ocp.control_signal`): θ_E(t) in the fixed frame; θ(t) + φ_1 in the
     line-of-sight frame, φ_1 read from the simulated positions."""
-    signal = transcribed_signal(result, [red.control])
-    if red.frame == "fixed":
-        return lambda t, P, E: signal.at(t)[0]
-    return lambda t, P, E: signal.at(t)[0] + float(np.arctan2(*(E - P[0])[::-1]))
+    return ScheduledHeading(transcribed_signal(result, [red.control]), line_of_sight=red.frame != "fixed")
 
 
 def relay_arcs(red: Reduction, players: Players, result: Result) -> dict[str, float]:

@@ -14,8 +14,9 @@ a baseline measured in the same run; and the pursuit re-simulation against the O
   SciPy's ``hybr`` on the NumPy tape's defects.
 - ``test_pursuit_resimulation``: an engagement's OCP solve with its ``resimulation`` analysis
   against the same solve without it (``ratio``: what the check costs), and the re-simulation itself,
-  the compiled RK4 of :mod:`gamespec.pursuit.integrator`, against SciPy's ``solve_ivp`` with a
-  Python right-hand side integrating the same heading (``speedup``; the route it replaced).
+  the compiled RK4 of :mod:`gamespec.pursuit.integrator` (as a study runs it), against SciPy's
+  ``solve_ivp`` with a Python right-hand side integrating the same heading (``speedup``; the route
+  it replaced).
 
 Run: ``python -m pytest benchmarks/test_bench_game_simulation.py --benchmark-enable -s`` (``-m slow``
 adds the whole run).
@@ -24,6 +25,7 @@ adds the whole run).
 from __future__ import annotations
 
 import time
+from functools import partial
 
 import numpy as np
 import pytest
@@ -38,7 +40,7 @@ from gamespec.loader import load
 from gamespec.ocp.transcription import Transcription
 from gamespec.pursuit.ocp_generation import to_ocp
 from gamespec.pursuit.ocp_report import heading_law
-from gamespec.pursuit.simulation import capture_bound, simulate
+from gamespec.pursuit.simulation import capture_bound, compiled_integration, simulate
 from gamespec.solving import compile_spec
 from tests.conftest import PROBLEMS
 from tests.games.test_compiled_simulation import _interpreted_advance, _interpreted_states
@@ -167,14 +169,15 @@ def test_pursuit_resimulation(benchmark) -> None:
     spec = gamespec.load(path)
     plain = compile_spec(spec, "casadi", analyses="none")
     checked = compile_spec(gamespec.load(path), "casadi", analyses=["resimulation"])
-    benchmark.pedantic(checked.solve, rounds=3, iterations=1)
-    plain.solve()
-    result, baseline = _cpu(plain.solve, repeat=5)
-    with_check = _cpu(checked.solve, repeat=5)[1]
+    with compiled_integration():
+        benchmark.pedantic(checked.solve, rounds=3, iterations=1)
+        plain.solve()
+        result, baseline = _cpu(plain.solve, repeat=5)
+        with_check = _cpu(checked.solve, repeat=5)[1]
     _, inverse = to_ocp(spec)
     heading = heading_law(inverse.reduction, result)
     t_max = 1.01 * capture_bound(inverse.players)
-    compiled = _cpu(simulate, inverse.players, heading, t_max, repeat=20)[1]
+    compiled = _cpu(partial(simulate, method="compiled"), inverse.players, heading, t_max, repeat=20)[1]
 
     def python_law(t: float, P: np.ndarray, E: np.ndarray) -> float:
         return heading(t, P, E)

@@ -9,11 +9,11 @@
   (t_c = (r_0 − ε)/(u − v), Proposition 1 with one pursuer): status ``optimal``.
 
 Either way the capture time is read from the true dynamics (eq. 2.1) simulated under that plan
-(compiled RK4); the ``resimulated_*`` checks come from an independent integration of the same plan
-(DOP853), and ``predicted_capture_time_error`` compares the constant-bearing closed form with the
-simulation. The Result carries the same metrics as an OCP solution mapped back by
-:class:`gamespec.transforms.engagement.EngagementToOcp`. Relay pursuit and mixed strategies need
-the OCP.
+(RK45, or the compiled RK4 within a study); the ``resimulated_*`` checks come from an independent
+integration of the same plan (DOP853), and ``predicted_capture_time_error`` compares the
+constant-bearing closed form with the simulation. The Result carries the same metrics as an OCP
+solution mapped back by :class:`gamespec.transforms.engagement.EngagementToOcp`. Relay pursuit and
+mixed strategies need the OCP.
 """
 
 from __future__ import annotations

@@ -6,22 +6,27 @@ root that closes the distance, stationary ones stay put. The evader follows a he
 the first time an active pursuer is within the capture radius (Definition 1).
 
 A constant heading or a :class:`ScheduledHeading` (a signal of time, in the fixed or the first
-pursuer's line-of-sight frame: what a solution's heading is, :func:`gamespec.pursuit.ocp_report.heading_law`)
-is integrated by the compiled RK4 of :mod:`gamespec.pursuit.integrator`, its steps never across a
-mesh point of the signal, at most ``STEP_FRACTION`` r / (fastest pursuer's speed + the evader's) for
-the nearest pursuer's distance r (a pure-pursuit line of sight turns at a rate up to (u + v)/r) and
-at most ``t_max / MIN_STEPS``. A named SciPy ``method`` (an independent integration, as the
-analytic backend's check) and any other law (a Python function of the positions) is integrated by
-:func:`scipy.integrate.solve_ivp` with its capture event. A compiled integration takes a few ms
-where SciPy's took 25-50 ms, but the first one in a process costs about 0.7 s CPU (Numba's import,
-0.3 s, and the load of its cached machine code, 0.4 s): a single ``gamespec solve`` of an
-engagement pays that once.
+pursuer's line-of-sight frame: what a solution's heading is,
+:func:`gamespec.pursuit.ocp_report.heading_law`) is integrated by the compiled RK4 of
+:mod:`gamespec.pursuit.integrator` where asked for (:func:`compiled_integration`, what a study's
+points run in; ``method="compiled"`` for one call), its steps never across a mesh point of the
+signal, at most ``STEP_FRACTION`` r / (fastest pursuer's speed + the evader's) for the nearest
+pursuer's distance r (a pure-pursuit line of sight turns at a rate up to (u + v)/r) and at most
+``t_max / MIN_STEPS``. A named SciPy ``method`` (an independent integration, as the analytic
+backend's check), any other law (a Python function of the positions) and every integration outside
+:func:`compiled_integration` go through :func:`scipy.integrate.solve_ivp` with its capture event.
+A compiled integration takes a few ms where SciPy's takes 25-50 ms, but the first one in a process
+costs about 0.4 s CPU (Numba's import and the load of its cached machine code), and the very first
+on a machine about 8 s (the compilation, cached on disk): a loop of re-simulations gains, a single
+``gamespec solve`` of an engagement would lose, so the loop's owner asks for it. The two routes
+agree to 1e-9 of the capture time (``tests/pursuit/test_integrator.py``).
 """
 
 from __future__ import annotations
 
 import math
-from collections.abc import Callable
+from collections.abc import Callable, Iterator
+from contextlib import contextmanager
 from dataclasses import dataclass
 
 import numpy as np
@@ -154,6 +159,25 @@ class Trajectory:
         return np.linalg.norm(self.evader[:, None, :] - self.pursuers, axis=2)
 
 
+_COMPILED = False
+"""Whether :func:`simulate` integrates by the compiled RK4 (:func:`compiled_integration`)."""
+
+
+@contextmanager
+def compiled_integration() -> Iterator[None]:
+    """Within this block, integrate a constant or :class:`ScheduledHeading` heading by the compiled
+    RK4 (the module doc says when that pays: a loop of re-simulations, such as a study's points);
+    its machine code is loaded on entry."""
+    global _COMPILED
+    from gamespec.pursuit import integrator  # noqa: F401 (Numba's import and code load, here)
+
+    before, _COMPILED = _COMPILED, True
+    try:
+        yield
+    finally:
+        _COMPILED = before
+
+
 def simulate(
     players: Players,
     heading: HeadingLaw | float,
@@ -163,15 +187,18 @@ def simulate(
     rtol: float = 1e-10,
     method: str | None = None,
 ) -> Trajectory:
-    """Integrate eq. 2.1/3.1 from the initial positions until capture or ``t_max``: without a
-    ``method``, compiled RK4 for a constant or :class:`ScheduledHeading` heading; with one (a
-    :func:`scipy.integrate.solve_ivp` integrator, RK45 for any other law), SciPy at ``rtol``
+    """Integrate eq. 2.1/3.1 from the initial positions until capture or ``t_max``: by the compiled
+    RK4 for a constant or :class:`ScheduledHeading` heading with ``method="compiled"``, or without a
+    ``method`` within :func:`compiled_integration`; else by SciPy's ``method`` (RK45 by default) at ``rtol``
     (module doc)."""
     if isinstance(heading, int | float):
         heading = ScheduledHeading.constant(float(heading))
-    if method is None and isinstance(heading, ScheduledHeading):
+    compiled = method == "compiled" or (method is None and _COMPILED)
+    if compiled and isinstance(heading, ScheduledHeading):
         return _compiled(players, heading, t_max, samples)
-    return _solve_ivp(players, heading, t_max, samples, rtol, method or "RK45")
+    if method == "compiled":
+        raise ValueError("the compiled integrator takes a constant or scheduled heading only")
+    return _solve_ivp(players, heading, t_max, samples, rtol, "RK45" if method is None else method)
 
 
 def _compiled(players: Players, heading: ScheduledHeading, t_max: float, samples: int) -> Trajectory:

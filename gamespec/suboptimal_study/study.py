@@ -28,7 +28,7 @@ from gamespec.metrics import Finite
 from gamespec.pursuit import pure_pursuit
 from gamespec.pursuit.ocp_generation import trajectory_guess
 from gamespec.pursuit.pursuit_curve import constant_heading_pursuit
-from gamespec.pursuit.simulation import Players
+from gamespec.pursuit.simulation import Players, compiled_integration
 from gamespec.result import Result, Status
 from gamespec.solving import Solver, compile_spec
 from gamespec.studies.point_study import PointStudy, PointStudyModel
@@ -85,7 +85,14 @@ def _accepted(result: Result) -> bool:
 def evaluate(point: StudyPoint) -> dict[str, Any]:
     """Suboptimal and optimal capture times of one point (the row the store keeps): the optimum is
     the chain's re-solve of the engagement (its parameter map, the compiled OCP, its inverse map
-    with the re-simulation check), started from the suboptimal path in closed form."""
+    with the re-simulation check, by the compiled integrator: a study is a loop of them,
+    :func:`~gamespec.pursuit.simulation.compiled_integration`), started from the suboptimal path in
+    closed form."""
+    with compiled_integration():
+        return _evaluated(point)
+
+
+def _evaluated(point: StudyPoint) -> dict[str, Any]:
     spec = point_engagement(point)
     players = Players.from_spec(spec)
     compiled = _solver(point.v, point.r1, point.u, point.eps, point.methods[0], point.backend)

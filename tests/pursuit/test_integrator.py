@@ -47,7 +47,7 @@ def test_capture_and_paths_equal_a_tight_scipy_integration(strategies, eps, line
     players = _players(strategies, eps)
     heading = ScheduledHeading(_signal(), line_of_sight)
     t_max = 1.01 * capture_bound(players)
-    compiled = simulate(players, heading, t_max)
+    compiled = simulate(players, heading, t_max, method="compiled")
     reference = simulate(players, _python_law(heading), t_max, rtol=1e-12, method="DOP853")
     assert compiled.captured and reference.captured
     assert compiled.capture_time == pytest.approx(reference.capture_time, abs=AGREEMENT)
@@ -62,7 +62,7 @@ def test_no_capture_runs_to_the_end() -> None:
     """An evader as fast as its pursuer running straight away is never caught: the run ends at
     ``t_max`` with the distance unchanged."""
     players = Players(("P",), np.zeros((1, 2)), np.array([1.0]), ("pp",), np.array([1.0, 0.0]), 1.0, 0.1)
-    run = simulate(players, 0.0, 3.0)
+    run = simulate(players, 0.0, 3.0, method="compiled")
     assert not run.captured
     assert run.capture_time == 3.0
     np.testing.assert_allclose(run.distances()[:, 0], 1.0, atol=1e-12)

@@ -12,7 +12,13 @@ scaling of one phase, ``dx/ds = D_k f_k``), so that
   whole horizon likewise integrates ``sum_k D_k g_k``;
 - path constraints and bounds that use ``t``: imposed on each phase's copy at its own time;
 - links: ``x__{k+1}(0) = x__k(1)`` (continuity) or ``x__{k+1}(0) = jump(x__k(1), ...)``, boundary
-  constraints of the one problem.
+  constraints of the one problem;
+- measurements of phase ``k`` (its ``measurements:``): at time ``t`` the phase's normalized time
+  ``s = (t - S_k) / D_k``, a number when every duration up to and with phase ``k`` is one (a free
+  or parameter duration moves ``s`` with the solve or the parameters, and is refused); each
+  measured key becomes the same expression over the copies of the piece that holds ``s``, and all
+  phases' data one ``measurements:`` block of the one problem (times in ``s``; a key's entries at
+  another key's times weighted 0), so that its misfit is the sum of the phases' least-squares terms.
 
 The copies share the collocation grid of the one problem in their own normalized time. When the
 phases set their own numbers of intervals ``N_k``, the grid has ``g = gcd(N_k)`` uniform intervals
@@ -291,6 +297,7 @@ class _Lowerer:
         ends = self.ends(names, self.starts[0], self.starts[-1])
         ends.pop("t_0")
         ends |= self.linked_ends(lowered)
+        measured = self.measurements(lowered)
         mayer = _read(p.objective.mayer, ends, "objective.mayer", self.source)
         for i, text in enumerate(p.boundary_constraints):
             rel = _read(text, ends, f"boundary_constraints.{i}", self.source, relation=True)
@@ -324,6 +331,8 @@ class _Lowerer:
             "method": spec.method.model_dump() | {"intervals": common},
             "guess": parts.guess,
         }
+        if measured is not None:
+            data["problem"]["measurements"] = measured
         try:
             target = OptimalControlSpec.model_validate(data)
         except (ValidationError, SpecError) as err:
@@ -331,6 +340,57 @@ class _Lowerer:
             raise SpecError(f"the lowered problem is invalid: {reason}", field="problem.phases") from None
         target.with_source(spec.source, spec.file_hash)
         return Lowering(target, lowered, float(p.time.initial), timed)
+
+    def measurements(self, lowered: list[LoweredPhase]) -> dict[str, Any] | None:
+        """The phases' ``measurements:`` as one block of the lowered problem (the module doc), None
+        when no phase has any; a SpecError naming the phase's field for a time outside the phase or
+        a duration up to it that is not a number."""
+        rows: list[tuple[float, str, float, float]] = []
+        start = float(self.p.time.initial)
+        for k, (ph, phase) in enumerate(zip(self.p.phases, lowered, strict=True)):
+            value, field = ph.duration.value, f"problem.phases.{k}.measurements"
+            if ph.measurements is not None:
+                if not all(isinstance(q.duration.value, int | float) for q in self.p.phases[: k + 1]):
+                    reason = (
+                        "measurements need every duration up to and with their phase a number (a free or "
+                        "parameter duration moves the measurement times in the phase's normalized time)"
+                    )
+                    raise SpecError(reason, field=field, source=self.source)
+                rows += self.phase_rows(ph.measurements, k, phase.pieces, start, float(value), field)
+            if isinstance(value, int | float):
+                start += float(value)
+        if not rows:
+            return None
+        times = [row[0] for row in rows]
+        keys = list(dict.fromkeys(row[1] for row in rows))
+        values = {key: [0.0] * len(rows) for key in keys}
+        weights = {key: [0.0] * len(rows) for key in keys}
+        for i, (_, key, measured, weight) in enumerate(rows):
+            values[key][i], weights[key][i] = measured, weight
+        return {"times": times, "values": values, "weights": weights}
+
+    def phase_rows(
+        self, data: Any, k: int, pieces: list[Piece], start: float, duration: float, field: str
+    ) -> list[tuple[float, str, float, float]]:
+        """Phase ``k``'s data as (lowered time, lowered key, value, weight), one per time and key."""
+        m = len(pieces)
+        weights = data.weight_rows()
+        rows = []
+        for i, t in enumerate(data.times):
+            s = (float(t) - start) / duration
+            if not -1e-12 <= s <= 1 + 1e-12:
+                raise SpecError(
+                    f"time {t} lies outside the phase [{start}, {start + duration}]",
+                    field=f"{field}.times.{i}",
+                    source=self.source,
+                )
+            j = min(int(max(s, 0.0) * m), m - 1)
+            symbols = self.constants | {n: symbol(c) for n, c in pieces[j].states.items()}
+            for key, measured in data.values.items():
+                expr = _read(key, symbols, f"phases.{k}.measurements.values.{key}", self.source)
+                local = min(max(s * m - j, 0.0), 1.0)
+                rows.append((local, to_text(expr), float(measured[i]), weights[key][i]))
+        return rows
 
     def phase_state(self, ph: PhaseSpec, k: int, x: str) -> dict[str, Any]:
         """State ``x`` in phase ``k``: its bounds there, its value at the phase's start (the shared

@@ -31,6 +31,7 @@ from gamespec.limits import MAX_INTERVALS
 from gamespec.multiphase.lowering import SEPARATOR, lower
 from gamespec.registry import Kind
 from gamespec.specs.base import Number, SpecBase, StrictModel, Value
+from gamespec.specs.events import MeasurementsSpec
 from gamespec.specs.ocp import (
     NORMALIZED_TIME,
     ControlSpec,
@@ -110,6 +111,19 @@ class PhaseSpec(StrictModel):
     intervals: int | None = Field(
         None, ge=1, le=MAX_INTERVALS, description="Collocation intervals of this phase (method.intervals)."
     )
+    measurements: MeasurementsSpec | None = Field(
+        None,
+        description="Data measured in this phase: times on the horizon's clock inside the phase (every "
+        "duration up to and with this phase a number), values of its states or expressions of them, the "
+        "parameters and design; adds sum(weight*(model - measured)**2) to the objective.",
+    )
+
+    @model_serializer(mode="wrap")
+    def _without_unused_measurements(self, handler: SerializerFunctionWrapHandler) -> dict[str, Any]:
+        """The phase as data, ``measurements`` left out when absent (content hashes as before it
+        existed)."""
+        data: dict[str, Any] = handler(self)
+        return {k: v for k, v in data.items() if k != "measurements" or v is not None}
 
     @field_validator("duration", mode="before")
     @classmethod

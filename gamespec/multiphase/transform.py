@@ -1,4 +1,6 @@
-"""``multiphase_optimal_control`` → ``optimal_control``: the phases as one NLP.
+"""``multiphase_optimal_control`` → ``optimal_control``: the phases as one NLP; and the requested
+``free_event`` rewrite of an ``optimal_control`` problem (constraints at a free time: two phases
+meeting there, :mod:`gamespec.multiphase.event_time`), lowered and mapped back the same way.
 
 :meth:`PhasesToOcp.apply` is :func:`gamespec.multiphase.lowering.lower` (each phase's copy of the
 states and controls on a common normalized time, each duration a design variable or a parameter,
@@ -11,16 +13,17 @@ parameters of the lowered problem, so a compiled model re-solves for new paramet
 
 from __future__ import annotations
 
-from dataclasses import replace
+from dataclasses import dataclass, replace
 from typing import ClassVar
 
 from gamespec.compiling import NoOptions
+from gamespec.multiphase.event_time import FreeEventOptions, split_at_event
 from gamespec.multiphase.lowering import Lowering, lower
 from gamespec.multiphase.spec import MultiPhaseSpec
 from gamespec.multiphase.split import split_by_phase
 from gamespec.result import Result
 from gamespec.specs.ocp import OptimalControlSpec
-from gamespec.transforms.base import Transform, with_parameter_values
+from gamespec.transforms.base import OcpRewrite, Transform, with_parameter_values
 
 
 class PhasesToOcp(Transform[MultiPhaseSpec, OptimalControlSpec, NoOptions, Lowering]):
@@ -63,3 +66,33 @@ class PhasesToOcp(Transform[MultiPhaseSpec, OptimalControlSpec, NoOptions, Lower
         }
         split = split_by_phase(result, inverse_data)
         return split.model_copy(update={"metrics": split.metrics | {"plot": plot}})
+
+
+@dataclass(frozen=True)
+class EventSplit:
+    """The two-phase problem the rewrite made and its lowering (the ``phases`` inverse data)."""
+
+    phases: MultiPhaseSpec
+    lowering: Lowering
+
+
+class FreeEventTime(OcpRewrite[FreeEventOptions, EventSplit]):
+    """Constraints at a free time inside the horizon (:mod:`gamespec.multiphase.event_time`)."""
+
+    name: ClassVar[str] = "free_event"
+    options_model = FreeEventOptions
+
+    def apply(
+        self, spec: OptimalControlSpec, options: FreeEventOptions, upstream: Result | None = None
+    ) -> tuple[OptimalControlSpec, EventSplit]:
+        phased = split_at_event(spec, options)
+        lowering = lower(phased)
+        return lowering.target, EventSplit(phased, lowering)
+
+    def invert(self, result: Result, spec: OptimalControlSpec, inverse_data: EventSplit) -> Result:
+        split = PhasesToOcp().invert(result, inverse_data.phases, inverse_data.lowering)
+        phases = split.metrics.get("phases") or []
+        event = phases[0]["end"] if phases else None
+        return split.model_copy(
+            update={"kind": spec.kind, "problem": spec.name, "metrics": split.metrics | {"event_time": event}}
+        )

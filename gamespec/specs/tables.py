@@ -57,8 +57,9 @@ class TableSpec(StrictModel):
     _tables: dict[str, Table] = PrivateAttr(default_factory=dict)
     method: Method = Field(
         "linear",
-        description="linear (multilinear, extended linearly beyond the grid) or bspline (cubic "
-        "not-a-knot spline, arguments clamped to the grid).",
+        description="linear (multilinear, extended linearly beyond the grid), bspline (cubic "
+        "not-a-knot spline, arguments clamped to the grid) or akima (Akima's piecewise cubic as "
+        "SciPy's Akima1DInterpolator, one axis only, arguments clamped to the grid).",
     )
 
     @model_validator(mode="before")
@@ -99,6 +100,11 @@ def checked_table(name: str, axes: list[list[float]], values: Any, method: Metho
 
     if not 1 <= len(axes) <= MAX_TABLE_AXES:
         raise ValueError(f"a table needs 1 to {MAX_TABLE_AXES} axes, got {len(axes)}")
+    if method == "akima" and len(axes) > 1:
+        raise ValueError(
+            f"akima takes a table of one axis, this one has {len(axes)}: Akima's slopes depend on the "
+            "data nonlinearly, so there is no tensor-product Akima spline (use bspline or linear)"
+        )
     shape = tuple(len(a) for a in axes)
     if math.prod(shape) > MAX_TABLE_VALUES:
         raise ValueError(f"a table holds at most {MAX_TABLE_VALUES} values, this grid {math.prod(shape)}")

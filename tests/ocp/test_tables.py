@@ -102,6 +102,50 @@ def test_bspline_hessian_is_the_spline_second_derivative() -> None:
         assert float(second(at)) == pytest.approx(-math.sin(at), abs=1e-3)
 
 
+def test_akima_table_of_a_quadratic_reproduces_the_riccati_optimum() -> None:
+    """Akima's slopes are exact for a quadratic on an even grid (equal weights average the two
+    neighbouring secants; its end extrapolation continues the secants linearly), so the table of
+    x^2 is x^2 and the optimum is tanh(1)."""
+    tabulated = gamespec.solve(spec_from_dict(_lq("q(x) + u**2", _square("akima", 9))))
+    assert tabulated.status == gamespec.Status.OPTIMAL, tabulated.message
+    assert all(tabulated.metrics["checks_passed"].values())
+    assert tabulated.objective == pytest.approx(math.tanh(LQ_T), rel=1e-8)
+
+
+def test_akima_table_is_scipys_akima_with_its_derivatives_on_casadi() -> None:
+    """On an uneven grid of uneven data, CasADi's B-spline form of the Akima table equals SciPy's
+    Akima1DInterpolator (inside; clamped outside), its gradient equals central differences of the
+    SciPy route and its Hessian SciPy's second derivative."""
+    ca = pytest.importorskip("casadi")
+    from scipy.interpolate import Akima1DInterpolator
+
+    rng = np.random.default_rng(7)
+    grid = np.sort(rng.uniform(0.0, 6.0, 12))
+    data = np.sin(grid) + rng.normal(scale=0.2, size=grid.size)
+    table = checked_table("a", [grid.tolist()], data.tolist(), "akima")
+    reference = Akima1DInterpolator(grid, data)
+    x = ca.SX.sym("x")
+    value = table.casadi(x)
+    fn = ca.Function("a", [x], [value, ca.gradient(value, x), ca.hessian(value, x)[0]])
+    h = 1e-6
+    inside = rng.uniform(grid[0], grid[-1], 40)
+    assert np.allclose(table.numpy(inside), reference(inside), rtol=0, atol=1e-13)
+    for at in inside:
+        v, grad, second = (float(part) for part in fn(at))
+        assert v == pytest.approx(float(reference(at)), abs=1e-12)
+        slope = (table.floats(at + h) - table.floats(at - h)) / (2 * h)
+        assert grad == pytest.approx(slope, abs=1e-6)
+        assert second == pytest.approx(float(reference.derivative(2)(at)), abs=1e-8)
+    for beyond, edge in ((grid[0] - 1.0, data[0]), (grid[-1] + 1.0, data[-1])):
+        assert float(fn(beyond)[0]) == pytest.approx(edge, abs=1e-12)
+        assert table.floats(beyond) == pytest.approx(edge, abs=1e-12)
+
+
+def test_akima_table_of_two_axes_is_refused() -> None:
+    with pytest.raises(ValueError, match="akima takes a table of one axis"):
+        checked_table("a", [[0.0, 1.0, 2.0], [0.0, 1.0, 2.0]], np.zeros((3, 3)).tolist(), "akima")
+
+
 def test_table_csv_and_npz_files_are_read_next_to_the_problem_file(tmp_path: Path) -> None:
     grid = np.linspace(-2.0, 2.0, 9)
     (tmp_path / "q.csv").write_text("x,q\n" + "".join(f"{g},{g * g}\n" for g in grid))

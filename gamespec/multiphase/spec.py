@@ -220,9 +220,18 @@ class MultiPhaseProblem(StrictModel):
         return self
 
 
+def _component(name: str) -> bool:
+    """Whether ``name`` is a vector's component as the vector lowering writes it (``r__0``,
+    :mod:`gamespec.specs.vectors`): what a lowered spec's dump holds, so that it validates again
+    (:func:`gamespec.loader.with_values`); no phase copy looks so (a phase's name is an identifier)."""
+    base, _, index = name.rpartition(SEPARATOR)
+    return index.isdigit() and base.isidentifier() and SEPARATOR not in base
+
+
 def _refuse_separator(problem: dict[str, Any]) -> None:
     """A name the file gives (a parameter, state, control, design variable, definition, table or
-    phase) with the phases' separator ``__`` is refused, naming it (the lowered copies use it)."""
+    phase) with the phases' separator ``__`` is refused, naming it (the lowered copies use it),
+    but a vector state's, control's or definition's component (:func:`_component`)."""
     groups = ["parameters", "states", "controls", "design", "definitions", "tables"]
     found = [(f"problem.{g}.{n}", n) for g in groups if isinstance(problem.get(g), dict) for n in problem[g]]
     phases = problem.get("phases") if isinstance(problem.get("phases"), list) else []
@@ -231,7 +240,9 @@ def _refuse_separator(problem: dict[str, Any]) -> None:
         if isinstance(phase.get("definitions"), dict):
             found += [(f"problem.phases.{k}.definitions.{n}", n) for n in phase["definitions"]]
     for field, name in found:
-        if isinstance(name, str) and SEPARATOR in name:
+        vectors = ("problem.states.", "problem.controls.", "problem.definitions.")
+        component = isinstance(name, str) and field.startswith(vectors) and _component(name)
+        if isinstance(name, str) and SEPARATOR in name and not component:
             raise SpecError(
                 f"{name!r} cannot be a name (has {SEPARATOR}, which the phases' copies use)", field=field
             )

@@ -63,12 +63,14 @@ def points(spec, count: int, seed: int) -> list[dict[str, float]]:
     """``count`` valid random points of ``spec``'s runtime parameters (see module doc)."""
     rng = np.random.default_rng(seed)
     nominal = spec.runtime_parameters()
-    found = []
+    found, refused = [], []
     while len(found) < count:
         point = {n: v * (1 + SPREAD * rng.uniform(-1, 1)) for n, v in nominal.items()}
         try:
             with_values(spec, point)
-        except SpecError:
+        except SpecError as err:
+            refused.append(str(err))
+            assert len(refused) < 20 * count, f"{len(refused)} random points refused, the last: {err}"
             continue
         found.append(point)
     return found

@@ -283,7 +283,10 @@ KEPT_CHECKS = 4096
 def _tables_key(tables: Mapping[str, FileFunction]) -> tuple[Any, ...]:
     """The tables a text uses as part of a kept check's key: a table by its data (a spec validated
     again at new parameter values rebuilds its tables, with the same data), another file
-    function by itself."""
+    function by itself (NumPy is imported only for a text that uses a table: validating a file
+    without tables imports none, ``tests/core/test_startup_imports.py``)."""
+    if not tables:
+        return ()
     import numpy as np
 
     def data(function: FileFunction) -> Any:

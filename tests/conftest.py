@@ -31,6 +31,24 @@ def cli(capsys):
     return invoke
 
 
+def rest_to_rest(a: float, t_final: float, **problem: object) -> dict:
+    """The rest-to-rest double integrator ``x'' = u`` at 0 on [0, t_final] minimizing the integral
+    of u², parameter ``a``, with ``problem``'s entries added (an event, a constraint): the
+    closed-form cases of the interior-point tests."""
+    return {
+        "kind": "optimal_control",
+        "problem": {
+            "parameters": {"a": a},
+            "states": {"x": {"initial": 0.0, "final": 0.0}, "v": {"initial": 0.0, "final": 0.0}},
+            "controls": {"u": {}},
+            "dynamics": {"x": "v", "v": "u"},
+            "objective": {"lagrange": "u**2"},
+            "time": {"final": t_final},
+            **problem,
+        },
+    }
+
+
 def assert_optimal_means_checked(result) -> None:
     """The status policy's invariant (README "Statuses and exit codes"): an ``optimal`` Result has
     every verdict in ``metrics["checks_passed"]`` True, every value with a verdict or a tolerance

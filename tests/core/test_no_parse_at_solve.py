@@ -17,7 +17,7 @@ from gamespec.loader import load, spec_from_dict
 from gamespec.result import Result
 from gamespec.solving import compile_spec
 from gamespec.symbolic import canonical, grammar
-from tests.conftest import PROBLEMS
+from tests.conftest import PROBLEMS, rest_to_rest
 from tests.flowfield.test_stages import _spec
 
 
@@ -73,21 +73,9 @@ def test_a_flow_field_game_solves_again_without_parsing_text(monkeypatch):
 def _event_spec(a: float) -> dict:
     """A rest-to-rest double integrator through ``x(1) = sqrt(a)`` (an ``at:`` event) with a
     boundary constraint at a fixed time (``v(t=1.5)``)."""
-    return {
-        "kind": "optimal_control",
-        "name": "through_a_point",
-        "problem": {
-            "parameters": {"a": a},
-            "states": {"x": {"initial": 0.0, "final": 0.0}, "v": {"initial": 0.0, "final": 0.0}},
-            "controls": {"u": {}},
-            "dynamics": {"x": "v", "v": "u"},
-            "objective": {"lagrange": "u**2"},
-            "time": {"final": 2.0},
-            "at": [{"time": 1.0, "constraints": ["x == sqrt(a)"]}],
-            "boundary_constraints": ["v(t=1.5) <= a + 10"],
-        },
-        "method": {"intervals": 10, "degree": 3},
-    }
+    at = [{"time": 1.0, "constraints": ["x == sqrt(a)"]}]
+    spec = rest_to_rest(a, 2.0, at=at, boundary_constraints=["v(t=1.5) <= a + 10"])
+    return spec | {"name": "through_a_point", "method": {"intervals": 10, "degree": 3}}
 
 
 CASES = {

@@ -8,6 +8,7 @@ import pytest
 import gamespec
 from gamespec.errors import SpecError
 from gamespec.loader import spec_from_dict
+from tests.conftest import rest_to_rest
 
 A, T = 1.0, 2.0
 
@@ -15,19 +16,8 @@ A, T = 1.0, 2.0
 def _through(bounds: list[float]) -> dict:
     """min integral of u^2, x'' = u, rest to rest at x = 0 on [0, T], passing x = a at some free
     time t_e within ``bounds``."""
-    return {
-        "kind": "optimal_control",
-        "problem": {
-            "parameters": {"a": A},
-            "states": {"x": {"initial": 0.0, "final": 0.0}, "v": {"initial": 0.0, "final": 0.0}},
-            "controls": {"u": {}},
-            "dynamics": {"x": "v", "v": "u"},
-            "objective": {"lagrange": "u**2"},
-            "time": {"final": T},
-        },
-        "transforms": [{"free_event": {"bounds": bounds, "constraints": ["x == a"]}}],
-        "method": {"intervals": 6, "degree": 3},
-    }
+    event = {"free_event": {"bounds": bounds, "constraints": ["x == a"]}}
+    return rest_to_rest(A, T) | {"transforms": [event], "method": {"intervals": 6, "degree": 3}}
 
 
 def _energy(x: float, v: float, tau: float) -> float:

@@ -11,23 +11,12 @@ from scipy.integrate import solve_ivp
 import gamespec
 from gamespec.errors import SpecError, UnsupportedFeature
 from gamespec.loader import spec_from_dict
-from tests.conftest import PROBLEMS
+from tests.conftest import PROBLEMS, rest_to_rest
 
 
 def _through(a: float, t_final: float, at: float, intervals: int) -> dict:
-    return {
-        "kind": "optimal_control",
-        "problem": {
-            "parameters": {"a": a},
-            "states": {"x": {"initial": 0.0, "final": 0.0}, "v": {"initial": 0.0, "final": 0.0}},
-            "controls": {"u": {}},
-            "dynamics": {"x": "v", "v": "u"},
-            "objective": {"lagrange": "u**2"},
-            "time": {"final": t_final},
-            "at": [{"time": at, "constraints": ["x == a"]}],
-        },
-        "method": {"intervals": intervals, "degree": 3},
-    }
+    spec = rest_to_rest(a, t_final, at=[{"time": at, "constraints": ["x == a"]}])
+    return spec | {"method": {"intervals": intervals, "degree": 3}}
 
 
 @pytest.mark.parametrize("intervals", [10, 7])

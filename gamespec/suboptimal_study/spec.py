@@ -16,7 +16,7 @@ from pydantic import Field, ValidationError, ValidationInfo, field_validator, mo
 from gamespec.errors import SpecError
 from gamespec.limits import MAX_STUDY_POINTS
 from gamespec.registry import Kind
-from gamespec.specs.base import BackendName, Number, StudySpecBase, StrictModel
+from gamespec.specs.base import BackendName, Number, StrictModel, StudySpecBase
 from gamespec.specs.ocp import MethodSpec
 
 MethodChange = dict[str, int | float | str]

@@ -27,6 +27,7 @@ from __future__ import annotations
 import math
 from collections.abc import Callable, Iterator
 from contextlib import contextmanager
+from contextvars import ContextVar
 from dataclasses import dataclass
 
 import numpy as np
@@ -159,8 +160,9 @@ class Trajectory:
         return np.linalg.norm(self.evader[:, None, :] - self.pursuers, axis=2)
 
 
-_COMPILED = False
-"""Whether :func:`simulate` integrates by the compiled RK4 (:func:`compiled_integration`)."""
+_COMPILED: ContextVar[bool] = ContextVar("compiled_integration", default=False)
+"""Whether :func:`simulate` integrates by the compiled RK4 (:func:`compiled_integration`), per
+thread (a Dask worker runs several points at once)."""
 
 
 @contextmanager
@@ -168,14 +170,13 @@ def compiled_integration() -> Iterator[None]:
     """Within this block, integrate a constant or :class:`ScheduledHeading` heading by the compiled
     RK4 (the module doc says when that pays: a loop of re-simulations, such as a study's points);
     its machine code is loaded on entry."""
-    global _COMPILED
     from gamespec.pursuit import integrator  # noqa: F401 (Numba's import and code load, here)
 
-    before, _COMPILED = _COMPILED, True
+    token = _COMPILED.set(True)
     try:
         yield
     finally:
-        _COMPILED = before
+        _COMPILED.reset(token)
 
 
 def simulate(
@@ -193,7 +194,7 @@ def simulate(
     (module doc)."""
     if isinstance(heading, int | float):
         heading = ScheduledHeading.constant(float(heading))
-    compiled = method == "compiled" or (method is None and _COMPILED)
+    compiled = method == "compiled" or (method is None and _COMPILED.get())
     if compiled and isinstance(heading, ScheduledHeading):
         return _compiled(players, heading, t_max, samples)
     if method == "compiled":

@@ -8,7 +8,14 @@ import numpy as np
 import pytest
 
 from gamespec.ocp.control_signal import TranscribedSignal
-from gamespec.pursuit.simulation import Players, ScheduledHeading, capture_bound, simulate
+from gamespec.pursuit import simulation
+from gamespec.pursuit.simulation import (
+    Players,
+    ScheduledHeading,
+    capture_bound,
+    compiled_integration,
+    simulate,
+)
 
 AGREEMENT = 1e-9
 """Capture times and positions of the two integrations agree to this (absolute, in lengths and
@@ -67,3 +74,20 @@ def test_no_capture_runs_to_the_end() -> None:
     assert run.capture_time == 3.0
     np.testing.assert_allclose(run.distances()[:, 0], 1.0, atol=1e-12)
     np.testing.assert_allclose(run.evader[-1], [4.0, 0.0], atol=1e-12)
+
+
+def test_the_compiled_route_is_taken_only_where_a_loop_asks_for_it(monkeypatch) -> None:
+    """Without a method, a constant heading goes through SciPy unless inside
+    :func:`~gamespec.pursuit.simulation.compiled_integration`, and the block leaves the route as
+    it found it."""
+    players = Players(("P",), np.zeros((1, 2)), np.array([1.0]), ("pp",), np.array([0.5, 0.0]), 0.5, 0.1)
+    taken = []
+    compiled = simulation._compiled
+    monkeypatch.setattr(simulation, "_compiled", lambda *args: taken.append(args) or compiled(*args))
+    outside = simulate(players, 0.0, 3.0)
+    with compiled_integration():
+        inside = simulate(players, 0.0, 3.0)
+    after = simulate(players, 0.0, 3.0)
+    assert len(taken) == 1
+    assert inside.capture_time == pytest.approx(outside.capture_time, abs=1e-8)
+    assert after.capture_time == outside.capture_time

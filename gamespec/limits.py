@@ -123,3 +123,8 @@ MAX_RESULT_VALUES = 100_000_000
 
 MAX_TEXT_CHARS = 10_000
 """Longest text item of a saved text array (characters)."""
+
+MAX_HJI_NODE_STEPS = 10_000_000_000
+"""Most node updates of an ``hji`` value function: nodes per axis squared times the time steps the
+CFL condition asks for (the largest grid, 801², over about 15,000 steps: minutes of CPU, and bounded
+in wall time by ``solver.options.hji.max_wall_time``)."""

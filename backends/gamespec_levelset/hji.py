@@ -71,16 +71,19 @@ from scipy import ndimage
 
 from gamespec.compiling import Backend, CompiledModel, Inputs, refuse_inputs
 from gamespec.errors import ExpressionError, SpecError, UnsupportedFeature
+from gamespec.flowfield.budget import UNLIMITED, Budget
 from gamespec.flowfield.grid import Grid
 from gamespec.flowfield.scratch import Scratch
 from gamespec.flowfield.tvd_rk import tvd_rk3_step
 from gamespec.flowfield.upwind import GHOSTS, extrapolate_ghosts, upwind_pair
+from gamespec.limits import MAX_GAME_STATE, MAX_HJI_NODE_STEPS
 from gamespec.result import Result, Status
 from gamespec.specs.base import StrictModel
 from gamespec.specs.differential_game import DifferentialGameSpec
 from gamespec.symbolic.calculus import numeric_function
 from gamespec.symbolic.grammar import Relation
 from gamespec.symbolic.language import parse, parse_relation, symbol
+from gamespec.terminal import progress
 
 ONE_SIDED = "a set is one one-sided relation (g <= c or g >= c)"
 
@@ -117,6 +120,13 @@ class HJIOptions(StrictModel):
         "linear between them).",
     )
     cfl: float = Field(0.5, gt=0, le=1, description="The CFL number of the time step.")
+    max_wall_time: float | None = Field(
+        300.0,
+        gt=0,
+        description="Seconds of wall time the two value functions (the grid's and the half-resolution "
+        "one's) may take, checked after every step: past it the run stops with the status time_limit "
+        "(null: no limit; the hj_reachability engine is not stopped).",
+    )
     control_samples: int = Field(
         33, ge=3, le=257, description="Samples of a control that does not enter the dynamics affinely."
     )
@@ -337,13 +347,15 @@ class ReachRun:
     """What :func:`reach_value` computes: ``value`` φ(·, T) and ``half`` φ(·, T/2); ``arrival`` the
     first τ at which each node's φ reaches zero (the minimum time to capture, ``inf`` where it does
     not within T; linear in τ between steps); ``probe_arrival`` the same for the bilinear
-    interpolation of φ at one point (the initial state), and the ``steps`` taken."""
+    interpolation of φ at one point (the initial state), and the ``steps`` taken; ``timed_out`` when
+    the budget stopped the run before the horizon."""
 
     value: np.ndarray
     half: np.ndarray
     arrival: np.ndarray
     probe_arrival: float
     steps: int
+    timed_out: bool = False
 
 
 def reach_value(
@@ -355,15 +367,16 @@ def reach_value(
     cfl: float,
     avoid: np.ndarray | None = None,
     probe: tuple[float, float] | None = None,
+    budget: Budget = UNLIMITED,
 ) -> ReachRun:
     """φ of ``∂φ/∂τ = min(0, H)`` from ``initial`` up to ``horizon`` (module doc); with ``avoid``
     (``g``, positive inside the avoid set) the reach–avoid value ``φ ← max(min(φ_step, φ), g)``
-    from ``max(initial, g)``."""
+    from ``max(initial, g)``. Each step is counted on ``budget``'s progress line, and the run stops
+    when it expires; :func:`time_steps` bounds their number first."""
     g = GHOSTS
     nx, ny = grid.shape
     dx = grid.spacing
-    rate_bound = float((hamiltonian.speed[0] / dx[0] + hamiltonian.speed[1] / dx[1]).max())
-    steps = 2 * max(1, math.ceil(horizon / 2 * rate_bound / cfl))
+    steps = time_steps(hamiltonian, grid, horizon, cfl)
     dt = horizon / steps
     padded = [np.zeros((nx + 2 * g, ny + 2 * g)) for _ in range(3)]
     inner = [a[g:-g, g:-g] for a in padded]
@@ -385,6 +398,9 @@ def reach_value(
 
     half = inner[0].copy()
     for step in range(steps):
+        if budget.expired():
+            return ReachRun(inner[0].copy(), half, arrival, probe_arrival, step, timed_out=True)
+        budget.advance(f"tau = {step * dt:.3g} of {horizon:g}")
         before = inner[0].copy()
         tvd_rk3_step(inner[0], inner[1], inner[2], dt, rate)
         np.minimum(inner[0], before, out=inner[0])
@@ -399,6 +415,26 @@ def reach_value(
         if step + 1 == steps // 2:
             half = inner[0].copy()
     return ReachRun(inner[0].copy(), half, arrival, probe_arrival, steps)
+
+
+def time_steps(hamiltonian: SampledHamiltonian, grid: Grid, horizon: float, cfl: float) -> int:
+    """The even number of TVD-RK3 steps to ``horizon`` that the CFL condition ``dt·Σ_i α_i/Δx_i ≤ cfl``
+    asks for; a SpecError when the dynamics' speed on the grid is not finite or the node updates
+    (nodes times steps) would exceed :data:`~gamespec.limits.MAX_HJI_NODE_STEPS`."""
+    dx = grid.spacing
+    rate_bound = float((hamiltonian.speed[0] / dx[0] + hamiltonian.speed[1] / dx[1]).max())
+    if not math.isfinite(rate_bound):
+        raise SpecError("the dynamics' speed on the hji grid is not finite", field="problem.dynamics")
+    fewest = horizon * rate_bound / cfl
+    work = fewest * grid.shape[0] * grid.shape[1]
+    if work > MAX_HJI_NODE_STEPS:
+        raise SpecError(
+            f"{grid.shape[0]}x{grid.shape[1]} nodes over the {fewest:.3g} CFL steps to tau = {horizon:g} "
+            f"are {work:.3g} node updates, more than MAX_HJI_NODE_STEPS = {MAX_HJI_NODE_STEPS:.0e} "
+            "(fewer nodes, a shorter horizon, or a box where the dynamics are slower)",
+            field="solver.options.hji",
+        )
+    return 2 * max(1, math.ceil(fewest / 2))
 
 
 def bilinear(grid: Grid, point: tuple[float, float] | None) -> list[tuple[int, int, float]]:
@@ -462,12 +498,22 @@ class HJIModel(CompiledModel):
             return x, y
 
         self.box = (corner("lower"), corner("upper"))
+        if any(abs(v) > MAX_GAME_STATE for v in (*self.box[0], *self.box[1])):
+            raise SpecError(
+                f"the grid {self.box} reaches beyond MAX_GAME_STATE = {MAX_GAME_STATE:.0e}",
+                field="solver.options.hji",
+            )
 
     def _region(
-        self, nodes: int, parameters: dict[str, float], horizon: float, probe: tuple[float, float] | None
+        self,
+        nodes: int,
+        parameters: dict[str, float],
+        horizon: float,
+        probe: tuple[float, float] | None,
+        budget: Budget,
     ) -> tuple[Grid, ReachRun, bool]:
-        """The grid, the reach (–avoid) run on it and whether the min and max were taken separately
-        (Isaacs' condition holds for the sampled controls)."""
+        """The grid, the reach (–avoid) run on it (stopped when ``budget`` expires) and whether the
+        min and max were taken separately (Isaacs' condition holds for the sampled controls)."""
         grid = Grid(self.box[0], self.box[1], (nodes, nodes))
         ham = sampled_hamiltonian(self.parsed, grid, self.options.control_samples, parameters)
         start = target(self.parsed, grid, parameters)
@@ -477,7 +523,7 @@ class HJIModel(CompiledModel):
         if o.engine == "hj_reachability":
             run = self._hj_reachability(grid, start, horizon, parameters, barrier, probe)
         else:
-            run = reach_value(ham, grid, start, horizon, o.scheme, o.cfl, barrier, probe)
+            run = reach_value(ham, grid, start, horizon, o.scheme, o.cfl, barrier, probe, budget)
         return grid, run, ham.joint is None
 
     def _hj_reachability(
@@ -517,8 +563,20 @@ class HJIModel(CompiledModel):
                     f"the initial state {probe} lies outside the grid {self.box}", field="solver.options.hji"
                 )
         n = self.options.nodes
-        grid, run, separable = self._region(n, values, horizon, probe)
-        coarse_grid, coarse, _ = self._region((n + 1) // 2, values, horizon, probe)
+        with progress(f"{self.game.name} (hji value, {n}x{n} and the half-resolution grid)") as tracker:
+            budget = Budget(self.options.max_wall_time, tracker)
+            grid, run, separable = self._region(n, values, horizon, probe, budget)
+            coarse_grid, coarse, _ = self._region((n + 1) // 2, values, horizon, probe, budget)
+        stopped = next((r for r in (run, coarse) if r.timed_out), None)
+        if stopped is not None:
+            which = "the grid's" if stopped is run else "the half-resolution grid's"
+            return Result(
+                status=Status.TIME_LIMIT,
+                message=budget.message(f"{which} value function after {stopped.steps} steps"),
+                iterations=run.steps,
+                parameters=values,
+                metrics={"solution_concept": "value_function", "information": "feedback"},
+            )
         captured = run.value <= 0
         shift = boundary_shift(captured, coarse.value <= 0, grid)
         cell = float(np.prod(grid.spacing))

@@ -45,6 +45,10 @@ TINY: dict[str, dict[str, Any]] = {
 """Per kind, the values (by dotted path, set only where the file has the path) that make a solve of
 a shipped file take about a second: its numerics are then exercised, not its size."""
 
+HJI_WALL_TIME_S = 1.0
+"""``solver.options.hji.max_wall_time`` of a tiny ``hji`` solve: a mutant whose dynamics are fast on
+the grid asks for legitimately many CFL steps, and must stop at this limit (``time_limit``)."""
+
 STORE_KINDS = frozenset({"pursuit_suboptimal_study", "rcs_multi_obstacle_study"})
 """The kinds whose file names a store folder (redirected into the test's own folder)."""
 
@@ -113,6 +117,8 @@ def tiny_overrides(path: Path, store: Path) -> list[str]:
     rh = document.get("receding_horizon")
     if rh is not None:
         values["receding_horizon.time_limit"] = rh["step"]
+    if document.get("solver", {}).get("backend") == "hji":
+        values["solver.options.hji.max_wall_time"] = HJI_WALL_TIME_S
     if kind in STORE_KINDS:
         values["store"] = str(store)
     return [f"{k}={json.dumps(v)}" for k, v in values.items()]

@@ -280,3 +280,25 @@ def test_games_it_cannot_solve_are_refused_with_the_reason(tmp_path):
     file = tmp_path / "timed.yaml"
     file.write_text(CHAUFFEUR.read_text().replace("- w + gamma*w*cos(psi)", "- w*(1 + t) + gamma*w*cos(psi)"))
     assert "autonomous" in HJIBackend().unsupported(load(file))
+
+
+def test_work_beyond_the_limits_is_refused_before_it_runs():
+    """A grid reaching beyond MAX_GAME_STATE is refused at compile; dynamics so fast on the grid
+    that the CFL steps times the nodes exceed MAX_HJI_NODE_STEPS are refused before a step is
+    taken (issue 27, item 2: the work a file implies is checked before anything runs)."""
+    from gamespec.errors import SpecError
+
+    with pytest.raises(SpecError, match="MAX_GAME_STATE"):
+        compile_spec(load(CHAUFFEUR, ["problem.states.y.upper=1e300"]))
+    fast = compile_spec(load(CHAUFFEUR, ["problem.states.y.upper=1e8"]))
+    with pytest.raises(SpecError, match="MAX_HJI_NODE_STEPS"):
+        fast.solve()
+
+
+def test_a_run_past_its_wall_time_stops_with_time_limit():
+    """``max_wall_time`` is checked after every step: a run stopped by it says so, with the steps
+    it took, and holds no capture region (none was computed)."""
+    result = compile_spec(load(CHAUFFEUR, ["solver.options.hji.max_wall_time=1e-6"])).solve()
+    assert result.status is Status.TIME_LIMIT, result.message
+    assert "max_wall_time" in result.message and result.iterations is not None
+    assert "capture_region" not in result.metrics

@@ -24,6 +24,7 @@ import sympy as sp
 
 from gamespec.games.expressions import GameExpressions, game_expressions
 from gamespec.games.feedback import LQGame, LQPlayer
+from gamespec.games.problems import initial_state
 from gamespec.specs.differential_game import DifferentialGameSpec
 
 
@@ -70,7 +71,8 @@ class LQForm:
     """A game's expressions parsed once into SymPy (in the parameters' symbols): the dynamics, each
     player's Lagrange and Mayer terms in its minimized sense, the horizon, over ``z = (x, u)`` (the
     controls of every player in the file's order, player ``i``'s at ``controls[i]``, its sense at
-    ``senses[i]``) and ``x_f``; ``zero_sum`` when every player takes the game's payoff."""
+    ``senses[i]``) and ``x_f``; ``zero_sum`` when every player takes the game's payoff; ``game`` the
+    spec, whose initial state (an expression of the parameters) each :func:`lq_game` evaluates."""
 
     dynamics: list[sp.Expr]
     costs: list[tuple[sp.Expr, sp.Expr]]
@@ -83,8 +85,7 @@ class LQForm:
     senses: list[str]
     controls: list[slice]
     zero_sum: bool
-    x0: np.ndarray
-    t0: float
+    game: DifferentialGameSpec
 
 
 def lq_form(game: DifferentialGameSpec, expressions: GameExpressions | None = None) -> LQForm | str:
@@ -115,8 +116,7 @@ def lq_form(game: DifferentialGameSpec, expressions: GameExpressions | None = No
         senses=[pl.objective for pl in p.players.values()],
         controls=slices,
         zero_sum=all(pl.payoff is None for pl in p.players.values()),
-        x0=np.array([*(float(s.initial) for s in p.states.values()), 1.0]),
-        t0=float(p.time.initial),
+        game=game,
     )
 
 
@@ -153,4 +153,6 @@ def lq_game(form: LQForm, parameters: Mapping[str, float]) -> LQGame | str:
         Q, N, R = _homogeneous(*running, n)
         S, _, _ = _homogeneous(*final, n)
         players.append(LQPlayer(name, columns, Q, N, R, S))
-    return LQGame(A, B, tuple(players), form.x0, form.t0, float(horizon))
+    start = initial_state(form.game, parameters)
+    x0 = np.array([*(start[name] for name in form.states), 1.0])
+    return LQGame(A, B, tuple(players), x0, float(form.game.problem.time.initial), float(horizon))

@@ -43,6 +43,17 @@ def test_feedback_saddle_of_the_scalar_game(gamma2, value) -> None:
     assert ("solution", "feedback_saddle") in outcome(result)
 
 
+def test_an_initial_state_written_as_an_expression_is_evaluated_at_each_solve() -> None:
+    """``x(0) = 2·T`` (an expression of a parameter): the value is ``½ P(0) x₀²``, x₀ taken at the
+    solve's parameter values (the value of the game is quadratic in the initial state)."""
+    spec = _spec(SCALAR.replace("x: {initial: 1.0}", "x: {initial: 2*T}"))
+    for T in (1.0, 0.5):
+        result = solve(spec, parameters={"g2": 1.2, "T": T})
+        assert result.status is Status.OPTIMAL, result.message
+        P0 = 1 / (1 + (1 - 1 / 1.2) * T)
+        assert result.objective == pytest.approx(0.5 * P0 * (2 * T) ** 2, rel=1e-8)
+
+
 def test_the_open_loop_game_without_a_saddle_is_refused_where_the_feedback_one_is_solved() -> None:
     data = yaml.safe_load(SCALAR)
     data["problem"]["parameters"]["g2"] = 0.8

@@ -6,6 +6,9 @@ is a bug and keeps its traceback.
 
 from __future__ import annotations
 
+from collections.abc import Iterator
+from contextlib import contextmanager
+
 
 class GamespecError(Exception):
     """Root of all errors gamespec raises on purpose."""
@@ -28,6 +31,18 @@ class SpecError(GamespecError):
 class RefusedInput(SpecError):
     """Well-formed input that gamespec refuses to read: beyond a limit of :mod:`gamespec.limits`, a
     recursive alias, a duplicate key."""
+
+
+@contextmanager
+def sourced(source: str) -> Iterator[None]:
+    """Name the file ``source`` in a SpecError raised inside that names none (``<spec>``): a
+    backend's refusal at compile or solve time knows the field, not the file."""
+    try:
+        yield
+    except SpecError as err:
+        if err.source != "<spec>" or source == "<spec>":
+            raise
+        raise type(err)(err.reason, field=err.field, source=source) from None
 
 
 class ExpressionError(GamespecError):

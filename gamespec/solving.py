@@ -41,7 +41,7 @@ from gamespec import registry
 from gamespec.analyses import SKIPPED, Selection, check_names, kind_analyses, run_analyses, skipped_checks
 from gamespec.compiling import Backend, CompiledModel, Inputs
 from gamespec.compiling.study_protocol import Study
-from gamespec.errors import BackendError, ExpressionError, SpecError, UnsupportedFeature
+from gamespec.errors import BackendError, ExpressionError, SpecError, UnsupportedFeature, sourced
 from gamespec.loader import load, with_values
 from gamespec.result import Provenance, Result, Status
 from gamespec.specs.base import SpecBase, StrictModel
@@ -405,16 +405,17 @@ class Solver:
         values = target.runtime_parameters() or None
         last = steps[-1] if steps else None
         start = guess if guess is not None or last is None else last.transform.guess(last.inverse)
-        result = self.compiled.solve(parameters=values, guess=start, inputs=inputs)
-        result = self._kind_analysed(target, result)
-        for index in reversed(range(len(steps))):
-            step = steps[index]
-            result = self._mapped(step, result)
-            is_last = index == len(steps) - 1
-            if result.ok:
-                result = self._verified(step, result, values, inputs, multistart=is_last)
-            elif is_last:
-                result = self._restarted(step, values, inputs) or result
+        with sourced(self.spec.source):
+            result = self.compiled.solve(parameters=values, guess=start, inputs=inputs)
+            result = self._kind_analysed(target, result)
+            for index in reversed(range(len(steps))):
+                step = steps[index]
+                result = self._mapped(step, result)
+                is_last = index == len(steps) - 1
+                if result.ok:
+                    result = self._verified(step, result, values, inputs, multistart=is_last)
+                elif is_last:
+                    result = self._restarted(step, values, inputs) or result
         provenance = Provenance(
             spec_hash=spec_hash(spec),
             source=self.spec.source,
@@ -530,9 +531,10 @@ def compile_spec(
     name = backend_name(spec, backend)
     instance = get_backend(name)
     start = time.perf_counter()
-    steps = build_steps(spec, instance, options)
-    target = steps[-1].target if steps else spec
-    compiled = instance.compile(target, instance.options(target, options))
+    with sourced(spec.source):
+        steps = build_steps(spec, instance, options)
+        target = steps[-1].target if steps else spec
+        compiled = instance.compile(target, instance.options(target, options))
     build = time.perf_counter() - start
     return Solver(spec, instance, steps, compiled, build, selection)
 

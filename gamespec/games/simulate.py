@@ -124,7 +124,12 @@ class Dynamics:
             library = casadi_library(ca)
             f = ca.vertcat(*(translate(self.expressions.dynamics[n], values, library) for n in self.states))
             dae = {"x": x, "p": p, "t": sigma, "ode": length * f}
-            options = {"abstol": ATOL, "reltol": RTOL, "max_num_steps": 100000}
+            options = {
+                "abstol": ATOL,
+                "reltol": RTOL,
+                "max_num_steps": 100000,
+                "disable_internal_warnings": True,
+            }
             self._integrators[width] = ca.integrator("true_system", "cvodes", dae, 0.0, 1.0, options)
         return self._integrators[width]
 

@@ -45,9 +45,20 @@ TINY: dict[str, dict[str, Any]] = {
 """Per kind, the values (by dotted path, set only where the file has the path) that make a solve of
 a shipped file take about a second: its numerics are then exercised, not its size."""
 
-HJI_WALL_TIME_S = 1.0
-"""``solver.options.hji.max_wall_time`` of a tiny ``hji`` solve: a mutant whose dynamics are fast on
-the grid asks for legitimately many CFL steps, and must stop at this limit (``time_limit``)."""
+SOLVER_BUDGETS: dict[str, dict[str, Any]] = {
+    "hji": {"solver.options.hji.max_wall_time": 1.0},
+    "casadi": {"solver.options.casadi.max_iter": 100},
+}
+"""Per backend, the options that bound the work of one tiny solve: a mutant may legitimately ask
+for much work (dynamics fast on an HJI grid: many CFL steps; a parameter of 1e300: IPOPT's 3000
+iterations), and must then stop at the limit with an honest status (``time_limit``,
+``iteration_limit``)."""
+
+CASADI_KINDS = frozenset({"optimal_control", "multiphase_optimal_control", "engagement", "differential_game"})
+"""The kinds whose default backend is ``casadi`` (when the file names none)."""
+
+REFINEMENTS = 3
+"""``method.refine.max_iterations`` of a tiny solve whose file refines its mesh."""
 
 STORE_KINDS = frozenset({"pursuit_suboptimal_study", "rcs_multi_obstacle_study"})
 """The kinds whose file names a store folder (redirected into the test's own folder)."""
@@ -117,8 +128,10 @@ def tiny_overrides(path: Path, store: Path) -> list[str]:
     rh = document.get("receding_horizon")
     if rh is not None:
         values["receding_horizon.time_limit"] = rh["step"]
-    if document.get("solver", {}).get("backend") == "hji":
-        values["solver.options.hji.max_wall_time"] = HJI_WALL_TIME_S
+    backend = document.get("solver", {}).get("backend", "casadi" if kind in CASADI_KINDS else None)
+    values |= SOLVER_BUDGETS.get(backend, {})
+    if _has(document, "method.refine"):
+        values["method.refine.max_iterations"] = REFINEMENTS
     if kind in STORE_KINDS:
         values["store"] = str(store)
     return [f"{k}={json.dumps(v)}" for k, v in values.items()]

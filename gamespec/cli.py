@@ -512,7 +512,7 @@ def plot(
         loaded = Result.load(result)
         paths = plot_result(loaded, folder, animate=animate)
         if animate and not any(p.suffix == ".gif" for p in paths):
-            print(f"no animation: a {loaded.kind} Result of this sort has none", file=sys.stderr)
+            _console().print(f"no animation: a {loaded.kind} Result of this sort has none")
     for path in paths:
         _console().print(f"wrote {path}")
 

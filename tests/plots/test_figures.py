@@ -370,8 +370,8 @@ def test_a_moving_obstacle_is_drawn_at_the_closest_approach(tmp_path) -> None:
 
 
 def test_animate_says_when_a_kind_has_no_animation(cli, tmp_path) -> None:
-    code, _, err = cli("plot", fixtures.FIXTURES / "linear_flow", "--out", tmp_path, "--animate")
-    assert code == 0 and "no animation" in err and "flow_field_game" in err
+    code, out, err = cli("plot", fixtures.FIXTURES / "linear_flow", "--out", tmp_path, "--animate")
+    assert code == 0 and "no animation" in out and "flow_field_game" in out and err == ""
     assert not list(tmp_path.glob("*.gif"))
 
 

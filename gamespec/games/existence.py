@@ -95,7 +95,8 @@ def escape(A, B, Q, N, R, S, duration: float) -> tuple[float | None, np.ndarray]
         return (A.T @ P + P @ A + Q - PB @ Rinv @ PB.T).ravel()
 
     def escaped(_: float, flat: np.ndarray) -> float:
-        return bound - np.abs(flat).max()
+        largest = np.abs(flat).max()
+        return float(bound - largest) if np.isfinite(largest) else -1.0
 
     escaped.terminal = True
     sol = solve_ivp(rhs, (0.0, duration), S.ravel(), method="LSODA", rtol=1e-12, atol=1e-14, events=escaped)

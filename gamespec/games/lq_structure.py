@@ -22,9 +22,11 @@ from dataclasses import dataclass
 import numpy as np
 import sympy as sp
 
+from gamespec.errors import SpecError
 from gamespec.games.expressions import GameExpressions, game_expressions
 from gamespec.games.feedback import LQGame, LQPlayer
 from gamespec.games.problems import initial_state
+from gamespec.limits import MAX_LQ_ENTRY
 from gamespec.specs.differential_game import DifferentialGameSpec
 
 
@@ -153,6 +155,17 @@ def lq_game(form: LQForm, parameters: Mapping[str, float]) -> LQGame | str:
         Q, N, R = _homogeneous(*running, n)
         S, _, _ = _homogeneous(*final, n)
         players.append(LQPlayer(name, columns, Q, N, R, S))
+    for name, M in [("the dynamics", np.hstack([A, B]))] + [
+        (f"{pl.name}'s payoff", np.hstack([pl.Q, pl.N, pl.S])) for pl in players
+    ]:
+        if not np.abs(M).max(initial=0.0) <= MAX_LQ_ENTRY:
+            raise SpecError(
+                f"{name} as an LQ game have an entry of {np.abs(M).max():.3g}, beyond MAX_LQ_ENTRY = "
+                f"{MAX_LQ_ENTRY:g} (the Riccati equations of the existence test and the feedback "
+                "equilibrium would overflow)",
+                field="problem.dynamics" if name == "the dynamics" else "problem.payoff",
+                source=form.game.source,
+            )
     start = initial_state(form.game, parameters)
     x0 = np.array([*(start[name] for name in form.states), 1.0])
     return LQGame(A, B, tuple(players), x0, float(form.game.problem.time.initial), float(horizon))

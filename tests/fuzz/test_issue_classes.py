@@ -161,6 +161,19 @@ def test_non_finite_numbers_in_an_lq_game(tmp_path, bad, where) -> None:
     _refused(["validate", _yaml(tmp_path, data)], "problem.")
 
 
+@pytest.mark.parametrize(
+    ("assignment", "field"),
+    [("problem.dynamics.x=1e+300", "problem.dynamics"), ("problem.parameters.s=1e300", "problem.payoff")],
+)
+def test_huge_entries_of_an_lq_differential_game(assignment, field) -> None:
+    """Found by the long solve-path fuzz: ẋ = 1e300 (an affine term) ran the existence test's
+    Riccati integration for minutes; now its matrices are checked against MAX_LQ_ENTRY."""
+    path = PROBLEMS / "ch7" / "scalar_lq_three_sevenths.yaml"
+    outcome = run_cli(["solve", path, "--set", assignment], bound_s=10 * ONE_SECOND)
+    assert_promise(outcome, str(path))
+    assert outcome.code == 2 and f"{field}: " in outcome.err and "MAX_LQ_ENTRY" in outcome.err, outcome
+
+
 @pytest.mark.parametrize("coordinate", [2**63, 1e308])
 def test_huge_coordinates_of_an_engagement(tmp_path, coordinate) -> None:
     data = _load(ENGAGEMENT)

@@ -29,12 +29,14 @@ chapter-5 fields (about 6e-5 against extremal shooting at twice the files' resol
 
 from __future__ import annotations
 
+import math
 import sys
 from dataclasses import dataclass
 from functools import cached_property
 
 import numpy as np
 
+from gamespec.errors import SpecError
 from gamespec.flowfield.band import Window, band_window
 from gamespec.flowfield.budget import UNLIMITED, Budget
 from gamespec.flowfield.capture import first_zero, margin
@@ -43,6 +45,7 @@ from gamespec.flowfield.hamiltonian import FlowHamiltonian
 from gamespec.flowfield.scratch import Scratch
 from gamespec.flowfield.tvd_rk import tvd_rk3_step
 from gamespec.flowfield.upwind import GHOSTS, extrapolate_ghosts, upwind_pair
+from gamespec.limits import MAX_GRID_CELL_STEPS
 
 BAND_CELLS = 15.0
 """How far above the highest level read the band of exact values reaches, in cells: with the
@@ -275,6 +278,21 @@ def grid_error_estimate(fine: LevelSetReach, coarse: LevelSetReach) -> dict[str,
     }
 
 
+def check_steps(grid: Grid, dt: float, t_max: float) -> None:
+    """The load-time bound on the work (:meth:`~gamespec.flowfield.spec.FlowGameMethod.check_work`,
+    which knows the agents' speeds only) again with the flow's speed on the grid in the CFL step
+    ``dt``: the cells times the steps to ``t_max`` within
+    :data:`~gamespec.limits.MAX_GRID_CELL_STEPS`; a SpecError naming ``problem.flow`` otherwise."""
+    cells = grid.shape[0] * grid.shape[1]
+    steps = t_max / dt if dt > 0 else math.inf
+    if not cells * steps <= MAX_GRID_CELL_STEPS:
+        raise SpecError(
+            f"the flow's speed on the grid makes the CFL step {dt:.3g}: {cells} cells times "
+            f"{steps:.3g} steps to max_time exceed the limit of {MAX_GRID_CELL_STEPS:g} cell steps",
+            field="problem.flow",
+        )
+
+
 def capture_by_level_sets(
     solver: LevelSetSolver,
     origins: np.ndarray,
@@ -298,6 +316,7 @@ def capture_by_level_sets(
     watches = [_LevelWatch(c) for c in levels]
     phi = initial_cones(grid, origins)
     dt = solver.max_step
+    check_steps(grid, dt, t_max)
     snap_t, snaps = [0.0], [np.minimum(phi, band, dtype=np.float32)]
     t, steps = 0.0, 0
     message, timed_out = f"no capture before t_max = {t_max:g}", False

@@ -47,6 +47,7 @@ a shipped file take about a second: its numerics are then exercised, not its siz
 
 SOLVER_BUDGETS: dict[str, dict[str, Any]] = {
     "hji": {"solver.options.hji.max_wall_time": 1.0},
+    "levelset": {"solver.options.levelset.max_wall_time": 1.0},
     "casadi": {"solver.options.casadi.max_iter": 100},
 }
 """Per backend, the options that bound the work of one tiny solve: a mutant may legitimately ask

@@ -174,6 +174,16 @@ def test_huge_entries_of_an_lq_differential_game(assignment, field) -> None:
     assert outcome.code == 2 and f"{field}: " in outcome.err and "MAX_LQ_ENTRY" in outcome.err, outcome
 
 
+def test_a_flow_too_fast_for_its_grid_is_refused_before_the_first_step() -> None:
+    """Found by the long solve-path fuzz: a drift of 1e300 passed the load-time bound (the agents'
+    speeds) and made the level sets' CFL step 1e-300; the step with the flow is bounded too."""
+    path = PROBLEMS / "ch5" / "hurricane_hugo.yaml"
+    sets = ["method.grid.nodes=[15, 15]", "method.max_time=1.0", 'problem.flow.drift.1="-1e300"']
+    outcome = run_cli(["solve", path, *(x for a in sets for x in ("--set", a))], bound_s=10 * ONE_SECOND)
+    assert_promise(outcome, str(path))
+    assert outcome.code == 2 and "problem.flow: " in outcome.err and "cell steps" in outcome.err, outcome
+
+
 @pytest.mark.parametrize("coordinate", [2**63, 1e308])
 def test_huge_coordinates_of_an_engagement(tmp_path, coordinate) -> None:
     data = _load(ENGAGEMENT)

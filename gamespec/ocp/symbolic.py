@@ -270,14 +270,21 @@ class SymbolicOcp:
         return self._kept_texts[key]
 
     @cached_property
-    def guess_profiles(self) -> dict[str, Any]:
-        """The guess's expressions over the parameters and ``tau`` walked once, by field
-        (:meth:`kept_expression`; a guess does not change with the mesh)."""
+    def profiles(self) -> dict[str, Any]:
+        """The guess's expressions and the grid inputs' defaults over the parameters and ``tau``
+        walked once in NumPy, by field (:func:`~gamespec.symbolic.grammar.kept_expression`; None
+        where the walk refuses one; neither changes with the mesh)."""
         names = [*self.parameters, NORMALIZED_TIME]
-        return {
-            f"guess.{group}.{name}": kept_expression(raw, names, LibraryAlgebra(NUMPY))
+        texts = {
+            f"guess.{group}.{name}": raw
             for group in ("states", "controls")
             for name, raw in getattr(self.spec.guess, group).items()
+        }
+        texts |= {f"problem.inputs.{n}.default": i.default for n, i in self.spec.problem.inputs.items()}
+        arrays = LibraryAlgebra(NUMPY)
+        return {
+            field: kept_expression(raw, names, arrays)
+            for field, raw in texts.items()
             if isinstance(raw, str) and raw != "linear"
         }
 
@@ -373,6 +380,13 @@ class SymbolicOcp:
         no text."""
         self._sympy  # noqa: B018 (a cached property, built here)
         self.initial_values  # noqa: B018
+        return self
+
+    def kept_for_solves(self) -> SymbolicOcp:
+        """This problem with the walks a transcription's solves take (:attr:`profiles`,
+        :attr:`kept_boundary`) kept now, when it is compiled, so that the first solve walks no text."""
+        self.profiles  # noqa: B018 (a cached property, built here)
+        self.kept_boundary  # noqa: B018
         return self
 
     @cached_property

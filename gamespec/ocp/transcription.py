@@ -70,7 +70,7 @@ class Transcription:
         if not shared:
             raise ValueError("a transcription shares the parsed problem of its own problem only")
         self.spec = spec
-        self.ocp = parsed or SymbolicOcp(spec)
+        self.ocp = (parsed or SymbolicOcp(spec)).kept_for_solves()
         m = spec.method
         mesh = None if m.mesh is None else tuple(m.mesh)
         degrees = None if m.degrees is None else tuple(m.degrees)
@@ -251,7 +251,7 @@ class Transcription:
         if raw == "linear":
             a, b = _linear_ends(start, end, lo, hi)
             return a + (b - a) * tau
-        kept = self.ocp.guess_profiles.get(field)
+        kept = self.ocp.profiles.get(field)
         values = dict(params) | {NORMALIZED_TIME: tau}
         try:
             value = expression(raw, values, ARRAYS) if kept is None else taken(kept, values, raw)

@@ -79,14 +79,16 @@ def _event_spec(a: float) -> dict:
 
 
 def _refined_event_spec(a: float) -> dict:
-    """:func:`_event_spec` made nonlinear (``v' = u - 2 sin(x)``, a definition in the running cost)
-    with ``x`` free at the end, a boundary constraint over the end values (the ``linear`` guess's
-    flat-gradient check reads it), a chained path constraint with numbers outside and ``h``
-    refinement: two refined meshes, each with the ``at:`` event and ``v(t=1.5)``."""
+    """:func:`_event_spec` made nonlinear (``v' = u - 2 sin(x) + w``, ``w`` a grid input whose
+    default names ``a``; a definition in the running cost) with ``x`` free at the end, a boundary
+    constraint over the end values (the ``linear`` guess's flat-gradient check reads it), a chained
+    path constraint with numbers outside and ``h`` refinement: two refined meshes, each with the
+    ``at:`` event and ``v(t=1.5)``."""
     spec = _event_spec(a)
     problem = spec["problem"]
     problem["states"]["x"] = {"initial": 0.0}
-    problem["dynamics"]["v"] = "u - 2*sin(x)"
+    problem["inputs"] = {"w": {"default": "0.1*a*tau"}}
+    problem["dynamics"]["v"] = "u - 2*sin(x) + w"
     problem["definitions"] = {"e": "v**2"}
     problem["objective"]["lagrange"] = "u**2 + 0.1*e"
     problem["boundary_constraints"].append("x_f**2 + v_0**2 == 0.04")

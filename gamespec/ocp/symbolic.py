@@ -43,7 +43,7 @@ HORIZON_FLOOR = 1e-6
 EVALUATIONS_KEPT = 8
 """How many parameter values' bounds a :class:`SymbolicOcp` keeps."""
 ALGEBRAS_KEPT = 8
-"""For how many algebras a :class:`SymbolicOcp` keeps the walks of its terms (:meth:`SymbolicOcp._kept`)."""
+"""For how many algebras a :class:`SymbolicOcp` keeps the walks of its terms (:meth:`SymbolicOcp._keep`)."""
 
 
 @dataclass(frozen=True)
@@ -202,12 +202,12 @@ class SymbolicOcp:
 
     def running_terms(self, values: Mapping[str, Any], algebra: Algebra) -> RunningTerms:
         """The running terms over ``values`` (each of :attr:`running_names` by name): the file's
-        texts walked once per algebra (:meth:`_kept`) and taken at ``values``."""
-        kept = self._kept(algebra, running=True)
+        texts walked once per algebra (:meth:`_keep`) and taken at ``values``."""
+        kept = self._kept_running(algebra)
         if kept is None:
             scope = self._scope(self._shifted(values, "t", algebra), algebra)
             return self._running_over(scope, algebra)
-        return kept.taken(values | self.functions)
+        return kept.taken(dict(values) | self.functions)
 
     def _running_over(self, scope: Mapping[str, Any], algebra: Algebra) -> RunningTerms:
         """The running terms over ``scope`` (the names, the definitions and the tables)."""
@@ -226,11 +226,11 @@ class SymbolicOcp:
 
     def end_terms(self, values: Mapping[str, Any], algebra: Algebra) -> EndTerms:
         """The end-point terms over ``values`` (each of :attr:`end_names` by name): the file's
-        texts walked once per algebra (:meth:`_kept`) and taken at ``values``."""
-        kept = self._kept(algebra, running=False)
+        texts walked once per algebra (:meth:`_keep`) and taken at ``values``."""
+        kept = self._kept_end(algebra)
         if kept is None:
             return self._end_over(self._shifted(values, "t_f", algebra) | self.functions, algebra)
-        return kept.taken(values | self.functions)
+        return kept.taken(dict(values) | self.functions)
 
     def _end_over(self, scope: Mapping[str, Any], algebra: Algebra) -> EndTerms:
         """The end-point terms over ``scope`` (the names and the tables)."""
@@ -295,21 +295,34 @@ class SymbolicOcp:
         return [self.kept_relation(text, self.end_names) for text in self.spec.problem.boundary_constraints]
 
     @cached_property
-    def _kept_terms(self) -> dict[tuple[Algebra, bool], KeptTerms | None]:
+    def _kept_terms(self) -> dict[tuple[Algebra, bool], Any]:
         """The last :data:`ALGEBRAS_KEPT` algebras' :class:`KeptTerms` (running ones and end ones)."""
         return {}
 
-    def _kept(self, algebra: Algebra, running: bool) -> KeptTerms | None:
-        """The running (else the end-point) terms walked once in ``algebra``, each step kept
-        (:class:`~gamespec.symbolic.grammar.DeferredAlgebra`), so that each call, and each model
-        built on this problem (another mesh of :mod:`gamespec.compiling.refinement`), takes them
-        again without walking text (issue 27, item 3). The time shifted by a free initial time and
-        each definition are steps taken once per call, as the walk builds them once. None where the
-        walk refuses a step it cannot keep (then the text is walked each time, which names the
-        refusal)."""
+    def _kept_running(self, algebra: Algebra) -> KeptTerms[RunningTerms] | None:
+        """The running terms walked once in ``algebra`` (:meth:`_keep`)."""
+        found: KeptTerms[RunningTerms] | None = self._keep(algebra, True, self._running_over)
+        return found
+
+    def _kept_end(self, algebra: Algebra) -> KeptTerms[EndTerms] | None:
+        """The end-point terms walked once in ``algebra`` (:meth:`_keep`)."""
+        found: KeptTerms[EndTerms] | None = self._keep(algebra, False, self._end_over)
+        return found
+
+    def _keep(
+        self, algebra: Algebra, running: bool, build: Callable[[Mapping[str, Any], Algebra], Terms]
+    ) -> KeptTerms[Terms] | None:
+        """The running (else the end-point) terms, ``build`` over their scope, walked once in
+        ``algebra`` with each step kept (:class:`~gamespec.symbolic.grammar.DeferredAlgebra`), so
+        that each call, and each model built on this problem (another mesh of
+        :mod:`gamespec.compiling.refinement`), takes them again without walking text (issue 27,
+        item 3). The time shifted by a free initial time and each definition are steps taken once
+        per call, as the walk builds them once. None where the walk refuses a step it cannot keep
+        (then the text is walked each time, which names the refusal)."""
         key = (algebra, running)
         if key in self._kept_terms:
-            return self._kept_terms[key]
+            kept: KeptTerms[Terms] | None = self._kept_terms[key]
+            return kept
         deferred = DeferredAlgebra(algebra)
         names = self.running_names if running else self.end_names
         scope: dict[str, Any] = {n: deferred_name(n) for n in names} | self.functions
@@ -322,13 +335,9 @@ class SymbolicOcp:
             for name, raw in texts:
                 steps.append((name, expression(raw, scope, deferred)))
                 scope[name] = deferred_name(name)
-            terms: RunningTerms | EndTerms = (
-                self._running_over(scope, deferred) if running else self._end_over(scope, deferred)
-            )
+            found = KeptTerms(tuple(steps), build(scope, deferred))
         except ExpressionError:
             found = None
-        else:
-            found = KeptTerms(tuple(steps), terms)
         if len(self._kept_terms) >= 2 * ALGEBRAS_KEPT:
             self._kept_terms.pop(next(iter(self._kept_terms)))
         self._kept_terms[key] = found

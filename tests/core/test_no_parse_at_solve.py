@@ -166,7 +166,7 @@ def test_first_solve_and_a_solve_at_new_values_walk_no_text(monkeypatch, case):
 def test_adaptive_mesh_refinement_walks_no_text(monkeypatch, backend):
     """The hyper-sensitive problem's hp refinement (three meshes here) builds each mesh's model from
     the problem the compiled model parsed (its kept walks taken again, :meth:`~gamespec.ocp.symbolic.
-    SymbolicOcp._kept`): with the walker refused, the same meshes, iterations and objectives, to the
+    SymbolicOcp._keep`): with the walker refused, the same meshes, iterations and objectives, to the
     bit, as a fresh compile with the walker allowed."""
     sets = [f"solver.backend={backend}", "method.refine.max_iterations=2"]
     path = PROBLEMS / "ocp" / "hyper_sensitive.yaml"

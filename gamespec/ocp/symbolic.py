@@ -12,7 +12,7 @@ from __future__ import annotations
 import ast
 import dataclasses
 import math
-from collections.abc import Callable, Mapping, Sequence
+from collections.abc import Callable, Container, Mapping, Sequence
 from dataclasses import dataclass
 from functools import cached_property
 from typing import Any, Generic, TypeVar
@@ -81,12 +81,19 @@ class KeptTerms(Generic[Terms]):
     steps: tuple[tuple[str, Any], ...]
     terms: Terms
 
+    def scope(self, values: Mapping[str, Any], only: Container[str] | None = None) -> dict[str, Any]:
+        """``values`` (by name; the tables too) and each step's value (of the steps named in
+        ``only``, when given) over them and the steps before it."""
+        scope = dict(values)
+        for name, step in self.steps:
+            if only is None or name in only:
+                scope[name] = _taken(step, scope)
+        return scope
+
     def taken(self, values: Mapping[str, Any]) -> Terms:
         """The terms at ``values`` (by name; the tables too): what walking the texts over them
         builds, step for step in the same algebra."""
-        scope = dict(values)
-        for name, step in self.steps:
-            scope[name] = _taken(step, scope)
+        scope = self.scope(values)
         found = {f.name: _taken(getattr(self.terms, f.name), scope) for f in dataclasses.fields(self.terms)}
         return dataclasses.replace(self.terms, **found)
 
@@ -196,9 +203,16 @@ class SymbolicOcp:
         return {**values, name: algebra.binary(ast.Add, values[name], values[INITIAL_TIME])}
 
     def definitions(self, values: Mapping[str, Any], algebra: Algebra) -> dict[str, Any]:
-        """Each definition by name, built over ``values`` and the earlier ones."""
-        scope = self._scope(values, algebra)
-        return {name: scope[name] for name in self.spec.problem.definitions}
+        """Each definition by name, built over ``values`` and the earlier ones: the steps of the
+        running terms' kept walk (:meth:`_keep`) but a free initial time's shift, so that a failed
+        solve's diagnosis (:mod:`gamespec.ocp.diagnostics`) walks no text."""
+        defined = self.spec.problem.definitions
+        kept = self._kept_running(algebra)
+        if kept is None:
+            scope = self._scope(values, algebra)
+        else:
+            scope = kept.scope(dict(values) | self.functions, only=defined)
+        return {name: scope[name] for name in defined}
 
     def running_terms(self, values: Mapping[str, Any], algebra: Algebra) -> RunningTerms:
         """The running terms over ``values`` (each of :attr:`running_names` by name): the file's

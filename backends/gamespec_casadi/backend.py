@@ -22,6 +22,7 @@ from gamespec.compiling import Availability, Inputs
 from gamespec.compiling.collocation import IPOPT_DEFAULTS, CollocationBackend, CollocationModel
 from gamespec.errors import BackendError
 from gamespec.ocp.compiled_checks import prepare as prepare_checks
+from gamespec.ocp.symbolic import SymbolicOcp
 from gamespec.ocp.transcription import Guess, Transcription
 from gamespec.result import Result, Status
 from gamespec.specs.base import StrictModel
@@ -107,7 +108,9 @@ class CasadiModel(CollocationModel):
 
     options: CasadiOptions
 
-    def __init__(self, spec: OptimalControlSpec, options: CasadiOptions) -> None:
+    def __init__(
+        self, spec: OptimalControlSpec, options: CasadiOptions, parsed: SymbolicOcp | None = None
+    ) -> None:
         import casadi as ca
 
         from gamespec_casadi.nlp import collocation_nlp
@@ -115,7 +118,7 @@ class CasadiModel(CollocationModel):
         if not ca.has_nlpsol(options.solver):
             raise BackendError(f"casadi has no NLP solver plugin {options.solver!r}")
         self.ca = ca
-        self.tr = tr = Transcription(spec)
+        self.tr = tr = Transcription(spec, parsed)
         prepare_checks(tr)
         self.options = options
         self.sx, self.su = tr.compiled_scaling.states, tr.compiled_scaling.controls

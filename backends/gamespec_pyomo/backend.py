@@ -25,6 +25,7 @@ from gamespec.compiling import Availability, Inputs
 from gamespec.compiling.collocation import IPOPT_DEFAULTS, CollocationBackend, CollocationModel
 from gamespec.errors import BackendError
 from gamespec.ocp.compiled_checks import prepare as prepare_checks
+from gamespec.ocp.symbolic import SymbolicOcp
 from gamespec.ocp.transcription import Bounds, Transcription
 from gamespec.result import Result, Status
 from gamespec.specs.base import StrictModel
@@ -112,11 +113,13 @@ class PyomoModel(CollocationModel):
 
     options: PyomoOptions
 
-    def __init__(self, spec: OptimalControlSpec, options: PyomoOptions) -> None:
+    def __init__(
+        self, spec: OptimalControlSpec, options: PyomoOptions, parsed: SymbolicOcp | None = None
+    ) -> None:
         import pyomo.environ as pyo
 
         self.pyo = pyo
-        self.tr = Transcription(spec)
+        self.tr = Transcription(spec, parsed)
         prepare_checks(self.tr)
         self.options = options
         self.executable = find_executable(options.solver)

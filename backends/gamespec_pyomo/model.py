@@ -20,6 +20,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable, Mapping
+from functools import lru_cache
 from typing import Any
 
 import numpy as np
@@ -51,9 +52,12 @@ def _refused(name: str) -> Callable[..., Any]:
     return refuse
 
 
+@lru_cache(maxsize=1)
 def pyomo_library() -> Library:
     """Pyomo's intrinsic functions by gamespec's names (min/max through ``abs``, which the NL
-    format has; no atan2, sign or heaviside: they are refused when a problem uses them)."""
+    format has; no atan2, sign or heaviside: they are refused when a problem uses them). One
+    library per process, so that each model takes the problem's kept walks again
+    (:meth:`~gamespec.symbolic.library.LibraryAlgebra.__eq__`)."""
     import pyomo.environ as pyo
 
     return Library.from_namespace(

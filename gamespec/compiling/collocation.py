@@ -11,6 +11,7 @@ from typing import Any, ClassVar, TypeVar
 
 from gamespec.compiling import Backend, CompiledModel, Inputs
 from gamespec.ocp.inputs import InputGrid
+from gamespec.ocp.symbolic import SymbolicOcp
 from gamespec.ocp.transcription import Transcription
 from gamespec.result import Result
 from gamespec.specs.base import NLP_OPTIONS, SpecBase, StrictModel
@@ -79,8 +80,9 @@ class CollocationModel(CompiledModel):
     options: Any
 
     @abstractmethod
-    def __init__(self, spec: OptimalControlSpec, options: Any) -> None:
-        """Build the model of ``spec`` with the backend's ``options`` (refinement builds one per mesh)."""
+    def __init__(self, spec: OptimalControlSpec, options: Any, parsed: SymbolicOcp | None = None) -> None:
+        """Build the model of ``spec`` with the backend's ``options`` (refinement builds one per
+        mesh, passing the first one's ``parsed`` problem: :class:`Transcription`)."""
 
     def input_grid(self, parameters: Mapping[str, float] | None = None) -> InputGrid:
         """Where ``solve(inputs=...)`` expects its values (see :meth:`Transcription.input_grid`)."""

@@ -20,7 +20,9 @@ hyper-sensitive problem's boundary layers at t_f = 1e4) says only that the inter
 it is split in two, under either strategy, and no degree is raised on it.
 
 The model is rebuilt for each mesh (its NLP changes size) by the backend's own model class, so the
-loop is the same for every collocation backend; the history goes to ``metrics["refinement"]``.
+loop is the same for every collocation backend, from the problem the first model parsed (its kept
+walks taken again: no mesh walks text, issue 27, item 3); the history goes to
+``metrics["refinement"]``.
 """
 
 from __future__ import annotations
@@ -144,7 +146,7 @@ def refined(
             update["degrees"] = degrees
         method = current.tr.spec.method.model_copy(update=update)
         spec = current.tr.spec.model_copy(update={"method": method})
-        current = type(model)(spec, model.options)
+        current = type(model)(spec, model.options, parsed=model.tr.ocp)
         result = current.solve_once(parameters, guess=result, inputs=inputs)
         history.append(_entry(current.tr, result))
     defect = result.checks.get("max_defect_relative")

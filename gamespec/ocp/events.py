@@ -20,7 +20,15 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from gamespec.ocp.collocation import Grid
-from gamespec.symbolic.grammar import Algebra, Relation, at_time_name, expression, relation
+from gamespec.symbolic.grammar import (
+    Algebra,
+    Relation,
+    at_time_name,
+    expression,
+    relation,
+    taken,
+    taken_relation,
+)
 
 Weights = tuple[np.ndarray, np.ndarray]
 """Node indices and weights of a state's value at one time (:func:`node_weights`)."""
@@ -128,7 +136,21 @@ class InteriorPoints:
         for i, x in enumerate(tr.ocp.states):
             scope |= {f"{x}_0": X[i, 0], f"{x}_f": X[i, last]}
         scope["t_f"] = tr.ocp.final_time(tr.ocp.parameter_values())[0]
-        return [relation(problem.boundary_constraints[i], scope, algebra) for i in sorted(inline)]
+        return self._relations([problem.boundary_constraints[i] for i in sorted(inline)], scope, algebra)
+
+    def _relations(self, texts: list[str], values: Mapping[str, Any], algebra: Algebra) -> list[Relation]:
+        """The constraints ``texts`` over ``values`` (by name) in ``algebra``: each text walked once
+        per algebra and names, for every mesh of the problem
+        (:meth:`~gamespec.ocp.symbolic.SymbolicOcp.kept_relation`; issue 27, item 3)."""
+        ocp = self.tr.ocp
+        found = []
+        for text in texts:
+            kept = ocp.kept_relation(text, list(values), algebra)
+            if kept is None:
+                found.append(relation(text, dict(values) | ocp.functions, algebra))
+            else:
+                found.append(taken_relation(kept, values, text))
+        return found
 
     def terms(self, X: Any, others: Mapping[str, Any], algebra: Algebra) -> InteriorTerms:
         """The terms over the state nodes ``X`` (unscaled) and the parameters and design variables
@@ -136,11 +158,11 @@ class InteriorPoints:
         tr = self.tr
         problem = tr.spec.problem
         events, measured, _ = self._weights
-        base = dict(others) | tr.ocp.functions
+        base = dict(others)
         constraints = self._inline(X, base, algebra)
         for event, (nodes, weights) in zip(problem.at, events, strict=True):
             scope = base | dict(zip(tr.ocp.states, states_at(X, nodes, weights, tr.n_x), strict=True))
-            constraints += [relation(c, scope, algebra) for c in event.constraints]
+            constraints += self._relations(event.constraints, scope, algebra)
         misfit: Any = algebra.number(0.0)
         data = problem.measurements
         if data is not None:
@@ -148,9 +170,13 @@ class InteriorPoints:
             for i, (nodes, weights) in enumerate(measured):
                 scope = base | dict(zip(tr.ocp.states, states_at(X, nodes, weights, tr.n_x), strict=True))
                 for key, values in data.values.items():
-                    residual = algebra.binary(
-                        ast.Sub, expression(key, scope, algebra), algebra.number(values[i])
+                    kept = tr.ocp.kept_expression(key, list(scope), algebra)
+                    value = (
+                        expression(key, scope | tr.ocp.functions, algebra)
+                        if kept is None
+                        else taken(kept, scope, key)
                     )
+                    residual = algebra.binary(ast.Sub, value, algebra.number(values[i]))
                     square = algebra.binary(ast.Mult, residual, residual)
                     misfit = algebra.binary(
                         ast.Add, misfit, algebra.binary(ast.Mult, algebra.number(rows[key][i]), square)

@@ -10,17 +10,31 @@ Everything is stated for minimization: ``J = sign * (Mayer + integral of Lagrang
 from __future__ import annotations
 
 import ast
+import dataclasses
 import math
-from collections.abc import Callable, Mapping, Sequence
+from collections.abc import Callable, Container, Mapping, Sequence
 from dataclasses import dataclass
 from functools import cached_property
-from typing import Any
+from typing import Any, Generic, TypeVar
 
 import numpy as np
 
-from gamespec.errors import SpecError
-from gamespec.specs.ocp import INITIAL_TIME, EvaluatedValues, OptimalControlSpec
-from gamespec.symbolic.grammar import FLOATS, Algebra, Relation, dependencies, expression, relation, unknowns
+from gamespec.errors import ExpressionError, SpecError
+from gamespec.specs.ocp import INITIAL_TIME, NORMALIZED_TIME, EvaluatedValues, OptimalControlSpec
+from gamespec.symbolic.grammar import (
+    FLOATS,
+    Algebra,
+    Deferred,
+    DeferredAlgebra,
+    Relation,
+    deferred_name,
+    dependencies,
+    expression,
+    kept_expression,
+    kept_relation,
+    relation,
+    unknowns,
+)
 from gamespec.symbolic.library import NUMPY, LibraryAlgebra
 from gamespec.symbolic.tape import vectorized
 
@@ -28,6 +42,8 @@ HORIZON_FLOOR = 1e-6
 """The shortest horizon a free initial time allows, relative to the longest: ``T`` stays positive."""
 EVALUATIONS_KEPT = 8
 """How many parameter values' bounds a :class:`SymbolicOcp` keeps."""
+ALGEBRAS_KEPT = 8
+"""For how many algebras a :class:`SymbolicOcp` keeps the walks of its terms (:meth:`SymbolicOcp._keep`)."""
 
 
 @dataclass(frozen=True)
@@ -51,6 +67,44 @@ class EndTerms:
 
     mayer: Any
     boundary: list[Relation]
+
+
+Terms = TypeVar("Terms", RunningTerms, EndTerms)
+
+
+@dataclass(frozen=True)
+class KeptTerms(Generic[Terms]):
+    """Terms walked once over :class:`~gamespec.symbolic.grammar.Deferred` names: the ``steps``
+    that compute named values first, in order (each a kept walk over the names and the steps
+    before it), and the terms, each a kept walk over those (a relation's bounds as numbers)."""
+
+    steps: tuple[tuple[str, Any], ...]
+    terms: Terms
+
+    def scope(self, values: Mapping[str, Any], only: Container[str] | None = None) -> dict[str, Any]:
+        """``values`` (by name; the tables too) and each step's value (of the steps named in
+        ``only``, when given) over them and the steps before it."""
+        scope = dict(values)
+        for name, step in self.steps:
+            if only is None or name in only:
+                scope[name] = _taken(step, scope)
+        return scope
+
+    def taken(self, values: Mapping[str, Any]) -> Terms:
+        """The terms at ``values`` (by name; the tables too): what walking the texts over them
+        builds, step for step in the same algebra."""
+        scope = self.scope(values)
+        found = {f.name: _taken(getattr(self.terms, f.name), scope) for f in dataclasses.fields(self.terms)}
+        return dataclasses.replace(self.terms, **found)
+
+
+def _taken(term: Any, scope: Mapping[str, Any]) -> Any:
+    """A kept term (a walk, a relation of one, a list of them) at ``scope``."""
+    if isinstance(term, list):
+        return [_taken(t, scope) for t in term]
+    if isinstance(term, Relation):
+        return Relation(_taken(term.expr, scope), term.lower, term.upper)
+    return term(scope) if type(term) is Deferred else term
 
 
 @dataclass(frozen=True)
@@ -149,14 +203,29 @@ class SymbolicOcp:
         return {**values, name: algebra.binary(ast.Add, values[name], values[INITIAL_TIME])}
 
     def definitions(self, values: Mapping[str, Any], algebra: Algebra) -> dict[str, Any]:
-        """Each definition by name, built over ``values`` and the earlier ones."""
-        scope = self._scope(values, algebra)
-        return {name: scope[name] for name in self.spec.problem.definitions}
+        """Each definition by name, built over ``values`` and the earlier ones: the steps of the
+        running terms' kept walk (:meth:`_keep`) but a free initial time's shift, so that a failed
+        solve's diagnosis (:mod:`gamespec.ocp.diagnostics`) walks no text."""
+        defined = self.spec.problem.definitions
+        kept = self._kept_running(algebra)
+        if kept is None:
+            scope = self._scope(values, algebra)
+        else:
+            scope = kept.scope(dict(values) | self.functions, only=defined)
+        return {name: scope[name] for name in defined}
 
     def running_terms(self, values: Mapping[str, Any], algebra: Algebra) -> RunningTerms:
-        """The running terms over ``values`` (each of :attr:`running_names` by name)."""
+        """The running terms over ``values`` (each of :attr:`running_names` by name): the file's
+        texts walked once per algebra (:meth:`_keep`) and taken at ``values``."""
+        kept = self._kept_running(algebra)
+        if kept is None:
+            scope = self._scope(self._shifted(values, "t", algebra), algebra)
+            return self._running_over(scope, algebra)
+        return kept.taken(dict(values) | self.functions)
+
+    def _running_over(self, scope: Mapping[str, Any], algebra: Algebra) -> RunningTerms:
+        """The running terms over ``scope`` (the names, the definitions and the tables)."""
         problem = self.spec.problem
-        scope = self._scope(self._shifted(values, "t", algebra), algebra)
         lagrange = expression(problem.objective.lagrange, scope, algebra)
         path = [relation(c, scope, algebra) for c in problem.path_constraints]
         for name, key, raw in problem.time_varying_bounds():
@@ -170,9 +239,16 @@ class SymbolicOcp:
         )
 
     def end_terms(self, values: Mapping[str, Any], algebra: Algebra) -> EndTerms:
-        """The end-point terms over ``values`` (each of :attr:`end_names` by name)."""
+        """The end-point terms over ``values`` (each of :attr:`end_names` by name): the file's
+        texts walked once per algebra (:meth:`_keep`) and taken at ``values``."""
+        kept = self._kept_end(algebra)
+        if kept is None:
+            return self._end_over(self._shifted(values, "t_f", algebra) | self.functions, algebra)
+        return kept.taken(dict(values) | self.functions)
+
+    def _end_over(self, scope: Mapping[str, Any], algebra: Algebra) -> EndTerms:
+        """The end-point terms over ``scope`` (the names and the tables)."""
         problem = self.spec.problem
-        scope = self._shifted(values, "t_f", algebra) | self.functions
         mayer = expression(problem.objective.mayer, scope, algebra)
         inline = problem.inline_points()
         boundary = [
@@ -182,6 +258,104 @@ class SymbolicOcp:
             lo, hi, _ = self.final_time(self.parameter_values())
             boundary.append(Relation(scope["t_f"], lo, hi))
         return EndTerms(mayer=algebra.binary(ast.Mult, algebra.number(self.sign), mayer), boundary=boundary)
+
+    @cached_property
+    def _kept_texts(self) -> dict[tuple[Any, ...], Any]:
+        """The texts :meth:`kept_relation` and :meth:`kept_expression` walked, by text, names and
+        algebra."""
+        return {}
+
+    def kept_relation(self, text: str, names: Sequence[str], algebra: Algebra = FLOATS) -> Relation | None:
+        """The constraint ``text`` over ``names`` and the file's tables walked once per algebra
+        (:func:`~gamespec.symbolic.grammar.kept_relation`: None where the walk refuses it), for
+        every transcription of this problem (issue 27, item 3)."""
+        key = (True, text, tuple(names), algebra)
+        if key not in self._kept_texts:
+            self._kept_texts[key] = kept_relation(text, names, algebra, self.functions)
+        found: Relation | None = self._kept_texts[key]
+        return found
+
+    def kept_expression(self, text: str | float, names: Sequence[str], algebra: Algebra = FLOATS) -> Any:
+        """The expression ``text`` over ``names`` and the file's tables walked once per algebra
+        (:func:`~gamespec.symbolic.grammar.kept_expression`: None where the walk refuses it)."""
+        key = (False, text, tuple(names), algebra)
+        if key not in self._kept_texts:
+            self._kept_texts[key] = kept_expression(text, names, algebra, self.functions)
+        return self._kept_texts[key]
+
+    @cached_property
+    def profiles(self) -> dict[str, Any]:
+        """The guess's expressions and the grid inputs' defaults over the parameters and ``tau``
+        walked once in NumPy, by field (:func:`~gamespec.symbolic.grammar.kept_expression`; None
+        where the walk refuses one; neither changes with the mesh)."""
+        names = [*self.parameters, NORMALIZED_TIME]
+        texts = {
+            f"guess.{group}.{name}": raw
+            for group in ("states", "controls")
+            for name, raw in getattr(self.spec.guess, group).items()
+        }
+        texts |= {f"problem.inputs.{n}.default": i.default for n, i in self.spec.problem.inputs.items()}
+        arrays = LibraryAlgebra(NUMPY)
+        return {
+            field: kept_expression(raw, names, arrays)
+            for field, raw in texts.items()
+            if isinstance(raw, str) and raw != "linear"
+        }
+
+    @cached_property
+    def kept_boundary(self) -> list[Relation | None]:
+        """Each boundary constraint walked once in floats over :attr:`end_names`
+        (:meth:`kept_relation`; None for one that names a state at a fixed time)."""
+        return [self.kept_relation(text, self.end_names) for text in self.spec.problem.boundary_constraints]
+
+    @cached_property
+    def _kept_terms(self) -> dict[tuple[Algebra, bool], Any]:
+        """The last :data:`ALGEBRAS_KEPT` algebras' :class:`KeptTerms` (running ones and end ones)."""
+        return {}
+
+    def _kept_running(self, algebra: Algebra) -> KeptTerms[RunningTerms] | None:
+        """The running terms walked once in ``algebra`` (:meth:`_keep`)."""
+        found: KeptTerms[RunningTerms] | None = self._keep(algebra, True, self._running_over)
+        return found
+
+    def _kept_end(self, algebra: Algebra) -> KeptTerms[EndTerms] | None:
+        """The end-point terms walked once in ``algebra`` (:meth:`_keep`)."""
+        found: KeptTerms[EndTerms] | None = self._keep(algebra, False, self._end_over)
+        return found
+
+    def _keep(
+        self, algebra: Algebra, running: bool, build: Callable[[Mapping[str, Any], Algebra], Terms]
+    ) -> KeptTerms[Terms] | None:
+        """The running (else the end-point) terms, ``build`` over their scope, walked once in
+        ``algebra`` with each step kept (:class:`~gamespec.symbolic.grammar.DeferredAlgebra`), so
+        that each call, and each model built on this problem (another mesh of
+        :mod:`gamespec.compiling.refinement`), takes them again without walking text (issue 27,
+        item 3). The time shifted by a free initial time and each definition are steps taken once
+        per call, as the walk builds them once. None where the walk refuses a step it cannot keep
+        (then the text is walked each time, which names the refusal)."""
+        key = (algebra, running)
+        if key in self._kept_terms:
+            kept: KeptTerms[Terms] | None = self._kept_terms[key]
+            return kept
+        deferred = DeferredAlgebra(algebra)
+        names = self.running_names if running else self.end_names
+        scope: dict[str, Any] = {n: deferred_name(n) for n in names} | self.functions
+        steps: list[tuple[str, Any]] = []
+        time = "t" if running else "t_f"
+        texts = self.spec.problem.definitions.items() if running else {}.items()
+        try:
+            if self.free_initial:
+                steps.append((time, self._shifted(scope, time, deferred)[time]))
+            for name, raw in texts:
+                steps.append((name, expression(raw, scope, deferred)))
+                scope[name] = deferred_name(name)
+            found = KeptTerms(tuple(steps), build(scope, deferred))
+        except ExpressionError:
+            found = None
+        if len(self._kept_terms) >= 2 * ALGEBRAS_KEPT:
+            self._kept_terms.pop(next(iter(self._kept_terms)))
+        self._kept_terms[key] = found
+        return found
 
     @cached_property
     def running_structure(self) -> RunningTerms:
@@ -229,6 +403,13 @@ class SymbolicOcp:
         no text."""
         self._sympy  # noqa: B018 (a cached property, built here)
         self.initial_values  # noqa: B018
+        return self
+
+    def kept_for_solves(self) -> SymbolicOcp:
+        """This problem with the walks a transcription's solves take (:attr:`profiles`,
+        :attr:`kept_boundary`) kept now, when it is compiled, so that the first solve walks no text."""
+        self.profiles  # noqa: B018 (a cached property, built here)
+        self.kept_boundary  # noqa: B018
         return self
 
     @cached_property

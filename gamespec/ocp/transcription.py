@@ -32,15 +32,7 @@ from gamespec.ocp.scaling import Scaling, variable_scaling
 from gamespec.ocp.symbolic import SymbolicOcp
 from gamespec.result import Result, Status
 from gamespec.specs.ocp import INITIAL_TIME, NORMALIZED_TIME, OptimalControlSpec, bounds_midpoint
-from gamespec.symbolic.grammar import (
-    FLOATS,
-    dependencies,
-    expression,
-    kept_expression,
-    relation,
-    taken,
-    unknowns,
-)
+from gamespec.symbolic.grammar import Relation, dependencies, expression, taken, unknowns
 
 
 @dataclass(frozen=True)
@@ -70,23 +62,21 @@ class Guess:
 class Transcription:
     """The discretized form of an ``optimal_control`` spec, independent of any backend."""
 
-    def __init__(self, spec: OptimalControlSpec) -> None:
+    def __init__(self, spec: OptimalControlSpec, parsed: SymbolicOcp | None = None) -> None:
+        """The transcription of ``spec`` on its mesh; ``parsed``: its problem as another mesh's
+        transcription parsed it (:mod:`gamespec.compiling.refinement`, which changes the method
+        only), whose kept walks this one takes again (issue 27, item 3)."""
+        shared = parsed is None or (parsed.spec.problem is spec.problem and parsed.spec.guess is spec.guess)
+        if not shared:
+            raise ValueError("a transcription shares the parsed problem of its own problem only")
         self.spec = spec
-        self.ocp = SymbolicOcp(spec)
+        self.ocp = (parsed or SymbolicOcp(spec)).kept_for_solves()
         m = spec.method
         mesh = None if m.mesh is None else tuple(m.mesh)
         degrees = None if m.degrees is None else tuple(m.degrees)
         grid = Grid(m.scheme, m.intervals, m.degree if m.scheme == "radau" else 1, m.grading, mesh, degrees)
         self.grid = with_event_breaks(grid, spec) if mesh is None and degrees is None else grid
         self.t0 = spec.problem.time.origin
-        # The guess's expressions walked once, here, by field (issue 27, item 3).
-        names = [*spec.problem.parameters, NORMALIZED_TIME]
-        self._profiles = {
-            f"guess.{group}.{name}": kept_expression(raw, names, ARRAYS)
-            for group in ("states", "controls")
-            for name, raw in getattr(spec.guess, group).items()
-            if isinstance(raw, str) and raw != "linear"
-        }
         self._last_bounds: tuple[tuple[tuple[str, float], ...], Bounds] | None = None
 
     @cached_property
@@ -233,7 +223,8 @@ class Transcription:
             for name, row in zip(names, rows, strict=True):
                 values |= {f"{name}_0": float(row[0]), f"{name}_f": float(row[-1])}
         ends = [f"{self.ocp.states[i]}_{e}" for i in free for e in "0f"]
-        if any(_flat(text, values, ends) for text in self.spec.problem.boundary_constraints):
+        texts = zip(self.ocp.kept_boundary, self.spec.problem.boundary_constraints, strict=True)
+        if any(_flat(kept, text, values, ends) for kept, text in texts):
             for i in free:
                 lo, hi = bounds[i][:2]
                 X[i] += (
@@ -260,7 +251,7 @@ class Transcription:
         if raw == "linear":
             a, b = _linear_ends(start, end, lo, hi)
             return a + (b - a) * tau
-        kept = self._profiles.get(field)
+        kept = self.ocp.profiles.get(field)
         values = dict(params) | {NORMALIZED_TIME: tau}
         try:
             value = expression(raw, values, ARRAYS) if kept is None else taken(kept, values, raw)
@@ -443,15 +434,19 @@ class Transcription:
         )
 
 
-def _flat(text: str, values: Mapping[str, float], names: list[str]) -> bool:
-    """Whether the constraint ``text`` uses some of ``names`` and its gradient in them vanishes at
-    ``values`` (central differences; False where it is not defined there)."""
+def _flat(kept: Relation | None, text: str, values: Mapping[str, float], names: list[str]) -> bool:
+    """Whether the constraint ``text`` (``kept``: its walk kept over the end names,
+    :attr:`~gamespec.ocp.symbolic.SymbolicOcp.kept_boundary`; None for one the walk refuses there)
+    uses some of ``names`` and its gradient in them vanishes at ``values`` (central differences;
+    False where it is not defined there)."""
+    if kept is None:
+        return False
     try:
-        used = dependencies(relation(text, dict(values) | unknowns(names), FLOATS).expr) & set(names)
+        used = dependencies(taken(kept.expr, dict(values) | unknowns(names), text)) & set(names)
         slopes = []
         for name in used:
             h = 1e-6 * max(1.0, abs(values[name]))
-            up, down = (relation(text, dict(values) | {name: values[name] + s}, FLOATS).expr for s in (h, -h))
+            up, down = (taken(kept.expr, dict(values) | {name: values[name] + s}, text) for s in (h, -h))
             slopes.append(abs(up - down) / (2 * h))
     except ExpressionError:
         return False

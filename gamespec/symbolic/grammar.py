@@ -551,7 +551,7 @@ def relation(text: str, symbols: Mapping[str, Any], algebra: Algebra) -> Relatio
         return Relation(diff, 0.0, inf)
     if len(ops) == 2 and ops[0] == ops[1] and ops[0] is not ast.Eq:
         lo, mid, hi = terms
-        lo_f, hi_f = algebra.scalar(lo), algebra.scalar(hi)
+        lo_f, hi_f = (walk.apply(node, algebra.scalar, term) for term in (lo, hi))
         if lo_f is None or hi_f is None:
             raise walk.fail(node, "the outer terms of a chained constraint must be numbers")
         if ops[0] in (ast.GtE, ast.Gt):
@@ -586,11 +586,39 @@ def taken(value: Any, values: Mapping[str, Any], text: str | float) -> Any:
         raise ExpressionError(str(text)[:40] + "...", "expression nested too deeply") from None
 
 
-def kept_expression(text: str | float, names: Iterable[str], algebra: Algebra = FLOATS) -> Any:
-    """The walk of ``text`` in ``algebra`` over ``names`` kept for later (:func:`kept`; taken with
-    :func:`taken` at the names' values), None when the walk refuses it."""
+def kept_expression(
+    text: str | float,
+    names: Iterable[str],
+    algebra: Algebra = FLOATS,
+    tables: Mapping[str, FileFunction] | None = None,
+) -> Any:
+    """The walk of ``text`` in ``algebra`` over ``names`` (and the file's ``tables``) kept for
+    later (:func:`kept`; taken with :func:`taken` at the names' values), None when the walk
+    refuses it."""
     deferred = DeferredAlgebra(algebra)
-    return kept(lambda: expression(text, {n: deferred_name(n) for n in names}, deferred), text)
+    symbols = {n: deferred_name(n) for n in names} | dict(tables or {})
+    return kept(lambda: expression(text, symbols, deferred), text)
+
+
+def kept_relation(
+    text: str,
+    names: Iterable[str],
+    algebra: Algebra = FLOATS,
+    tables: Mapping[str, FileFunction] | None = None,
+) -> Relation | None:
+    """The walk of the constraint ``text`` in ``algebra`` over ``names`` (and the file's
+    ``tables``) kept for later: its expression a kept walk (:func:`kept`), its bounds numbers;
+    None when the walk refuses it. Taken with :func:`taken_relation`."""
+    deferred = DeferredAlgebra(algebra)
+    symbols = {n: deferred_name(n) for n in names} | dict(tables or {})
+    found: Relation | None = kept(lambda: relation(text, symbols, deferred), text)
+    return found
+
+
+def taken_relation(value: Relation, values: Mapping[str, Any], text: str) -> Relation:
+    """A kept relation (:func:`kept_relation`) at ``values``: the relation the walk of its algebra
+    over them gives."""
+    return Relation(taken(value.expr, values, text), value.lower, value.upper)
 
 
 @lru_cache(maxsize=4096, typed=True)

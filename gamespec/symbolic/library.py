@@ -10,7 +10,7 @@ import ast
 import operator
 from collections.abc import Callable, Iterator, Mapping
 from dataclasses import dataclass
-from functools import cached_property
+from functools import cached_property, lru_cache
 from typing import Any
 
 from gamespec.symbolic.grammar import BINARY, FLOATS, FUNCTION_ARITY, FileFunction, Refused
@@ -84,10 +84,12 @@ def _casadi_table(table: FileFunction) -> Callable[..., Any]:
 NUMPY = Library(_NumpyFunctions(), power=_numpy_power, tables=_numpy_table)
 
 
+@lru_cache(maxsize=1)
 def casadi_library(ca: Any) -> Library:
     """CasADi's functions by gamespec's names; ``heaviside(x) = (1 + sign(x))/2``, which is 1/2 at 0
     as SymPy's ``Heaviside`` (CasADi's ``sign(0) = 0``); a table is a ``casadi.interpolant``
-    (:class:`gamespec.symbolic.tables.Table`)."""
+    (:class:`gamespec.symbolic.tables.Table`). One library per process: the algebras over it are
+    one algebra (:class:`LibraryAlgebra`), whose kept walks every CasADi model takes again."""
     library = Library.from_namespace(
         ca, abs=ca.fabs, min=ca.fmin, max=ca.fmax, heaviside=lambda x: 0.5 * (1 + ca.sign(x))
     )
@@ -101,6 +103,14 @@ class LibraryAlgebra:
 
     def __init__(self, library: Library) -> None:
         self.library = library
+
+    def __eq__(self, other: object) -> bool:
+        """The algebras over one library are one algebra: what
+        :class:`~gamespec.ocp.symbolic.SymbolicOcp` keeps walked in one is taken in another."""
+        return isinstance(other, LibraryAlgebra) and other.library is self.library
+
+    def __hash__(self) -> int:
+        return id(self.library)
 
     @staticmethod
     def _numbers(*args: Any) -> bool:

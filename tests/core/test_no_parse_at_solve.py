@@ -78,6 +78,25 @@ def _event_spec(a: float) -> dict:
     return spec | {"name": "through_a_point", "method": {"intervals": 10, "degree": 3}}
 
 
+def _refined_event_spec(a: float) -> dict:
+    """:func:`_event_spec` made nonlinear (``v' = u - 2 sin(x) + w``, ``w`` a grid input whose
+    default names ``a``; a definition in the running cost) with ``x`` free at the end, a boundary
+    constraint over the end values (the ``linear`` guess's flat-gradient check reads it), a chained
+    path constraint with numbers outside and ``h`` refinement: two refined meshes, each with the
+    ``at:`` event and ``v(t=1.5)``."""
+    spec = _event_spec(a)
+    problem = spec["problem"]
+    problem["states"]["x"] = {"initial": 0.0}
+    problem["inputs"] = {"w": {"default": "0.1*a*tau"}}
+    problem["dynamics"]["v"] = "u - 2*sin(x) + w"
+    problem["definitions"] = {"e": "v**2"}
+    problem["objective"]["lagrange"] = "u**2 + 0.1*e"
+    problem["boundary_constraints"].append("x_f**2 + v_0**2 == 0.04")
+    problem["path_constraints"] = ["-2 <= v + a*0 <= 2"]
+    spec["method"]["refine"] = {"strategy": "h", "tolerance": 1e-12, "max_iterations": 2}
+    return spec
+
+
 CASES = {
     "bryson_denham": (
         lambda: load(PROBLEMS / "ocp" / "bryson_denham.yaml", ["method.intervals=10"]),
@@ -91,6 +110,7 @@ CASES = {
         {"q": 5.0},
     ),
     "at_event": (lambda: spec_from_dict(_event_spec(0.49)), {"a": 0.25}),
+    "refined_mesh": (lambda: spec_from_dict(_refined_event_spec(0.49)), {"a": 0.25}),
     "hji_chauffeur": (
         lambda: load(
             PROBLEMS / "ch7" / "homicidal_chauffeur_capture_time.yaml", ["solver.options.hji.nodes=21"]
@@ -105,6 +125,17 @@ CASES = {
         {"s1_final": 0.04},
     ),
 }
+
+
+def _history(result: Result) -> np.ndarray:
+    """Each mesh's size, degree, iterations, objective and defect (NaN where its re-integration
+    overflows; :mod:`gamespec.compiling.refinement`), a row per mesh."""
+    keys = ("intervals", "max_degree", "iterations", "objective", "max_defect_relative")
+    return np.array([[entry[k] for k in keys] for entry in result.metrics["refinement"]], dtype=float)
+
+
+def _same_history(mine: Result, theirs: Result) -> bool:
+    return np.array_equal(_history(mine), _history(theirs), equal_nan=True)
 
 
 @pytest.mark.parametrize("case", list(CASES))
@@ -126,6 +157,40 @@ def test_first_solve_and_a_solve_at_new_values_walk_no_text(monkeypatch, case):
             math.isinf(mine.objective) and math.isinf(theirs.objective)
         )
     assert solved[1].objective != solved[0].objective
+    if case == "refined_mesh":
+        assert all(_same_history(m, t) for m, t in zip(solved, fresh, strict=True))
+        assert all(len(_history(r)) == 3 for r in solved)
+
+
+@pytest.mark.parametrize("backend", ["casadi", "pyomo"])
+def test_adaptive_mesh_refinement_walks_no_text(monkeypatch, backend):
+    """The hyper-sensitive problem's hp refinement (three meshes here) builds each mesh's model from
+    the problem the compiled model parsed (its kept walks taken again, :meth:`~gamespec.ocp.symbolic.
+    SymbolicOcp._keep`): with the walker refused, the same meshes, iterations and objectives, to the
+    bit, as a fresh compile with the walker allowed."""
+    sets = [f"solver.backend={backend}", "method.refine.max_iterations=2"]
+    path = PROBLEMS / "ocp" / "hyper_sensitive.yaml"
+    compiled = compile_spec(load(path, sets))
+    with monkeypatch.context() as patched:
+        _refuse_parsing(patched)
+        refined = compiled.solve()
+    fresh = compile_spec(load(path, sets)).solve()
+    assert refined.status == fresh.status and refined.objective == fresh.objective
+    assert _same_history(refined, fresh) and len(_history(refined)) == 3
+    assert np.array_equal(refined.states["x"], fresh.states["x"])
+
+
+def test_a_chained_constraint_with_a_parameter_outside_is_refused_by_field():
+    """The outer terms of a chained constraint are numbers (:func:`gamespec.symbolic.grammar.
+    relation`); one that names a parameter is refused at load with the field and the reason, as
+    its SymPy check says (the kept walk's refusal of a parameter's value, a ``ValueError``, once
+    escaped as ``problem: depends on a parameter's value``), so no solve walks it."""
+    for where, text in [("path_constraints", "-a <= v <= a"), ("boundary_constraints", "-a <= x_f <= 2*a")]:
+        with pytest.raises(SpecError) as refused:
+            spec_from_dict(rest_to_rest(0.3, 2.0, **{where: [text]}))
+        assert refused.value.field == f"problem.{where}.0"
+        assert "outer terms of a chained constraint must be numbers" in str(refused.value)
+    assert grammar.kept_relation("-a <= x <= a", ["a", "x"]) is None
 
 
 def test_the_rcs_plot_of_a_saved_result_walks_no_text(monkeypatch, tmp_path):
@@ -161,6 +226,24 @@ TEXTS = [
     "1e300*a*a",
 ]
 VALUES = [-1.0, 0.0, 1.0, 2.0, 3.0, 1e200]
+
+
+@pytest.mark.parametrize("text", ["-1 <= x*a <= 2", "x >= sqrt(a)", "log(a) == x", "2 >= x*a >= 1e-3"])
+def test_kept_relation_is_the_float_walk(text):
+    """A kept constraint (:func:`gamespec.symbolic.grammar.kept_relation`) at each value of ``a``
+    gives the float walk's relation, or its refusal with the same message and column."""
+    kept = grammar.kept_relation(text, ["a", "x"])
+    assert kept is not None
+    for a in VALUES:
+        values = {"a": a, "x": 0.5}
+        try:
+            expected = grammar.relation(text, values, grammar.FLOATS)
+        except ExpressionError as err:
+            with pytest.raises(ExpressionError) as found:
+                grammar.taken_relation(kept, values, text)
+            assert (str(found.value), found.value.column) == (str(err), err.column)
+        else:
+            assert grammar.taken_relation(kept, values, text) == expected
 
 
 @pytest.mark.parametrize("text", TEXTS)

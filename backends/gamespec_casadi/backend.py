@@ -125,6 +125,9 @@ class CasadiModel(CollocationModel):
         self.solver = nlp_solver(nlp, options)
         self.shape = (tr.n_x, tr.grid.n_nodes, tr.n_u, len(tr.grid.eval_index))
         self._last: np.ndarray | None = None
+        self._last_multipliers: dict[str, Any] = {}
+        """The multipliers of the last solution, the warm start's with ``_last`` (IPOPT reads them
+        with ``warm_start_init_point: yes``, and ignores them otherwise)."""
 
     def pack(self, X: np.ndarray, U: np.ndarray, d: np.ndarray, T: float) -> np.ndarray:
         """The NLP's variables: X and U divided by their scale factors (also the joint game
@@ -157,8 +160,9 @@ class CasadiModel(CollocationModel):
         params = tr.ocp.parameter_values(parameters)
         b = tr.bounds(params)
         Win = tr.input_values(params, inputs)
+        multipliers: dict[str, np.ndarray] = {}
         if guess is None and self._last is not None and self.options.warm_start:
-            w0 = self._last
+            w0, multipliers = self._last, self._last_multipliers
         else:
             start: Guess = tr.guess(params, guess)
             w0 = self.pack(start.X, start.U, start.d, start.T)
@@ -168,7 +172,9 @@ class CasadiModel(CollocationModel):
         p_val = np.concatenate([[params[n] for n in tr.ocp.parameters], Win.ravel(order="F"), horizon])
         tic = time.perf_counter()
         lbg, ubg = self.constraint_bounds(params)
-        sol = self.solver(x0=np.clip(w0, lbx, ubx), lbx=lbx, ubx=ubx, lbg=lbg, ubg=ubg, p=p_val)
+        sol = self.solver(
+            x0=np.clip(w0, lbx, ubx), lbx=lbx, ubx=ubx, lbg=lbg, ubg=ubg, p=p_val, **multipliers
+        )
         elapsed = time.perf_counter() - tic
         stats = self.solver.stats()
         native = stats.get("return_status", "unknown")
@@ -176,6 +182,7 @@ class CasadiModel(CollocationModel):
         w = np.asarray(sol["x"]).ravel()
         if status.ok:
             self._last = w
+            self._last_multipliers = {"lam_x0": sol["lam_x"], "lam_g0": sol["lam_g"]}
         X, U, d, T = self._unpack(w, b.t_lower)
         nx = self.shape[0]
         lam_g = np.asarray(sol["lam_g"]).ravel()

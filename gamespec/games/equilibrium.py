@@ -109,6 +109,15 @@ class BestResponder:
                 raise SpecError(f"{value} is not a finite number", field=name, source=self.spec.source)
         self.spec = with_parameter_values(self.spec, values)
 
+    def check_responses(self, on: bool) -> None:
+        """Whether this player's responses carry the OCP solution checks (re-integration, constraint
+        violation, control swings, Hamiltonian; :attr:`~gamespec.ocp.transcription.Transcription.checked`):
+        a caller that reads none of them turns them off; a model whose mesh is refined keeps them
+        (the refinement reads its defects)."""
+        tr = getattr(self.solver.compiled, "tr", None)
+        if tr is not None and tr.spec.method.refine is None:
+            tr.checked = on
+
     def respond(self, others: Mapping[str, np.ndarray]) -> tuple[np.ndarray | None, Result]:
         inputs = self._inputs(others)
         result = self.solver.solve_spec(self.spec, inputs=inputs)

@@ -42,6 +42,10 @@ from gamespec.symbolic.grammar import (
     unknowns,
 )
 
+UNCHECKED = "solution checks not computed (Transcription.checked is off: the caller reads none of them)"
+"""Why a Result of :meth:`Transcription.result` has no checks when they are turned off: its
+``metrics.checks_skipped`` says so, and it is ``feasible``, not ``optimal`` (nothing verified it)."""
+
 
 @dataclass(frozen=True)
 class Bounds:
@@ -88,6 +92,9 @@ class Transcription:
             if isinstance(raw, str) and raw != "linear"
         }
         self._last_bounds: tuple[tuple[tuple[str, float], ...], Bounds] | None = None
+        self.checked = True
+        """Whether :meth:`result` computes the solution checks (a caller that reads none of them,
+        a receding horizon's best responses, turns them off: see :data:`UNCHECKED`)."""
 
     @cached_property
     def interior(self) -> InteriorPoints:
@@ -404,9 +411,14 @@ class Transcription:
         if defect_multipliers is not None and self.grid.scheme == "radau":
             lam = defect_multipliers * self.costate_rows[None, :]
             costates = {f"lambda_{n}": lam[i] for i, n in enumerate(self.ocp.states)}
-        checks, skipped = solution_checks(
-            self, Trajectory(X, U, inputs, T), {**params, **optimized}, lam, integral_multipliers
-        )
+        if self.checked:
+            checks, skipped = solution_checks(
+                self, Trajectory(X, U, inputs, T), {**params, **optimized}, lam, integral_multipliers
+            )
+        else:
+            checks, skipped = {}, {"solution_checks": UNCHECKED}
+            if status is Status.OPTIMAL:
+                status, message = Status.FEASIBLE, f"{message}; not verified optimal: {UNCHECKED}"
         refine = self.spec.method.refine
         tolerances = check_tolerances(checks, refine.tolerance if refine else None)
         if lam is not None:

@@ -395,8 +395,9 @@ class Transcription:
         design variables (``metrics["design"]``), a pass/fail verdict per check against its
         tolerance (``metrics["checks_passed"]`` and ``metrics["check_tolerances"]``, see
         :func:`~gamespec.ocp.checks.verdicts`) and the checks left out with the reason
-        (``metrics["checks_skipped"]``). ``integral_multipliers``: the NLP multipliers of the
-        integral constraints' rows, which enter the Hamiltonian check."""
+        (``metrics["checks_skipped"]``; all of them, ``feasible``, when :attr:`checked` is off).
+        ``integral_multipliers``: the NLP multipliers of the integral constraints' rows, which enter
+        the Hamiltonian check."""
         if objective is not None:
             objective -= self.ocp.sign * float(self.rate_penalty(U))
         values = np.zeros(self.n_d) if design is None else np.asarray(design, dtype=float)

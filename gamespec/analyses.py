@@ -252,7 +252,7 @@ def run_analyses(
     chosen = selected(declared, selection)
     key = ""
     if chosen:
-        key = spec_hash(spec.model_copy(update={"analyses": None}))
+        key = spec_hash(spec if spec.analyses is None else spec.model_copy(update={"analyses": None}))
         key += "" if options is None else options.model_dump_json()
     for analysis in chosen:
         result = cache.outputs(analysis, key, result, spec, inverse).merged(result)

@@ -31,7 +31,7 @@ from __future__ import annotations
 
 import datetime as _dt
 import time
-from dataclasses import dataclass, replace
+from dataclasses import dataclass, field, replace
 from functools import cache, cached_property
 from importlib.metadata import PackageNotFoundError, version
 from pathlib import Path
@@ -295,6 +295,9 @@ class Solver:
     build_time_s: float
     analyses: Selection = "all"
     """Which analyses every solve of it runs (:mod:`gamespec.analyses`)."""
+    _last_mapped: tuple[SpecBase, tuple[bool, tuple[str, ...] | None], list[AnyStep]] | None = field(
+        default=None, init=False, repr=False, compare=False
+    )
 
     @property
     def target_spec(self) -> SpecBase:
@@ -340,7 +343,12 @@ class Solver:
         it. When ``spec`` differs in more (a dotted field that
         is no runtime parameter, a requested transform's option, a starting point), every step is
         re-applied. A re-applied chain must end in the compiled target's structure (``guessed``:
-        the caller gives the compiled model a starting point), else a SpecError naming ``names``."""
+        the caller gives the compiled model a starting point), else a SpecError naming ``names``.
+        The steps mapped without re-applying anything are kept for the last ``spec`` (a frozen
+        object: a game's best responses re-solve one spec many times with new grid inputs only)."""
+        key = (guessed, tuple(names) if names is not None else None)
+        if self._last_mapped is not None and self._last_mapped[0] is spec and self._last_mapped[1] == key:
+            return self._last_mapped[2]
         current = _unrequested(spec)
         steps: list[AnyStep] = []
         if self._same_structure(spec, names):
@@ -353,6 +361,7 @@ class Solver:
                 steps.append(_with_analysis_values(step, current, fields) if fields else step)
                 current = steps[-1].target
             else:
+                self._last_mapped = (spec, key, steps)
                 return steps
         requested = [options for _, options in requested_steps(spec)]
         for index in range(len(steps), len(self.steps)):

@@ -128,6 +128,10 @@ class CasadiModel(CollocationModel):
         self.solver = nlp_solver(nlp, options)
         self.shape = (tr.n_x, tr.grid.n_nodes, tr.n_u, len(tr.grid.eval_index))
         self._last: np.ndarray | None = None
+        self._kept: tuple[dict[str, float], tuple[Any, ...]] | None = None
+        self._last_multipliers: dict[str, Any] = {}
+        """The multipliers of the last solution, the warm start's with ``_last`` (IPOPT reads them
+        with ``warm_start_init_point: yes``, and ignores them otherwise)."""
 
     def pack(self, X: np.ndarray, U: np.ndarray, d: np.ndarray, T: float) -> np.ndarray:
         """The NLP's variables: X and U divided by their scale factors (also the joint game
@@ -153,25 +157,40 @@ class CasadiModel(CollocationModel):
         lbg[-n:], ubg[-n:] = np.array(self.tr.ocp.integral_bounds(params)).T
         return lbg, ubg
 
+    def _numbers(self, parameters: dict[str, float] | None) -> tuple[Any, ...]:
+        """The parameter values of a solve at ``parameters`` and its variable and constraint bounds
+        ``(params, bounds, lbx, ubx, lbg, ubg)``, kept for the last ``parameters`` (a game's best
+        responses re-solve at the same values with new grid inputs)."""
+        given = dict(parameters or {})
+        if self._kept is not None and self._kept[0] == given:
+            return self._kept[1]
+        tr = self.tr
+        params = tr.ocp.parameter_values(parameters)
+        b = tr.bounds(params)
+        lbx = self.pack(b.x_lower, b.u_lower, b.d_lower, b.t_lower)
+        ubx = self.pack(b.x_upper, b.u_upper, b.d_upper, b.t_upper)
+        numbers = (params, b, lbx, ubx, *self.constraint_bounds(params))
+        self._kept = (given, numbers)
+        return numbers
+
     def solve_once(
         self, parameters: dict[str, float] | None = None, guess: Result | None = None, inputs: Inputs = None
     ) -> Result:
         tr = self.tr
-        params = tr.ocp.parameter_values(parameters)
-        b = tr.bounds(params)
+        params, b, lbx, ubx, lbg, ubg = self._numbers(parameters)
         Win = tr.input_values(params, inputs)
+        multipliers: dict[str, np.ndarray] = {}
         if guess is None and self._last is not None and self.options.warm_start:
-            w0 = self._last
+            w0, multipliers = self._last, self._last_multipliers
         else:
             start: Guess = tr.guess(params, guess)
             w0 = self.pack(start.X, start.U, start.d, start.T)
-        lbx = self.pack(b.x_lower, b.u_lower, b.d_lower, b.t_lower)
-        ubx = self.pack(b.x_upper, b.u_upper, b.d_upper, b.t_upper)
         horizon = [] if tr.free_time else [b.t_lower]
         p_val = np.concatenate([[params[n] for n in tr.ocp.parameters], Win.ravel(order="F"), horizon])
         tic = time.perf_counter()
-        lbg, ubg = self.constraint_bounds(params)
-        sol = self.solver(x0=np.clip(w0, lbx, ubx), lbx=lbx, ubx=ubx, lbg=lbg, ubg=ubg, p=p_val)
+        sol = self.solver(
+            x0=np.clip(w0, lbx, ubx), lbx=lbx, ubx=ubx, lbg=lbg, ubg=ubg, p=p_val, **multipliers
+        )
         elapsed = time.perf_counter() - tic
         stats = self.solver.stats()
         native = stats.get("return_status", "unknown")
@@ -179,6 +198,7 @@ class CasadiModel(CollocationModel):
         w = np.asarray(sol["x"]).ravel()
         if status.ok:
             self._last = w
+            self._last_multipliers = {"lam_x0": sol["lam_x"], "lam_g0": sol["lam_g"]}
         X, U, d, T = self._unpack(w, b.t_lower)
         nx = self.shape[0]
         lam_g = np.asarray(sol["lam_g"]).ravel()

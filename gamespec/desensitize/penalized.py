@@ -15,6 +15,7 @@ control under sampled parameters: ``monte_carlo`` (``metrics.monte_carlo``, open
 from __future__ import annotations
 
 from dataclasses import dataclass
+from functools import lru_cache
 from typing import Any
 
 import numpy as np
@@ -26,6 +27,7 @@ from gamespec.desensitize.montecarlo import monte_carlo, tracking
 from gamespec.desensitize.simulate import dense_integral, evaluate
 from gamespec.desensitize.spec import DesensitizeOptions
 from gamespec.errors import SpecError
+from gamespec.ocp.collocation import Grid
 from gamespec.ocp.symbolic import SymbolicOcp
 from gamespec.ocp.transcription import Transcription
 from gamespec.result import Result
@@ -189,9 +191,7 @@ def _penalty_value(spec: OptimalControlSpec, result: Result, penalty: Penalty) -
         return final
     if len(result.metrics.get("refinement", ())) > 1:
         return dense_integral(result, SymbolicOcp(spec), penalty.running) + final
-    grid = Transcription(spec).grid
-    _, _, q = grid.triplets
-    idx = grid.eval_index
+    q, idx = _quadrature(Transcription(spec).grid)
     t = np.asarray(result.time)
     values: dict[sp.Symbol, Any] = {symbol(k): v for k, v in result.parameters.items()}
     values.update({symbol(k): np.asarray(v)[idx] for k, v in result.states.items()})
@@ -199,6 +199,13 @@ def _penalty_value(spec: OptimalControlSpec, result: Result, penalty: Penalty) -
     values[TIME] = t[idx]
     running = evaluate([penalty.running], values, (len(idx),))[0]
     return float((t[-1] - t[0]) * q @ running) + final
+
+
+@lru_cache(maxsize=64)
+def _quadrature(grid: Grid) -> tuple[np.ndarray, np.ndarray]:
+    """The grid's quadrature weights and evaluation points, computed once per grid (a frozen value:
+    every re-solve of a compiled chain reports on the same one)."""
+    return grid.triplets[2], grid.eval_index
 
 
 def _end_values(result: Result) -> dict[sp.Symbol, float]:

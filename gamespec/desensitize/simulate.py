@@ -60,8 +60,15 @@ class Trajectories:
 
 def evaluate(exprs: list[sp.Expr], values: Values, shape: tuple[int, ...]) -> np.ndarray:
     """The expressions with each symbol of ``values`` given its value, stacked (len(exprs), *shape)."""
-    function = numeric_function(exprs, list(values))
+    function = _numeric(tuple(exprs), tuple(values))
     return np.broadcast_to(function(*values.values()), (len(exprs), *shape))
+
+
+@lru_cache(maxsize=256)
+def _numeric(exprs: tuple[sp.Expr, ...], args: tuple[sp.Symbol, ...]) -> Callable[..., np.ndarray]:
+    """:func:`numeric_function` of ``exprs`` in ``args``, recorded once per pair (a report
+    evaluates the same terms on every re-solve of a compiled chain)."""
+    return numeric_function(exprs, args)
 
 
 DENSE = 20

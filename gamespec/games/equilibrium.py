@@ -89,6 +89,8 @@ class BestResponder:
     last: Result | None = None
     validated: dict[str, float] | None = None
     """The values other than the step's own (:data:`STEP_VALUES`) the spec was last validated with."""
+    answered: tuple[OptimalControlSpec, dict[str, np.ndarray]] | None = None
+    """The spec and grid inputs of the last response (what :meth:`response_at` compares)."""
 
     def set_values(self, values: Mapping[str, float]) -> None:
         """Runtime parameter values (the initial state, the start time, the game's parameters) for
@@ -107,16 +109,39 @@ class BestResponder:
                 raise SpecError(f"{value} is not a finite number", field=name, source=self.spec.source)
         self.spec = with_parameter_values(self.spec, values)
 
+    def check_responses(self, on: bool) -> None:
+        """Whether this player's responses carry the OCP solution checks (re-integration, constraint
+        violation, control swings, Hamiltonian; :attr:`~gamespec.ocp.transcription.Transcription.checked`):
+        a caller that reads none of them turns them off; a model whose mesh is refined keeps them
+        (the refinement reads its defects)."""
+        tr = getattr(self.solver.compiled, "tr", None)
+        if tr is not None and tr.spec.method.refine is None:
+            tr.checked = on
+
     def respond(self, others: Mapping[str, np.ndarray]) -> tuple[np.ndarray | None, Result]:
-        inputs = {
-            c: np.asarray(others[o])[row] for o, cs in self.opponents.items() for row, c in enumerate(cs)
-        }
+        inputs = self._inputs(others)
         result = self.solver.solve_spec(self.spec, inputs=inputs)
         self.solves += 1
-        self.last = result
-        if not result.ok:
-            return None, result
-        return np.array([result.controls[c] for c in self.controls]), result
+        self.last, self.answered = result, (self.spec, inputs)
+        return self._strategy(result), result
+
+    def response_at(self, others: Mapping[str, np.ndarray]) -> tuple[np.ndarray | None, Result]:
+        """The best response to ``others``: the last one when it answered exactly these strategies
+        with the same values (the same problem: solving it again gives the same optimum within
+        IPOPT's tolerance), else a new one (:meth:`respond`)."""
+        inputs = self._inputs(others)
+        if self.last is not None and self.answered is not None and self.answered[0] is self.spec:
+            before = self.answered[1]
+            same = before.keys() == inputs.keys()
+            if same and all(np.array_equal(before[c], v) for c, v in inputs.items()):
+                return self._strategy(self.last), self.last
+        return self.respond(others)
+
+    def _inputs(self, others: Mapping[str, np.ndarray]) -> dict[str, np.ndarray]:
+        return {c: np.asarray(others[o])[row] for o, cs in self.opponents.items() for row, c in enumerate(cs)}
+
+    def _strategy(self, result: Result) -> np.ndarray | None:
+        return np.array([result.controls[c] for c in self.controls]) if result.ok else None
 
     @property
     def points(self) -> int:
@@ -305,7 +330,7 @@ class GameModel:
             missing = dict.fromkeys((r.name for r in order), None)
             note = "a player's problem goes through transforms: no payoffs or gap at the returned point"
             return Equilibrium(concept, missing, dict(missing), dict(missing), None, note)
-        responses = {r.name: r.respond({o: point[o] for o in r.opponents})[1] for r in order}
+        responses = {r.name: r.response_at({o: point[o] for o in r.opponents})[1] for r in order}
         payoffs: dict[str, float | None] = {}
         best: dict[str, float | None] = {}
         improvements: dict[str, float | None] = {}

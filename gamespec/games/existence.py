@@ -30,9 +30,8 @@ from collections.abc import Mapping
 from dataclasses import dataclass
 
 import numpy as np
-from scipy.integrate import solve_ivp
 
-from gamespec.games.feedback import LQGame
+from gamespec.games.feedback import LQGame, solve_ivp
 from gamespec.games.lq_structure import LQForm, lq_game
 
 ESCAPE = 1e8

@@ -33,9 +33,18 @@ from __future__ import annotations
 
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
+from typing import Any
 
 import numpy as np
-from scipy.integrate import solve_ivp
+
+
+def solve_ivp(*args: Any, **kwargs: Any) -> Any:
+    """SciPy's ``solve_ivp`` (the same arguments), imported on first use: scipy.integrate costs a
+    command's start-up ~0.3 s, and a game solved by best responses never integrates here."""
+    from scipy.integrate import solve_ivp as scipy_solve_ivp
+
+    return scipy_solve_ivp(*args, **kwargs)
+
 
 ESCAPE = 1e8
 """``‖P_i‖`` beyond this multiple of ``max(1, ‖S_i‖, ‖Q_i‖)`` counts as a finite escape."""

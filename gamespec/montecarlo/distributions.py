@@ -11,7 +11,14 @@ from dataclasses import dataclass, field
 from typing import Protocol, runtime_checkable
 
 import numpy as np
-from scipy.special import ndtri
+
+
+def ndtri(u: np.ndarray) -> np.ndarray:
+    """The standard normal's inverse CDF (SciPy's ``ndtri``), imported on first use: scipy.special
+    costs a command's start-up ~0.2 s, and a file that samples nothing never calls it."""
+    from scipy.special import ndtri as scipy_ndtri
+
+    return np.asarray(scipy_ndtri(u))
 
 
 @runtime_checkable

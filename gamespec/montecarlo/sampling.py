@@ -10,7 +10,6 @@ from __future__ import annotations
 from collections.abc import Mapping
 
 import numpy as np
-from scipy.stats import qmc
 
 from gamespec.montecarlo.distributions import Distribution
 
@@ -24,6 +23,8 @@ def _uniforms(n: int, width: int, seed: int, method: str) -> np.ndarray:
     if method == "random":
         u = np.random.default_rng(seed).random((n, width))
     elif method == "latin_hypercube":
+        from scipy.stats import qmc  # scipy.stats costs a command's start-up ~0.5 s: imported when used
+
         u = qmc.LatinHypercube(d=width, seed=np.random.default_rng(seed)).random(n)
     else:
         raise ValueError(f"unknown sampling method {method!r}; expected one of {', '.join(METHODS)}")

@@ -8,7 +8,6 @@ from collections.abc import Mapping
 from dataclasses import dataclass
 
 import numpy as np
-from scipy.stats import norm, t
 
 
 @dataclass(frozen=True)
@@ -55,6 +54,8 @@ def _summary(values: np.ndarray, confidence: float) -> Summary:
         return Summary(0, flat.size, nan, nan, nan, nan, nan, nan, confidence)
     mean = float(finite.mean())
     std = float(finite.std(ddof=1)) if n > 1 else nan
+    from scipy.stats import t  # scipy.stats costs a command's start-up ~0.5 s: imported when used
+
     half = float(t.ppf(0.5 + confidence / 2, n - 1)) * std / math.sqrt(n) if n > 1 else nan
     return Summary(
         n=n,
@@ -85,6 +86,8 @@ def proportion(events: np.ndarray, confidence: float = 0.95) -> Proportion:
         raise ValueError("proportion needs at least one event")
     k = int(flags.sum())
     p = k / n
+    from scipy.stats import norm  # imported when used (see _summary)
+
     z = float(norm.ppf(0.5 + confidence / 2))
     centre = (p + z * z / (2 * n)) / (1 + z * z / n)
     half = z * math.sqrt(p * (1 - p) / n + z * z / (4 * n * n)) / (1 + z * z / n)

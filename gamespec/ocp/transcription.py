@@ -34,6 +34,10 @@ from gamespec.result import Result, Status
 from gamespec.specs.ocp import INITIAL_TIME, NORMALIZED_TIME, OptimalControlSpec, bounds_midpoint
 from gamespec.symbolic.grammar import Relation, dependencies, expression, taken, unknowns
 
+UNCHECKED = "solution checks not computed (Transcription.checked is off: the caller reads none of them)"
+"""Why a Result of :meth:`Transcription.result` has no checks when they are turned off: its
+``metrics.checks_skipped`` says so, and it is ``feasible``, not ``optimal`` (nothing verified it)."""
+
 
 @dataclass(frozen=True)
 class Bounds:
@@ -78,6 +82,9 @@ class Transcription:
         self.grid = with_event_breaks(grid, spec) if mesh is None and degrees is None else grid
         self.t0 = spec.problem.time.origin
         self._last_bounds: tuple[tuple[tuple[str, float], ...], Bounds] | None = None
+        self.checked = True
+        """Whether :meth:`result` computes the solution checks (a caller that reads none of them,
+        a receding horizon's best responses, turns them off: see :data:`UNCHECKED`)."""
 
     @cached_property
     def interior(self) -> InteriorPoints:
@@ -379,8 +386,9 @@ class Transcription:
         design variables (``metrics["design"]``), a pass/fail verdict per check against its
         tolerance (``metrics["checks_passed"]`` and ``metrics["check_tolerances"]``, see
         :func:`~gamespec.ocp.checks.verdicts`) and the checks left out with the reason
-        (``metrics["checks_skipped"]``). ``integral_multipliers``: the NLP multipliers of the
-        integral constraints' rows, which enter the Hamiltonian check."""
+        (``metrics["checks_skipped"]``; all of them, ``feasible``, when :attr:`checked` is off).
+        ``integral_multipliers``: the NLP multipliers of the integral constraints' rows, which enter
+        the Hamiltonian check."""
         if objective is not None:
             objective -= self.ocp.sign * float(self.rate_penalty(U))
         values = np.zeros(self.n_d) if design is None else np.asarray(design, dtype=float)
@@ -395,9 +403,14 @@ class Transcription:
         if defect_multipliers is not None and self.grid.scheme == "radau":
             lam = defect_multipliers * self.costate_rows[None, :]
             costates = {f"lambda_{n}": lam[i] for i, n in enumerate(self.ocp.states)}
-        checks, skipped = solution_checks(
-            self, Trajectory(X, U, inputs, T), {**params, **optimized}, lam, integral_multipliers
-        )
+        if self.checked:
+            checks, skipped = solution_checks(
+                self, Trajectory(X, U, inputs, T), {**params, **optimized}, lam, integral_multipliers
+            )
+        else:
+            checks, skipped = {}, {"solution_checks": UNCHECKED}
+            if status is Status.OPTIMAL:
+                status, message = Status.FEASIBLE, f"{message}; not verified optimal: {UNCHECKED}"
         refine = self.spec.method.refine
         tolerances = check_tolerances(checks, refine.tolerance if refine else None)
         if lam is not None:

@@ -107,8 +107,10 @@ def float_value(expr: sp.Basic) -> float:
     return value
 
 
+@lru_cache(maxsize=4096)
 def symbol(name: str) -> sp.Symbol:
-    """The SymPy symbol gamespec uses for a declared name (real-valued)."""
+    """The SymPy symbol gamespec uses for a declared name (real-valued; kept per name: a symbol is
+    immutable, and reports rebuild the same ones for every Result)."""
     return TIME if name == "t" else sp.Symbol(name, real=True)
 
 

@@ -202,7 +202,7 @@ def _chapter_7(*sets: str) -> dict:
 def test_chapter_7_run_is_unchanged_by_the_compiled_routes(monkeypatch) -> None:
     """Section 7.3.2 at Q = 1: capture time, each player's clearance of the obstacle and who
     collides are those of the run with the interpreted true system and point evaluation and
-    IPOPT's default ``max_iter`` (the file caps it at 150)."""
+    IPOPT's default ``max_iter`` (the file caps it at 60)."""
     compiled = _chapter_7()
 
     def advance(self, x0, params, plan, t0, duration, breaks):

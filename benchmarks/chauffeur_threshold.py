@@ -33,9 +33,11 @@ def isaacs_threshold(gamma: float) -> float:
     return math.sqrt(1 - gamma**2) + gamma * math.asin(gamma) - 1
 
 
-def chauffeur_model(box: float, nodes: int, horizon: float) -> CompiledModel:
-    """The reduced chauffeur on ``[−box, box]²`` with ``nodes`` per axis up to ``horizon``."""
+def chauffeur_model(box: float, nodes: int, horizon: float, flux: str | None = None) -> CompiledModel:
+    """The reduced chauffeur on ``[−box, box]²`` with ``nodes`` per axis up to ``horizon``, by the
+    numerical Hamiltonian ``flux`` (``solver.options.hji.flux``; None: the default)."""
     sets = [f"solver.options.hji.nodes={nodes}", f"problem.time.final={horizon}"]
+    sets += [] if flux is None else [f"solver.options.hji.flux={flux}"]
     sets += [f"solver.options.hji.lower=[{-box},{-box}]", f"solver.options.hji.upper=[{box},{box}]"]
     return compile_spec(load(FILE, sets))
 
@@ -62,6 +64,7 @@ def main() -> None:
     parser.add_argument("--horizon", type=float, nargs="+", default=[8.0], help="horizons T")
     parser.add_argument("--width", type=float, default=0.0025, help="the bracket's width in ℓ")
     parser.add_argument("--within", type=float, nargs=2, default=[0.2, 0.4], help="the ℓ to bisect")
+    parser.add_argument("--flux", choices=["upwind", "lax_friedrichs"], help="solver.options.hji.flux")
     args = parser.parse_args()
     spec = load(FILE)
     gamma = float(spec.problem.parameters["gamma"])
@@ -73,7 +76,8 @@ def main() -> None:
         for horizon in args.horizon:
             for nodes in args.nodes:
                 start = time.process_time()
-                low, high = switch_bracket(chauffeur_model(box, nodes, horizon), *args.within, args.width)
+                model = chauffeur_model(box, nodes, horizon, args.flux)
+                low, high = switch_bracket(model, *args.within, args.width)
                 print(
                     f"| ±{box:g} | {nodes} | {2 * box / (nodes - 1):.4f} | {horizon:g} | "
                     f"[{low:.4f}, {high:.4f}] | {(low + high) / 2 - star:+.4f} | "

@@ -6,13 +6,18 @@ y = γR (where the car's turning just matches the pedestrian's sideways run), an
 leaks through it; below it the set stops growing (``metrics.capture_region.converged``). The study
 bisects ℓ on that verdict (:func:`switch_bracket`) for boxes and grids given on the command line.
 
-What the table shows (measured for issue 26): the switch does not depend on the box (the value at
-the gap point is the same to 1e-4 on [−1, 1]², [−1.5, 1.5]² and [−3, 3]² at one spacing) but on the
-spacing: the numerical dissipation fills in the narrow neck between the arcs, so the switch lies
-above ℓ* by an error that falls under refinement more slowly than the spacing (about as h^(2/3)).
+What the table shows (measured for issue 26; the table is in ``docs/feedback-equilibria.md``): the
+switch does not depend on the box (by Lax–Friedrichs, the value at the gap point is the same to 1e-4
+on [−1, 1]², [−1.5, 1.5]² and [−3, 3]² at one spacing) but on the spacing: the numerical dissipation
+narrows the neck between the arcs, so the switch lies above ℓ* by an error that falls under
+refinement. By the default upwind flux (``solver.options.hji.flux``) it is about 0.3 spacings and
+falls as h (+0.0157, +0.0079, +0.0036 at 41, 81 and 161 nodes on [−1, 1]², T = 8); by local
+Lax–Friedrichs, whose dissipation is the fastest control sample's, about as h^0.6 (+0.0407, +0.0282,
++0.0175), for about half the CPU per solve.
 
 Run: ``python -m benchmarks.chauffeur_threshold [--box 1.0] [--nodes 41 81 161] [--horizon 8]
-[--within 0.2 0.4]`` (minutes; not part of the test suite).
+[--within 0.2 0.4] [--flux lax_friedrichs]`` (minutes; the 161-node grid about 20 minutes of CPU;
+not part of the test suite).
 """
 
 from __future__ import annotations

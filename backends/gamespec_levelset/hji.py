@@ -22,7 +22,8 @@ Its dissipation is that of the fastest sample, wherever the optimal one is slow:
 chauffeur's narrow neck between the barrier's arcs, and the study over ℓ's switch lies above
 Isaacs' threshold by an error that falls as h^0.6 against the upwind flux's h^1
 (``benchmarks/chauffeur_threshold.py``; ``docs/feedback-equilibria.md``). The upwind flux costs
-about twice as much per step (the sums run over every pair of samples, not the two players' apart).
+1.7 to 2.5 times the CPU per solve (41 to 81 nodes: its sums run over every pair of samples, not
+over the two players' apart).
 The ghost nodes extrapolate linearly, so what lies outside the box is guessed: the box must hold the
 manoeuvres that capture (a region too small for them stops growing early).
 
@@ -47,8 +48,9 @@ the initial state (φ interpolated bilinearly there) is decided: ``capture`` at 
 part connected to the target the same at the bound as at half of it, clear of the grid's edge:
 :func:`converged`), else ``undecided`` (``iteration_limit``). The bound must exceed twice the time
 the set takes to settle: a set still creeping into a narrow neck at T/2 reads as growing (the
-chauffeur's study over ℓ, ``benchmarks/chauffeur_threshold.py``, switches 0.005 lower at T = 4
-than at T = 8 or 16 at spacing 0.05). The concept is ``saddle`` when the min and max separate
+chauffeur's study over ℓ, ``benchmarks/chauffeur_threshold.py``, switched 0.005 lower at T = 4
+than at T = 8 or 16 at spacing 0.05 by the Lax–Friedrichs flux; by the upwind flux the same at all
+three). The concept is ``saddle`` when the min and max separate
 (Isaacs' minimax condition, under which the upper and lower values of eqs. 4.9–4.10 agree), else
 ``upper_value`` (eq. 4.9's order: the maximizer answers the minimizer's control); the information
 pattern is feedback. The value generalizes the reachability front of eq. 5.22 (the level of the

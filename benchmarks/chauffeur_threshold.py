@@ -6,13 +6,18 @@ y = γR (where the car's turning just matches the pedestrian's sideways run), an
 leaks through it; below it the set stops growing (``metrics.capture_region.converged``). The study
 bisects ℓ on that verdict (:func:`switch_bracket`) for boxes and grids given on the command line.
 
-What the table shows (measured for issue 26): the switch does not depend on the box (the value at
-the gap point is the same to 1e-4 on [−1, 1]², [−1.5, 1.5]² and [−3, 3]² at one spacing) but on the
-spacing: the numerical dissipation fills in the narrow neck between the arcs, so the switch lies
-above ℓ* by an error that falls under refinement more slowly than the spacing (about as h^(2/3)).
+What the table shows (measured for issue 26; the table is in ``docs/feedback-equilibria.md``): the
+switch does not depend on the box (by Lax–Friedrichs, the value at the gap point is the same to 1e-4
+on [−1, 1]², [−1.5, 1.5]² and [−3, 3]² at one spacing) but on the spacing: the numerical dissipation
+narrows the neck between the arcs, so the switch lies above ℓ* by an error that falls under
+refinement. By the default upwind flux (``solver.options.hji.flux``) it is about 0.3 spacings and
+falls as h (+0.0157, +0.0079, +0.0036 at 41, 81 and 161 nodes on [−1, 1]², T = 8); by local
+Lax–Friedrichs, whose dissipation is the fastest control sample's, about as h^0.6 (+0.0407, +0.0282,
++0.0175), for about half the CPU per solve.
 
 Run: ``python -m benchmarks.chauffeur_threshold [--box 1.0] [--nodes 41 81 161] [--horizon 8]
-[--within 0.2 0.4]`` (minutes; not part of the test suite).
+[--within 0.2 0.4] [--flux lax_friedrichs]`` (minutes; the 161-node grid about 20 minutes of CPU;
+not part of the test suite).
 """
 
 from __future__ import annotations
@@ -33,9 +38,11 @@ def isaacs_threshold(gamma: float) -> float:
     return math.sqrt(1 - gamma**2) + gamma * math.asin(gamma) - 1
 
 
-def chauffeur_model(box: float, nodes: int, horizon: float) -> CompiledModel:
-    """The reduced chauffeur on ``[−box, box]²`` with ``nodes`` per axis up to ``horizon``."""
+def chauffeur_model(box: float, nodes: int, horizon: float, flux: str | None = None) -> CompiledModel:
+    """The reduced chauffeur on ``[−box, box]²`` with ``nodes`` per axis up to ``horizon``, by the
+    numerical Hamiltonian ``flux`` (``solver.options.hji.flux``; None: the default)."""
     sets = [f"solver.options.hji.nodes={nodes}", f"problem.time.final={horizon}"]
+    sets += [] if flux is None else [f"solver.options.hji.flux={flux}"]
     sets += [f"solver.options.hji.lower=[{-box},{-box}]", f"solver.options.hji.upper=[{box},{box}]"]
     return compile_spec(load(FILE, sets))
 
@@ -62,6 +69,7 @@ def main() -> None:
     parser.add_argument("--horizon", type=float, nargs="+", default=[8.0], help="horizons T")
     parser.add_argument("--width", type=float, default=0.0025, help="the bracket's width in ℓ")
     parser.add_argument("--within", type=float, nargs=2, default=[0.2, 0.4], help="the ℓ to bisect")
+    parser.add_argument("--flux", choices=["upwind", "lax_friedrichs"], help="solver.options.hji.flux")
     args = parser.parse_args()
     spec = load(FILE)
     gamma = float(spec.problem.parameters["gamma"])
@@ -73,7 +81,8 @@ def main() -> None:
         for horizon in args.horizon:
             for nodes in args.nodes:
                 start = time.process_time()
-                low, high = switch_bracket(chauffeur_model(box, nodes, horizon), *args.within, args.width)
+                model = chauffeur_model(box, nodes, horizon, args.flux)
+                low, high = switch_bracket(model, *args.within, args.width)
                 print(
                     f"| ±{box:g} | {nodes} | {2 * box / (nodes - 1):.4f} | {horizon:g} | "
                     f"[{low:.4f}, {high:.4f}] | {(low + high) / 2 - star:+.4f} | "

@@ -8,11 +8,24 @@ solves ``∂φ/∂τ = min(0, H(x, ∇φ))`` from ``φ(x, 0) = l(x)``, with the 
 ``H(x, p) = min_u max_d p · f(x, u, d)`` (u: the minimizing players' controls, d: the maximizing
 ones'); a node is captured within the horizon T when ``φ(x, T) ≤ 0``. The scheme is the project's
 level-set numerics (:mod:`gamespec.flowfield.upwind`: one-sided derivatives with ghost nodes by
-linear extrapolation; :mod:`gamespec.flowfield.tvd_rk`: TVD-RK3) with a local Lax–Friedrichs flux
-``Ĥ = H(x, (p⁻ + p⁺)/2) + Σ_i α_i (p⁺_i − p⁻_i)/2``, ``α_i ≥ max |f_i|`` over the controls, and the
-reach clamp ``φ ← min(φ, φ_before)`` after each step. The ghost nodes extrapolate linearly, so what
-lies outside the box is guessed: the box must hold the manoeuvres that capture (a region too small
-for them stops growing early).
+linear extrapolation; :mod:`gamespec.flowfield.tvd_rk`: TVD-RK3) with a numerical Hamiltonian
+``Ĥ(p⁻, p⁺)`` (``flux``) and the reach clamp ``φ ← min(φ, φ_before)`` after each step. ``upwind``
+(the default): ``Ĥ = min_u max_d Σ_i [max(f_i, 0) p⁺_i + min(f_i, 0) p⁻_i]``, f = f(x, u, d) over
+the control samples: every sample's Hamiltonian is linear in p, ``∂φ/∂τ = f · ∇φ`` carries φ
+against f, and each is upwinded exactly (its own ``α_i = |f_i|``); the min and max of monotone
+fluxes are monotone (nondecreasing in p⁺, nonincreasing in p⁻), consistent (``Ĥ(p, p) = H(p)``), and
+add no dissipation beyond each sample's upwinding. ``lax_friedrichs``: the local Lax–Friedrichs flux
+``Ĥ = H(x, (p⁻ + p⁺)/2) + Σ_i α_i (p⁺_i − p⁻_i)/2`` with ``α_i = max |f_i|`` over every sample at the
+node (Osher & Shu 1991; Osher & Fedkiw §5.3.1's LLF, as ToolboxLS's ``artificialDissipationLLF``:
+for dynamics linear in p per sample, the bound over all costates is the bound over the samples).
+Its dissipation is that of the fastest sample, wherever the optimal one is slow: it fills in the
+chauffeur's narrow neck between the barrier's arcs, and the study over ℓ's switch lies above
+Isaacs' threshold by an error that falls as h^0.6 against the upwind flux's h^1
+(``benchmarks/chauffeur_threshold.py``; ``docs/feedback-equilibria.md``). The upwind flux costs
+1.7 to 2.5 times the CPU per solve (41 to 81 nodes: its sums run over every pair of samples, not
+over the two players' apart).
+The ghost nodes extrapolate linearly, so what lies outside the box is guessed: the box must hold the
+manoeuvres that capture (a region too small for them stops growing early).
 
 The min and max over the control boxes are taken over samples: a control that enters the dynamics
 affinely (zero second derivative) is sampled at its two bounds (exact: a linear function's optimum
@@ -35,8 +48,9 @@ the initial state (φ interpolated bilinearly there) is decided: ``capture`` at 
 part connected to the target the same at the bound as at half of it, clear of the grid's edge:
 :func:`converged`), else ``undecided`` (``iteration_limit``). The bound must exceed twice the time
 the set takes to settle: a set still creeping into a narrow neck at T/2 reads as growing (the
-chauffeur's study over ℓ, ``benchmarks/chauffeur_threshold.py``, switches 0.005 lower at T = 4
-than at T = 8 or 16 at spacing 0.05). The concept is ``saddle`` when the min and max separate
+chauffeur's study over ℓ, ``benchmarks/chauffeur_threshold.py``, switched 0.005 lower at T = 4
+than at T = 8 or 16 at spacing 0.05 by the Lax–Friedrichs flux; by the upwind flux the same at all
+three). The concept is ``saddle`` when the min and max separate
 (Isaacs' minimax condition, under which the upper and lower values of eqs. 4.9–4.10 agree), else
 ``upper_value`` (eq. 4.9's order: the maximizer answers the minimizer's control); the information
 pattern is feedback. The value generalizes the reachability front of eq. 5.22 (the level of the
@@ -59,6 +73,7 @@ degree also checks that the half-resolution grid decides the same, with a captur
 
 from __future__ import annotations
 
+import dataclasses
 import itertools
 import math
 from dataclasses import dataclass
@@ -86,6 +101,7 @@ from gamespec.symbolic.language import parse, parse_relation, symbol
 from gamespec.terminal import progress
 
 ONE_SIDED = "a set is one one-sided relation (g <= c or g >= c)"
+Flux = Literal["upwind", "lax_friedrichs"]
 
 
 class HJIOptions(StrictModel):
@@ -107,6 +123,12 @@ class HJIOptions(StrictModel):
         None, gt=0, description="How long the pursuers have to capture (default: the game's horizon)."
     )
     scheme: Literal["first_order", "eno2", "weno5"] = Field("eno2", description="The upwind scheme.")
+    flux: Flux = Field(
+        "upwind",
+        description="The numerical Hamiltonian: upwind (each control sample's p·f upwinded exactly, then "
+        "the min and max over the samples) or lax_friedrichs (H at the mean costate plus the dissipation "
+        "of the fastest sample per axis and node); engine: hj_reachability uses its own Lax–Friedrichs.",
+    )
     engine: Literal["gamespec", "hj_reachability"] = Field(
         "gamespec",
         description="gamespec: the project's level-set numerics; hj_reachability: the same value by "
@@ -158,13 +180,18 @@ class SampledHamiltonian:
     """The dynamics at every node for each sample of the controls: ``base`` f(x, u₀, d₀) (2, nx, ny);
     separable: ``pursuer`` f(x, u_k, d₀) − base (K, 2, nx, ny) and ``evader`` f(x, u₀, d_m) − base
     (M, 2, nx, ny); otherwise ``joint`` f(x, u_k, d_m) − base (K, M, 2, nx, ny). ``speed`` (2, nx, ny)
-    is ``max |f_i|`` over the samples (the Lax–Friedrichs α)."""
+    is ``max |f_i|`` over the samples (the Lax–Friedrichs α, and the CFL condition's speed);
+    ``magnitude`` (2, K, M, nx, ny) is ``|f_i(x, u_k, d_m)|`` per axis and sample pair, for the
+    upwind flux (:meth:`numerical`; None when the Lax–Friedrichs flux is used); ``work`` holds that
+    flux's buffers."""
 
     base: np.ndarray
     pursuer: np.ndarray | None
     evader: np.ndarray | None
     joint: np.ndarray | None
     speed: np.ndarray
+    magnitude: np.ndarray | None = None
+    work: dict[str, np.ndarray] = dataclasses.field(default_factory=dict, repr=False, compare=False)
 
     def __call__(self, p: np.ndarray) -> np.ndarray:
         """``min_u max_d p · f`` at every node for the costate ``p`` (2, nx, ny)."""
@@ -176,6 +203,40 @@ class SampledHamiltonian:
         value += np.einsum("i...,ki...->k...", p, self.pursuer).min(axis=0)
         value += np.einsum("i...,ki...->k...", p, self.evader).max(axis=0)
         return value
+
+    def numerical(self, minus: np.ndarray, plus: np.ndarray) -> np.ndarray:
+        """The numerical Hamiltonian ``Ĥ(p⁻, p⁺)`` (2, nx, ny each; module doc): Lax–Friedrichs
+        ``H(p̄) + Σ_i α_i (p⁺_i − p⁻_i)/2`` with ``p̄ = (p⁻ + p⁺)/2`` and α = ``speed`` when
+        ``magnitude`` is None; else upwind, ``min_k max_m Σ_i [f_i p̄_i + |f_i| (p⁺_i − p⁻_i)/2]``
+        with ``f = f(x, u_k, d_m)``, which is ``Σ_i max(f_i, 0) p⁺_i + min(f_i, 0) p⁻_i``: each
+        sample's linear Hamiltonian upwinded exactly (``∂φ/∂τ = f · ∇φ`` carries φ against f, so
+        its information comes from the side f points to), then the min and max over the samples.
+        The sums over the sample pairs are formed in buffers kept from call to call."""
+        mean, jump = (minus + plus) / 2, (plus - minus) / 2
+        if self.magnitude is None:
+            lax_friedrichs: np.ndarray = self(mean) + self.speed[0] * jump[0] + self.speed[1] * jump[1]
+            return lax_friedrichs
+        work = self.work
+        if not work:
+            shape = self.magnitude.shape[1:]
+            work.update(pairs=np.empty(shape), term=np.empty(shape))
+            if self.evader is not None:
+                work.update(evader=np.empty(self.evader[:, 0].shape), part=np.empty(self.evader[:, 0].shape))
+        pairs, term = work["pairs"], work["term"]
+        np.multiply(self.magnitude[0], jump[0], out=pairs)
+        pairs += np.multiply(self.magnitude[1], jump[1], out=term)
+        if self.joint is not None:
+            pairs += np.multiply(self.joint[:, :, 0], mean[0], out=term)
+            pairs += np.multiply(self.joint[:, :, 1], mean[1], out=term)
+            best = pairs.max(axis=1).min(axis=0)
+        else:
+            assert self.pursuer is not None and self.evader is not None, "a separable game has both"
+            evader = np.multiply(self.evader[:, 0], mean[0], out=work["evader"])
+            evader += np.multiply(self.evader[:, 1], mean[1], out=work["part"])
+            pairs += evader
+            best = (pairs.max(axis=1) + self.pursuer[:, 0] * mean[0] + self.pursuer[:, 1] * mean[1]).min(0)
+        upwind: np.ndarray = self.base[0] * mean[0] + self.base[1] * mean[1] + best
+        return upwind
 
 
 def _samples(
@@ -268,9 +329,10 @@ def control_samples(game: ParsedGame, samples: int, parameters: dict[str, float]
 
 
 def sampled_hamiltonian(
-    game: ParsedGame, grid: Grid, samples: int, parameters: dict[str, float]
+    game: ParsedGame, grid: Grid, samples: int, parameters: dict[str, float], flux: Flux
 ) -> SampledHamiltonian:
-    """The dynamics of ``game`` sampled at ``grid``'s nodes over the players' control boxes (module doc)."""
+    """The dynamics of ``game`` sampled at ``grid``'s nodes over the players' control boxes (module
+    doc), with the magnitudes per sample pair when the ``flux`` is ``upwind``."""
     sampled = control_samples(game, samples, parameters)
     controls, us, ds, separable = sampled.controls, sampled.us, sampled.ds, sampled.separable
     f = numeric_function(sampled.exprs, [symbol(s) for s in sampled.states] + [symbol(c) for c in controls])
@@ -286,10 +348,16 @@ def sampled_hamiltonian(
         evader = np.stack([at(u0 | d) - base for d in ds])
         highest = base + pursuer.max(axis=0) + evader.max(axis=0)
         speed = np.maximum(highest, -(base + pursuer.min(axis=0) + evader.min(axis=0)))
-        return SampledHamiltonian(base, pursuer, evader, None, speed)
+        magnitude = None
+        if flux == "upwind":
+            magnitude = np.ascontiguousarray(
+                np.abs(np.moveaxis(base + pursuer[:, None] + evader[None], 2, 0))
+            )
+        return SampledHamiltonian(base, pursuer, evader, None, speed, magnitude)
     joint = np.stack([np.stack([at(u | d) - base for d in ds]) for u in us])
-    speed = np.abs(joint + base).max(axis=(0, 1))
-    return SampledHamiltonian(base, None, None, joint, speed)
+    magnitude = np.ascontiguousarray(np.abs(np.moveaxis(joint + base, 2, 0)))
+    speed = magnitude.max(axis=(1, 2))
+    return SampledHamiltonian(base, None, None, joint, speed, magnitude if flux == "upwind" else None)
 
 
 def _number(
@@ -389,12 +457,9 @@ def reach_value(
 
     def rate(k: int) -> np.ndarray:
         extrapolate_ghosts(padded[k])
-        lx, rx = (a.copy() for a in upwind_pair(padded[k][:, g:-g], 0, dx[0], scheme, scratch))
-        ly, ry = (a.copy() for a in upwind_pair(padded[k][g:-g, :], 1, dx[1], scheme, scratch))
-        central = np.stack([(lx + rx) / 2, (ly + ry) / 2])
-        dissipation = hamiltonian.speed[0] * (rx - lx) / 2 + hamiltonian.speed[1] * (ry - ly) / 2
-        total: np.ndarray = hamiltonian(central) + dissipation
-        return total
+        lx, rx = upwind_pair(padded[k][:, g:-g], 0, dx[0], scheme, scratch)
+        ly, ry = upwind_pair(padded[k][g:-g, :], 1, dx[1], scheme, scratch)  # the other axis' buffers
+        return hamiltonian.numerical(np.stack([lx, ly]), np.stack([rx, ry]))
 
     half = inner[0].copy()
     for step in range(steps):
@@ -515,11 +580,11 @@ class HJIModel(CompiledModel):
         """The grid, the reach (–avoid) run on it (stopped when ``budget`` expires) and whether the
         min and max were taken separately (Isaacs' condition holds for the sampled controls)."""
         grid = Grid(self.box[0], self.box[1], (nodes, nodes))
-        ham = sampled_hamiltonian(self.parsed, grid, self.options.control_samples, parameters)
+        o = self.options
+        ham = sampled_hamiltonian(self.parsed, grid, o.control_samples, parameters, o.flux)
         start = target(self.parsed, grid, parameters)
         avoid = self.game.problem.avoid
         barrier = None if avoid is None else -relation_level(self.parsed, "problem.avoid", grid, parameters)
-        o = self.options
         if o.engine == "hj_reachability":
             run = self._hj_reachability(grid, start, horizon, parameters, barrier, probe)
         else:

@@ -6,7 +6,9 @@ from the target's level, with ``φ ← max(φ, g)`` for an avoid set (reach–av
 hj_reachability (Bansal & Tomlin's JAX toolbox: its upwind ENO2/WENO5 schemes, TVD-RK3, the
 ``backwards_reachable_tube`` Hamiltonian postprocessor and the ``static_obstacle`` value
 postprocessor, linear extrapolation at the grid's edge as in the project's engine). Its Lax–Friedrichs
-dissipation is global (one α per axis over the grid), the project's local. The dynamics are printed
+dissipation is global (one α per axis over the grid), the project's local (``flux: lax_friedrichs``)
+or, by default, none beyond each control sample's upwinding (``flux: upwind``), so the two engines
+differ by their dissipation near a narrow neck (the chauffeur's threshold). The dynamics are printed
 by SymPy's JAX printer (``lambdify(..., modules="jax")``) and the Hamiltonian's min and max are over
 the same control samples (:func:`gamespec_levelset.hji.control_samples`). Values are kept at
 the times the caller asks for (``hj_outputs`` per half horizon), so the capture times are linear

@@ -339,7 +339,11 @@ def best_reply(game: DiscreteGame, solution: FeedbackStrategies, player: int) ->
         "reply",
         "ipopt",
         {"x": v, "f": cost},
-        {"ipopt": {"print_level": 0, "sb": "yes", "tol": 1e-12}, "print_time": False},
+        {
+            "ipopt": {"print_level": 0, "sb": "yes", "tol": 1e-12},
+            "print_time": False,
+            "show_eval_warnings": False,
+        },
     )
     lower = np.tile(game.lower[own], K)
     upper = np.tile(game.upper[own], K)

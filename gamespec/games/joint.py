@@ -328,7 +328,13 @@ class JointSystem:
             "bound_relax_factor": 0.0,
             "fixed_variable_treatment": "make_parameter",
         }
-        options = {"ipopt": ipopt, "print_time": False, "calc_lam_p": False, "calc_lam_x": False}
+        options = {
+            "ipopt": ipopt,
+            "print_time": False,
+            "calc_lam_p": False,
+            "calc_lam_x": False,
+            "show_eval_warnings": False,
+        }
         self.solver = ca.nlpsol("joint", "ipopt", {"x": z, "p": p, "f": 0, "g": F}, options)
 
     def _start(

@@ -131,12 +131,16 @@ def read_table_file(file: str, folder: Path) -> tuple[list[np.ndarray], np.ndarr
     """The axes and values of a CSV or NPZ table ``file`` inside ``folder``; a ValueError naming what
     is wrong (a path leaving the folder, a missing or oversized file, malformed data)."""
     base = folder.resolve()
-    path = (base / file).resolve()
-    if Path(file).is_absolute() or not path.is_relative_to(base):
-        raise ValueError(f"table file {file!r} must lie inside the problem file's folder")
-    if not path.is_file():
-        raise ValueError(f"table file {file!r} not found next to the problem file")
-    if path.stat().st_size > MAX_FILE_BYTES:
+    try:
+        path = (base / file).resolve()
+        if Path(file).is_absolute() or not path.is_relative_to(base):
+            raise ValueError(f"table file {file!r} must lie inside the problem file's folder")
+        if not path.is_file():
+            raise ValueError(f"table file {file!r} not found next to the problem file")
+        size = path.stat().st_size
+    except OSError as err:
+        raise ValueError(f"table file {file[:60]!r}: {err.strerror or err}") from None
+    if size > MAX_FILE_BYTES:
         raise ValueError(f"table file {file!r} is larger than {MAX_FILE_BYTES} bytes")
     suffix = path.suffix.lower()
     if suffix == ".csv":

@@ -125,7 +125,13 @@ class SympyAlgebra:
         return CONSTANTS[name]
 
     def binary(self, op: type[ast.operator], left: sp.Expr, right: sp.Expr) -> sp.Expr:
-        return self.finite(BINARY[op](left, right))
+        """``left op right``; a quotient of zeros SymPy's floats divide as mpmath does (raising),
+        refused as the floats' walk refuses it."""
+        try:
+            value = BINARY[op](left, right)
+        except ZeroDivisionError:
+            raise Refused("is infinite, undefined or not real") from None
+        return self.finite(value)
 
     def negate(self, value: sp.Expr) -> sp.Expr:
         return -value

@@ -224,3 +224,15 @@ def test_checks_of_a_failed_solve_evaluate_to_nan_not_an_error() -> None:
     result = gamespec.solve(spec_from_dict(data, source="test"), "casadi")
     assert result.status.value != "optimal"
     assert math.isnan(result.checks["hamiltonian_end_error"])
+
+
+@pytest.mark.parametrize("text", ["(-0.0 / -0.0)", "0.0/0.0", "1/(-0.0)"])
+def test_a_quotient_by_a_zero_float_is_refused_in_sympy_as_in_floats(text):
+    """SymPy's floats divide a zero by a zero as mpmath does, raising ZeroDivisionError (found by
+    the long solve-path fuzz in a flow-field drift); both walks refuse it with one message."""
+    messages = []
+    for algebra in (FLOATS, SYMPY):
+        with pytest.raises(ExpressionError) as refused:
+            expression(text, {}, algebra)
+        messages.append(str(refused.value))
+    assert messages[0] == messages[1] and "undefined" in messages[0]

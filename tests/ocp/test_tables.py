@@ -179,6 +179,7 @@ def test_two_axis_csv_grid(tmp_path: Path) -> None:
         ({"axes": [[0, 1, 2]], "values": [0, 1, 2], "method": "bspline"}, "at least 4"),
         ({"file": "../outside.csv"}, "inside the problem file's folder"),
         ({"file": "missing.csv"}, "not found"),
+        ({"file": "-" * 300 + ".csv"}, "File name too long"),
     ],
 )
 def test_bad_tables_are_refused_at_load(table: dict, reason: str) -> None:

@@ -83,9 +83,11 @@ def array(
 
 
 def state(result: Result, name: str, ndim: int = 1, *, last: int | None = None) -> np.ndarray:
-    """``result.states[name]`` as :func:`array` checks it, one row per point of ``result.time``."""
-    rows = None if result.time is None else len(result.time)
-    return shaped(result.states.get(name), f"states.{name}", ndim, rows=rows, last=last)
+    """``result.states[name]`` as :func:`array` checks it, one row per point of ``result.time``
+    (which must be there: a trajectory without its time grid is refused)."""
+    if result.time is None:
+        raise ValueError(f"states.{name} has no time grid (time is missing)")
+    return shaped(result.states.get(name), f"states.{name}", ndim, rows=len(result.time), last=last)
 
 
 def shaped(

@@ -86,12 +86,14 @@ def nlp_solver(nlp: Any, options: CasadiOptions) -> Any:
     ipopt["max_wall_time"] = options.max_wall_time
     # NaN in a function evaluation ends as the status numerical_error; CasADi's own warnings about it
     # (and about the parameter multipliers lam_p, which nothing reads) would be extra lines on stderr
-    # (README, "Bad input": one line).
+    # (README, "Bad input": one line). So would its check of the inputs (an overconstrained NLP is a
+    # warning there): CasadiModel.solve_once makes the same checks and says them in the Result.
     nlp_opts: dict[str, Any] = {
         "ipopt": ipopt | IPOPT_DEFAULTS | options.ipopt,
         "print_time": False,
         "show_eval_warnings": False,
         "calc_lam_p": False,
+        "inputs_check": False,
     }
     if options.graph == "assembled" and options.solver == "ipopt":
         from gamespec_casadi.assembly import assembled_nlp
@@ -101,6 +103,19 @@ def nlp_solver(nlp: Any, options: CasadiOptions) -> Any:
     else:
         problem = nlp.closed()
     return ca.nlpsol("gamespec", options.solver, problem, nlp_opts)
+
+
+def ill_posed(lbx: np.ndarray, ubx: np.ndarray, lbg: np.ndarray, ubg: np.ndarray) -> str:
+    """What CasADi's own check of an NLP's bounds finds (turned off in :func:`nlp_solver`, where it
+    prints): a BackendError for a lower bound above its upper one (the transcription's bug: the
+    spec orders every bound at load); the note that the NLP has more equality rows than variables
+    (every bound fixing a control, say), else ''."""
+    if np.any(lbx > ubx) or np.any(lbg > ubg):
+        raise BackendError("the NLP has a lower bound above its upper bound")
+    equalities = int(np.sum(lbx == ubx) + np.sum(lbg == ubg))
+    if equalities > len(lbx):
+        return f"overconstrained: {equalities} equalities (fixed variables included) for {len(lbx)} variables"
+    return ""
 
 
 class CasadiModel(CollocationModel):
@@ -187,6 +202,7 @@ class CasadiModel(CollocationModel):
             w0 = self.pack(start.X, start.U, start.d, start.T)
         horizon = [] if tr.free_time else [b.t_lower]
         p_val = np.concatenate([[params[n] for n in tr.ocp.parameters], Win.ravel(order="F"), horizon])
+        posed = ill_posed(lbx, ubx, lbg, ubg)
         tic = time.perf_counter()
         sol = self.solver(
             x0=np.clip(w0, lbx, ubx), lbx=lbx, ubx=ubx, lbg=lbg, ubg=ubg, p=p_val, **multipliers
@@ -195,6 +211,8 @@ class CasadiModel(CollocationModel):
         stats = self.solver.stats()
         native = stats.get("return_status", "unknown")
         status = STATUS_MAP.get(native, Status.ERROR)
+        if posed and not status.ok:
+            native = f"{native} ({posed})"
         w = np.asarray(sol["x"]).ravel()
         if status.ok:
             self._last = w

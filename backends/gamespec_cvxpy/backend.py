@@ -86,19 +86,25 @@ class _Problem:
         self.options = options
         self.seconds = 0.0
         self.note = ""
-        self.raised = False
+        self.raised = ""
+        """Why the last run raised (empty when it did not)."""
 
     def _run(self, solver: str, solver_options: dict[str, Any]) -> Status:
         import cvxpy as cp
 
         start = time.perf_counter()
-        self.raised = False
+        self.raised = ""
         try:
             with warnings.catch_warnings():
                 warnings.filterwarnings("ignore", message="Solution may be inaccurate")
                 self.problem.solve(solver=solver, warm_start=True, **solver_options)
         except cp.SolverError:
-            self.raised = True
+            self.raised = "a solver error"
+            return Status.NUMERICAL_ERROR
+        except ValueError as err:
+            if "Problem data contains NaN" not in str(err):
+                raise
+            self.raised = "problem data with NaN or Inf (an input of extreme magnitude)"
             return Status.NUMERICAL_ERROR
         finally:
             self.seconds += time.perf_counter() - start
@@ -119,7 +125,7 @@ class _Problem:
     @property
     def reported(self) -> str:
         """What the solver reported last (cvxpy's status, or that it raised)."""
-        return "a solver error" if self.raised else self.problem.status
+        return self.raised or self.problem.status
 
 
 class MeanProblem:

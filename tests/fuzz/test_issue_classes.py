@@ -174,6 +174,16 @@ def test_huge_entries_of_an_lq_differential_game(assignment, field) -> None:
     assert outcome.code == 2 and f"{field}: " in outcome.err and "MAX_LQ_ENTRY" in outcome.err, outcome
 
 
+def test_an_overconstrained_nlp_is_said_in_the_one_line() -> None:
+    """Found by the long solve-path fuzz: a control fixed by its bounds (u in [1, 1]) leaves more
+    equalities than variables; CasADi printed a warning beside the status line, now the status's
+    message says it."""
+    path = PROBLEMS / "ocp" / "min_time_double_integrator.yaml"
+    outcome = run_cli(["solve", path, "--set", "problem.controls.u.lower=1"], bound_s=10 * ONE_SECOND)
+    assert_promise(outcome, str(path))
+    assert outcome.code == 1 and "overconstrained" in outcome.err, outcome
+
+
 def test_a_flow_too_fast_for_its_grid_is_refused_before_the_first_step() -> None:
     """Found by the long solve-path fuzz: a drift of 1e300 passed the load-time bound (the agents'
     speeds) and made the level sets' CFL step 1e-300; the step with the flow is bounded too."""

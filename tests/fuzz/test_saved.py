@@ -27,7 +27,15 @@ from gamespec.limits import MAX_ARRAY_VALUES
 from gamespec.result import Result
 from tests.conftest import PROBLEMS
 from tests.fuzz.harness import TIME_BOUND_S, assert_promise, cpu_bound, run_cli
-from tests.fuzz.saved import RESULTS, STORES, _npy, result_tampering, store_tampering
+from tests.fuzz.saved import (
+    RESULTS,
+    STORES,
+    _members,
+    _npy,
+    _write_members,
+    result_tampering,
+    store_tampering,
+)
 
 pytestmark = pytest.mark.skipif(not RESULTS or not STORES, reason="no seeds: python -m tests.fuzz.make_saved")
 
@@ -176,6 +184,15 @@ def _npy_member(header: str, data: bytes = b"") -> Callable[[Path], None]:
     return tamper
 
 
+def _without_member(name: str) -> Callable[[Path], None]:
+    def tamper(folder: Path) -> None:
+        members = _members(folder / "arrays.npz")
+        del members[name]
+        _write_members(folder / "arrays.npz", members)
+
+    return tamper
+
+
 ISSUE_CASES = {
     "a symlink to /dev/zero": ("optimal_control", lambda f: _replace_by_link(f, "/dev/zero"), "leads out"),
     "a header claiming 10**15 values": (
@@ -214,6 +231,11 @@ ISSUE_CASES = {
         "pursuit_scenario",
         _json_edit(lambda d: d.__setitem__("kind", "differential_game")),
         "states.pursuers",
+    ),
+    "a scenario without its time grid (found by the long fuzz)": (
+        "pursuit_scenario",
+        _without_member("time.npy"),
+        "no time grid",
     ),
     "allocation_history.2.assignment.2 = '0'": (
         "pursuit_scenario",

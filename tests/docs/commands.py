@@ -48,8 +48,10 @@ from typing import Any
 ROOT = Path(__file__).resolve().parents[2]
 SLOW_CPU_S = 2.5
 """A command whose recorded CPU time reaches this many seconds is tagged ``slow``."""
-DEFAULT_BUDGET_CPU_S = 35.0
-"""The recorded CPU time of all commands of the default suite together stays under this."""
+DEFAULT_BUDGET_CPU_S = 38.0
+"""The recorded CPU time of all commands of the default suite together stays under this (raised
+from 35 s when the chapter-7 Q = 0 run, 0.9 s since its best responses skip unread checks, stopped
+being slow; the whole default suite then took 2 min 41 s on two idle cores)."""
 SUBCOMMANDS = (
     "solve",
     "validate",

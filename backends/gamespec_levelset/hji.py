@@ -586,6 +586,7 @@ class HJIModel(CompiledModel):
         avoid = self.game.problem.avoid
         barrier = None if avoid is None else -relation_level(self.parsed, "problem.avoid", grid, parameters)
         if o.engine == "hj_reachability":
+            time_steps(ham, grid, horizon, o.cfl)  # the same work bound; its own steps are not stopped
             run = self._hj_reachability(grid, start, horizon, parameters, barrier, probe)
         else:
             run = reach_value(ham, grid, start, horizon, o.scheme, o.cfl, barrier, probe, budget)

@@ -173,9 +173,10 @@ class CasadiModel(CollocationModel):
         return lbg, ubg
 
     def _numbers(self, parameters: dict[str, float] | None) -> tuple[Any, ...]:
-        """The parameter values of a solve at ``parameters`` and its variable and constraint bounds
-        ``(params, bounds, lbx, ubx, lbg, ubg)``, kept for the last ``parameters`` (a game's best
-        responses re-solve at the same values with new grid inputs)."""
+        """The parameter values of a solve at ``parameters``, its variable and constraint bounds and
+        what :func:`ill_posed` says of them ``(params, bounds, lbx, ubx, lbg, ubg, posed)``, kept for
+        the last ``parameters`` (a game's best responses re-solve at the same values with new grid
+        inputs)."""
         given = dict(parameters or {})
         if self._kept is not None and self._kept[0] == given:
             return self._kept[1]
@@ -184,7 +185,8 @@ class CasadiModel(CollocationModel):
         b = tr.bounds(params)
         lbx = self.pack(b.x_lower, b.u_lower, b.d_lower, b.t_lower)
         ubx = self.pack(b.x_upper, b.u_upper, b.d_upper, b.t_upper)
-        numbers = (params, b, lbx, ubx, *self.constraint_bounds(params))
+        lbg, ubg = self.constraint_bounds(params)
+        numbers = (params, b, lbx, ubx, lbg, ubg, ill_posed(lbx, ubx, lbg, ubg))
         self._kept = (given, numbers)
         return numbers
 
@@ -192,7 +194,7 @@ class CasadiModel(CollocationModel):
         self, parameters: dict[str, float] | None = None, guess: Result | None = None, inputs: Inputs = None
     ) -> Result:
         tr = self.tr
-        params, b, lbx, ubx, lbg, ubg = self._numbers(parameters)
+        params, b, lbx, ubx, lbg, ubg, posed = self._numbers(parameters)
         Win = tr.input_values(params, inputs)
         multipliers: dict[str, np.ndarray] = {}
         if guess is None and self._last is not None and self.options.warm_start:
@@ -202,7 +204,6 @@ class CasadiModel(CollocationModel):
             w0 = self.pack(start.X, start.U, start.d, start.T)
         horizon = [] if tr.free_time else [b.t_lower]
         p_val = np.concatenate([[params[n] for n in tr.ocp.parameters], Win.ravel(order="F"), horizon])
-        posed = ill_posed(lbx, ubx, lbg, ubg)
         tic = time.perf_counter()
         sol = self.solver(
             x0=np.clip(w0, lbx, ubx), lbx=lbx, ubx=ubx, lbg=lbg, ubg=ubg, p=p_val, **multipliers

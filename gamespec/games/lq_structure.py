@@ -155,15 +155,15 @@ def lq_game(form: LQForm, parameters: Mapping[str, float]) -> LQGame | str:
         Q, N, R = _homogeneous(*running, n)
         S, _, _ = _homogeneous(*final, n)
         players.append(LQPlayer(name, columns, Q, N, R, S))
-    for name, M in [("the dynamics", np.hstack([A, B]))] + [
-        (f"{pl.name}'s payoff", np.hstack([pl.Q, pl.N, pl.S])) for pl in players
-    ]:
+    checked = [("the dynamics", "problem.dynamics", np.hstack([A, B]))]
+    checked += [(f"{pl.name}'s payoff", "problem.payoff", np.hstack([pl.Q, pl.N, pl.S])) for pl in players]
+    for name, field, M in checked:
         if not np.abs(M).max(initial=0.0) <= MAX_LQ_ENTRY:
             raise SpecError(
                 f"{name} as an LQ game have an entry of {np.abs(M).max():.3g}, beyond MAX_LQ_ENTRY = "
                 f"{MAX_LQ_ENTRY:g} (the Riccati equations of the existence test and the feedback "
                 "equilibrium would overflow)",
-                field="problem.dynamics" if name == "the dynamics" else "problem.payoff",
+                field=field,
                 source=form.game.source,
             )
     start = initial_state(form.game, parameters)

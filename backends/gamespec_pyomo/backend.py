@@ -373,6 +373,11 @@ class PyomoBackend(CollocationBackend[PyomoOptions]):
     name: ClassVar[str] = "pyomo"
     options_model = PyomoOptions
     nlp_field: ClassVar[str] = "options"
+    features: ClassVar[frozenset[str]] = CollocationBackend.features | {
+        "interior_points",
+        "measurements",
+        "free_initial_time",
+    }
 
     @classmethod
     def available(cls) -> Availability:

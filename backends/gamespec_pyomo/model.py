@@ -126,13 +126,14 @@ def build_model(tr: Transcription, params: Mapping[str, float]) -> Any:
 
     x_ends = ([m.X[i, 0] for i in range(tr.n_x)], [m.X[i, grid.n_nodes - 1] for i in range(tr.n_x)])
     ends = ocp.end_terms(ocp.end_values(x_ends, tr.end_controls(m.U), tr.t0 + m.T, others), algebra)
-    boundary = [_relation(r, r.expr) for r in ends.boundary]
+    interior = tr.interior.terms(m.X, others, algebra)
+    boundary = [_relation(r, r.expr) for r in [*ends.boundary, *interior.constraints]]
     m.boundary = pyo.Constraint(range(len(boundary)), rule=lambda _m, r: boundary[r])
     integral = [m.T * sum(float(w) * terms[r] for w, terms in zip(q, integrands, strict=True)) for r in n_int]
     m.integral_value = pyo.Var(n_int, initialize=0.0)
     m.integral = pyo.Constraint(n_int, rule=lambda _m, r: m.integral_value[r] == integral[r])
     running = sum(float(w) * term for w, term in zip(q, L, strict=True))
-    m.objective = pyo.Objective(expr=ends.mayer + m.T * running + tr.rate_penalty(m.U))
+    m.objective = pyo.Objective(expr=ends.mayer + m.T * running + tr.rate_penalty(m.U) + interior.misfit)
     m.dual = pyo.Suffix(direction=pyo.Suffix.IMPORT)
     m.scaling_factor = pyo.Suffix(direction=pyo.Suffix.EXPORT)
     for (i, _), var in m.X.items():

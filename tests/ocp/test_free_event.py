@@ -26,10 +26,11 @@ def _energy(x: float, v: float, tau: float) -> float:
     return 12 * x**2 / tau**3 - 12 * x * v / tau**2 + 4 * v**2 / tau
 
 
-def test_free_event_time_is_found_where_the_closed_form_puts_it() -> None:
+@pytest.mark.parametrize("backend", ["casadi", "pyomo"])
+def test_free_event_time_is_found_where_the_closed_form_puts_it(backend: str) -> None:
     """Each leg is a minimum-energy move; by the problem's symmetry under t -> T - t the best pass is
     at t_e = T/2 at rest, J* = 2 * 12 a^2/(T/2)^3 = 192 a^2/T^3, the fixed-time optimum at T/2."""
-    result = gamespec.solve(spec_from_dict(_through([0.3, 1.9])))
+    result = gamespec.solve(spec_from_dict(_through([0.3, 1.9])), backend=backend)
     assert result.status == gamespec.Status.OPTIMAL, result.message
     assert result.metrics["event_time"] == pytest.approx(T / 2, abs=1e-6)
     assert result.objective == pytest.approx(192 * A**2 / T**3, rel=1e-8)

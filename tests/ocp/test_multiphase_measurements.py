@@ -53,11 +53,12 @@ def _decay() -> dict:
     }
 
 
-def test_two_phase_fit_recovers_the_rates_that_made_the_data() -> None:
+@pytest.mark.parametrize("backend", ["casadi", "pyomo"])
+def test_two_phase_fit_recovers_the_rates_that_made_the_data(backend: str) -> None:
     """Exact data: the fit is the generating rates (to the collocation error) with a zero misfit;
     the second phase has its own 16 intervals (two pieces of the common 8), so its times fall on
     two different copies of the state."""
-    result = gamespec.solve(spec_from_dict(_decay()))
+    result = gamespec.solve(spec_from_dict(_decay()), backend=backend)
     assert result.status == gamespec.Status.OPTIMAL, result.message
     for name, rate in RATES.items():
         assert result.metrics["design"][name] == pytest.approx(rate, rel=1e-6)

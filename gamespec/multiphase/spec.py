@@ -24,7 +24,14 @@ from __future__ import annotations
 
 from typing import Any, ClassVar, Literal
 
-from pydantic import Field, SerializerFunctionWrapHandler, field_validator, model_serializer, model_validator
+from pydantic import (
+    Field,
+    SerializerFunctionWrapHandler,
+    ValidationInfo,
+    field_validator,
+    model_serializer,
+    model_validator,
+)
 
 from gamespec.errors import ExpressionError, SpecError
 from gamespec.limits import MAX_INTERVALS
@@ -285,12 +292,12 @@ class MultiPhaseSpec(OcpFamily, SpecBase):
 
     @model_validator(mode="before")
     @classmethod
-    def _lower_vectors(cls, data: object) -> object:
+    def _lower_vectors(cls, data: object, info: ValidationInfo) -> object:
         """Vector states and controls as their components (:mod:`gamespec.specs.vectors`)."""
         if not isinstance(data, dict) or not isinstance(data.get("problem"), dict):
             return data
         _refuse_separator(data["problem"])
-        problem, _ = lower_problem(data["problem"], phases=True)
+        problem, _ = lower_problem(data["problem"], phases=True, context=info.context)
         return data if problem is data["problem"] else {**data, "problem": problem}
 
     @model_validator(mode="after")

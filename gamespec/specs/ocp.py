@@ -17,7 +17,14 @@ from collections.abc import Mapping
 from dataclasses import dataclass
 from typing import Any, ClassVar, Literal
 
-from pydantic import Field, SerializerFunctionWrapHandler, field_validator, model_serializer, model_validator
+from pydantic import (
+    Field,
+    SerializerFunctionWrapHandler,
+    ValidationInfo,
+    field_validator,
+    model_serializer,
+    model_validator,
+)
 
 from gamespec.errors import ExpressionError, SpecError
 from gamespec.limits import MAX_INTERVALS
@@ -27,7 +34,7 @@ from gamespec.specs.events import EventSpec, MeasurementsSpec
 from gamespec.specs.plot import PlotHint
 from gamespec.specs.tables import TableSpec
 from gamespec.specs.uncertainty import UncertainParameter
-from gamespec.specs.vectors import lower_problem
+from gamespec.specs.vectors import Lowering, lower_problem
 from gamespec.symbolic.canonical import check
 from gamespec.symbolic.grammar import (
     FLOATS,
@@ -837,6 +844,18 @@ class OcpFamily(ProblemParameters):
         return {n: float(v) for n, v in self.problem.parameters.items() if not isinstance(v, str)}
 
 
+def _event_lowered(step: Any, i: int, lowering: Lowering) -> Any:
+    """One requested transform, a ``free_event``'s constraints read as the vector lowering reads an
+    interior point's (:mod:`gamespec.specs.vectors`); any other as written."""
+    if not isinstance(step, dict) or not isinstance(step.get("free_event"), dict):
+        return step
+    options = step["free_event"]
+    if "constraints" not in options:
+        return step
+    constraints = lowering.event(options["constraints"], f"transforms.{i}.free_event")
+    return {**step, "free_event": {**options, "constraints": constraints}}
+
+
 class OptimalControlSpec(OcpFamily, SpecBase):
     """An optimal-control problem (kind ``optimal_control``); its runtime parameters are
     ``problem.parameters``, its starting point ``guess`` and ``problem.time.guess``."""
@@ -860,16 +879,21 @@ class OptimalControlSpec(OcpFamily, SpecBase):
 
     @model_validator(mode="before")
     @classmethod
-    def _lower_vectors(cls, data: object) -> object:
-        """Vector states and controls as their components (:mod:`gamespec.specs.vectors`)."""
+    def _lower_vectors(cls, data: object, info: ValidationInfo) -> object:
+        """Vector states and controls as their components (:mod:`gamespec.specs.vectors`), in the
+        problem, the guess and a requested ``free_event``'s constraints."""
         if not isinstance(data, dict) or not isinstance(data.get("problem"), dict):
             return data
-        problem, guess = lower_problem(data["problem"])
+        problem, lowering = lower_problem(data["problem"], context=info.context)
         if problem is data["problem"]:
             return data
         lowered = {**data, "problem": problem}
         if isinstance(data.get("guess"), dict):
-            lowered["guess"] = guess(data["guess"], "guess")
+            lowered["guess"] = lowering.guess(data["guess"], "guess")
+        if isinstance(data.get("transforms"), list):
+            lowered["transforms"] = [
+                _event_lowered(step, i, lowering) for i, step in enumerate(data["transforms"])
+            ]
         return lowered
 
     def analysis_values(self) -> dict[str, Any]:

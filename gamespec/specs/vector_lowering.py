@@ -1,20 +1,21 @@
 """The vector reading of an ``optimal_control`` or ``multiphase_optimal_control`` problem
 (:mod:`gamespec.specs.vectors` says what it means): SymPy over the vector language of
-:mod:`gamespec.symbolic.vectors`, written back as the components' scalar expressions. Imported
-only for a file that has vectors or definitions at the ends (loading any other file needs no
-SymPy)."""
+:mod:`gamespec.symbolic.vectors`, written back as the components' scalar expressions. The
+tables are SymPy's opaque functions of :func:`gamespec.symbolic.tables.sympy_function`, printed
+back as calls. Imported only for a file that has vectors or definitions at the ends (loading any
+other file needs no SymPy)."""
 
 from __future__ import annotations
 
 import ast
 import copy
-from collections.abc import Callable, Mapping
+from collections.abc import Mapping
 from typing import Any
 
 import sympy as sp
 
 from gamespec.errors import ExpressionError, SpecError
-from gamespec.symbolic.grammar import syntax_tree
+from gamespec.symbolic.grammar import FileFunction, at_time, at_time_name, numeric_value, syntax_tree
 from gamespec.symbolic.language import symbol
 from gamespec.symbolic.printer import relation_texts, to_text
 from gamespec.symbolic.vectors import VECTORS, Vector, is_vector, parse_vector, parse_vector_relation
@@ -38,8 +39,15 @@ class _Lowering:
     """The vector reading of one problem (module doc); each method's ``where`` is the field of the
     value it reads, named by a SpecError."""
 
-    def __init__(self, problem: Mapping[str, Any], sizes: dict[str, int], phases: bool) -> None:
+    def __init__(
+        self,
+        problem: Mapping[str, Any],
+        sizes: dict[str, int],
+        phases: bool,
+        tables: Mapping[str, FileFunction],
+    ) -> None:
         self.sizes = sizes
+        self.tables = dict(tables)
         self.end_definitions = not phases
         """Whether a definition's end values (``h_0``, ``h_f``) are made: in one phase only (a phase
         may replace a definition, so that a multi-phase file's end value would be ambiguous)."""
@@ -51,17 +59,24 @@ class _Lowering:
             *(n for n in problem.get("controls", {}) if n not in sizes),
         ]
         self.params = {n: symbol(n) for n in [*problem.get("parameters", {}), *problem.get("design", {})]}
-        self.running: dict[str, Any] = {n: symbol(n) for n in [*scalars, "t"]}
+        self.running: dict[str, Any] = {n: symbol(n) for n in [*scalars, "t"]} | self.tables
         self.running |= {n: _vector(n, k) for n, k in sizes.items()}
         variables = [*problem.get("states", {}), *problem.get("controls", {})]
-        self.ends: dict[str, Any] = dict(self.params) | {"t_f": symbol("t_f")}
+        self.ends: dict[str, Any] = self.params | self.tables | {"t_f": symbol("t_f")}
         if _start(problem) == symbol("t_0"):
             self.ends["t_0"] = symbol("t_0")
         for name in variables:
             for end in ("_0", "_f"):
                 k = sizes.get(name)
                 self.ends[name + end] = symbol(name + end) if k is None else _vector(name, k, end)
-        self.timed = self.params | {"t": symbol("t"), "tau": symbol("tau")}
+        self.timed = self.params | self.tables | {"t": symbol("t"), "tau": symbol("tau")}
+        states = problem.get("states", {})
+        self.points: dict[str, Any] = self.params | self.tables
+        """The symbols of a constraint at a point inside the horizon (``at:``, a measured key): the
+        states then, the parameters, the design variables and the tables."""
+        self.points |= {n: _vector(n, sizes[n]) if n in sizes else symbol(n) for n in states}
+        if not phases:
+            self.ends |= _timed_states(problem.get("boundary_constraints", []), states, sizes)
         self.defined_ends: set[str] = set()
         self.inputs = set(problem.get("inputs", {}))
         self.scalar_variables = [
@@ -99,7 +114,7 @@ class _Lowering:
             if isinstance(node, ast.Subscript | ast.List):
                 return True
             if isinstance(node, ast.Name) and (
-                is_vector(symbols.get(node.id)) or node.id in self.defined_ends
+                is_vector(symbols.get(node.id)) or node.id in self.defined_ends or node.id in self.sizes
             ):
                 return True
             if (
@@ -198,7 +213,11 @@ class _Lowering:
     def link_phases(self, names: list[Any]) -> None:
         """The end symbols of each phase by name (``phases.ascent.r_f``, a vector for a vector)."""
         for phase in (n for n in names if isinstance(n, str)):
-            linked = {f"phases.{phase}.{n}": v for n, v in self.ends.items() if n not in self.params}
+            linked = {
+                f"phases.{phase}.{n}": v
+                for n, v in self.ends.items()
+                if n not in self.params and n not in self.tables
+            }
             for name, value in list(linked.items()):
                 prefix = name.rsplit(".", 1)[0]
                 if is_vector(value):
@@ -250,6 +269,45 @@ class _Lowering:
             out["jump"] = self.dynamics(raw["jump"], f"{field}.jump", self.ends)
         if isinstance(raw.get("guess"), Mapping):
             out["guess"] = self.guess(raw["guess"], f"{field}.guess")
+        if isinstance(raw.get("at"), list):
+            out["at"] = [
+                {**p, "constraints": self.at_point(p.get("constraints", []), self.points, f"{field}.at.{i}")}
+                for i, p in enumerate(raw["at"])
+            ]
+        if isinstance(raw.get("measurements"), Mapping):
+            out["measurements"] = self.measurements(raw["measurements"], f"{field}.measurements")
+        return out
+
+    def at_point(self, texts: Any, symbols: Mapping[str, Any], where: str) -> Any:
+        """The constraints of one interior point (a list of texts), each vector one per component."""
+        if not isinstance(texts, list):
+            return texts
+        return [
+            t
+            for j, c in enumerate(texts)
+            for t in (self.relations(c, symbols, f"{where}.constraints.{j}") if isinstance(c, str) else [c])
+        ]
+
+    def event(self, texts: Any, where: str) -> Any:
+        """A ``free_event``'s constraints: an interior point's, with ``t`` the event time."""
+        return self.at_point(texts, self.points | {"t": symbol("t")}, where)
+
+    def measurements(self, raw: Mapping[str, Any], where: str) -> dict[str, Any]:
+        """The measured keys (and the weights' keys) as the scalar expressions they name; a vector
+        cannot be a key (its components can), nor two keys one expression."""
+        keys: dict[str, str] = {}
+        for key in raw.get("values", {}):
+            if is_vector(self.value(key, self.points, f"{where}.values.{key}")):
+                reason = "a measured key is a scalar: measure a vector's components (r[0], r[1], ...)"
+                raise SpecError(reason, field=f"{where}.values.{key}")
+            keys[key] = self.scalar(key, self.points, f"{where}.values.{key}")
+        twice = sorted(k for k in keys if list(keys.values()).count(keys[k]) > 1)
+        if twice:
+            raise SpecError(f"keys {twice} measure one expression", field=f"{where}.values")
+        out = dict(raw)
+        for section in ("values", "weights"):
+            if isinstance(raw.get(section), Mapping):
+                out[section] = {keys.get(k, k): v for k, v in raw[section].items()}
         return out
 
     def phase(self, raw: Any, field: str) -> Any:
@@ -295,6 +353,33 @@ class _Lowering:
         return lowered
 
 
+def _timed_states(texts: Any, states: Mapping[str, Any], sizes: Mapping[str, int]) -> dict[str, Any]:
+    """The end symbols of the states at fixed times in the boundary constraints (``x(t=5)``, as
+    :func:`~gamespec.symbolic.grammar.at_time_name` spells it): a vector state's the vector of its
+    components' (``r(t=5)``: ``r__0(t=5.0)``, ...). A time that is not a number is left to the
+    parse, which refuses it and names the field."""
+    found: dict[str, Any] = {}
+    for text in texts if isinstance(texts, list) else []:
+        try:
+            calls = at_time(syntax_tree(text)) if isinstance(text, str) else []
+        except ExpressionError:
+            continue
+        for name, node in calls:
+            try:
+                time = numeric_value(ast.unparse(node), {})
+            except ExpressionError:
+                continue
+            if name not in states:
+                continue
+            n = sizes.get(name)
+            found[at_time_name(name, time)] = (
+                symbol(at_time_name(name, time))
+                if n is None
+                else Vector([symbol(at_time_name(component(name, i), time)) for i in range(n)])
+            )
+    return found
+
+
 def _start(problem: Mapping[str, Any]) -> sp.Expr:
     """The initial time as SymPy: the file's number, or the symbol ``t_0`` when it is free."""
     initial = (problem.get("time") or {}).get("initial", 0.0)
@@ -312,13 +397,18 @@ def _number(value: float) -> sp.Expr:
 
 
 def lowered(
-    problem: dict[str, Any], sizes: dict[str, int], field: str, phases: bool
-) -> tuple[dict[str, Any], Callable[[dict[str, Any], str], dict[str, Any]]]:
-    """:func:`gamespec.specs.vectors.lower_problem` once it is known to have work to do."""
-    low = _Lowering(problem, sizes, phases)
+    problem: dict[str, Any],
+    sizes: dict[str, int],
+    field: str,
+    phases: bool,
+    tables: Mapping[str, FileFunction],
+) -> tuple[dict[str, Any], _Lowering]:
+    """:func:`gamespec.specs.vectors.lower_problem` once it is known to have work to do (``tables``:
+    the file's, as functions of the expressions)."""
+    low = _Lowering(problem, sizes, phases, tables)
     if phases:
         low.link_phases([ph.get("name") for ph in problem.get("phases", []) if isinstance(ph, Mapping)])
     out = low.sections(problem, field, _start(problem))
     if phases and isinstance(problem.get("phases"), list):
         out["phases"] = [low.phase(ph, f"{field}.phases.{k}") for k, ph in enumerate(problem["phases"])]
-    return out, low.guess
+    return out, low

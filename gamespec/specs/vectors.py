@@ -16,20 +16,35 @@ scalar form by construction:
   constraint per component (``r_f == [1, 0, 0]``, ``-1 <= u <= 1``); a chained one becomes two
   one-sided constraints.
 
-A file without ``size:`` is returned unchanged (its expressions are not re-printed). A file with
-vectors cannot have ``tables:`` yet (refused with the reason).
+- a table of the file takes scalars (``CL(norm(v), r[2])``) and stays a call of the table: SymPy
+  sees it as an opaque function (:func:`gamespec.symbolic.tables.sympy_function`), printed back by
+  name (the tables are read here, with the file's folder, and handed on read);
+- an interior point (``at:``) and a measured key (``measurements:``) are read over the states (a
+  vector as its components), the parameters, the design variables and the tables: ``r == [1, 0]``
+  at a time is one constraint per component, ``norm(r)`` or ``r[0]`` a measured key (a vector
+  cannot be one: its components can);
+- ``r(t=1)`` in a boundary constraint is the vector state at that time (``r(t=1)[0] == 1``,
+  ``norm(r(t=1)) == 1``, ``r(t=1) == [1, 0]``), written back as its components' values then
+  (``r__0(t=1.0)``);
+- the constraints of a requested ``free_event`` (``transforms:``) are read as an interior point's,
+  with ``t`` the event time.
+
+A file without ``size:`` is returned unchanged (its expressions are not re-printed).
 """
 
 from __future__ import annotations
 
 import ast
 import math
-from collections.abc import Callable, Mapping
-from typing import Any
+from collections.abc import Mapping
+from typing import Any, Protocol
+
+from pydantic import ValidationError
 
 from gamespec.errors import ExpressionError, SpecError
 from gamespec.limits import MAX_VECTOR_SIZE
-from gamespec.symbolic.grammar import syntax_tree
+from gamespec.specs.tables import TableSpec
+from gamespec.symbolic.grammar import FileFunction, syntax_tree
 
 
 def _sizes(group: Any, where: str) -> dict[str, int]:
@@ -64,15 +79,6 @@ def _names_in(text: str) -> list[ast.AST]:
         return []
 
 
-def _uses_times(problem: Mapping[str, Any]) -> bool:
-    """Whether an end term has a value at a fixed time (``x(t=5)``)."""
-    return any(
-        isinstance(n, ast.Call) and any(k.arg == "t" for k in n.keywords)
-        for text in _end_texts(problem)
-        for n in _names_in(text)
-    )
-
-
 def _uses_end_definitions(problem: Mapping[str, Any]) -> bool:
     """Whether the Mayer term or a boundary constraint names a definition at an end (``h_f``)."""
     definitions = problem.get("definitions")
@@ -93,10 +99,14 @@ def _expression(value: Any) -> bool:
     return isinstance(value, _EXPRESSION) and not isinstance(value, bool)
 
 
+def _texts(value: Any) -> bool:
+    return isinstance(value, list) and all(isinstance(v, str) for v in value)
+
+
 def _well_formed(problem: Mapping[str, Any], phases: bool) -> bool:
     """Whether the sections the lowering reads have the shapes it reads (mappings with string keys,
-    lists of constraint texts, expressions as texts or numbers, a numeric or free initial time);
-    anything else is left to the schema, which names the field in one line."""
+    lists of constraint texts, measured keys as texts, expressions as texts or numbers, a numeric
+    or free initial time); anything else is left to the schema, which names the field in one line."""
 
     def section_ok(raw: Mapping[str, Any]) -> bool:
         for key in _MAPS:
@@ -118,7 +128,18 @@ def _well_formed(problem: Mapping[str, Any], phases: bool) -> bool:
             ):
                 return False
         integrals = raw.get("integral_constraints", [])
-        return isinstance(integrals, list) and all(isinstance(c, Mapping) for c in integrals)
+        if not isinstance(integrals, list) or not all(isinstance(c, Mapping) for c in integrals):
+            return False
+        points = raw.get("at", [])
+        if not isinstance(points, list) or not all(
+            isinstance(p, Mapping) and _texts(p.get("constraints", [])) for p in points
+        ):
+            return False
+        measured = raw.get("measurements") or {}
+        return isinstance(measured, Mapping) and all(
+            isinstance(measured.get(k, {}), Mapping) and _texts(list(measured.get(k, {})))
+            for k in ("values", "weights")
+        )
 
     time = problem.get("time", {})
     if not isinstance(time, Mapping):
@@ -134,33 +155,65 @@ def _well_formed(problem: Mapping[str, Any], phases: bool) -> bool:
     return section_ok(problem) and all(section_ok(p) for p in phase_list)
 
 
+class Lowering(Protocol):
+    """What else of a file a problem's lowering reads: its guess and a ``free_event``'s constraints."""
+
+    def guess(self, raw: dict[str, Any], where: str) -> dict[str, Any]:
+        """A guess mapping (``states``/``controls`` values) with each vector given per component."""
+
+    def event(self, texts: Any, where: str) -> Any:
+        """The constraints at a free event time, each vector constraint one per component."""
+
+
+class _Unchanged:
+    """The lowering of a file that has nothing to lower: everything as written."""
+
+    def guess(self, raw: dict[str, Any], where: str) -> dict[str, Any]:
+        return raw
+
+    def event(self, texts: Any, where: str) -> Any:
+        return texts
+
+
+UNCHANGED: Lowering = _Unchanged()
+
+
 def lower_problem(
-    problem: dict[str, Any], field: str = "problem", *, phases: bool = False
-) -> tuple[dict[str, Any], Callable[[dict[str, Any], str], dict[str, Any]]]:
+    problem: dict[str, Any],
+    field: str = "problem",
+    *,
+    phases: bool = False,
+    context: Mapping[str, Any] | None = None,
+) -> tuple[dict[str, Any], Lowering]:
     """``problem`` (an ``optimal_control`` problem mapping, or a ``multiphase_optimal_control``
-    one when ``phases``) with its vectors lowered (module doc), and the lowering of a guess mapping
-    (``states``/``controls`` values) of the same problem. The definitions at the ends are for a
-    single phase (a phase may replace a definition, so that its end value would be ambiguous)."""
+    one when ``phases``) with its vectors lowered (module doc), and the lowering of the rest of the
+    file (:class:`Lowering`). The definitions at the ends are for a single phase (a phase may
+    replace a definition, so that its end value would be ambiguous). ``context`` is the validation's
+    (the folder of a table's file)."""
     sizes = _sizes(problem.get("states", {}), f"{field}.states") | _sizes(
         problem.get("controls", {}), f"{field}.controls"
     )
     if not sizes and (phases or not _uses_end_definitions(problem)):
-        return problem, lambda guess, where: guess
+        return problem, UNCHANGED
     if not _well_formed(problem, phases):
-        return problem, lambda guess, where: guess
-    for key, what in (("tables", "tables"), ("at", "interior-point constraints (at:)")):
-        if problem.get(key):
-            raise SpecError(
-                f"{what} in a file with vector states or end-point definitions are not supported yet: "
-                "write the components as scalar states and the definitions out",
-                field=f"{field}.{key}",
-            )
-    if _uses_times(problem):
-        raise SpecError(
-            "x(t=...) in a file with vector states or end-point definitions is not supported yet: "
-            "use at: in a file of scalar states",
-            field=f"{field}.boundary_constraints",
-        )
+        return problem, UNCHANGED
+    read = _read_tables(problem.get("tables", {}), context)
+    if read is None:
+        return problem, UNCHANGED
     from gamespec.specs.vector_lowering import lowered
 
-    return lowered(problem, sizes, field, phases)
+    return lowered({**problem, "tables": read[0]} if read[0] else problem, sizes, field, phases, read[1])
+
+
+def _read_tables(
+    raw: Any, context: Mapping[str, Any] | None
+) -> tuple[dict[str, Any], dict[str, FileFunction]] | None:
+    """The tables as data (a file's read in, :class:`~gamespec.specs.tables.TableSpec`) and as the
+    functions of the expressions; None where one is malformed (left to the schema, which names it)."""
+    if not isinstance(raw, Mapping) or not all(isinstance(k, str) for k in raw):
+        return None
+    try:
+        specs = {name: TableSpec.model_validate(spec, context=context) for name, spec in raw.items()}
+        return {n: t.model_dump() for n, t in specs.items()}, {n: t.named(n) for n, t in specs.items()}
+    except (ValidationError, ValueError):
+        return None

@@ -500,6 +500,19 @@ def at_time_name(name: str, time: float) -> str:
     return f"{name}(t={float(time)!r})"
 
 
+def at_time_parts(name: str) -> tuple[str, float] | None:
+    """The name and time of a symbol :func:`at_time_name` spells (``x(t=5.0)`` → ``("x", 5.0)``),
+    or None for any other name."""
+    base, marker, rest = name.partition("(t=")
+    if not marker or not rest.endswith(")"):
+        return None
+    try:
+        time = float(rest[:-1])
+    except ValueError:
+        return None
+    return (base, time) if at_time_name(base, time) == name else None
+
+
 def expression(text: str | float, symbols: Mapping[str, Any], algebra: Algebra) -> Any:
     """The value of an expression (no comparisons) in ``algebra``, each name taking its value in
     ``symbols``."""

@@ -3,7 +3,8 @@ are data"): generated problems (the engagement reduction, sensitivity equations)
 and written out with :func:`to_text`, never assembled from f-strings.
 
 The printer is SymPy's :class:`~sympy.printing.str.StrPrinter` (precedence and parentheses) over a
-whitelist of node types: symbols, exact integers and rationals (``a/b``), floats (``repr``, so they
+whitelist of node types: symbols (a state at a fixed time, ``x(t=5.0)``, as the grammar spells it),
+a file's tables (by name), exact integers and rationals (``a/b``), floats (``repr``, so they
 round-trip exactly), ``pi`` and ``E`` (as ``exp(1)``), ``+ * **`` and the functions of
 :data:`~gamespec.symbolic.language.FUNCTIONS` by the language's names (``abs``, binary ``min``/``max``,
 ``sign``, ``heaviside`` with SymPy's value 1/2 at 0) — everything SymPy's derivatives of the language
@@ -25,7 +26,7 @@ from sympy.printing.precedence import PRECEDENCE
 from sympy.printing.str import StrPrinter
 
 from gamespec.errors import ExpressionError
-from gamespec.symbolic.grammar import Relation
+from gamespec.symbolic.grammar import Relation, at_time_parts
 from gamespec.symbolic.language import CONSTANTS, FUNCTIONS
 
 _FUNCTION_NAMES: dict[type, str] = {
@@ -68,16 +69,19 @@ class LanguagePrinter(StrPrinter):
         return super()._print(expr, **kwargs)
 
     def _print_Symbol(self, expr: sp.Symbol) -> str:
-        """A name, or a dotted name (``phases.ascent.x_f``, a multi-phase link)."""
-        name = expr.name
+        """A name, a dotted name (``phases.ascent.x_f``, a multi-phase link), or a state's value at
+        a fixed time (``x(t=5.0)``, :func:`~gamespec.symbolic.grammar.at_time_name`)."""
+        timed = at_time_parts(expr.name)
+        name = expr.name if timed is None else timed[0]
         parts = name.split(".")
         if (
             not all(p.isidentifier() and not keyword.iskeyword(p) for p in parts)
             or parts[0] in FUNCTIONS
             or parts[0] in CONSTANTS
+            or (timed is not None and len(parts) > 1)
         ):
             raise self.fail(f"symbol name {name!r} cannot be written in the language")
-        return name
+        return str(expr.name)
 
     def _print_Float(self, expr: sp.Float) -> str:
         """The nearest double, in full (``repr``): a double-precision Float parses back to itself

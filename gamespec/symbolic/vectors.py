@@ -4,7 +4,8 @@ column vectors beside scalars, for vector states and controls (``r: {size: 3}``)
 A vector is an immutable SymPy column matrix. ``+`` and ``-`` act between vectors of one size,
 ``*`` and ``/`` between a vector and a scalar; ``v[i]`` is a component (negative ``i`` from the
 end), ``[a, b, c]`` a vector of scalars; ``dot(a, b)``, ``cross(a, b)`` (size 3) and ``norm(a)``
-(``sqrt(dot(a, a))``) are the vector functions. Everything else on a vector (``sin(r)``, ``r**2``,
+(``sqrt(dot(a, a))``) are the vector functions; a table of the file (``CL(norm(v), r[2])``) takes
+scalars and stays SymPy's opaque function of them. Everything else on a vector (``sin(r)``, ``r**2``,
 ``r * v``) is refused with the reason, so that a file means one thing. The scalar results are
 SymPy expressions of the components, printed back to the language by
 :func:`~gamespec.symbolic.printer.to_text` (:mod:`gamespec.specs.vectors` lowers a file this way).
@@ -18,7 +19,7 @@ from typing import Any
 
 import sympy as sp
 
-from gamespec.symbolic.grammar import Refused, relation
+from gamespec.symbolic.grammar import FileFunction, Refused, relation
 from gamespec.symbolic.grammar import expression as walk
 from gamespec.symbolic.language import SYMPY, Relation
 
@@ -77,6 +78,12 @@ class VectorSympyAlgebra:
         if any(is_vector(a) for a in args):
             raise Refused(f"{name} takes scalars: apply it to each component (r[0])")
         return SYMPY.call(name, args)
+
+    def tabulated(self, function: FileFunction, args: list[Any]) -> Any:
+        """A table (:mod:`gamespec.symbolic.tables`) of scalars: SymPy's opaque function of it."""
+        if any(is_vector(a) for a in args):
+            raise Refused(f"table {function.name} takes scalars: give it components (r[0]) or norm(r)")
+        return SYMPY.tabulated(function, args)
 
     def _vector_call(self, name: str, args: list[Any]) -> Any:
         if not all(is_vector(a) for a in args):

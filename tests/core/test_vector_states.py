@@ -294,8 +294,3 @@ def test_a_multiphase_file_has_no_definitions_at_the_ends() -> None:
 def test_a_malformed_vector_file_is_one_schema_error(change: dict) -> None:
     with pytest.raises(SpecError):
         _spec({**VECTOR, **change})
-
-
-def test_interior_points_with_vectors_are_refused_with_the_reason() -> None:
-    with pytest.raises(SpecError, match="not supported yet"):
-        _spec({**VECTOR, "at": [{"time": 0.5, "constraints": ["r__0 == 0.5"]}]})

@@ -323,3 +323,43 @@ def test_a_scalar_file_with_points_and_tables_is_read_as_written() -> None:
     spec = spec_from_dict(data)
     assert spec.problem.at[0].constraints == ["r0 == a0", "r1 == a1"]
     assert spec.problem.path_constraints == ["W(r0) <= 1/1"]
+
+
+def _two_phases(vector: bool) -> dict:
+    """Two phases of a planar point paying ``W(r_0)``, linked through a table of the second
+    phase's start; the first phase measures ``|r|`` (vector) or its written-out form (scalar)."""
+    if vector:
+        problem = {
+            "states": {"r": {"size": 2, "initial": 0, "final": [1, 0.5]}},
+            "controls": {"u": {"size": 2}},
+            "dynamics": {"r": "u"},
+            "objective": {"lagrange": "dot(u, u) + W(r[0])"},
+            "boundary_constraints": ["W(phases.b.r_0[0]) >= 0.2"],
+        }
+        key = "norm(r)"
+    else:
+        problem = {
+            "states": {"r0": {"initial": 0, "final": 1}, "r1": {"initial": 0, "final": 0.5}},
+            "controls": {"u0": {}, "u1": {}},
+            "dynamics": {"r0": "u0", "r1": "u1"},
+            "objective": {"lagrange": "u0**2 + u1**2 + W(r0)"},
+            "boundary_constraints": ["W(phases.b.r0_0) >= 0.2"],
+        }
+        key = "sqrt(r0**2 + r1**2)"
+    measured = {"times": [0.5], "values": {key: [0.3]}}
+    problem |= {
+        "tables": {"W": TABLES["W"]},
+        "phases": [
+            {"name": "a", "duration": 1.0, "measurements": measured},
+            {"name": "b", "duration": 1.0},
+        ],
+    }
+    return {"kind": "multiphase_optimal_control", "problem": problem, "method": {"intervals": 6}}
+
+
+def test_vector_phases_with_a_table_and_measurements_equal_the_scalar_form() -> None:
+    spec = spec_from_dict(_two_phases(vector=True))
+    assert spec.problem.boundary_constraints == ["W(phases.b.r__0_0) - 0.2 >= 0.0"]
+    assert list(spec.problem.phases[0].measurements.values) == ["sqrt(r__0**2 + r__1**2)"]
+    one, two = _solve(_two_phases(vector=True)), _solve(_two_phases(vector=False))
+    _same(one, two, {"r__0": "r0", "r__1": "r1"})

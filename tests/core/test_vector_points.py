@@ -363,3 +363,16 @@ def test_vector_phases_with_a_table_and_measurements_equal_the_scalar_form() -> 
     assert list(spec.problem.phases[0].measurements.values) == ["sqrt(r__0**2 + r__1**2)"]
     one, two = _solve(_two_phases(vector=True)), _solve(_two_phases(vector=False))
     _same(one, two, {"r__0": "r0", "r__1": "r1"})
+
+
+def test_a_state_at_a_time_prints_as_the_grammar_spells_it() -> None:
+    """The printer writes ``x(t=5.0)`` back as it is read; a name that only looks like one is
+    refused."""
+    from gamespec.errors import ExpressionError
+    from gamespec.symbolic.language import symbol
+    from gamespec.symbolic.printer import to_text
+
+    assert to_text(2 * symbol("x(t=5.0)") + 1) == "2*x(t=5.0) + 1"
+    for name in ("x(t=5)", "phases.a.x(t=1.0)", "x(t=y)"):
+        with pytest.raises(ExpressionError, match="cannot be written"):
+            to_text(symbol(name))

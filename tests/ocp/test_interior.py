@@ -94,7 +94,9 @@ def test_least_squares_fit_of_synthetic_data_recovers_the_parameters(backend: st
         atol=1e-12,
     )
     x, y = sol.y
-    result = gamespec.solve(spec_from_dict(_decay(times, {"x": list(x), "x + y": list(x + y)})), backend=backend)
+    result = gamespec.solve(
+        spec_from_dict(_decay(times, {"x": list(x), "x + y": list(x + y)})), backend=backend
+    )
     assert result.status == gamespec.Status.OPTIMAL, result.message
     assert result.metrics["design"]["k"] == pytest.approx(k, rel=1e-6)
     assert result.metrics["design"]["c"] == pytest.approx(c, rel=1e-6)

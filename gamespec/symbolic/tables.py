@@ -38,6 +38,8 @@ from gamespec.symbolic.grammar import FileFunction
 if TYPE_CHECKING:
     import numpy as np
 
+    from gamespec.symbolic.truncated import TruncatedTable
+
 Method = Literal["linear", "bspline", "akima"]
 MIN_POINTS: dict[str, int] = {"linear": 2, "bspline": 4, "akima": 3}
 """The fewest grid points per axis each method needs (a cubic not-a-knot spline: four; Akima's
@@ -66,7 +68,9 @@ class Table(FileFunction):
         return [upper(lower(a, lo), hi) for a, (lo, hi) in zip(args, ranges, strict=True)]
 
     @cached_property
-    def _scipy(self) -> Any:
+    def scipy(self) -> Any:
+        """SciPy's interpolant of the table (``bspline``: the ``NdBSpline``, its knots ``t`` and
+        coefficients ``c``), a function of an array of points, one row each."""
         import numpy as np
         from scipy.interpolate import NdBSpline, RegularGridInterpolator, make_interp_spline
 
@@ -110,7 +114,7 @@ class Table(FileFunction):
         arrays = np.broadcast_arrays(*(np.asarray(a, dtype=float) for a in args))
         clamped = self._clamped(list(arrays), np.maximum, np.minimum)
         points = np.stack([np.ravel(a) for a in clamped], axis=-1)
-        return np.asarray(self._scipy(points), dtype=float).reshape(arrays[0].shape)
+        return np.asarray(self.scipy(points), dtype=float).reshape(arrays[0].shape)
 
     def floats(self, *args: float) -> float:
         if any(math.isnan(a) for a in args):
@@ -137,6 +141,13 @@ class Table(FileFunction):
         import casadi as ca
 
         return self._interpolant(ca.vertcat(*self._clamped(list(args), ca.fmax, ca.fmin)))
+
+    @cached_property
+    def truncated(self) -> TruncatedTable:
+        """The table in arithmetic and ``abs`` alone (:mod:`gamespec.symbolic.truncated`)."""
+        from gamespec.symbolic.truncated import TruncatedTable
+
+        return TruncatedTable.of(self)
 
     @cached_property
     def sympy(self) -> Any:

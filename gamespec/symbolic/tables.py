@@ -3,7 +3,8 @@
 A :class:`Table` is a :class:`~gamespec.symbolic.grammar.FileFunction`: its name, among the symbols
 of a walk, makes ``CL(mach, alpha)`` a call the grammar knows for that file, and each algebra
 builds it its own way — floats and NumPy arrays through SciPy, CasADi through
-``casadi.interpolant`` (whose derivatives, and for ``bspline`` the Hessian, come with it), SymPy as
+``casadi.interpolant`` (whose derivatives, and for ``bspline`` the Hessian, come with it), Pyomo as
+the same function in arithmetic and ``abs`` (:mod:`gamespec.symbolic.truncated`), SymPy as
 an opaque function whose derivatives are functions of the language's checks but print nowhere (a
 transform that differentiates a table is refused by the printer).
 

@@ -143,7 +143,10 @@ def _shift(coefficients: np.ndarray, delta: float) -> np.ndarray:
 
     k = coefficients.size - 1
     return np.array(
-        [sum(coefficients[m] * math.comb(m, j) * delta ** (m - j) for m in range(j, k + 1)) for j in range(k + 1)]
+        [
+            sum(coefficients[m] * math.comb(m, j) * delta ** (m - j) for m in range(j, k + 1))
+            for j in range(k + 1)
+        ]
     )
 
 
@@ -211,4 +214,3 @@ def _contract(coefficients: np.ndarray, axes: Sequence[Sequence[Basis]], args: S
         if inner.any():
             total = total + basis(args[0]) * _contract(inner, rest, args[1:])
     return total
-

@@ -374,6 +374,7 @@ class PyomoBackend(CollocationBackend[PyomoOptions]):
     options_model = PyomoOptions
     nlp_field: ClassVar[str] = "options"
     features: ClassVar[frozenset[str]] = CollocationBackend.features | {
+        "tables",
         "interior_points",
         "measurements",
         "free_initial_time",

@@ -27,7 +27,7 @@ import numpy as np
 
 from gamespec.errors import UnsupportedFeature
 from gamespec.ocp.transcription import Transcription
-from gamespec.symbolic.grammar import Relation
+from gamespec.symbolic.grammar import FileFunction, Relation
 from gamespec.symbolic.library import Library, LibraryAlgebra
 
 
@@ -52,15 +52,36 @@ def _refused(name: str) -> Callable[..., Any]:
     return refuse
 
 
+TABLE_TOLERANCE = 1e-9
+"""The largest error of a table's arithmetic form the backend takes, relative to the values' range
+(:meth:`~gamespec.symbolic.truncated.TruncatedTable.error`, measured for each table)."""
+
+
+@lru_cache(maxsize=64)
+def _pyomo_table(table: FileFunction) -> Callable[..., Any]:
+    """A table as arithmetic and ``abs`` (:mod:`gamespec.symbolic.truncated`), refused when its
+    measured rounding exceeds :data:`TABLE_TOLERANCE`."""
+    form = table.truncated  # type: ignore[attr-defined]
+    error = form.error(table)
+    if not error <= TABLE_TOLERANCE:
+        raise UnsupportedFeature(
+            f"backend 'pyomo' cannot take table {table.name!r}: its form in abs (no conditionals, "
+            f"which ripopt differentiates wrongly) is off by {error:.1e} of the values' range, more than "
+            f"{TABLE_TOLERANCE:g} (grid intervals of very different sizes); use the casadi backend"
+        )
+    return form  # type: ignore[no-any-return]
+
+
 @lru_cache(maxsize=1)
 def pyomo_library() -> Library:
     """Pyomo's intrinsic functions by gamespec's names (min/max through ``abs``, which the NL
-    format has; no atan2, sign or heaviside: they are refused when a problem uses them). One
-    library per process, so that each model takes the problem's kept walks again
+    format has; no atan2, sign or heaviside: they are refused when a problem uses them) and the
+    file's tables in arithmetic and ``abs`` (:func:`_pyomo_table`). One library per process, so
+    that each model takes the problem's kept walks again
     (:meth:`~gamespec.symbolic.library.LibraryAlgebra.__eq__`)."""
     import pyomo.environ as pyo
 
-    return Library.from_namespace(
+    library = Library.from_namespace(
         pyo,
         atan2=_refused("atan2"),
         sign=_refused("sign"),
@@ -69,6 +90,7 @@ def pyomo_library() -> Library:
         min=_minimum,
         max=_maximum,
     )
+    return Library(library.functions, library.power, tables=_pyomo_table)
 
 
 def _finite(value: float) -> float | None:

@@ -3,7 +3,8 @@
 A :class:`Table` is a :class:`~gamespec.symbolic.grammar.FileFunction`: its name, among the symbols
 of a walk, makes ``CL(mach, alpha)`` a call the grammar knows for that file, and each algebra
 builds it its own way — floats and NumPy arrays through SciPy, CasADi through
-``casadi.interpolant`` (whose derivatives, and for ``bspline`` the Hessian, come with it), SymPy as
+``casadi.interpolant`` (whose derivatives, and for ``bspline`` the Hessian, come with it), Pyomo as
+the same function in arithmetic and ``abs`` (:mod:`gamespec.symbolic.truncated`), SymPy as
 an opaque function whose derivatives are functions of the language's checks but print nowhere (a
 transform that differentiates a table is refused by the printer).
 
@@ -38,6 +39,8 @@ from gamespec.symbolic.grammar import FileFunction
 if TYPE_CHECKING:
     import numpy as np
 
+    from gamespec.symbolic.truncated import TruncatedTable
+
 Method = Literal["linear", "bspline", "akima"]
 MIN_POINTS: dict[str, int] = {"linear": 2, "bspline": 4, "akima": 3}
 """The fewest grid points per axis each method needs (a cubic not-a-knot spline: four; Akima's
@@ -66,7 +69,9 @@ class Table(FileFunction):
         return [upper(lower(a, lo), hi) for a, (lo, hi) in zip(args, ranges, strict=True)]
 
     @cached_property
-    def _scipy(self) -> Any:
+    def scipy(self) -> Any:
+        """SciPy's interpolant of the table (``bspline``: the ``NdBSpline``, its knots ``t`` and
+        coefficients ``c``), a function of an array of points, one row each."""
         import numpy as np
         from scipy.interpolate import NdBSpline, RegularGridInterpolator, make_interp_spline
 
@@ -110,7 +115,7 @@ class Table(FileFunction):
         arrays = np.broadcast_arrays(*(np.asarray(a, dtype=float) for a in args))
         clamped = self._clamped(list(arrays), np.maximum, np.minimum)
         points = np.stack([np.ravel(a) for a in clamped], axis=-1)
-        return np.asarray(self._scipy(points), dtype=float).reshape(arrays[0].shape)
+        return np.asarray(self.scipy(points), dtype=float).reshape(arrays[0].shape)
 
     def floats(self, *args: float) -> float:
         if any(math.isnan(a) for a in args):
@@ -137,6 +142,13 @@ class Table(FileFunction):
         import casadi as ca
 
         return self._interpolant(ca.vertcat(*self._clamped(list(args), ca.fmax, ca.fmin)))
+
+    @cached_property
+    def truncated(self) -> TruncatedTable:
+        """The table in arithmetic and ``abs`` alone (:mod:`gamespec.symbolic.truncated`)."""
+        from gamespec.symbolic.truncated import TruncatedTable
+
+        return TruncatedTable.of(self)
 
     @cached_property
     def sympy(self) -> Any:

@@ -197,9 +197,50 @@ def test_table_calls_are_checked_by_the_grammar() -> None:
         spec_from_dict(_lq("u**2", {"x": tables["q"]}))
 
 
-def test_pyomo_refuses_a_table_naming_it() -> None:
-    spec = spec_from_dict(_lq("q(x) + u**2", _square("linear", 5)))
-    with pytest.raises(UnsupportedFeature, match=r"table\(s\) q: no interpolant on pyomo"):
+@pytest.mark.parametrize(
+    ("method", "axes"),
+    [("linear", 3), ("bspline", 3), ("bspline", 2), ("linear", 1), ("bspline", 1), ("akima", 1)],
+)
+def test_pyomo_form_of_a_table_is_the_scipy_table(method: str, axes: int) -> None:
+    """The Pyomo expression of a table (arithmetic and abs, :mod:`gamespec.symbolic.truncated`),
+    evaluated by Pyomo at fixed Vars, equals the SciPy route inside and beyond the grid."""
+    pyo = pytest.importorskip("pyomo.environ")
+    rng = np.random.default_rng(3)
+    grids = [np.sort(rng.uniform(0, 4, 6)), np.linspace(-1, 1, 5), np.array([0.0, 0.5, 2.0, 3.0])][:axes]
+    if method == "akima":
+        grids = [np.sort(rng.uniform(0, 4, 8))]
+    values = rng.normal(size=tuple(len(g) for g in grids))
+    table = checked_table("g", [g.tolist() for g in grids], values.tolist(), method)
+    model = pyo.ConcreteModel()
+    model.x = pyo.Var(range(len(grids)))
+    expr = table.truncated(*(model.x[i] for i in range(len(grids))))
+    points = rng.uniform([g[0] - 0.5 for g in grids], [g[-1] + 0.5 for g in grids], size=(100, len(grids)))
+    for point in points:
+        for i, value in enumerate(point):
+            model.x[i].value = float(value)
+        assert pyo.value(expr) == pytest.approx(table.floats(*point), abs=1e-10)
+
+
+@pytest.mark.parametrize(("method", "points"), [("bspline", 9), ("akima", 9), ("linear", 41)])
+def test_a_table_solves_the_same_on_pyomo_as_on_casadi(method: str, points: int) -> None:
+    """The tabulated LQ problem on both backends: the same optimum (tanh(1) where the table is
+    x^2 exactly; the linear table's O(h^2) offset alike on both)."""
+    spec = spec_from_dict(_lq("q(x) + u**2", _square(method, points)))
+    on_casadi, on_pyomo = (gamespec.solve(spec, backend=b) for b in ("casadi", "pyomo"))
+    assert on_pyomo.status == gamespec.Status.OPTIMAL, on_pyomo.message
+    assert all(on_pyomo.metrics["checks_passed"].values())
+    assert on_pyomo.objective == pytest.approx(on_casadi.objective, rel=1e-9)
+    if method != "linear":
+        assert on_pyomo.objective == pytest.approx(math.tanh(LQ_T), rel=1e-8)
+
+
+def test_pyomo_refuses_a_table_whose_form_would_round_beyond_the_tolerance() -> None:
+    """Grid intervals of very different sizes make the truncated powers cancel: measured, and
+    refused naming the table."""
+    grid = np.concatenate([np.linspace(0.0, 1e-4, 5), np.linspace(1.0, 1e4, 20)])
+    tables = {"q": {"axes": [grid.tolist()], "values": np.sin(grid).tolist(), "method": "bspline"}}
+    spec = spec_from_dict(_lq("q(x) + u**2", tables))
+    with pytest.raises(UnsupportedFeature, match="cannot take table 'q'"):
         gamespec.solve(spec, backend="pyomo")
 
 

@@ -177,7 +177,8 @@ class TruncatedTable:
     def __call__(self, *args: Any) -> Any:
         """The table at ``args`` (numbers, NumPy arrays broadcast together, or a target's
         expressions with ``+``, ``*`` and ``abs``)."""
-        return _contract(self.coefficients, self.axes, args)
+        values = [[basis(arg) for basis in bases] for bases, arg in zip(self.axes, args, strict=True)]
+        return _contract(self.coefficients, values)
 
     def error(self, table: Table) -> float:
         """The largest difference from :meth:`Table.numpy` at the grid's points and midpoints (at
@@ -200,17 +201,17 @@ class TruncatedTable:
         return float(np.max(np.abs(self(*points.T) - expected))) / scale
 
 
-def _contract(coefficients: np.ndarray, axes: Sequence[Sequence[Basis]], args: Sequence[Any]) -> Any:
-    """``sum_i axes[0][i](args[0]) * (the rest contracted with coefficients[i])``, the last axis a
-    plain sum (zero coefficients left out)."""
-    first, rest = axes[0], axes[1:]
+def _contract(coefficients: np.ndarray, values: Sequence[Sequence[Any]]) -> Any:
+    """``sum_i values[0][i] * (the rest contracted with coefficients[i])``, each axis' basis
+    functions evaluated once (``values``), the last axis a plain sum (zero coefficients left out)."""
+    first, rest = values[0], values[1:]
     total: Any = 0.0
-    for i, basis in enumerate(first):
+    for i, value in enumerate(first):
         inner = coefficients[i]
         if not rest:
             if inner != 0.0:
-                total = total + float(inner) * basis(args[0])
+                total = total + float(inner) * value
             continue
         if inner.any():
-            total = total + basis(args[0]) * _contract(inner, rest, args[1:])
+            total = total + value * _contract(inner, rest)
     return total

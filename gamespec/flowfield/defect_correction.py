@@ -55,13 +55,13 @@ AXIS_BAND = 0.1
 """A node's characteristic within this fraction of its speed of an axis is swept both ways."""
 
 
-@njit(cache=True, inline="always", error_model="numpy")
+@njit(cache=True, error_model="numpy")
 def _second_order(t0: float, t1: float, t2: float) -> float:
     """``h·D₂ = (3T − 4T₁ + T₂)/2`` (the ``αT − β`` of a second-order side)."""
     return 1.5 * t0 - 2.0 * t1 + 0.5 * t2
 
 
-@njit(cache=True, inline="always", error_model="numpy")
+@njit(cache=True, error_model="numpy")
 def _finite(values: np.ndarray, i: int, j: int, di: int, dj: int) -> bool:
     """Whether the seven nodes ``(i + k di, j + k dj)``, ``|k| ≤ 3``, lie on the grid with values."""
     nx, ny = values.shape
@@ -73,7 +73,7 @@ def _finite(values: np.ndarray, i: int, j: int, di: int, dj: int) -> bool:
     return True
 
 
-@njit(cache=True, inline="always", error_model="numpy")
+@njit(cache=True, error_model="numpy")
 def _rough(a: float, b: float, c: float, d: float, e: float) -> bool:
     """Whether the WENO-Z weights (Borges et al. 2008, q = 2; Jiang–Shu indicators,
     ``ε = 10⁻⁶ max(a², …, e²)``, Osher & Fedkiw eq. 3.38) of the three candidate stencils over the
@@ -89,7 +89,7 @@ def _rough(a: float, b: float, c: float, d: float, e: float) -> bool:
     return max(max(abs(z0 - total), abs(z1 - total)), abs(z2 - total)) > ROUGH * total
 
 
-@njit(cache=True, inline="always", error_model="numpy")
+@njit(cache=True, error_model="numpy")
 def _fifth_order(a: float, b: float, c: float, d: float, e: float) -> float:
     """``h·D₅``, the upwind-biased fifth-order difference over the undivided differences ``a … e``
     (the three third-order candidates at their linear weights 1/10, 6/10, 3/10)."""

@@ -28,7 +28,7 @@ NEWTON_TOLERANCE = 1e-13
 """Newton stops when the characteristic ends within this of the node (relative to the spacing)."""
 
 
-@njit(cache=True, inline="always", error_model="numpy")
+@njit(cache=True, error_model="numpy")
 def _cubic(s: float) -> tuple[float, float, float, float, float, float, float, float]:
     """The cubic Lagrange weights on the nodes 0 … 3 at ``s`` and their derivatives."""
     a, b, c, d = s, s - 1.0, s - 2.0, s - 3.0
@@ -55,35 +55,43 @@ def _drift(
     j0 = min(max(math.floor(v) - 1, 0), ny - 4)
     wx = _cubic(u - i0)
     wy = _cubic(v - j0)
-    out = np.zeros(6)
+    fx = fy = fxx = fxy = fyx = fyy = 0.0
     for a in range(4):
         for b in range(4):
             w, wdx, wdy = wx[a] * wy[b], wx[a + 4] * wy[b] / spacing[0], wx[a] * wy[b + 4] / spacing[1]
-            for k in range(2):
-                value = flow[k, i0 + a, j0 + b]
-                out[k] += w * value
-                out[2 + 2 * k] += wdx * value
-                out[3 + 2 * k] += wdy * value
-    return out[0], out[1], out[2], out[3], out[4], out[5]
+            gx, gy = flow[0, i0 + a, j0 + b], flow[1, i0 + a, j0 + b]
+            fx += w * gx
+            fy += w * gy
+            fxx += wdx * gx
+            fxy += wdy * gx
+            fyx += wdx * gy
+            fyy += wdy * gy
+    return fx, fy, fxx, fxy, fyx, fyy
 
 
-@njit(cache=True, inline="always", error_model="numpy")
+@njit(cache=True, error_model="numpy")
 def _rate(
     flow: np.ndarray,
     lower: tuple[float, float],
     spacing: tuple[float, float],
     speed: float,
-    state: np.ndarray,
-) -> np.ndarray:
-    """``(ẋ, ṗ)`` of the characteristic at ``state = (x, y, p_x, p_y)``."""
-    fx, fy, fxx, fxy, fyx, fyy = _drift(flow, lower, spacing, state[0], state[1])
-    norm = math.sqrt(state[2] * state[2] + state[3] * state[3])
-    out = np.empty(4)
-    out[0] = speed * state[2] / norm + fx
-    out[1] = speed * state[3] / norm + fy
-    out[2] = -(fxx * state[2] + fyx * state[3])
-    out[3] = -(fxy * state[2] + fyy * state[3])
-    return out
+    x: float,
+    y: float,
+    px: float,
+    py: float,
+) -> tuple[float, float, float, float]:
+    """``(ẋ, ẏ, ṗ_x, ṗ_y)`` of the characteristic at ``(x, y, p_x, p_y)``."""
+    fx, fy, fxx, fxy, fyx, fyy = _drift(flow, lower, spacing, x, y)
+    norm = math.sqrt(px * px + py * py)
+    return speed * px / norm + fx, speed * py / norm + fy, -(fxx * px + fyx * py), -(fxy * px + fyy * py)
+
+
+@njit(cache=True, error_model="numpy")
+def _ahead(
+    x: float, y: float, px: float, py: float, rate: tuple[float, float, float, float], h: float
+) -> tuple[float, float, float, float]:
+    """The state ``h`` along ``rate`` (an RK4 stage's point)."""
+    return x + h * rate[0], y + h * rate[1], px + h * rate[2], py + h * rate[3]
 
 
 @njit(cache=True, error_model="numpy")
@@ -99,17 +107,39 @@ def _end(
 ) -> tuple[float, float]:
     """Where the characteristic from the edge at ``angle`` is after ``time`` (RK4)."""
     nx_, ny_ = math.cos(angle), math.sin(angle)
-    state = np.array([origin[0] + radius * nx_, origin[1] + radius * ny_, nx_, ny_])
-    fx, fy, _, _, _, _ = _drift(flow, lower, spacing, state[0], state[1])
-    state[2:] /= speed + fx * nx_ + fy * ny_
+    x, y = origin[0] + radius * nx_, origin[1] + radius * ny_
+    fx, fy, _, _, _, _ = _drift(flow, lower, spacing, x, y)
+    scale = speed + fx * nx_ + fy * ny_
+    px, py = nx_ / scale, ny_ / scale
     h = time / RK4_STEPS
     for _ in range(RK4_STEPS):
-        k1 = _rate(flow, lower, spacing, speed, state)
-        k2 = _rate(flow, lower, spacing, speed, state + 0.5 * h * k1)
-        k3 = _rate(flow, lower, spacing, speed, state + 0.5 * h * k2)
-        k4 = _rate(flow, lower, spacing, speed, state + h * k3)
-        state = state + h / 6.0 * (k1 + 2.0 * k2 + 2.0 * k3 + k4)
-    return state[0], state[1]
+        a = _rate(flow, lower, spacing, speed, x, y, px, py)
+        b = _rate(
+            flow,
+            lower,
+            spacing,
+            speed,
+            x + h / 2 * a[0],
+            y + h / 2 * a[1],
+            px + h / 2 * a[2],
+            py + h / 2 * a[3],
+        )
+        c = _rate(
+            flow,
+            lower,
+            spacing,
+            speed,
+            x + h / 2 * b[0],
+            y + h / 2 * b[1],
+            px + h / 2 * b[2],
+            py + h / 2 * b[3],
+        )
+        d = _rate(flow, lower, spacing, speed, x + h * c[0], y + h * c[1], px + h * c[2], py + h * c[3])
+        x += h / 6 * (a[0] + 2 * b[0] + 2 * c[0] + d[0])
+        y += h / 6 * (a[1] + 2 * b[1] + 2 * c[1] + d[1])
+        px += h / 6 * (a[2] + 2 * b[2] + 2 * c[2] + d[2])
+        py += h / 6 * (a[3] + 2 * b[3] + 2 * c[3] + d[3])
+    return x, y
 
 
 @njit(cache=True, error_model="numpy")

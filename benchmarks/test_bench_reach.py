@@ -314,7 +314,8 @@ def test_level_sets_against_hj_reachability(benchmark, n: int) -> None:
     hj = benchmark.pedantic(hj_rows, args=(n,), rounds=1, warmup_rounds=0)
     compiled_band = level_set_rows(n)[-1]
     _report(benchmark, [compiled_band, *hj], hj[-1])
-    assert abs(hj[-1].error - compiled_band.error) < 0.05 * compiled_band.error + 1e-5  # float32 in JAX
+    # at least as accurate (JAX runs float32: its error stops near 1.6e-5 at 401², ours is 2.2e-8)
+    assert compiled_band.error <= 1.05 * hj[-1].error
     assert compiled_band.cpu <= hj[-1].cpu
 
 

@@ -164,12 +164,15 @@ def time_to_reach(
     disk beyond the start band, +inf where ``T > t_max``).
 
     ``order``: 1 or 2, the march alone; 5 (the default), the second-order march from start values
-    shot along the characteristics (:mod:`gamespec.flowfield.start_band`), then WENO5 defect
-    correction (:mod:`gamespec.flowfield.defect_correction`) until no value at or below ``t_max``
-    changes by more than ``tolerance`` in a pass (a ``RuntimeWarning`` after ``passes`` passes
-    without). ``reopen``: the relative change that re-opens a node in the march (module doc)."""
+    shot along the characteristics (:mod:`gamespec.flowfield.start_band`), then corrected by
+    fifth-order differences (:mod:`gamespec.flowfield.defect_correction`) until no value at or
+    below ``t_max`` changes by more than ``tolerance`` times the largest in a pass (a
+    ``RuntimeWarning`` when ``passes`` passes run out first). ``reopen``: the relative change that
+    re-opens a node in the march (module doc)."""
     if order not in (1, 2, 5):
         raise ValueError("order must be 1, 2 or 5")
+    if passes < 1 or not tolerance > 0:
+        raise ValueError("the correction needs at least one pass and a positive tolerance")
     flow = np.ascontiguousarray(np.moveaxis(np.asarray(drift, dtype=float), -1, 0))
     fastest = float(np.hypot(flow[0], flow[1]).max())
     if fastest >= speed:
@@ -196,7 +199,7 @@ def time_to_reach(
         done, change = correct(values, state, flow, float(speed), spacing, float(t_max), allowed, int(passes))
         if change > allowed:
             warnings.warn(
-                f"the WENO5 correction of the time-to-reach map changed it by {change:.1e} in its "
+                f"the fifth-order correction of the time-to-reach map changed it by {change:.1e} in its "
                 f"last of {done} passes (allowed {allowed:.1e})",
                 RuntimeWarning,
                 stacklevel=2,

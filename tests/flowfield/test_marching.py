@@ -111,6 +111,10 @@ def test_fifth_order_route_warns_when_its_passes_run_out() -> None:
     drift = np.broadcast_to(np.array([0.4, -0.3]), (51, 51, 2))
     with pytest.warns(RuntimeWarning, match="in its last of 2 passes"):
         time_to_reach(grid, drift, SPEED, ORIGIN, RADIUS, t_max=1.6, passes=2)
+    with pytest.raises(ValueError, match="at least one pass"):
+        time_to_reach(grid, drift, SPEED, ORIGIN, RADIUS, passes=0)
+    with pytest.raises(ValueError, match="positive tolerance"):
+        time_to_reach(grid, drift, SPEED, ORIGIN, RADIUS, tolerance=float("nan"))
 
 
 ROTATION, PIVOT = 0.2, np.array([1.0, -1.0])

@@ -183,26 +183,63 @@ def time_to_reach(
     reach = 1.5 * max(spacing)
     origin_xy = (float(origin[0]), float(origin[1]))
     _start(grid.points, flow, float(speed), origin_xy, float(radius), reach, values, state)
-    marched_to = t_max
+    marched_to = float(t_max)
     if order == 5:
-        lower = (float(grid.lower[0]), float(grid.lower[1]))
-        inner = 2 * max(spacing)
-        shoot(values, grid.points, flow, lower, spacing, float(speed), origin_xy, float(radius), inner, reach)
-        marched_to = t_max + MARGIN_CELLS * max(spacing) / (speed - fastest)
+        _shot_start(grid, values, flow, float(speed), origin_xy, float(radius), reach)
+        marched_to = float(t_max + MARGIN_CELLS * max(spacing) / (speed - fastest))
     shift = np.zeros((4, *grid.shape))
-    _march(values, state, shift, flow, float(speed), spacing, float(marched_to), min(order, 2), float(reopen))
+    _march(values, state, shift, flow, float(speed), spacing, marched_to, min(order, 2), float(reopen))
     if order == 5:
-        values[values > marched_to] = np.inf
-        state[~np.isfinite(values)] = FAR
-        reached = values[values <= t_max]
-        allowed = tolerance * max(float(reached.max()) if reached.size else 0.0, 1.0)
-        done, change = correct(values, state, flow, float(speed), spacing, float(t_max), allowed, int(passes))
-        if change > allowed:
-            warnings.warn(
-                f"the fifth-order correction of the time-to-reach map changed it by {change:.1e} in its "
-                f"last of {done} passes (allowed {allowed:.1e})",
-                RuntimeWarning,
-                stacklevel=2,
-            )
+        _corrected(values, state, flow, float(speed), spacing, float(t_max), marched_to, tolerance, passes)
     values[values > t_max] = np.inf
     return values
+
+
+def _shot_start(
+    grid: Grid,
+    values: np.ndarray,
+    flow: np.ndarray,
+    speed: float,
+    origin: tuple[float, float],
+    radius: float,
+    reach: float,
+) -> None:
+    """The start band's values shot along the characteristics, from two cells inside the edge to
+    ``reach`` outside (:mod:`gamespec.flowfield.start_band`); a warning where Newton failed."""
+    spacing = (float(grid.spacing[0]), float(grid.spacing[1]))
+    lower = (float(grid.lower[0]), float(grid.lower[1]))
+    failed = shoot(values, grid.points, flow, lower, spacing, speed, origin, radius, 2 * max(spacing), reach)
+    if failed:
+        warnings.warn(
+            f"{failed} start nodes of the time-to-reach map keep the uniform-flow closed form "
+            "(second order): shooting their characteristics did not converge",
+            RuntimeWarning,
+            stacklevel=3,
+        )
+
+
+def _corrected(
+    values: np.ndarray,
+    state: np.ndarray,
+    flow: np.ndarray,
+    speed: float,
+    spacing: tuple[float, float],
+    t_max: float,
+    marched_to: float,
+    tolerance: float,
+    passes: int,
+) -> None:
+    """The marched map (to ``marched_to``) corrected in place to fifth order
+    (:mod:`gamespec.flowfield.defect_correction`); a warning when the passes run out."""
+    values[values > marched_to] = np.inf
+    state[~np.isfinite(values)] = FAR
+    reached = values[values <= t_max]
+    allowed = tolerance * max(float(reached.max()) if reached.size else 0.0, 1.0)
+    done, change = correct(values, state, flow, speed, spacing, t_max, allowed, int(passes))
+    if change > allowed:
+        warnings.warn(
+            f"the fifth-order correction of the time-to-reach map changed it by {change:.1e} in its "
+            f"last of {done} passes (allowed {allowed:.1e})",
+            RuntimeWarning,
+            stacklevel=3,
+        )

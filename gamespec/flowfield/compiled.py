@@ -32,7 +32,7 @@ def _side(is0: float, is1: float, is2: float, eps: float, t0: float, t1: float, 
 
 
 @njit(cache=True, inline="always", error_model="numpy")
-def _indicators(x: float, y: float) -> tuple[float, float, float]:
+def indicators(x: float, y: float) -> tuple[float, float, float]:
     """The three smoothness indicators (divided by 3) of the adjacent second differences ``x, y``:
     ``(x − 3y)²``, ``(x + y)²`` and ``(3x − y)²``, each plus ``13/3 (y − x)²``."""
     jump = y - x
@@ -55,10 +55,10 @@ def _weno5_pair(
     eps_minus = (max(inner, d0 * d0) * WENO_EPSILON + floor) * 4.0
     eps_plus = (max(inner, d5 * d5) * WENO_EPSILON + floor) * 4.0
     central = (7.0 * (d2 + d3) - d1 - d4) * scale
-    rise01, _, _ = _indicators(s0, s1)
-    rise12, mid12, _ = _indicators(s1, s2)
-    _, mid23, fall23 = _indicators(s2, s3)
-    _, _, fall34 = _indicators(s3, s4)
+    rise01, _, _ = indicators(s0, s1)
+    rise12, mid12, _ = indicators(s1, s2)
+    _, mid23, fall23 = indicators(s2, s3)
+    _, _, fall34 = indicators(s3, s4)
     t01 = s0 - 2.0 * s1 + s2
     t12 = s1 - 2.0 * s2 + s3
     t23 = s2 - 2.0 * s3 + s4

@@ -45,7 +45,9 @@ import math
 import numpy as np
 from numba import njit
 
+from gamespec.flowfield.compiled import indicators
 from gamespec.flowfield.godunov import START, update
+from gamespec.flowfield.upwind import WENO_EPSILON
 
 ROUGH = 3.0
 """A side whose WENO-Z weights depart from the linear ones by more than this is rough."""
@@ -75,14 +77,15 @@ def _finite(values: np.ndarray, i: int, j: int, di: int, dj: int) -> bool:
 
 @njit(cache=True, error_model="numpy")
 def _rough(a: float, b: float, c: float, d: float, e: float) -> bool:
-    """Whether the WENO-Z weights (Borges et al. 2008, q = 2; Jiang–Shu indicators,
-    ``ε = 10⁻⁶ max(a², …, e²)``, Osher & Fedkiw eq. 3.38) of the three candidate stencils over the
-    undivided differences ``a … e`` (upwind first) depart from the linear ones by more than
-    ``ROUGH`` of them: a kink within the stencil."""
-    s0 = 13.0 / 12.0 * (a - 2.0 * b + c) ** 2 + 0.25 * (a - 4.0 * b + 3.0 * c) ** 2
-    s1 = 13.0 / 12.0 * (b - 2.0 * c + d) ** 2 + 0.25 * (b - d) ** 2
-    s2 = 13.0 / 12.0 * (c - 2.0 * d + e) ** 2 + 0.25 * (3.0 * c - 4.0 * d + e) ** 2
-    eps = 1e-6 * max(max(max(a * a, b * b), max(c * c, d * d)), e * e) + 1e-99
+    """Whether the WENO-Z weights (Borges et al. 2008, q = 2) of the three candidate stencils over
+    the undivided differences ``a … e`` (upwind first) depart from the linear ones by more than
+    ``ROUGH`` of them: a kink within the stencil. The Jiang–Shu indicators and the ε rule are the
+    level-set operator's (:func:`gamespec.flowfield.compiled.indicators`, four times the
+    indicators, ε scaled alike)."""
+    s0, _, _ = indicators(b - a, c - b)
+    _, s1, _ = indicators(c - b, d - c)
+    _, _, s2 = indicators(d - c, e - d)
+    eps = (max(max(max(a * a, b * b), max(c * c, d * d)), e * e) * WENO_EPSILON + 1e-99) * 4.0
     tau = abs(s0 - s2)
     z0, z1, z2 = 1.0 + (tau / (s0 + eps)) ** 2, 1.0 + (tau / (s1 + eps)) ** 2, 1.0 + (tau / (s2 + eps)) ** 2
     total = 0.1 * z0 + 0.6 * z1 + 0.3 * z2

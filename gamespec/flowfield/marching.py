@@ -66,7 +66,7 @@ PASSES = 200
 """The fifth-order route's most defect-correction passes."""
 MARGIN_CELLS = 6
 """The fifth-order route marches this many cells (at the slowest pace) beyond ``t_max``, so the
-WENO5 stencils of the nodes it returns read corrected values."""
+fifth-order stencils of the nodes it returns read corrected values."""
 
 
 @njit(cache=True, error_model="numpy")
